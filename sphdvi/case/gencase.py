@@ -1,0 +1,491 @@
+"""``sphdvi gencase``: a case file becomes particles, constants, bodies and links.
+
+The steps follow GenCase: read the definition, draw, resolve the constants
+from the drawn fluid, read everything else (expressions can now use H, B...),
+assemble the particle arrays in DualSPHysics order (fixed boundary, moving,
+floating, fluid; by mk within each type), set the initial density and
+velocities, compute floating-body mass properties, check the whole, and write
+``<casename>.h5`` plus ``<casename>_All.vtp`` for ParaView.
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from .._version import __version__
+from ..errors import CaseError, Warnings
+from .constants import hydrostatic_density, resolve_constants
+from .model import Body, Case, Constants
+from .reader import (case_name_from_path, open_case, parse_domain_spec, read_constantsdef,
+                     read_mkconfig, read_sections)
+
+TYPE_FIXED, TYPE_MOVING, TYPE_FLOATING, TYPE_FLUID = 0, 1, 2, 3
+TYPE_NAMES = {0: "Fixed boundary", 1: "Moving boundary", 2: "Floating", 3: "Fluid"}
+DEFAULT_MAX_NODES = 200_000_000
+
+
+@dataclass
+class GenCaseResult:
+    case: Case
+    constants: Constants
+    particles: dict
+    bodies: list
+    domain: dict
+    mkinfo: list
+    warnings: Warnings
+    primitives: list = field(default_factory=list)
+    files: list = field(default_factory=list)
+
+
+def define_builtin_variables(reader, cdef, casename: str) -> None:
+    v = reader.vars
+    v.define("Rhop0", cdef.rhop0, constant=True)
+    for i, c in enumerate("xyz"):
+        v.define(f"Gravity_{c}", float(cdef.gravity[i]), constant=True)
+    v.define("CaseName", casename, constant=True)
+
+
+def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT_MAX_NODES,
+               warnings: Warnings | None = None) -> GenCaseResult:
+    """Read, draw and assemble a case (nothing is written)."""
+    warnings = warnings if warnings is not None else Warnings()
+    root, reader, text = open_case(path, warnings)
+    casename = case_name_from_path(path)
+    casedef = root.find("casedef")
+    cdef = read_constantsdef(reader, casedef)
+    boundcount, fluidcount = read_mkconfig(reader, casedef)
+    define_builtin_variables(reader, cdef, casename)
+    geometry = reader.child(casedef, "geometry", required=True)
+    from .draw import run_geometry
+    drawing = run_geometry(reader, geometry, casename=casename, outdir=outdir, max_nodes=max_nodes)
+    if drawing.pos.shape[0] == 0:
+        raise reader.error(geometry, "the geometry commands created no particles",
+                           "drawing commands inside <mainlist> that create particles inside pointmin..pointmax")
+    fluid_z = drawing.pos[drawing.is_fluid, 2]
+    consts = resolve_constants(cdef, drawing.dp, drawing.is2d, drawing.posy2d, fluid_z)
+    if fluid_z.size and not consts.cs0 > 0:
+        raise reader.error(casedef.find("constantsdef"), "the speed of sound is zero (the fluid has no height)",
+                           'a <speedsound value=".."/> or <hswl value=".."/>')
+    for name, value in (("H", consts.h), ("B", consts.b), ("MassFluid", consts.massfluid),
+                        ("MassBound", consts.massbound)):
+        reader.vars.define(name, value, constant=True)
+    case = Case(name=casename, file=os.path.abspath(path), source=text, constantsdef=cdef,
+                boundcount=boundcount, fluidcount=fluidcount)
+    read_sections(case, root, reader)
+    particles, mkinfo = assemble_particles(case, drawing, consts, reader)
+    bodies = floating_bodies(case, particles, consts, drawing.primitives, reader)
+    apply_floating_velocities(particles, bodies)
+    domain = resolve_domain(case, particles, consts, reader)
+    check_case(case, particles, bodies, mkinfo, domain, reader)
+    reader.warn_unread_attributes(root)
+    return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
+                         mkinfo=mkinfo, warnings=warnings, primitives=list(drawing.primitives),
+                         files=list(drawing.shape_files))
+
+
+# ---------------------------------------------------------------------------
+# particles
+# ---------------------------------------------------------------------------
+def bound_roles(case: Case) -> tuple[set, set]:
+    """mkbound labels that float, and labels with an imposed motion (incl. wave paddles)."""
+    floating = {mk for f in case.floatings for mk in f.mkbound}
+    moving = {m["ref"] for m in case.motions}
+    return floating, moving
+
+
+def assemble_particles(case: Case, drawing, consts: Constants, reader):
+    """Particle arrays in DualSPHysics order with types, global mk, density and velocity."""
+    is_fluid = np.asarray(drawing.is_fluid, dtype=bool)
+    label = np.asarray(drawing.mk, dtype=np.int64)
+    bad = label[is_fluid & (label >= case.fluidcount)]
+    if bad.size:
+        raise CaseError(f"mkfluid {int(bad.max())} is not below fluidcount={case.fluidcount}", file=reader.file,
+                        element="mkconfig", expected="mkfluid < fluidcount (raise fluidcount in <mkconfig>)")
+    bad = label[~is_fluid & (label >= case.boundcount)]
+    if bad.size:
+        raise CaseError(f"mkbound {int(bad.max())} is not below boundcount={case.boundcount}", file=reader.file,
+                        element="mkconfig", expected="mkbound < boundcount (raise boundcount in <mkconfig>)")
+    floating, moving = bound_roles(case)
+    both = floating & moving
+    if both:
+        raise CaseError(f"mkbound {sorted(both)} is both floating and moving", file=reader.file,
+                        element="motion", expected="a floating body or an imposed motion, not both")
+    ptype = np.full(label.shape, TYPE_FIXED, dtype=np.uint8)
+    ptype[is_fluid] = TYPE_FLUID
+    if floating:
+        ptype[~is_fluid & np.isin(label, list(floating))] = TYPE_FLOATING
+    if moving:
+        ptype[~is_fluid & np.isin(label, list(moving))] = TYPE_MOVING
+    mk = np.where(is_fluid, label + 1, label + case.fluidcount + 1).astype(np.int32)
+    order = np.lexsort((np.arange(label.size), mk, ptype))
+    pos = np.ascontiguousarray(drawing.pos[order], dtype=np.float64)
+    ptype, mk, label, is_fluid = ptype[order], mk[order], label[order], is_fluid[order]
+    n = pos.shape[0]
+    mass = np.where(is_fluid, consts.massfluid, consts.massbound).astype(np.float64)
+    rhop = np.full(n, consts.rhop0)
+    vel = np.zeros((n, 3))
+    if is_fluid.any():
+        rhop[is_fluid] = initial_fluid_density(pos[is_fluid], consts, case.constantsdef.rhopgradient)
+    particles = {"pos": pos, "vel": vel, "rhop": rhop, "mass": mass, "type": ptype, "mk": mk,
+                 "idp": np.arange(n, dtype=np.int64), "label": label}
+    apply_initials(case, particles, consts, reader)
+    mkinfo = []
+    for t in (TYPE_FIXED, TYPE_MOVING, TYPE_FLOATING, TYPE_FLUID):
+        for m in np.unique(mk[ptype == t]):
+            sel = np.flatnonzero((ptype == t) & (mk == m))
+            mkinfo.append({"type": int(t), "mk": int(m), "label": int(label[sel[0]]),
+                           "begin": int(sel[0]), "count": int(sel.size)})
+    return particles, mkinfo
+
+
+def initial_fluid_density(pos: np.ndarray, consts: Constants, rhopgradient: int) -> np.ndarray:
+    """rhopgradient 1: ρ0; 2: hydrostatic below the top of each particle's water column;
+    3: hydrostatic below the highest fluid particle."""
+    if rhopgradient == 1:
+        return np.full(pos.shape[0], consts.rhop0)
+    z = pos[:, 2]
+    if rhopgradient == 3:
+        top = np.full(z.shape, z.max())
+    else:
+        key_x = np.round((pos[:, 0] - pos[:, 0].min()) / consts.dp).astype(np.int64)
+        key_y = np.round((pos[:, 1] - pos[:, 1].min()) / consts.dp).astype(np.int64)
+        key = key_x * (key_y.max() + 1) + key_y
+        uniq, inverse = np.unique(key, return_inverse=True)
+        col_top = np.full(uniq.size, -np.inf)
+        np.maximum.at(col_top, inverse, z)
+        top = col_top[inverse]
+    return hydrostatic_density(top - z, consts.rhop0, consts.gravity[2], consts.b, consts.gamma)
+
+
+def _select(case, particles, item):
+    """Particles named by an <initials> item (mkfluid/mkbound labels, optional onlypos box)."""
+    ptype, label, pos = particles["type"], particles["label"], particles["pos"]
+    sel = np.zeros(ptype.size, dtype=bool)
+    if "mkfluid" in item:
+        sel |= (ptype == TYPE_FLUID) & np.isin(label, item["mkfluid"])
+    if "mkbound" in item:
+        sel |= (ptype != TYPE_FLUID) & np.isin(label, item["mkbound"])
+    box = item.get("onlypos")
+    if box:
+        for i in range(3):
+            lo, hi = box["posmin"][i], box["posmax"][i]
+            if lo is not None:
+                sel &= pos[:, i] >= lo
+            if hi is not None:
+                sel &= pos[:, i] <= hi
+    return sel
+
+
+def apply_initials(case: Case, particles: dict, consts: Constants, reader) -> None:
+    """``<initials>``: velocities, densities, moves and rotations of selected particles."""
+    pos, vel, rhop = particles["pos"], particles["vel"], particles["rhop"]
+    for item in case.initials:
+        sel = _select(case, particles, item)
+        if not sel.any():
+            raise CaseError(f"<{item['type']}> selects no particles", file=reader.file, line=item["line"],
+                            element=item["type"], expected="mkfluid/mkbound labels that were drawn")
+        kind = item["type"]
+        if kind == "velocity":
+            if "vel" in item:
+                vel[sel] = item["vel"]
+            else:
+                d = np.asarray(item["direction"], float)
+                norm = np.linalg.norm(d)
+                if norm == 0:
+                    raise CaseError("velocity <direction> is zero", file=reader.file, line=item["line"],
+                                    element="velocity", expected="a non-zero direction")
+                d = d / norm
+                z = pos[sel, 2]
+                p = item["params"]
+                if item["profile"] == "velocity":
+                    mag = np.full(z.shape, p["v"])
+                elif item["profile"] == "velocity2":
+                    mag = np.interp(z, [p["z"], p["z2"]], [p["v"], p["v2"]])
+                else:
+                    coef = np.polyfit([p["z"], p["z2"], p["z3"]], [p["v"], p["v2"], p["v3"]], 2)
+                    mag = np.polyval(coef, z)
+                vel[sel] = mag[:, None] * d[None, :]
+        elif kind == "densityuniform":
+            rhop[sel] = item["rhop"]
+        elif kind == "densitygradient":
+            p1, p2 = np.asarray(item["pos1"]), np.asarray(item["pos2"])
+            axis = p2 - p1
+            length2 = float(axis @ axis)
+            s = np.clip((pos[sel] - p1) @ axis / length2, 0.0, 1.0) if length2 > 0 else 0.0
+            rhop[sel] = item["rhop1"] + s * (item["rhop2"] - item["rhop1"])
+        elif kind == "densitydepth":
+            zs = item["posswl"][2] if item.get("posswl") else pos[sel, 2].max()
+            g = item.get("gravity", consts.gravity)[2]
+            r0 = item.get("rhop0", consts.rhop0)
+            gam = item.get("gamma", consts.gamma)
+            b = item.get("b", consts.b)
+            rhop[sel] = hydrostatic_density(zs - pos[sel, 2], r0, g, b, gam)
+        elif kind == "move":
+            pos[sel] += np.asarray(item["move"])
+        elif kind == "rotateaxis":
+            p1, p2 = np.asarray(item["axisp1"]), np.asarray(item["axisp2"])
+            pos[sel] = rotate_about_axis(pos[sel], p1, p2, math.radians(item["angle_deg"]))
+
+
+def rotate_about_axis(points: np.ndarray, p1, p2, angle: float) -> np.ndarray:
+    """Rotate points by ``angle`` (rad) about the line p1→p2 (Rodrigues' formula)."""
+    k = np.asarray(p2, float) - np.asarray(p1, float)
+    k = k / np.linalg.norm(k)
+    r = points - p1
+    c, s = math.cos(angle), math.sin(angle)
+    return p1 + r * c + np.cross(k, r) * s + np.outer(r @ k, k) * (1 - c)
+
+
+# ---------------------------------------------------------------------------
+# floating bodies
+# ---------------------------------------------------------------------------
+def particle_inertia(pos: np.ndarray, center: np.ndarray, mpart: float) -> np.ndarray:
+    """Inertia tensor of point masses about ``center``: Σ m [(r·r) I − r rᵀ]."""
+    r = pos - center
+    rr = np.einsum("ij,ij->i", r, r)
+    return mpart * (np.eye(3) * rr.sum() - r.T @ r)
+
+
+def floating_bodies(case: Case, particles: dict, consts: Constants, primitives, reader) -> list:
+    """Mass, centre and inertia of each floating mkbound, from its particles (as GenCase)."""
+    bodies = []
+    ptype, label, pos = particles["type"], particles["label"], particles["pos"]
+    vol = consts.dp ** (2 if consts.is2d else 3)
+    for fd in case.floatings:
+        for mkb in fd.mkbound:
+            sel = np.flatnonzero((ptype == TYPE_FLOATING) & (label == mkb))
+            if sel.size == 0:
+                raise CaseError(f"floating mkbound {mkb} has no particles", file=reader.file, line=fd.line,
+                                element="floating", expected="an mkbound drawn by the geometry commands")
+            count = int(sel.size)
+            rhopbody = fd.rhopbody if fd.rhopbody is not None else (
+                fd.relativeweight * consts.rhop0 if fd.relativeweight is not None else None)
+            if fd.massbody is not None:
+                massbody = fd.massbody
+            else:
+                massbody = rhopbody * vol * count
+            if isinstance(fd.masspart, float):
+                masspart = fd.masspart
+            elif rhopbody is not None and fd.masspart is None:
+                masspart = rhopbody * vol
+            else:
+                masspart = massbody / count
+            center = np.asarray(fd.center, float) if fd.center is not None else pos[sel].mean(axis=0)
+            inertia = np.asarray(fd.inertia, float) if fd.inertia is not None else \
+                particle_inertia(pos[sel], center, massbody / count)
+            particles["mass"][sel] = masspart
+            analytic = analytic_properties(primitives, mkb, consts.is2d,
+                                           rhopbody if rhopbody is not None else None, massbody)
+            bodies.append(Body(mkbound=int(mkb), mk=int(particles["mk"][sel[0]]), begin=int(sel[0]), count=count,
+                               mass=float(massbody), masspart=float(masspart), center=center.tolist(),
+                               inertia=inertia.tolist(), translation_dof=list(fd.translation_dof),
+                               rotation_dof=list(fd.rotation_dof), linearvelini=list(fd.linearvelini),
+                               angularvelini=list(fd.angularvelini), property=fd.property, analytic=analytic,
+                               linearvel=fd.linearvel, angularvel=fd.angularvel,
+                               linearforce=fd.linearforce, angularforce=fd.angularforce))
+    return bodies
+
+
+def apply_floating_velocities(particles: dict, bodies: list) -> None:
+    """Initial body velocities become the rigid velocity field v + ω × (r − c) of its particles."""
+    for b in bodies:
+        sl = slice(b.begin, b.begin + b.count)
+        r = particles["pos"][sl] - np.asarray(b.center)
+        particles["vel"][sl] = np.asarray(b.linearvelini) + np.cross(np.asarray(b.angularvelini), r)
+
+
+def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody) -> dict | None:
+    """Mass and central inertia of a floating body drawn as exactly one solid primitive."""
+    mine = [p for p in primitives if not p.get("fluid") and p.get("mk") == mkbound]
+    if len(mine) != 1:
+        return None
+    prim = mine[0]
+    shape, par = prim.get("shape"), prim.get("params", {})
+    try:
+        if shape == "box":
+            size = np.abs(np.asarray(par["size"], float))
+            if is2d:
+                volume = size[0] * size[2]
+            else:
+                volume = float(np.prod(size))
+            sx, sy, sz = size
+            diag = np.array([sy * sy + sz * sz, sx * sx + sz * sz, sx * sx + sy * sy]) / 12.0
+        elif shape == "sphere":
+            r = float(par["radius"])
+            volume = math.pi * r * r if is2d else 4.0 / 3.0 * math.pi * r ** 3
+            diag = np.full(3, r * r / 2.0 if is2d else 2.0 * r * r / 5.0)
+        elif shape == "cylinder":
+            r = float(par["radius"])
+            p1, p2 = np.asarray(par["point1"], float), np.asarray(par["point2"], float)
+            length = float(np.linalg.norm(p2 - p1))
+            if is2d:
+                return None
+            volume = math.pi * r * r * length
+            axis = (p2 - p1) / length
+            if not np.allclose(np.abs(axis), np.round(np.abs(axis))):
+                return None
+            ia = r * r / 2.0
+            it = (3 * r * r + length * length) / 12.0
+            diag = np.where(np.abs(axis) > 0.5, ia, it)
+        else:
+            return None
+    except (KeyError, TypeError, ValueError):
+        return None
+    mass = density * volume if density is not None else massbody
+    return {"shape": shape, "volume": float(volume), "mass": float(mass),
+            "inertia": np.diag(mass * diag).tolist()}
+
+
+# ---------------------------------------------------------------------------
+# domain and checks
+# ---------------------------------------------------------------------------
+def resolve_domain(case: Case, particles: dict, consts: Constants, reader) -> dict:
+    """Simulation domain: particle bounding box modified by ``<simulationdomain>``."""
+    pos = particles["pos"]
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    extent = hi - lo
+    posmin, posmax = lo.copy(), hi.copy()
+    spec = case.simulationdomain
+    for i in range(3):
+        posmin[i] = parse_domain_spec(spec["posmin"][i], lo[i], extent[i])
+        posmax[i] = parse_domain_spec(spec["posmax"][i], hi[i], extent[i])
+    if consts.is2d:
+        posmin[1] = posmax[1] = consts.posy2d
+    if np.any(posmax < posmin):
+        raise CaseError(f"simulation domain is empty: posmin {posmin.tolist()} > posmax {posmax.tolist()}",
+                        file=reader.file, element="simulationdomain", expected="posmin <= posmax")
+    return {"posmin": posmin.tolist(), "posmax": posmax.tolist()}
+
+
+def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
+    """Semantic checks that need the particles (the reader already checked each element)."""
+    pos, ptype, label = particles["pos"], particles["type"], particles["label"]
+    lo, hi = np.asarray(domain["posmin"]), np.asarray(domain["posmax"])
+    fluid = ptype == TYPE_FLUID
+    tol = 1e-9 * max(1.0, float(np.abs(pos).max()))
+    outside = fluid & np.any((pos < lo - tol) | (pos > hi + tol), axis=1)
+    if outside.any():
+        i = int(np.flatnonzero(outside)[0])
+        raise CaseError(f"{int(outside.sum())} fluid particles lie outside the simulation domain "
+                        f"(first at {pos[i].tolist()})", file=reader.file, element="simulationdomain",
+                        expected=f"posmin {lo.tolist()} <= fluid positions <= posmax {hi.tolist()}")
+    bound_labels = set(np.unique(label[ptype != TYPE_FLUID]).tolist())
+    for m in case.motions:
+        if m["ref"] not in bound_labels:
+            raise CaseError(f"motion of mkbound {m['ref']}, which has no particles", file=reader.file,
+                            line=m["line"], element="objreal", expected="an mkbound drawn by the geometry")
+    for wp in case.special.get("wavepaddles", []):
+        if wp["mkbound"] not in {m["ref"] for m in case.motions}:
+            raise CaseError(f"wave paddle mkbound {wp['mkbound']} has no <motion> object", file=reader.file,
+                            line=wp["line"], element=wp["type"],
+                            expected=f'<motion><objreal ref="{wp["mkbound"]}"> with an <mvnull>')
+    chrono = case.special.get("chrono")
+    floating_labels = {b.mkbound for b in bodies}
+    if chrono:
+        for b in chrono["bodies"]:
+            if b["mkbound"] not in bound_labels:
+                raise CaseError(f"chrono body '{b['id']}' uses mkbound {b['mkbound']}, which has no particles",
+                                file=reader.file, line=b["line"], element="body" + b["kind"],
+                                expected="an mkbound drawn by the geometry")
+            if b["kind"] == "floating" and b["mkbound"] not in floating_labels:
+                raise CaseError(f"chrono bodyfloating '{b['id']}' (mkbound {b['mkbound']}) is not in <floatings>",
+                                file=reader.file, line=b["line"], element="bodyfloating",
+                                expected=f'<floating mkbound="{b["mkbound"]}" ...> in <casedef><floatings>')
+        if case.parameters.get("RigidAlgorithm") not in (0, 3):
+            reader.warn(None, "<special><chrono> is present but RigidAlgorithm is "
+                        f"{case.parameters.get('RigidAlgorithm')}; sphdvi uses the DVI engine for the chrono bodies")
+    elif case.parameters.get("RigidAlgorithm") == 3:
+        raise CaseError("RigidAlgorithm=3 (Chrono) needs an <execution><special><chrono> section",
+                        file=reader.file, element="parameter", expected="a <chrono> section or RigidAlgorithm 1")
+    gauges = case.special.get("gauges")
+    if gauges:
+        for g in gauges["items"]:
+            if g["type"] == "force":
+                tgt = g.get("target", {}).get("mkbound")
+                try:
+                    mkb = int(float(tgt))
+                except (TypeError, ValueError):
+                    raise CaseError(f"force gauge '{g['name']}' has no valid <target mkbound>", file=reader.file,
+                                    line=g["line"], element="force", expected='<target mkbound="N"/>') from None
+                if mkb not in bound_labels:
+                    raise CaseError(f"force gauge '{g['name']}' targets mkbound {mkb}, which has no particles",
+                                    file=reader.file, line=g["line"], element="force",
+                                    expected="an mkbound drawn by the geometry")
+    known = bound_labels | set(np.unique(label[fluid]).tolist())
+    del known
+    for link in case.material_links:
+        for mk in link.get("mkbound", []):
+            if mk not in bound_labels:
+                reader.warn(None, f"<properties><link> line {link['line']}: mkbound {mk} has no particles")
+
+
+# ---------------------------------------------------------------------------
+# output
+# ---------------------------------------------------------------------------
+def write_outputs(result: GenCaseResult, outdir: str) -> list[str]:
+    """Write ``<casename>.h5`` and ``<casename>_All.vtp`` into ``outdir``."""
+    from ..io.casefile import write_case_h5
+    from ..io.vtkxml import write_vtp_points
+    os.makedirs(outdir, exist_ok=True)
+    case, consts, p = result.case, result.constants, result.particles
+    h5 = os.path.join(outdir, f"{case.name}.h5")
+    chrono = case.special.get("chrono") or {}
+    json_items = {
+        "links": chrono.get("links", []), "chrono": chrono, "motions": case.motions,
+        "materials": {k: asdict(v) for k, v in case.materials.items()},
+        "material_links": case.material_links, "gauges": case.special.get("gauges", {}),
+        "special": case.special, "initials": case.initials, "normals": case.normals,
+        "bodies_extra": [asdict(b) for b in result.bodies], "mkinfo": result.mkinfo,
+        "parameters_set": case.parameters_set, "constantsdef": asdict(case.constantsdef),
+        "mkconfig": {"boundcount": case.boundcount, "fluidcount": case.fluidcount},
+    }
+    particles = {k: p[k] for k in ("pos", "vel", "rhop", "mass", "type", "mk", "idp")}
+    write_case_h5(h5, casename=case.name, source_file=case.file, source_xml=case.source, version=__version__,
+                  particles=particles, constants=consts.to_dict(), parameters=case.parameters,
+                  domain=result.domain, bodies=result.bodies, json_items=json_items)
+    vtp = os.path.join(outdir, f"{case.name}_All.vtp")
+    press = consts.b * (np.power(p["rhop"] / consts.rhop0, consts.gamma) - 1.0)
+    write_vtp_points(vtp, p["pos"], {"Idp": p["idp"].astype(np.int64), "Vel": p["vel"].astype(np.float32),
+                                     "Rhop": p["rhop"].astype(np.float32), "Press": press.astype(np.float32),
+                                     "Mass": p["mass"].astype(np.float32), "Type": p["type"],
+                                     "Mk": p["mk"].astype(np.int32)})
+    return [h5, vtp] + list(result.files)
+
+
+def summary(result: GenCaseResult) -> str:
+    """A GenCase-like report: particles per mk and type, constants, bodies, memory."""
+    c, p, case = result.constants, result.particles, result.case
+    n = p["pos"].shape[0]
+    lines = [f"Case {case.name}: {'2D' if c.is2d else '3D'}, dp = {c.dp:g} m", "",
+             f"{'type':<17}{'mk':>6}{'label':>7}{'particles':>11}"]
+    for info in result.mkinfo:
+        lbl = ("mkfluid " if info["type"] == TYPE_FLUID else "mkbound ") + str(info["label"])
+        lines.append(f"{TYPE_NAMES[info['type']]:<17}{info['mk']:>6}{'':>2}{lbl:<12}{info['count']:>6}")
+    counts = {t: int((p["type"] == t).sum()) for t in TYPE_NAMES}
+    lines.append("")
+    lines.append(f"Particles: {n} total = {counts[0]} fixed + {counts[1]} moving + {counts[2]} floating "
+                 f"(boundary {counts[0] + counts[1] + counts[2]}) + {counts[3]} fluid")
+    lines.append(f"h = {c.h:.7g} m   (coefh = {c.coefh:.6g})")
+    lines.append(f"c0 = {c.cs0:.7g} m/s   (speedsystem {c.speedsystem:.6g} m/s, hswl {c.hswl:.6g} m)")
+    lines.append(f"B = {c.b:.7g} Pa   gamma = {c.gamma:g}   rhop0 = {c.rhop0:g} kg/m3")
+    unit = "kg/m" if c.is2d else "kg"
+    lines.append(f"massfluid = {c.massfluid:.7g} {unit}   massbound = {c.massbound:.7g} {unit}")
+    d = result.domain
+    lo = ", ".join(f"{v:.6g}" for v in d["posmin"])
+    hi = ", ".join(f"{v:.6g}" for v in d["posmax"])
+    lines.append(f"Domain: ({lo}) - ({hi})")
+    for b in result.bodies:
+        centre = ", ".join(f"{v:.6g}" for v in b.center)
+        diag = ", ".join(f"{b.inertia[i][i]:.6g}" for i in range(3))
+        lines.append(f"Floating mkbound {b.mkbound} (mk {b.mk}): {b.count} particles, mass {b.mass:.6g} {unit}, "
+                     f"centre ({centre}), inertia diag ({diag})")
+        if b.analytic:
+            a = b.analytic
+            diag = ", ".join(f"{a['inertia'][i][i]:.6g}" for i in range(3))
+            lines.append(f"    analytic {a['shape']}: mass {a['mass']:.6g} {unit}, inertia diag ({diag})")
+    mem = sum(np.asarray(p[k]).nbytes for k in ("pos", "vel", "rhop", "mass", "type", "mk", "idp"))
+    lines.append(f"Memory: {mem / 1e6:.2f} MB of particle data ({mem / max(n, 1):.0f} bytes per particle)")
+    return "\n".join(lines)

@@ -1,0 +1,128 @@
+"""The ``<execution><parameters>`` keys of DualSPHysics v5.4, with their defaults.
+
+Source of the keys and defaults: DualSPHysics ``doc/xml_format/_FmtXML__Parameters.xml``
+and ``../shared/design/case-format.md`` §2.8. A key written with a leading ``#``
+is disabled, as in DualSPHysics. Unknown keys are an error (DualSPHysics ignores
+them silently, which hides typos such as ``Visc``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Param:
+    kind: str          # "int", "float", "str"
+    default: object
+    doc: str
+    choices: tuple = ()
+    lo: float | None = None
+    hi: float | None = None
+
+
+PARAMETERS: dict[str, Param] = {
+    "SavePosDouble": Param("int", 0, "save positions in double precision", (0, 1)),
+    "Boundary": Param("int", 1, "boundary method 1:DBC, 2:mDBC", (1, 2)),
+    "SlipMode": Param("int", 1, "mDBC slip mode 1:DBC vel=0, 2:no-slip, 3:free slip", (1, 2, 3)),
+    "MdbcFastSingle": Param("int", 1, "mDBC matrix solve in single precision", (0, 1)),
+    "MdbcThreshold": Param("float", 0.0, "mDBC kernel-sum threshold", (), 0.0, 1.0),
+    "NoPenetration": Param("int", 0, "mDBC no-penetration correction", (0, 1)),
+    "StepAlgorithm": Param("int", 1, "1:Verlet, 2:Symplectic", (1, 2)),
+    "VerletSteps": Param("int", 40, "Verlet: steps between Euler steps", (), 1, 1e9),
+    "Kernel": Param("int", 2, "1:cubic spline, 2:Wendland", (1, 2)),
+    "ViscoTreatment": Param("int", 1, "1:artificial, 2:laminar+SPS, 3:laminar", (1, 2, 3)),
+    "Visco": Param("float", 0.01, "viscosity value (alpha or kinematic viscosity)", (), 0.0, 1e6),
+    "ViscoBoundFactor": Param("float", 1.0, "multiplier of Visco for fluid-boundary pairs", (), 0.0, 1e6),
+    "DensityDT": Param("int", 0, "density diffusion 0:none, 1:Molteni, 2:Fourtakas, 3:Fourtakas full", (0, 1, 2, 3)),
+    "DensityDTvalue": Param("float", 0.1, "density diffusion coefficient delta", (), 0.0, 1.0),
+    "Shifting": Param("int", 0, "0:none, 1:ignore bound, 2:ignore fixed, 3:full, 4:full advanced", (0, 1, 2, 3, 4)),
+    "ShiftCoef": Param("float", -2.0, "shifting coefficient", (), -1e6, 0.0),
+    "ShiftTFS": Param("float", 0.0, "free-surface threshold (0: 1.5 in 2D, 2.75 in 3D)", (), 0.0, 1e6),
+    "ShiftAdvCoef": Param("float", -0.01, "advanced shifting coefficient", (), -1e6, 0.0),
+    "ShiftAdvALE": Param("int", 0, "advanced shifting ALE correction", (0, 1)),
+    "ShiftAdvNCPress": Param("int", 0, "advanced shifting non-conservative pressure", (0, 1)),
+    "RigidAlgorithm": Param("int", 1, "0:collision-free, 1:SPH, 2:DEM, 3:Chrono", (0, 1, 2, 3)),
+    "FtPause": Param("float", 0.0, "time to freeze floatings at the start [s]", (), 0.0, 1e9),
+    "FtIgnoreRadius": Param("int", 0, "ignore floating radius with periodic conditions", (0, 1)),
+    "FtSaveAce": Param("int", 0, "save floating accelerations (debug)", (0, 1)),
+    "CoefDtMin": Param("float", 0.05, "DtMin = CoefDtMin*h/c0", (), 0.0, 1.0),
+    "DtIni": Param("float", 0.0, "initial dt [s] (0: h/c0)", (), 0.0, 1e3),
+    "DtMin": Param("float", 0.0, "minimum dt [s] (0: CoefDtMin*h/c0)", (), 0.0, 1e3),
+    "DtFixed": Param("float", 0.0, "fixed dt [s] (0: variable)", (), 0.0, 1e3),
+    "DtFixedFile": Param("str", "NONE", "file of dt values [ms] (NONE: disabled)"),
+    "DtAllParticles": Param("int", 0, "dt from all particles (1) or fluid/floating only (0)", (0, 1)),
+    "TimeMax": Param("float", 1.0, "simulated time [s]", (), 0.0, 1e12),
+    "TimeOut": Param("float", 0.01, "output interval [s]", (), 0.0, 1e12),
+    "TimeOutExtra": Param("float", 0.0, "extra floating output interval [s]", (), 0.0, 1e12),
+    "RhopOutMin": Param("float", 700.0, "minimum valid density [kg/m3]", (), 0.0, 1e9),
+    "RhopOutMax": Param("float", 1300.0, "maximum valid density [kg/m3]", (), 0.0, 1e9),
+    "PartsOutMax": Param("float", 1.0, "deprecated: fraction of fluid allowed out", (), 0.0, 1.0),
+    "WrnPartsOut": Param("int", 1, "warn about excluded particles", (0, 1)),
+    "MinFluidStop": Param("float", 0.0, "stop when the fluid fraction falls below this", (), 0.0, 1.0),
+    "XPeriodicIncY": Param("float", 0.0, "periodic X: increment of Y"),
+    "XPeriodicIncZ": Param("float", 0.0, "periodic X: increment of Z"),
+    "YPeriodicIncX": Param("float", 0.0, "periodic Y: increment of X"),
+    "YPeriodicIncZ": Param("float", 0.0, "periodic Y: increment of Z"),
+    "ZPeriodicIncX": Param("float", 0.0, "periodic Z: increment of X"),
+    "ZPeriodicIncY": Param("float", 0.0, "periodic Z: increment of Y"),
+    "XYPeriodic": Param("int", 0, "periodic in X and Y", (0, 1)),
+    "XZPeriodic": Param("int", 0, "periodic in X and Z", (0, 1)),
+    "YZPeriodic": Param("int", 0, "periodic in Y and Z", (0, 1)),
+    "IncZ": Param("float", 0.0, "deprecated: increase of the domain in +Z (fraction)", (), 0.0, 1e3),
+    "DomainFixed": Param("str", "", "deprecated: fixed domain xmin:ymin:zmin:xmax:ymax:zmax"),
+    "DomainFixedXmin": Param("float", None, "deprecated fixed domain limit"),
+    "DomainFixedXmax": Param("float", None, "deprecated fixed domain limit"),
+    "DomainFixedYmin": Param("float", None, "deprecated fixed domain limit"),
+    "DomainFixedYmax": Param("float", None, "deprecated fixed domain limit"),
+    "DomainFixedZmin": Param("float", None, "deprecated fixed domain limit"),
+    "DomainFixedZmax": Param("float", None, "deprecated fixed domain limit"),
+    "DeltaSPH": Param("float", 0.0, "deprecated: use DensityDT=1 and DensityDTvalue", (), 0.0, 1.0),
+    "PosDouble": Param("int", 0, "deprecated precision option", (0, 1, 2)),
+}
+
+PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ",
+                 "ZPeriodicIncX", "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
+DEPRECATED = {"PartsOutMax", "IncZ", "DomainFixed", "DeltaSPH", "PosDouble"} | {
+    k for k in PARAMETERS if k.startswith("DomainFixed")}
+
+
+def default_parameters() -> dict:
+    """All keys with their DualSPHysics defaults (``None`` where the default is 'not set')."""
+    return {k: p.default for k, p in PARAMETERS.items()}
+
+
+def coerce(key: str, value):
+    """Convert a value (number or text) to the key's type and check its range.
+
+    Returns the converted value or raises ValueError with the expected form.
+    """
+    spec = PARAMETERS[key]
+    if spec.kind == "str":
+        return str(value)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"'{value}' is not a number") from None
+    if number != number or number in (float("inf"), float("-inf")):
+        raise ValueError(f"'{value}' is not finite")
+    if spec.kind == "int":
+        if number != int(number):
+            raise ValueError(f"'{value}' is not an integer")
+        number = int(number)
+    if spec.choices and number not in spec.choices:
+        raise ValueError(f"{number} is not one of {', '.join(str(c) for c in spec.choices)}")
+    if spec.lo is not None and number < spec.lo:
+        raise ValueError(f"{number} is below {spec.lo}")
+    if spec.hi is not None and number > spec.hi:
+        raise ValueError(f"{number} is above {spec.hi}")
+    return number
+
+
+def closest_key(key: str) -> str | None:
+    """The known key most like ``key`` (for 'did you mean' hints)."""
+    import difflib
+    match = difflib.get_close_matches(key, PARAMETERS.keys(), n=1, cutoff=0.6)
+    if match:
+        return match[0]
+    lower = {k.lower(): k for k in PARAMETERS}
+    return lower.get(key.lower())

@@ -1,0 +1,915 @@
+"""Read a whole DualSPHysics ``<case>`` document into :class:`~sphdvi.case.model.Case`.
+
+The geometry commands are not executed here (that is :mod:`sphdvi.case.draw`);
+everything else is parsed into typed data and checked. Order matters because
+expressions can use variables: ``<predefinition>`` and the drawing commands
+define them, and the constants (H, B, masses) exist only after drawing. The
+gencase driver therefore calls :func:`open_case`, draws, resolves the
+constants, then :func:`read_sections`.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..errors import CaseError
+from .model import Case, ConstantsDef, FloatingDef, Material
+from .mkrange import parse_mk_range
+from .parameters import PARAMETERS, DEPRECATED, closest_key, coerce, default_parameters
+from .xmldoc import CaseReader, load_xml, strip_disabled
+
+CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initials", "motion",
+                    "properties", "normals", "patterns", "vres"}
+EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres"}
+SPECIAL_SUPPORTED = {"chrono", "gauges", "wavepaddles", "damping", "shifting"}
+SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
+    "accinputs", "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
+    "moorings", "forcepoints", "outputparts", "initialize", "savedt", "timeout", "inout", "vres"}
+
+
+def case_name_from_path(path: str) -> str:
+    """``CaseDambreak_Def.xml`` -> ``CaseDambreak`` (GenCase's naming)."""
+    base = os.path.basename(path)
+    if base.lower().endswith(".xml"):
+        base = base[:-4]
+    if base.endswith("_Def"):
+        base = base[:-4]
+    return base or "case"
+
+
+def open_case(path: str, warnings=None):
+    """Parse the file, drop disabled elements and check the top-level structure.
+
+    Returns ``(root, reader, source_text)``.
+    """
+    root, text = load_xml(path)
+    strip_disabled(root)
+    reader = CaseReader(path, warnings=warnings)
+    reader.mark(root)
+    casedef = root.find("casedef")
+    if casedef is None:
+        raise reader.error(root, "missing <casedef>", "<case><casedef>...</casedef><execution>...</execution></case>")
+    reader.check_children(root, {"casedef", "execution"})
+    reader.check_children(casedef, CASEDEF_CHILDREN)
+    execution = root.find("execution")
+    if execution is not None:
+        reader.check_children(execution, EXECUTION_CHILDREN)
+    reader.mark(casedef)
+    return root, reader, text
+
+
+# ---------------------------------------------------------------------------
+# constants
+# ---------------------------------------------------------------------------
+def read_constantsdef(reader: CaseReader, casedef) -> ConstantsDef:
+    """``<constantsdef>``: explicit values, or ``None`` for ``auto="true"``."""
+    el = reader.child(casedef, "constantsdef")
+    c = ConstantsDef()
+    if el is None:
+        return c
+    reader.check_children(el, {"lattice", "gravity", "rhop0", "rhopgradient", "hswl", "gamma",
+                               "speedsystem", "coefsound", "speedsound", "coefh", "hdp",
+                               "cflnumber", "h", "b", "massbound", "massfluid", "coefhdp"})
+    lat = reader.child(el, "lattice")
+    if lat is not None:
+        c.lattice_bound = reader.integer(lat, "bound", 1, lo=1, hi=2)
+        c.lattice_fluid = reader.integer(lat, "fluid", 1, lo=1, hi=2)
+    g = reader.child(el, "gravity")
+    if g is not None:
+        c.gravity = reader.vec3(g).tolist()
+    c.rhop0 = reader.child_value(el, "rhop0", 1000.0, positive=True)
+    rg = reader.child(el, "rhopgradient")
+    if rg is not None:
+        c.rhopgradient = reader.integer(rg, "value", lo=1, hi=3)
+    c.gamma = reader.child_value(el, "gamma", 7.0, positive=True)
+    c.coefsound = reader.child_value(el, "coefsound", 20.0, positive=True)
+    c.cflnumber = reader.child_value(el, "cflnumber", 0.2, positive=True, hi=10.0)
+    c.hswl = _auto_value(reader, el, "hswl", positive=True)
+    c.speedsystem = _auto_value(reader, el, "speedsystem", positive=True)
+    c.speedsound = _auto_value(reader, el, "speedsound", positive=True)
+    c.h = _auto_value(reader, el, "h", positive=True)
+    c.b = _auto_value(reader, el, "b", positive=True)
+    c.massbound = _auto_value(reader, el, "massbound", positive=True)
+    c.massfluid = _auto_value(reader, el, "massfluid", positive=True)
+    coefh = reader.child(el, "coefh")
+    hdp = reader.child(el, "hdp")
+    if coefh is not None and hdp is not None:
+        raise reader.error(hdp, "both <coefh> and <hdp> are given", "only one of them")
+    if hdp is not None:
+        c.hdp = reader.num(hdp, "value", positive=True, hi=100.0)
+    elif coefh is not None:
+        c.coefh = reader.num(coefh, "value", positive=True, hi=100.0)
+    return c
+
+
+def _auto_value(reader, parent, tag, **checks):
+    el = reader.child(parent, tag)
+    if el is None:
+        return None
+    auto = reader.boolean(el, "auto", False)
+    if auto:
+        reader.mark(el, "value")
+        return None
+    if el.get("value") is None:
+        raise reader.error(el, f"<{tag}> has neither value nor auto=\"true\"", 'value="..." or auto="true"')
+    return reader.num(el, "value", **checks)
+
+
+def read_mkconfig(reader: CaseReader, casedef) -> tuple[int, int]:
+    el = reader.child(casedef, "mkconfig")
+    if el is None:
+        return 240, 9
+    bc = reader.integer(el, "boundcount", 240, lo=1, hi=65000)
+    fc = reader.integer(el, "fluidcount", 9, lo=1, hi=65000)
+    for c in reader.children(el):
+        if c.tag not in ("mkorientfluid", "mkorientbound"):
+            raise reader.error(c, f"unknown element <{c.tag}> in <mkconfig>", "<mkorientfluid> or <mkorientbound>")
+        reader.integer(c, "mk", lo=0)
+        reader.text_attr(c, "orient")
+    return bc, fc
+
+
+# ---------------------------------------------------------------------------
+# sections read after drawing (expressions may use H, B, MassFluid, ...)
+# ---------------------------------------------------------------------------
+def read_sections(case: Case, root, reader: CaseReader) -> None:
+    """Read floatings, initials, motion, properties, normals and the execution block."""
+    casedef = root.find("casedef")
+    case.floatings = read_floatings(reader, casedef)
+    case.initials = read_initials(reader, casedef)
+    case.motions = read_motion(reader, casedef)
+    case.materials, case.material_links = read_properties(reader, casedef)
+    case.normals = read_normals(reader, casedef)
+    execution = root.find("execution")
+    params, set_keys, domain = read_parameters(reader, execution)
+    case.parameters, case.parameters_set, case.simulationdomain = params, set_keys, domain
+    case.special = read_special(reader, execution)
+
+
+def _mk_list(reader, el, attr):
+    raw = reader.text_attr(el, attr)
+    try:
+        return parse_mk_range(raw)
+    except ValueError as exc:
+        raise reader.error(el, f"{attr}: {exc}", 'mk values and ranges like "0-3,7"') from None
+
+
+def _series(reader, el, item_tag, allow_none=False):
+    """A time table ``<vel time x y z/>``... or ``file="x.csv"``; ``none`` marks a free component."""
+    if el is None:
+        return None
+    if el.get("file") is not None:
+        return {"file": reader.resolve_path(el, "file")}
+    times, values = [], []
+    for item in reader.children(el, item_tag):
+        times.append(reader.num(item, "time", nonnegative=True))
+        row = []
+        for comp in "xyz":
+            raw = item.get(comp)
+            reader.mark(item, comp)
+            if raw is not None and raw.strip().lower() == "none":
+                if not allow_none:
+                    raise reader.error(item, f"'{comp}=none' is not allowed here", "a number")
+                row.append(None)
+            else:
+                row.append(reader.num(item, comp, 0.0))
+        values.append(row)
+    if not times:
+        raise reader.error(el, f"no <{item_tag}> items and no file", f'<{item_tag} time=".." x=".." .../> items or file="..."')
+    if any(t2 < t1 for t1, t2 in zip(times, times[1:])):
+        raise reader.error(el, "times are not in increasing order", "non-decreasing times")
+    return {"times": times, "values": values}
+
+
+def read_floatings(reader, casedef) -> list:
+    el = reader.child(casedef, "floatings")
+    out = []
+    if el is None:
+        return out
+    allowed = {"massbody", "masspart", "center", "inertia", "inertiafull", "translationDOF",
+               "rotationDOF", "linearvelini", "angularvelini", "velini", "omegaini", "linearvel",
+               "angularvel", "linearforce", "angularforce"}
+    seen = {}
+    for f in reader.children(el):
+        if f.tag != "floating":
+            raise reader.error(f, f"unknown element <{f.tag}> in <floatings>", "<floating>")
+        reader.check_children(f, allowed)
+        fd = FloatingDef(mkbound=_mk_list(reader, f, "mkbound"), line=f.sourceline or 0)
+        for mk in fd.mkbound:
+            if mk in seen:
+                raise reader.error(f, f"mkbound {mk} is already floating (line {seen[mk]})", "each mkbound in one <floating>")
+            seen[mk] = f.sourceline
+        if f.get("rhopbody") is not None:
+            fd.rhopbody = reader.num(f, "rhopbody", nonnegative=True)
+            if fd.rhopbody == 0:
+                fd.rhopbody = None
+        if f.get("relativeweight") is not None:
+            fd.relativeweight = reader.num(f, "relativeweight", positive=True)
+        fd.property = reader.text_attr(f, "property", None)
+        mb = reader.child(f, "massbody")
+        if mb is not None:
+            fd.massbody = reader.num(mb, "value", positive=True)
+        mp = reader.child(f, "masspart")
+        if mp is not None:
+            raw = mp.get("value")
+            if raw is not None and raw.strip() == "distributed_bodymass":
+                reader.mark(mp, "value")
+                fd.masspart = "distributed_bodymass"
+            else:
+                fd.masspart = reader.num(mp, "value", positive=True)
+        sources = [s for s, v in (("rhopbody", fd.rhopbody), ("relativeweight", fd.relativeweight),
+                                  ("massbody", fd.massbody)) if v is not None]
+        if not sources:
+            raise reader.error(f, "no mass given", 'one of rhopbody="..", relativeweight="..", or <massbody value=".."/>')
+        if len(sources) > 1 and not (sources == ["rhopbody", "massbody"]):
+            raise reader.error(f, "mass given more than once (" + ", ".join(sources) + ")",
+                               "exactly one of rhopbody, relativeweight, massbody")
+        c = reader.child(f, "center")
+        if c is not None:
+            fd.center = reader.vec3(c).tolist()
+        ine = reader.child(f, "inertia")
+        inf = reader.child(f, "inertiafull")
+        if ine is not None and inf is not None:
+            raise reader.error(inf, "both <inertia> and <inertiafull>", "only one")
+        if ine is not None:
+            fd.inertia = np.diag(reader.vec3(ine)).tolist()
+        if inf is not None:
+            rows = reader.children(inf, "values")
+            if len(rows) != 3:
+                raise reader.error(inf, f"{len(rows)} <values> rows", "3 rows v11 v12 v13 / v21.. / v31..")
+            mat = [[reader.num(r, f"v{i + 1}{j + 1}") for j in range(3)] for i, r in enumerate(rows)]
+            fd.inertia = mat
+        for tag, attr in (("translationDOF", "translation_dof"), ("rotationDOF", "rotation_dof")):
+            d = reader.child(f, tag)
+            if d is not None:
+                v = reader.vec3(d, missing=1.0)
+                if not np.all(np.isin(v, (0.0, 1.0))):
+                    raise reader.error(d, f"{tag} components must be 0 or 1", "0 (locked) or 1 (free)")
+                setattr(fd, attr, [int(x) for x in v])
+        for tags, attr in ((("linearvelini", "velini"), "linearvelini"), (("angularvelini", "omegaini"), "angularvelini")):
+            for tag in tags:
+                d = reader.child(f, tag)
+                if d is not None:
+                    setattr(fd, attr, reader.vec3(d).tolist())
+        fd.linearvel = _series(reader, reader.child(f, "linearvel"), "vel", allow_none=True)
+        fd.angularvel = _series(reader, reader.child(f, "angularvel"), "vel", allow_none=True)
+        fd.linearforce = _series(reader, reader.child(f, "linearforce"), "force")
+        fd.angularforce = _series(reader, reader.child(f, "angularforce"), "force")
+        out.append(fd)
+    return out
+
+
+def read_initials(reader, casedef) -> list:
+    el = reader.child(casedef, "initials")
+    out = []
+    if el is None:
+        return out
+    for item in reader.children(el):
+        tag = item.tag
+        if tag not in ("velocity", "densityuniform", "densitygradient", "densitydepth", "move", "rotateaxis",
+                       "velwave", "velmesh", "densitymesh", "moverandom"):
+            raise reader.error(item, f"unknown initial condition <{tag}>",
+                               "velocity, densityuniform, densitygradient, densitydepth, move, rotateaxis")
+        if tag in ("velwave", "velmesh", "densitymesh", "moverandom"):
+            raise reader.error(item, f"<{tag}> is not supported by sphdvi",
+                               "velocity, densityuniform, densitygradient, densitydepth, move or rotateaxis")
+        d = {"type": tag, "line": item.sourceline}
+        if item.get("mkfluid") is not None:
+            d["mkfluid"] = _mk_list(reader, item, "mkfluid")
+        if item.get("mkbound") is not None:
+            d["mkbound"] = _mk_list(reader, item, "mkbound")
+        if "mkfluid" not in d and "mkbound" not in d:
+            raise reader.error(item, "missing mkfluid or mkbound", 'mkfluid="..." or mkbound="..."')
+        onlypos = reader.child(item, "onlypos")
+        if onlypos is not None:
+            lo = reader.child(onlypos, "posmin")
+            hi = reader.child(onlypos, "posmax")
+            d["onlypos"] = {
+                "posmin": [reader.num(lo, c, -np.inf) if lo is not None and lo.get(c) is not None else None for c in "xyz"],
+                "posmax": [reader.num(hi, c) if hi is not None and hi.get(c) is not None else None for c in "xyz"]}
+        if tag == "velocity":
+            direction = reader.child(item, "direction")
+            if direction is not None:
+                d["direction"] = reader.vec3(direction).tolist()
+                for prof in ("velocity", "velocity2", "velocity3"):
+                    p = reader.child(item, prof)
+                    if p is not None:
+                        d["profile"] = prof
+                        d["params"] = {k: reader.num(p, k) for k in p.keys()
+                                       if k in ("v", "v2", "v3", "z", "z2", "z3")}
+                if "profile" not in d:
+                    raise reader.error(item, "velocity with <direction> needs <velocity v=..>, <velocity2> or <velocity3>")
+            else:
+                d["vel"] = reader.vec3(item).tolist()
+        elif tag == "densityuniform":
+            d["rhop"] = reader.num(item, "rhop", positive=True)
+        elif tag == "densitygradient":
+            p1, p2 = reader.child(item, "pos1", True), reader.child(item, "pos2", True)
+            d["pos1"], d["rhop1"] = reader.vec3(p1).tolist(), reader.num(p1, "rhop", positive=True)
+            d["pos2"], d["rhop2"] = reader.vec3(p2).tolist(), reader.num(p2, "rhop", positive=True)
+        elif tag == "densitydepth":
+            p = reader.child(item, "posswl")
+            d["posswl"] = reader.vec3(p).tolist() if p is not None else None
+            for t in ("gravity",):
+                g = reader.child(item, t)
+                if g is not None:
+                    d[t] = reader.vec3(g).tolist()
+            for t in ("rhop0", "gamma", "b"):
+                if reader.child(item, t) is not None:
+                    d[t] = reader.child_value(item, t, positive=True)
+        elif tag == "move":
+            d["move"] = reader.vec3(item).tolist()
+        elif tag == "rotateaxis":
+            units = reader.text_attr(item, "anglesunits", "degrees", choices={"degrees", "radians"})
+            ang = reader.num(item, "angle")
+            d["angle_deg"] = ang if units.lower() == "degrees" else float(np.degrees(ang))
+            d["axisp1"] = reader.vec3(reader.child(item, "axisp1", True)).tolist()
+            d["axisp2"] = reader.vec3(reader.child(item, "axisp2", True)).tolist()
+        out.append(d)
+    return out
+
+
+MOVEMENTS = {
+    "wait": (), "mvnull": (),
+    "mvrect": ("vel",), "mvrectace": ("velini", "ace"),
+    "mvrot": ("vel", "axisp1", "axisp2"), "mvrotace": ("ace", "velini", "axisp1", "axisp2"),
+    "mvcir": ("vel", "ref", "axisp1", "axisp2"), "mvcirace": ("ace", "velini", "ref", "axisp1", "axisp2"),
+    "mvrectsinu": ("freq", "ampl", "phase"), "mvrotsinu": ("freq", "ampl", "phase", "axisp1", "axisp2"),
+    "mvcirsinu": ("freq", "ampl", "phase", "ref", "axisp1", "axisp2"),
+    "mvrectfile": ("file",), "mvrotfile": ("file", "axisp1", "axisp2"),
+}
+_ANGULAR = {"mvrot", "mvrotace", "mvcir", "mvcirace", "mvrotsinu", "mvcirsinu", "mvrotfile"}
+
+
+def read_motion(reader, casedef) -> list:
+    """``<motion>``: one dict per ``objreal`` with its chain of movements (hierarchy flattened
+    into ``parents``: the movements of enclosing ``<obj>`` elements, applied first)."""
+    el = reader.child(casedef, "motion")
+    out = []
+    if el is None:
+        return out
+    refs = {}
+
+    def walk(node, parents):
+        for child in reader.children(node):
+            if child.tag in ("objreal", "obj"):
+                chain = _read_movement_chain(reader, child)
+                if child.tag == "objreal":
+                    ref = reader.integer(child, "ref", lo=0)
+                    if ref in refs:
+                        raise reader.error(child, f"mkbound {ref} has two motions (line {refs[ref]})", "one <objreal> per mkbound")
+                    refs[ref] = child.sourceline
+                    out.append({"ref": ref, "line": child.sourceline, "parents": parents, **chain})
+                walk(child, parents + [chain])
+            elif child.tag in MOVEMENTS or child.tag == "begin":
+                continue
+            else:
+                raise reader.error(child, f"unknown motion element <{child.tag}>",
+                                   "objreal, obj, begin, " + ", ".join(sorted(MOVEMENTS)))
+    walk(el, [])
+    return out
+
+
+def _read_movement_chain(reader, obj):
+    begin = reader.child(obj, "begin")
+    movs = {}
+    order = []
+    for m in reader.children(obj):
+        if m.tag not in MOVEMENTS:
+            continue
+        mid = reader.integer(m, "id", lo=0)
+        if mid in movs:
+            raise reader.error(m, f"movement id {mid} is used twice", "unique ids")
+        d = {"type": m.tag, "id": mid, "duration": reader.num(m, "duration", -1.0),
+             "next": reader.integer(m, "next", None, lo=0) if m.get("next") is not None else None}
+        if d["duration"] < 0 and d["duration"] != -1:
+            raise reader.error(m, "negative duration", "duration >= 0 or -1 (forever)")
+        units = "degrees"
+        if m.tag in _ANGULAR or m.tag in ("mvrectsinu",):
+            units = reader.text_attr(m, "anglesunits", "degrees", choices={"degrees", "radians"}).lower()
+        d["anglesunits"] = units
+        for part in MOVEMENTS[m.tag]:
+            if part == "file":
+                f = reader.child(m, "file", True)
+                d["file"] = reader.resolve_path(f, "name")
+                d["fields"] = {k: reader.integer(f, k, lo=0) for k in f.keys()
+                               if k.startswith("field")}
+                continue
+            c = reader.child(m, part)
+            if c is None:
+                if part in ("phase", "velini"):
+                    continue
+                raise reader.error(m, f"missing <{part}>", f"<{part}> in <{m.tag}>")
+            if c.get("ang") is not None:
+                d[part] = reader.num(c, "ang")
+            elif c.get("v") is not None:
+                d[part] = reader.num(c, "v")
+            else:
+                d[part] = reader.vec3(c).tolist()
+        movs[mid] = d
+        order.append(mid)
+    for d in movs.values():
+        if d["next"] is not None and d["next"] not in movs:
+            raise reader.error(obj, f"movement {d['id']} continues with next={d['next']}, which does not exist",
+                               "next naming an id of this object")
+    chain = {"movements": [movs[i] for i in order]}
+    if begin is not None:
+        mov = reader.integer(begin, "mov", lo=0)
+        if mov not in movs:
+            raise reader.error(begin, f"mov={mov} names no movement", "an id of a movement of this object")
+        chain["begin"] = {"mov": mov, "start": reader.num(begin, "start", 0.0, nonnegative=True),
+                          "finish": reader.num(begin, "finish", None) if begin.get("finish") is not None else None}
+    elif order:
+        chain["begin"] = {"mov": order[0], "start": 0.0, "finish": None}
+    return chain
+
+
+MATERIAL_KEYS = {"Young_Modulus": "young", "PoissonRatio": "poisson",
+                 "Restitution_Coefficient": "restitution", "Kfric": "kfric", "Sfric": "sfric"}
+
+
+def _read_material(reader, el) -> Material:
+    mat = Material(name=reader.text_attr(el, "name"))
+    for c in reader.children(el):
+        key = c.tag
+        if key.endswith("_User"):
+            key = key[:-5]
+        if key in MATERIAL_KEYS:
+            value = reader.num(c, "value", nonnegative=True)
+            setattr(mat, MATERIAL_KEYS[key], value)
+        else:
+            mat.extra[c.tag] = {k: c.get(k) for k in c.keys()}
+            reader.mark(c, *c.keys())
+    for k in el.keys():
+        if k != "name":
+            mat.extra[k] = el.get(k)
+            reader.mark(el, k)
+    if mat.poisson is not None and not (0.0 <= mat.poisson < 0.5):
+        raise reader.error(el, f"PoissonRatio {mat.poisson} out of range", "0 <= nu < 0.5")
+    if mat.restitution is not None and mat.restitution > 1.0:
+        raise reader.error(el, f"Restitution_Coefficient {mat.restitution} above 1", "0 <= e <= 1")
+    return mat
+
+
+def read_properties(reader, casedef):
+    el = reader.child(casedef, "properties")
+    materials, links = {}, []
+    if el is None:
+        return materials, links
+    for c in reader.children(el):
+        if c.tag == "property":
+            m = _read_material(reader, c)
+            materials[m.name] = m
+        elif c.tag == "propertyfile":
+            path = reader.resolve_path(c, "file")
+            section = reader.text_attr(c, "path", "")
+            materials.update(_read_property_file(reader, c, path, section))
+        elif c.tag == "links":
+            for link in reader.children(c):
+                if link.tag != "link":
+                    raise reader.error(link, f"unknown element <{link.tag}>", "<link>")
+                d = {"property": reader.text_attr(link, "property"), "line": link.sourceline}
+                if link.get("mkbound") is not None:
+                    d["mkbound"] = _mk_list(reader, link, "mkbound")
+                if link.get("mkfluid") is not None:
+                    d["mkfluid"] = _mk_list(reader, link, "mkfluid")
+                if "mkbound" not in d and "mkfluid" not in d:
+                    raise reader.error(link, "missing mkbound or mkfluid")
+                links.append(d)
+        else:
+            raise reader.error(c, f"unknown element <{c.tag}> in <properties>", "property, propertyfile, links")
+    for d in links:
+        for name in d["property"].split("+"):
+            if name.strip() not in materials:
+                raise CaseError(f"property '{name.strip()}' is not defined", file=reader.file, line=d["line"],
+                                element="link", expected="a <property name> defined in <properties> or its propertyfile"
+                                + (f" (defined: {', '.join(sorted(materials))})" if materials else ""))
+    return materials, links
+
+
+def _read_property_file(reader, el, path, section):
+    sub_root, _ = load_xml_any(path, reader)
+    strip_disabled(sub_root)
+    node = sub_root
+    parts = [p for p in section.split(".") if p]
+    if parts and parts[0] == sub_root.tag:
+        parts = parts[1:]
+    for p in parts:
+        nxt = node.find(p)
+        if nxt is None:
+            raise reader.error(el, f"path '{section}' not found in {os.path.basename(path)}",
+                               "a dotted path of elements holding <property> items")
+        node = nxt
+    sub_reader = CaseReader(path, reader.vars, reader.warnings)
+    out = {}
+    for c in node.iter("property"):
+        sub_reader.mark(c)
+        m = _read_material(sub_reader, c)
+        out[m.name] = m
+    return out
+
+
+def load_xml_any(path, reader):
+    """Parse an auxiliary XML file (any root element)."""
+    from .xmldoc import parse_xml_text
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(64 * 1024 * 1024 + 1)
+    except OSError as exc:
+        raise CaseError(f"cannot read {path}: {exc.strerror}", file=reader.file) from None
+    return parse_xml_text(raw.decode("utf-8", errors="replace"), path), None
+
+
+def read_normals(reader, casedef) -> list:
+    el = reader.child(casedef, "normals")
+    out = []
+    if el is None:
+        return out
+    for c in reader.children(el):
+        d = {"type": c.tag, "line": c.sourceline}
+        for k in c.keys():
+            d[k] = c.get(k)
+            reader.mark(c, k)
+        for sub in reader.children(c):
+            d[sub.tag] = reader.vec3(sub, default=None) if any(sub.get(a) is not None for a in "xyz") \
+                else {k: sub.get(k) for k in sub.keys()}
+            if isinstance(d[sub.tag], np.ndarray):
+                d[sub.tag] = d[sub.tag].tolist()
+            reader.mark(sub, *sub.keys())
+        out.append(d)
+    return out
+
+
+# ---------------------------------------------------------------------------
+# execution
+# ---------------------------------------------------------------------------
+def read_parameters(reader, execution):
+    params = default_parameters()
+    set_keys = []
+    domain = {"posmin": ["default"] * 3, "posmax": ["default"] * 3}
+    el = reader.child(execution, "parameters") if execution is not None else None
+    if el is None:
+        return params, set_keys, domain
+    for p in reader.children(el):
+        if p.tag == "simulationdomain":
+            for which in ("posmin", "posmax"):
+                c = reader.child(p, which)
+                if c is not None:
+                    domain[which] = [_domain_spec(reader, c, comp) for comp in "xyz"]
+            continue
+        if p.tag != "parameter":
+            raise reader.error(p, f"unknown element <{p.tag}> in <parameters>", "<parameter key value> or <simulationdomain>")
+        key = reader.text_attr(p, "key")
+        if key.startswith("#"):
+            reader.mark(p, "value")
+            continue
+        if key not in PARAMETERS:
+            hint = closest_key(key)
+            raise reader.error(p, f"unknown parameter key '{key}'",
+                               f"'{hint}'" if hint else "a DualSPHysics parameter key (see sphdvi parameters list)")
+        if key in set_keys:
+            reader.warn(p, f"parameter '{key}' given twice; the last value is used")
+        raw = reader.raw(p, "value")
+        spec = PARAMETERS[key]
+        try:
+            if spec.kind == "str":
+                value = coerce(key, raw)
+            else:
+                value = coerce(key, reader.num(p, "value"))
+        except ValueError as exc:
+            raise reader.error(p, f"parameter {key}: {exc}", _expected_for(key)) from None
+        if key in DEPRECATED:
+            reader.warn(p, f"parameter '{key}' is deprecated in DualSPHysics")
+        params[key] = value
+        set_keys.append(key)
+    if params["RhopOutMin"] >= params["RhopOutMax"]:
+        raise reader.error(el, f"RhopOutMin ({params['RhopOutMin']}) >= RhopOutMax ({params['RhopOutMax']})",
+                           "RhopOutMin < RhopOutMax")
+    return params, set_keys, domain
+
+
+def _expected_for(key):
+    spec = PARAMETERS[key]
+    if spec.choices:
+        return "one of " + ", ".join(str(c) for c in spec.choices)
+    rng = []
+    if spec.lo is not None:
+        rng.append(f">= {spec.lo:g}")
+    if spec.hi is not None:
+        rng.append(f"<= {spec.hi:g}")
+    return ("a number " + " and ".join(rng)) if rng else "a number"
+
+
+def _domain_spec(reader, el, comp) -> str:
+    """Keep ``default``, ``default + 10%``, ``default - 2`` or a number; check the syntax now."""
+    raw = el.get(comp)
+    reader.mark(el, comp)
+    if raw is None:
+        return "default"
+    text = raw.strip()
+    try:
+        parse_domain_spec(text, 0.0, 1.0)
+    except ValueError as exc:
+        raise reader.error(el, f"{comp}={raw!r}: {exc}", "'default', 'default +|- value[%]' or a number") from None
+    return text
+
+
+def parse_domain_spec(text: str, default: float, extent: float) -> float:
+    """Evaluate a simulation-domain limit: ``default``, ``default + 50%``, ``default-2`` or a value."""
+    import re
+    s = text.replace(" ", "").lower()
+    if s == "default":
+        return default
+    m = re.fullmatch(r"default([+-])([0-9.eE+-]+)(%?)", s)
+    if m:
+        amount = float(m.group(2))
+        if m.group(3):
+            amount = extent * amount / 100.0
+        value = default + amount if m.group(1) == "+" else default - amount
+    else:
+        value = float(s)
+    if value != value or value in (float("inf"), float("-inf")):
+        raise ValueError("not finite")
+    return value
+
+
+def _value_children(reader, el, spec: dict, required=()) -> dict:
+    """Children written as ``<tag value=..>`` (num/int/str/bool) or ``<tag x y z>`` (vec)."""
+    out = {}
+    for c in reader.children(el):
+        if c.tag not in spec:
+            raise reader.error(c, f"unknown element <{c.tag}> in <{el.tag}>", "one of " + ", ".join(f"<{k}>" for k in sorted(spec)))
+    for tag, kind in spec.items():
+        c = reader.child(el, tag)
+        if c is None:
+            if tag in required:
+                raise reader.error(el, f"missing <{tag}>", f"<{tag}> in <{el.tag}>")
+            continue
+        if kind == "vec":
+            out[tag] = reader.vec3(c).tolist()
+        elif kind == "num":
+            out[tag] = reader.num(c, "value")
+        elif kind == "int":
+            out[tag] = reader.integer(c, "value")
+        elif kind == "bool":
+            out[tag] = reader.boolean(c, "value")
+        elif kind == "str":
+            out[tag] = reader.text_attr(c, "value")
+        elif kind == "mk":
+            out[tag] = _mk_list(reader, c, "value")
+        elif kind == "raw":
+            out[tag] = {k: c.get(k) for k in c.keys()}
+            reader.mark(c, *c.keys())
+    return out
+
+
+def read_special(reader, execution) -> dict:
+    out = {}
+    el = reader.child(execution, "special") if execution is not None else None
+    if el is None:
+        return out
+    for c in reader.children(el):
+        if c.tag not in SPECIAL_KNOWN:
+            raise reader.error(c, f"unknown special section <{c.tag}>", "one of " + ", ".join(sorted(SPECIAL_KNOWN)))
+        if c.tag not in SPECIAL_SUPPORTED:
+            raise reader.error(c, f"<special><{c.tag}> is not supported by sphdvi",
+                               "supported: " + ", ".join(sorted(SPECIAL_SUPPORTED)))
+        out[c.tag] = SPECIAL_READERS[c.tag](reader, c)
+    return out
+
+
+def read_chrono(reader, el) -> dict:
+    allowed = {"savedata", "schemescale", "ompthreads", "collision", "bodyfixed", "bodyfloating",
+               "bodymoving", "link_hinge", "link_spheric", "link_pointline", "link_linearspring",
+               "link_coulombdamping", "link_pulley", "gravity", "timestepper", "scaleforce",
+               "solver", "configfea", "nodes", "feafloating", "link_pointframe"}
+    reader.check_children(el, allowed)
+    out = {"savedata": -1.0, "schemescale": 1.0, "ompthreads": 1,
+           "collision": {"activate": False, "distancedp": 0.5, "contactmethod": 0},
+           "bodies": [], "links": []}
+    for tag in ("configfea", "nodes", "feafloating", "link_pointframe"):
+        c = el.find(tag)
+        if c is not None:
+            raise reader.error(c, f"<{tag}> (Chrono FEA) is not supported by sphdvi", "rigid bodies and links")
+    if el.find("savedata") is not None:
+        out["savedata"] = reader.child_value(el, "savedata")
+    if el.find("schemescale") is not None:
+        out["schemescale"] = reader.child_value(el, "schemescale", positive=True)
+    if el.find("ompthreads") is not None:
+        out["ompthreads"] = int(reader.child_value(el, "ompthreads", lo=1))
+    if el.find("solver") is not None:
+        s = reader.child(el, "solver")
+        out["solver"] = {k: s.get(k) for k in s.keys()}
+        reader.mark(s, *s.keys())
+    col = reader.child(el, "collision")
+    if col is not None:
+        reader.check_children(col, {"distancedp", "contactmethod"})
+        out["collision"] = {
+            "activate": reader.boolean(col, "activate", True),
+            "distancedp": reader.child_value(col, "distancedp", 0.5, nonnegative=True),
+            "contactmethod": int(reader.child_value(col, "contactmethod", 0, lo=0, hi=1)),
+        }
+    ids = {}
+    for b in reader.children(el):
+        if not b.tag.startswith("body"):
+            continue
+        kind = b.tag[4:]
+        bid = reader.text_attr(b, "id")
+        mks = _mk_list(reader, b, "mkbound")
+        names = [bid] if len(mks) == 1 else [f"{bid}{mk}" for mk in mks]
+        for name, mk in zip(names, mks):
+            if name in ids:
+                raise reader.error(b, f"body id '{name}' is used twice (line {ids[name]})", "unique body ids")
+            ids[name] = b.sourceline
+            body = {"kind": kind, "id": name, "mkbound": mk, "line": b.sourceline,
+                    "modelfile": reader.text_attr(b, "modelfile", None),
+                    "modelnormal": reader.text_attr(b, "modelnormal", "original",
+                                                    choices={"original", "invert", "twoface"}),
+                    "imposefric": reader.boolean(b, "imposefric", False)}
+            if kind == "moving":
+                body["massbody"] = reader.num(b, "massbody", positive=True)
+            out["bodies"].append(body)
+    for ln in reader.children(el):
+        if not ln.tag.startswith("link_"):
+            continue
+        out["links"].append(_read_link(reader, ln, ids))
+    scale = reader.child(el, "scaleforce")
+    if scale is not None:
+        out["scaleforce"] = []
+        for b in reader.children(scale, "body"):
+            out["scaleforce"].append({"mkbound": reader.integer(b, "mkbound", lo=0),
+                                      "scale": reader.vec3(b, default=np.ones(3), missing=1.0).tolist()})
+    return out
+
+
+LINK_SPECS = {
+    "link_hinge": {"rotpoint": "vec", "rotvector": "vec", "stiffness": "coef", "damping": "coef"},
+    "link_spheric": {"rotpoint": "vec", "stiffness": "coef", "damping": "coef"},
+    "link_pointline": {"slidingvector": "vec", "rotpoint": "vec", "rotvector": "vec", "rotvector2": "vec",
+                       "stiffness": "coef", "damping": "coef"},
+    "link_linearspring": {"point_fb1": "vec", "point_fb2": "vec", "stiffness": "coef", "damping": "coef",
+                          "rest_length": "num", "savevtk": "raw"},
+    "link_coulombdamping": {"point_fb1": "vec", "point_fb2": "vec", "rest_length": "num", "damping": "num",
+                            "savevtk": "raw"},
+    "link_pulley": {"rotpoint": "vec", "rotvector": "vec", "radius": "num", "radius2": "num"},
+}
+LINK_REQUIRED = {
+    "link_hinge": ("rotpoint", "rotvector"), "link_spheric": ("rotpoint",),
+    "link_pointline": ("slidingvector", "rotpoint"), "link_linearspring": ("point_fb1", "point_fb2", "stiffness", "rest_length"),
+    "link_coulombdamping": ("point_fb1", "point_fb2", "damping"), "link_pulley": ("rotpoint", "rotvector", "radius", "radius2"),
+}
+
+
+def _read_link(reader, ln, ids) -> dict:
+    spec = LINK_SPECS[ln.tag]
+    d = {"type": ln.tag[5:], "line": ln.sourceline, "name": reader.text_attr(ln, "name", None)}
+    for which in ("idbody1", "idbody2"):
+        v = reader.text_attr(ln, which, None)
+        if v is None:
+            if which == "idbody1" or ln.tag in ("link_linearspring", "link_coulombdamping", "link_pulley"):
+                raise reader.error(ln, f"missing attribute '{which}'", "the id of a body defined in <chrono>")
+        elif v not in ids:
+            raise reader.error(ln, f"{which}='{v}' names no body",
+                               "one of " + (", ".join(sorted(ids)) if ids else "(no bodies defined)"))
+        d[which] = v
+    for c in reader.children(ln):
+        if c.tag not in spec:
+            raise reader.error(c, f"unknown element <{c.tag}> in <{ln.tag}>", "one of " + ", ".join(f"<{k}>" for k in sorted(spec)))
+    for tag, kind in spec.items():
+        c = reader.child(ln, tag)
+        if c is None:
+            if tag in LINK_REQUIRED[ln.tag]:
+                raise reader.error(ln, f"missing <{tag}>", f"<{tag}> in <{ln.tag}>")
+            continue
+        if kind == "vec":
+            d[tag] = reader.vec3(c).tolist()
+        elif kind == "num":
+            d[tag] = reader.num(c, "value", nonnegative=True)
+        elif kind == "raw":
+            d[tag] = {s.tag: s.get("value") for s in c}
+            for s in c:
+                reader.mark(s, "value")
+        elif kind == "coef":
+            if c.get("file") is not None:
+                d[tag] = {"file": reader.resolve_path(c, "file")}
+            elif c.get("value") is not None:
+                d[tag] = reader.num(c, "value", nonnegative=True)
+            else:
+                rows = [(reader.num(r, "time", nonnegative=True), reader.num(r, "value", nonnegative=True))
+                        for r in reader.children(c)]
+                if not rows:
+                    raise reader.error(c, f"<{tag}> has no value", 'value=".." or a time table')
+                d[tag] = {"times": [r[0] for r in rows], "values": [r[1] for r in rows]}
+    for tag in ("rotvector", "slidingvector"):
+        if tag in d and tag in LINK_REQUIRED[ln.tag] and np.linalg.norm(d[tag]) == 0:
+            raise reader.error(ln, f"<{tag}> is the zero vector", "a non-zero direction")
+    if d["type"] == "pulley" and (d["radius"] <= 0 or d["radius2"] <= 0):
+        raise reader.error(ln, "pulley radii must be positive", "radius > 0 and radius2 > 0")
+    return d
+
+
+GAUGE_COMMON = {"savevtkpart": "bool", "computedt": "num", "computetime": "raw", "output": "bool",
+                "outputdt": "num", "outputtime": "raw"}
+GAUGE_SPECS = {
+    "velocity": {"point": "vec"},
+    "swl": {"point0": "vec", "point2": "vec", "pointdp": "raw", "masslimit": "raw"},
+    "maxz": {"point0": "vec", "height": "num", "distlimit": "raw"},
+    "force": {"target": "raw"},
+    "mesh": {"point": "vec", "vec1": "vec", "vec2": "vec", "vec3": "vec", "size1": "num", "size2": "num",
+             "size3": "num", "dirdat": "vec", "masslimit": "raw", "kclimit": "raw", "outputdata": "raw",
+             "outputfmt": "raw", "buffersize": "num"},
+}
+
+
+def read_gauges(reader, el) -> dict:
+    out = {"default": {}, "items": []}
+    names = set()
+    for c in reader.children(el):
+        if c.tag == "default":
+            out["default"] = _value_children(reader, c, GAUGE_COMMON)
+            continue
+        if c.tag not in GAUGE_SPECS:
+            raise reader.error(c, f"unknown gauge <{c.tag}>", "velocity, swl, maxz, force or mesh")
+        name = reader.text_attr(c, "name")
+        if name in names:
+            raise reader.error(c, f"gauge name '{name}' used twice", "unique gauge names")
+        names.add(name)
+        spec = {**GAUGE_COMMON, **GAUGE_SPECS[c.tag]}
+        d = {"type": c.tag, "name": name, "line": c.sourceline}
+        d.update(_value_children(reader, c, spec))
+        out["items"].append(d)
+    return out
+
+
+def read_wavepaddles(reader, el) -> list:
+    spec_common = {"mkbound": "int", "start": "num", "duration": "num", "depth": "num", "waveorder": "int",
+                   "waveheight": "num", "waveperiod": "num", "gainstroke": "num", "phase": "num",
+                   "ramp": "num", "savemotion": "raw", "awas_zsurf": "raw", "usefiledata": "raw"}
+    specs = {"piston": {**spec_common, "pistondir": "vec"},
+             "flap": {**spec_common, "variabledraft": "num", "flapaxis0": "vec", "flapaxis1": "vec"}}
+    out = []
+    for c in reader.children(el):
+        if c.tag not in specs:
+            raise reader.error(c, f"<wavepaddles><{c.tag}> is not supported by sphdvi",
+                               "<piston> or <flap> (regular waves)")
+        d = {"type": c.tag, "line": c.sourceline}
+        d.update(_value_children(reader, c, specs[c.tag], required=("mkbound", "depth", "waveheight", "waveperiod")))
+        d.setdefault("waveorder", 1)
+        if d["waveorder"] not in (1, 2):
+            raise reader.error(c, f"waveorder {d['waveorder']}", "1 or 2")
+        for k in ("depth", "waveheight", "waveperiod"):
+            if d[k] <= 0:
+                raise reader.error(c, f"<{k}> must be positive", f"{k} > 0")
+        if c.tag == "flap" and ("flapaxis0" not in d or "flapaxis1" not in d):
+            raise reader.error(c, "missing <flapaxis0>/<flapaxis1>", "the two points of the hinge axis")
+        d.setdefault("start", 0.0)
+        d.setdefault("duration", 0.0)
+        d.setdefault("gainstroke", 1.0)
+        d.setdefault("phase", 0.0)
+        d.setdefault("ramp", 0.0)
+        if c.tag == "piston":
+            d.setdefault("pistondir", [1.0, 0.0, 0.0])
+        out.append(d)
+    return out
+
+
+def read_damping(reader, el) -> list:
+    spec = {"limitmin": "vec", "limitmax": "vec", "overlimit": "num", "redumax": "num", "factorxyz": "vec"}
+    out = []
+    for c in reader.children(el):
+        if c.tag != "dampingzone":
+            raise reader.error(c, f"<damping><{c.tag}> is not supported by sphdvi", "<dampingzone>")
+        d = {"type": "zone", "line": c.sourceline}
+        d.update(_value_children(reader, c, spec, required=("limitmin", "limitmax")))
+        d.setdefault("overlimit", 0.0)
+        d.setdefault("redumax", 10.0)
+        d.setdefault("factorxyz", [1.0, 1.0, 1.0])
+        if np.allclose(d["limitmin"], d["limitmax"]):
+            raise reader.error(c, "limitmin equals limitmax", "two different points")
+        out.append(d)
+    return out
+
+
+def read_shifting(reader, el) -> dict:
+    d = {"zones": []}
+    for c in reader.children(el):
+        if c.tag == "shiftingzone":
+            zone = _value_children(reader, c, {"posref": "vec", "size": "vec", "vecx": "vec", "vecy": "vec",
+                                               "vecz": "vec", "rotateaxis": "raw"}, required=("posref",))
+            d["zones"].append(zone)
+        elif c.tag in ("mode", "coefficient", "fsthreshold"):
+            continue
+        else:
+            raise reader.error(c, f"unknown element <{c.tag}> in <shifting>", "mode, coefficient, fsthreshold, shiftingzone")
+    if el.find("mode") is not None:
+        d["mode"] = int(reader.child_value(el, "mode", lo=0, hi=4))
+    if el.find("coefficient") is not None:
+        d["coefficient"] = reader.child_value(el, "coefficient")
+    if el.find("fsthreshold") is not None:
+        d["fsthreshold"] = reader.child_value(el, "fsthreshold", nonnegative=True)
+    return d
+
+
+SPECIAL_READERS = {"chrono": read_chrono, "gauges": read_gauges, "wavepaddles": read_wavepaddles,
+                   "damping": read_damping, "shifting": read_shifting}
