@@ -1,0 +1,710 @@
+"""Collision detection: shapes, sort-and-sweep broad phase, narrow phase.
+
+Shapes (local frame of the shape, attached to a body with an offset pose):
+
+=========  =========================================  ===========================
+type       dims                                       notes
+=========  =========================================  ===========================
+SPHERE     (r, -, -)                                   analytic
+BOX        half extents (hx, hy, hz)                   box–box: separating axes +
+                                                       face clipping (≤ 4 points)
+CAPSULE    (r, half length, -) along local z           segment + radius
+CYLINDER   (r, half length, -) along local z           exact SDF, rim samples
+PLANE      -                                           half-space z_local ≤ 0 is
+                                                       solid, normal = local +z
+HULL       -                                           convex hull of vertices:
+                                                       vertices + facet planes
+CLOUD      (r, -, -)                                   sphere cloud (particles)
+=========  =========================================  ===========================
+
+Generic narrow phase ("samples against signed distance"): every shape has body
+fixed sample points with a radius (sphere centre, capsule axis points, box/hull
+vertices, cylinder rim points, cloud particles) and a signed distance function
+(exact inside; exact or a lower bound outside).  A contact is created for each
+sample of one shape whose distance to the other shape, minus its radius, is
+below the envelope.  Sphere/capsule pairs use closest points between segments
+and box pairs the separating-axis test; both are exact.  Limitation: for two
+polytopes other than box–box (hull–hull, hull–box, cylinder–box…) edge–edge
+contacts are missed (vertex–face only).
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from ._math import cross
+
+SPHERE = 0
+BOX = 1
+CAPSULE = 2
+CYLINDER = 3
+PLANE = 4
+HULL = 5
+CLOUD = 6
+SHAPE_NAMES = {"sphere": SPHERE, "box": BOX, "capsule": CAPSULE, "cylinder": CYLINDER,
+               "plane": PLANE, "hull": HULL, "convex": HULL, "mesh": HULL, "cloud": CLOUD,
+               "spherecloud": CLOUD}
+
+
+# ------------------------------------------------------------------ transforms
+@njit(cache=True)
+def shape_world_poses(sh_body, sh_pos, sh_R, pos, Rb, w_pos, w_R):
+    for s in range(sh_body.shape[0]):
+        b = sh_body[s]
+        if b < 0:
+            w_pos[s] = sh_pos[s]
+            w_R[s] = sh_R[s]
+        else:
+            w_pos[s] = pos[b] + Rb[b] @ sh_pos[s]
+            w_R[s] = Rb[b] @ sh_R[s]
+
+
+@njit(cache=True)
+def shape_aabbs(sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad, w_pos, w_R,
+                margin, lo, hi):
+    for s in range(sh_type.shape[0]):
+        t = sh_type[s]
+        R = w_R[s]
+        c = w_pos[s]
+        if t == PLANE:
+            for k in range(3):
+                lo[s, k] = -1e300
+                hi[s, k] = 1e300
+            continue
+        if t == SPHERE:
+            for k in range(3):
+                ext = sh_dims[s, 0]
+                lo[s, k] = c[k] - ext - margin
+                hi[s, k] = c[k] + ext + margin
+            continue
+        if t == BOX or t == CAPSULE or t == CYLINDER:
+            if t == BOX:
+                hx, hy, hz = sh_dims[s, 0], sh_dims[s, 1], sh_dims[s, 2]
+                rr = 0.0
+            elif t == CAPSULE:
+                hx, hy, hz = 0.0, 0.0, sh_dims[s, 1]
+                rr = sh_dims[s, 0]
+            else:
+                hx, hy, hz = sh_dims[s, 0], sh_dims[s, 0], sh_dims[s, 1]
+                rr = 0.0
+            for k in range(3):
+                ext = abs(R[k, 0]) * hx + abs(R[k, 1]) * hy + abs(R[k, 2]) * hz + rr
+                lo[s, k] = c[k] - ext - margin
+                hi[s, k] = c[k] + ext + margin
+            continue
+        # hull / cloud: bound of the transformed samples
+        for k in range(3):
+            lo[s, k] = 1e300
+            hi[s, k] = -1e300
+        r = samp_rad[s]
+        for p in range(samp_off[s], samp_off[s] + samp_cnt[s]):
+            wp = c + R @ samp_pts[p]
+            for k in range(3):
+                if wp[k] - r < lo[s, k]:
+                    lo[s, k] = wp[k] - r
+                if wp[k] + r > hi[s, k]:
+                    hi[s, k] = wp[k] + r
+        for k in range(3):
+            lo[s, k] -= margin
+            hi[s, k] += margin
+
+
+# ----------------------------------------------------------------- broad phase
+@njit(cache=True)
+def broad_phase(lo, hi, sh_body, sh_type, body_active, pairs):
+    """Sort-and-sweep along the axis of largest spread of the AABB centres;
+    planes are paired with every shape whose AABB reaches below them (tested
+    exactly in the narrow phase).  Returns the number of pairs (pairs may be
+    too small: then the count is still returned and the caller grows it)."""
+    ns = sh_type.shape[0]
+    idx = np.empty(ns, np.int64)
+    nfin = 0
+    for s in range(ns):
+        if sh_type[s] != PLANE:
+            idx[nfin] = s
+            nfin += 1
+    idx = idx[:nfin]
+    axis = 0
+    if nfin > 1:
+        best = -1.0
+        for k in range(3):
+            m = 0.0
+            m2 = 0.0
+            for q in range(nfin):
+                cc = 0.5 * (lo[idx[q], k] + hi[idx[q], k])
+                m += cc
+                m2 += cc * cc
+            var = m2 / nfin - (m / nfin) ** 2
+            if var > best:
+                best = var
+                axis = k
+    keys = np.empty(nfin)
+    for q in range(nfin):
+        keys[q] = lo[idx[q], axis]
+    order = idx[np.argsort(keys)]
+    cap = pairs.shape[0]
+    npair = 0
+    for q in range(nfin):
+        s = order[q]
+        bs = sh_body[s]
+        his = hi[s, axis]
+        for q2 in range(q + 1, nfin):
+            t = order[q2]
+            if lo[t, axis] > his:
+                break
+            bt = sh_body[t]
+            if bt == bs:
+                continue
+            if not (body_active[bs] if bs >= 0 else False) and not (body_active[bt] if bt >= 0 else False):
+                continue
+            ok = True
+            for k in range(3):
+                if lo[t, k] > hi[s, k] or lo[s, k] > hi[t, k]:
+                    ok = False
+                    break
+            if ok:
+                if npair < cap:
+                    pairs[npair, 0] = s
+                    pairs[npair, 1] = t
+                npair += 1
+    for s in range(ns):
+        if sh_type[s] != PLANE:
+            continue
+        bs = sh_body[s]
+        for q in range(nfin):
+            t = idx[q]
+            bt = sh_body[t]
+            if bt == bs:
+                continue
+            if not (body_active[bs] if bs >= 0 else False) and not (body_active[bt] if bt >= 0 else False):
+                continue
+            if npair < cap:
+                pairs[npair, 0] = s
+                pairs[npair, 1] = t
+            npair += 1
+    return npair
+
+
+# ---------------------------------------------------------- signed distances
+@njit(cache=True)
+def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes):
+    """Signed distance and outward unit gradient of shape s at local point q."""
+    g = np.zeros(3)
+    if t == SPHERE:
+        n = math.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2)
+        if n < 1e-14:
+            g[2] = 1.0
+        else:
+            g[:] = q / n
+        return n - dims[0], g
+    if t == PLANE:
+        g[2] = 1.0
+        return q[2], g
+    if t == BOX:
+        d0 = abs(q[0]) - dims[0]
+        d1 = abs(q[1]) - dims[1]
+        d2 = abs(q[2]) - dims[2]
+        if d0 > 0.0 or d1 > 0.0 or d2 > 0.0:
+            e0 = max(d0, 0.0)
+            e1 = max(d1, 0.0)
+            e2 = max(d2, 0.0)
+            n = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            g[0] = math.copysign(e0, q[0]) / n
+            g[1] = math.copysign(e1, q[1]) / n
+            g[2] = math.copysign(e2, q[2]) / n
+            return n, g
+        if d0 >= d1 and d0 >= d2:
+            g[0] = math.copysign(1.0, q[0])
+            return d0, g
+        if d1 >= d2:
+            g[1] = math.copysign(1.0, q[1])
+            return d1, g
+        g[2] = math.copysign(1.0, q[2])
+        return d2, g
+    if t == CAPSULE:
+        zc = min(max(q[2], -dims[1]), dims[1])
+        v0, v1, v2 = q[0], q[1], q[2] - zc
+        n = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+        if n < 1e-14:
+            g[0] = 1.0
+        else:
+            g[0] = v0 / n
+            g[1] = v1 / n
+            g[2] = v2 / n
+        return n - dims[0], g
+    if t == CYLINDER:
+        rho = math.sqrt(q[0] ** 2 + q[1] ** 2)
+        if rho < 1e-14:
+            rx, ry = 1.0, 0.0
+        else:
+            rx, ry = q[0] / rho, q[1] / rho
+        dr = rho - dims[0]
+        dz = abs(q[2]) - dims[1]
+        sz = math.copysign(1.0, q[2])
+        if dr > 0.0 or dz > 0.0:
+            er = max(dr, 0.0)
+            ez = max(dz, 0.0)
+            n = math.sqrt(er * er + ez * ez)
+            g[0] = er * rx / n
+            g[1] = er * ry / n
+            g[2] = ez * sz / n
+            return n, g
+        if dr > dz:
+            g[0] = rx
+            g[1] = ry
+            return dr, g
+        g[2] = sz
+        return dz, g
+    if t == HULL:
+        best = -1e300
+        for p in range(pl_off[s], pl_off[s] + pl_cnt[s]):
+            d = planes[p, 0] * q[0] + planes[p, 1] * q[1] + planes[p, 2] * q[2] + planes[p, 3]
+            if d > best:
+                best = d
+                g[0] = planes[p, 0]
+                g[1] = planes[p, 1]
+                g[2] = planes[p, 2]
+        return best, g
+    # CLOUD: union of spheres
+    best = 1e300
+    for p in range(samp_off[s], samp_off[s] + samp_cnt[s]):
+        v0 = q[0] - samp_pts[p, 0]
+        v1 = q[1] - samp_pts[p, 1]
+        v2 = q[2] - samp_pts[p, 2]
+        d2 = v0 * v0 + v1 * v1 + v2 * v2
+        if d2 < best:
+            best = d2
+            n = math.sqrt(d2)
+            if n < 1e-14:
+                g[0] = 0.0
+                g[1] = 0.0
+                g[2] = 1.0
+            else:
+                g[0] = v0 / n
+                g[1] = v1 / n
+                g[2] = v2 / n
+    return math.sqrt(best) - dims[0], g
+
+
+# ------------------------------------------------------------- contact output
+@njit(cache=True)
+def _emit(nc, cap, ba, bb, sa, sb, pt, n, gap, key, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    if nc < cap:
+        c_a[nc] = ba
+        c_b[nc] = bb
+        c_sa[nc] = sa
+        c_sb[nc] = sb
+        for k in range(3):
+            c_pt[nc, k] = pt[k]
+            c_n[nc, k] = n[k]
+        c_gap[nc] = gap
+        c_key[nc] = key
+    return nc + 1
+
+
+@njit(cache=True)
+def closest_segments(p1, q1, p2, q2):
+    """Closest points between segments [p1,q1] and [p2,q2] (Ericson §5.1.9)."""
+    d1 = q1 - p1
+    d2 = q2 - p2
+    r = p1 - p2
+    a = d1 @ d1
+    e = d2 @ d2
+    f = d2 @ r
+    if a <= 1e-20 and e <= 1e-20:
+        return p1.copy(), p2.copy()
+    if a <= 1e-20:
+        s = 0.0
+        t = min(max(f / e, 0.0), 1.0)
+    else:
+        c = d1 @ r
+        if e <= 1e-20:
+            t = 0.0
+            s = min(max(-c / a, 0.0), 1.0)
+        else:
+            bq = d1 @ d2
+            den = a * e - bq * bq
+            s = min(max((bq * f - c * e) / den, 0.0), 1.0) if den > 1e-20 else 0.0
+            t = (bq * s + f) / e
+            if t < 0.0:
+                t = 0.0
+                s = min(max(-c / a, 0.0), 1.0)
+            elif t > 1.0:
+                t = 1.0
+                s = min(max((bq - c) / a, 0.0), 1.0)
+    return p1 + d1 * s, p2 + d2 * t
+
+
+@njit(cache=True)
+def _segment_of(t, dims, c, R):
+    if t == CAPSULE:
+        ax = R[:, 2] * dims[1]
+        return c - ax, c + ax
+    return c.copy(), c.copy()
+
+
+@njit(cache=True)
+def _box_box(sa, sb, ba, bb, cA, RA, hA, cB, RB, hB, env, keybase, nc, cap,
+             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """Box–box: separating-axis test over 15 axes, then clipping of the incident
+    face against the reference face (≤ 4 points kept) or one edge–edge point."""
+    T = cB - cA
+    best_face = -1e300
+    face_ax = -1
+    best_edge = -1e300
+    edge_i = -1
+    edge_j = -1
+    edge_L = np.zeros(3)
+    for ax in range(6):
+        if ax < 3:
+            L = RA[:, ax]
+        else:
+            L = RB[:, ax - 3]
+        ra = 0.0
+        rbx = 0.0
+        for k in range(3):
+            ra += hA[k] * abs(RA[:, k] @ L)
+            rbx += hB[k] * abs(RB[:, k] @ L)
+        s = abs(T @ L) - ra - rbx
+        if s > env:
+            return nc
+        if s > best_face:
+            best_face = s
+            face_ax = ax
+    for i in range(3):
+        for j in range(3):
+            L = cross(RA[:, i], RB[:, j])
+            ln = math.sqrt(L @ L)
+            if ln < 1e-6:
+                continue
+            L = L / ln
+            ra = 0.0
+            rbx = 0.0
+            for k in range(3):
+                ra += hA[k] * abs(RA[:, k] @ L)
+                rbx += hB[k] * abs(RB[:, k] @ L)
+            s = abs(T @ L) - ra - rbx
+            if s > env:
+                return nc
+            if s > best_edge:
+                best_edge = s
+                edge_i = i
+                edge_j = j
+                edge_L[:] = L
+    scale = min(hA.min(), hB.min())
+    if edge_i >= 0 and best_edge > best_face + 0.05 * abs(best_face) + 1e-3 * scale:
+        L = edge_L.copy()
+        if T @ L < 0.0:
+            L = -L
+        pa = cA.copy()
+        pb = cB.copy()
+        for k in range(3):
+            if k != edge_i:
+                pa += hA[k] * math.copysign(1.0, RA[:, k] @ L) * RA[:, k]
+            if k != edge_j:
+                pb -= hB[k] * math.copysign(1.0, RB[:, k] @ L) * RB[:, k]
+        ea = RA[:, edge_i] * hA[edge_i]
+        eb = RB[:, edge_j] * hB[edge_j]
+        x1, x2 = closest_segments(pa - ea, pa + ea, pb - eb, pb + eb)
+        pt = 0.5 * (x1 + x2)
+        return _emit(nc, cap, ba, bb, sa, sb, pt, L, best_edge, keybase + 50,
+                     c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    # face contact: reference box r, incident box i, nref points from r to i
+    if face_ax < 3:
+        cr, Rr, hr, ci, Ri, hi_ = cA, RA, hA, cB, RB, hB
+        fi = face_ax
+        nref = RA[:, fi] * math.copysign(1.0, T @ RA[:, fi])
+        nab = nref.copy()
+    else:
+        cr, Rr, hr, ci, Ri, hi_ = cB, RB, hB, cA, RA, hA
+        fi = face_ax - 3
+        nref = RB[:, fi] * (-math.copysign(1.0, T @ RB[:, fi]))
+        nab = -nref
+    # incident face: most anti-parallel face of the incident box
+    jbest = 0
+    dbest = -1.0
+    for j in range(3):
+        dj = abs(Ri[:, j] @ nref)
+        if dj > dbest:
+            dbest = dj
+            jbest = j
+    ninc = -Ri[:, jbest] * math.copysign(1.0, Ri[:, jbest] @ nref)
+    fc = ci + ninc * hi_[jbest]
+    u = (jbest + 1) % 3
+    v = (jbest + 2) % 3
+    U = Ri[:, u] * hi_[u]
+    V = Ri[:, v] * hi_[v]
+    poly = np.empty((16, 3))
+    npoly = 4
+    poly[0] = fc + U + V
+    poly[1] = fc - U + V
+    poly[2] = fc - U - V
+    poly[3] = fc + U - V
+    tmp = np.empty((16, 3))
+    for side in range(4):
+        k = (fi + 1 + side // 2) % 3
+        sgn = 1.0 if side % 2 == 0 else -1.0
+        pn = Rr[:, k] * sgn
+        off = pn @ cr + hr[k]
+        nt = 0
+        for q in range(npoly):
+            P = poly[q]
+            Q = poly[(q + 1) % npoly]
+            dp = P @ pn - off
+            dq = Q @ pn - off
+            if dp <= 0.0:
+                tmp[nt] = P
+                nt += 1
+            if (dp <= 0.0) != (dq <= 0.0):
+                tmp[nt] = P + (Q - P) * (dp / (dp - dq))
+                nt += 1
+        npoly = nt
+        for q in range(nt):
+            poly[q] = tmp[q]
+        if npoly == 0:
+            return nc
+    # keep points below the envelope, at most 4 (deepest first, then spread)
+    depth = np.empty(npoly)
+    keep = np.zeros(npoly, np.bool_)
+    nk = 0
+    for q in range(npoly):
+        depth[q] = nref @ (poly[q] - cr) - hr[fi]
+    cand = 0
+    for q in range(npoly):
+        if depth[q] < env:
+            cand += 1
+    if cand == 0:
+        return nc
+    # deepest
+    first = -1
+    for q in range(npoly):
+        if depth[q] < env and (first < 0 or depth[q] < depth[first]):
+            first = q
+    keep[first] = True
+    nk = 1
+    while nk < min(4, cand):
+        far = -1
+        fd = -1.0
+        for q in range(npoly):
+            if keep[q] or depth[q] >= env:
+                continue
+            dmin = 1e300
+            for p in range(npoly):
+                if keep[p]:
+                    dv = poly[q] - poly[p]
+                    dd = dv @ dv
+                    if dd < dmin:
+                        dmin = dd
+            if dmin > fd:
+                fd = dmin
+                far = q
+        if far < 0:
+            break
+        keep[far] = True
+        nk += 1
+    for q in range(npoly):
+        if keep[q]:
+            pt = poly[q] - 0.5 * depth[q] * nref
+            nc = _emit(nc, cap, ba, bb, sa, sb, pt, nab, depth[q], keybase + q,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return nc
+
+
+@njit(cache=True)
+def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
+                    sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
+                    pl_off, pl_cnt, planes, w_pos, w_R, lo, hi, sh_body,
+                    c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """Samples of shape sp (radius ρ) against the SDF of shape so.  The contact
+    normal is −∇φ_so (from sp to so); ``swap`` reverses the pair order so that
+    the normal is always from the pair's first shape to its second."""
+    cP = w_pos[sp]
+    RP = w_R[sp]
+    cO = w_pos[so]
+    RO = w_R[so]
+    rho = samp_rad[sp]
+    to = sh_type[so]
+    for p in range(samp_off[sp], samp_off[sp] + samp_cnt[sp]):
+        x = cP + RP @ samp_pts[p]
+        # AABB cull against the other shape
+        out = False
+        for k in range(3):
+            if x[k] + rho < lo[so, k] or x[k] - rho > hi[so, k]:
+                out = True
+                break
+        if out:
+            continue
+        ql = RO.T @ (x - cO)
+        phi, gl = sdf_local(to, sh_dims[so], ql, so, samp_off, samp_cnt, samp_pts,
+                            pl_off, pl_cnt, planes)
+        gap = phi - rho
+        if gap >= env:
+            continue
+        gw = RO @ gl
+        pt = x - 0.5 * (rho + phi) * gw
+        key = keybase + (p - samp_off[sp]) * 2 + (1 if swap else 0)
+        if swap:
+            nc = _emit(nc, cap, bo, bp, so, sp, pt, gw, gap, key,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+        else:
+            nc = _emit(nc, cap, bp, bo, sp, so, pt, -gw, gap, key,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return nc
+
+
+@njit(cache=True)
+def _point_like(t):
+    return t == SPHERE or t == CLOUD
+
+
+@njit(cache=True)
+def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cnt,
+                 samp_pts, samp_rad, pl_off, pl_cnt, planes, w_pos, w_R, lo, hi,
+                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """All contacts of the candidate pairs with gap < env.  Returns the count
+    (which may exceed the capacity: the caller then grows and calls again)."""
+    cap = c_a.shape[0]
+    nc = 0
+    ns = sh_type.shape[0]
+    for q in range(npair):
+        s1 = pairs[q, 0]
+        s2 = pairs[q, 1]
+        # canonical order: lower type first (plane last for the sample loop)
+        t1 = sh_type[s1]
+        t2 = sh_type[s2]
+        if t1 == PLANE:
+            s1, s2 = s2, s1
+            t1, t2 = t2, t1
+        b1 = sh_body[s1]
+        b2 = sh_body[s2]
+        keybase = (np.int64(min(s1, s2)) * ns + max(s1, s2)) * 1048576
+        if (t1 == SPHERE or t1 == CAPSULE) and (t2 == SPHERE or t2 == CAPSULE):
+            p1, q1 = _segment_of(t1, sh_dims[s1], w_pos[s1], w_R[s1])
+            p2, q2 = _segment_of(t2, sh_dims[s2], w_pos[s2], w_R[s2])
+            x1, x2 = closest_segments(p1, q1, p2, q2)
+            dv = x2 - x1
+            dist = math.sqrt(dv @ dv)
+            gap = dist - sh_dims[s1, 0] - sh_dims[s2, 0]
+            if gap < env:
+                if dist > 1e-14:
+                    n = dv / dist
+                else:
+                    n = np.array([0.0, 0.0, 1.0])
+                pt = x1 + n * (sh_dims[s1, 0] + 0.5 * gap)
+                nc = _emit(nc, cap, b1, b2, s1, s2, pt, n, gap, keybase,
+                           c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            continue
+        if t1 == BOX and t2 == BOX:
+            nc = _box_box(s1, s2, b1, b2, w_pos[s1], w_R[s1], sh_dims[s1], w_pos[s2],
+                          w_R[s2], sh_dims[s2], env, keybase, nc, cap,
+                          c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            continue
+        pl1 = _point_like(t1)
+        pl2 = _point_like(t2)
+        if t1 != PLANE and (pl1 or not pl2):
+            nc = _samples_vs_sdf(s1, s2, b1, b2, False, nc, cap, env, keybase,
+                                 sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
+                                 pl_off, pl_cnt, planes, w_pos, w_R, lo, hi, sh_body,
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+        if t2 != PLANE and (pl2 or not pl1) and not (pl1 and pl2):
+            nc = _samples_vs_sdf(s2, s1, b2, b1, True, nc, cap, env, keybase,
+                                 sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
+                                 pl_off, pl_cnt, planes, w_pos, w_R, lo, hi, sh_body,
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return nc
+
+
+@njit(cache=True)
+def contact_materials(nc, c_sa, c_sb, sh_mat, mat_mu, mat_e, c_mu, c_e):
+    """Pair rule (Chrono's default composition): μ = min(μ1, μ2), e = min(e1, e2)."""
+    for i in range(nc):
+        m1 = sh_mat[c_sa[i]]
+        m2 = sh_mat[c_sb[i]]
+        c_mu[i] = min(mat_mu[m1], mat_mu[m2])
+        c_e[i] = min(mat_e[m1], mat_e[m2])
+
+
+@njit(cache=True)
+def match_warm_start(nc, c_key, prev_keys_sorted, prev_gamma3, out_gamma3):
+    """Warm start: copy last step's contact impulses for persistent keys."""
+    npk = prev_keys_sorted.shape[0]
+    for i in range(nc):
+        out_gamma3[i, 0] = 0.0
+        out_gamma3[i, 1] = 0.0
+        out_gamma3[i, 2] = 0.0
+        if npk == 0:
+            continue
+        j = np.searchsorted(prev_keys_sorted, c_key[i])
+        if j < npk and prev_keys_sorted[j] == c_key[i]:
+            for k in range(3):
+                out_gamma3[i, k] = prev_gamma3[j, k]
+
+
+# ------------------------------------------------------------- SMC (penalty)
+@njit(cache=True)
+def smc_forces(nc, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, sh_mat, sh_rad, mat_mu, mat_e,
+               mat_E, mat_nu, pos, Rb, vel, omega_b, inv_mass, force, torque_w, use_hertz):
+    """Smooth contact forces (Hertz, or Hooke when use_hertz is False).
+
+    E* = 1/((1−ν1²)/E1 + (1−ν2²)/E2), R* = R1R2/(R1+R2), δ = −gap,
+    Hertz: k_n = (4/3)E*√(R*δ), F_n = k_n δ − γ_n v_n with the damping
+    γ_n = −2√(5/6) β √(S_n m*), S_n = 2E*√(R*δ), β = ln e/√(ln²e + π²)
+    (Tsuji-type, as in Chrono's SMC Hertz model).  Hooke: k_n = E* R*.
+    Tangential: Coulomb-capped viscous friction F_t = −min(μF_n, γ_t|v_t|) t̂
+    with γ_t = γ_n (no tangential displacement history)."""
+    for i in range(nc):
+        gap = c_gap[i]
+        if gap >= 0.0:
+            continue
+        delta = -gap
+        a = c_a[i]
+        bb = c_b[i]
+        m1 = sh_mat[c_sa[i]]
+        m2 = sh_mat[c_sb[i]]
+        Es = 1.0 / ((1.0 - mat_nu[m1] ** 2) / mat_E[m1] + (1.0 - mat_nu[m2] ** 2) / mat_E[m2])
+        R1 = sh_rad[c_sa[i]]
+        R2 = sh_rad[c_sb[i]]
+        Rs = R1 * R2 / (R1 + R2)
+        ma = 1.0 / inv_mass[a] if (a >= 0 and inv_mass[a] > 0.0) else 0.0
+        mb = 1.0 / inv_mass[bb] if (bb >= 0 and inv_mass[bb] > 0.0) else 0.0
+        if ma > 0.0 and mb > 0.0:
+            ms = ma * mb / (ma + mb)
+        else:
+            ms = ma + mb
+        e = min(mat_e[m1], mat_e[m2])
+        mu = min(mat_mu[m1], mat_mu[m2])
+        n = c_n[i]
+        P = c_pt[i]
+        # relative velocity of b w.r.t. a at P
+        vr = np.zeros(3)
+        if bb >= 0:
+            vr += vel[bb] + cross(Rb[bb] @ omega_b[bb], P - pos[bb])
+        if a >= 0:
+            vr -= vel[a] + cross(Rb[a] @ omega_b[a], P - pos[a])
+        vn = vr @ n
+        vt = vr - vn * n
+        lne = math.log(max(e, 1e-6))
+        beta = lne / math.sqrt(lne * lne + math.pi * math.pi)
+        if use_hertz:
+            sq = math.sqrt(Rs * delta)
+            kn = 4.0 / 3.0 * Es * sq
+            Sn = 2.0 * Es * sq
+        else:
+            kn = Es * Rs
+            Sn = kn
+        gn = -2.0 * math.sqrt(5.0 / 6.0) * beta * math.sqrt(Sn * ms)
+        Fn = kn * delta - gn * vn
+        if Fn < 0.0:
+            Fn = 0.0
+        vtn = math.sqrt(vt @ vt)
+        F = Fn * n
+        if vtn > 1e-12:
+            ft = min(mu * Fn, gn * vtn)
+            F = F - ft * vt / vtn
+        # F acts on b, −F on a
+        if bb >= 0:
+            force[bb] += F
+            torque_w[bb] += cross(P - pos[bb], F)
+        if a >= 0:
+            force[a] -= F
+            torque_w[a] -= cross(P - pos[a], F)

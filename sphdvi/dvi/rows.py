@@ -1,0 +1,381 @@
+"""Row builders: joints (generic mate), force elements as compliance/boxed rows,
+imposed velocities and frictional contacts.  All are numba kernels that append
+rows to preallocated arrays and return the new row count.
+
+Angular Jacobian blocks are first written in the world frame (``ρ·ω_world``) and
+converted to the body frame (``Rᵀρ``) because bodies store ω in their own frame.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from ._math import cross, mat_to_rotvec
+from .solvers import BILATERAL, BOXED, FRIC_N, FRIC_T, UNILATERAL
+
+LINK_CONTACT = -1
+LINK_IMPOSED = -2
+
+MOTOR_NONE = 0
+MOTOR_POSITION = 1
+MOTOR_SPEED = 2
+
+
+@njit(cache=True)
+def _body_frame(i, pos, Rb):
+    """Pose of body i (world pose for i = -1)."""
+    if i < 0:
+        return np.zeros(3), np.eye(3)
+    return pos[i].copy(), Rb[i].copy()
+
+
+@njit(cache=True)
+def _write_row(k, a, bb, lin_a, angw_a, lin_b, angw_b, Ra, Rb_, ra, rb, J):
+    """Store row k; angular parts converted to each body's frame."""
+    ra[k] = a
+    rb[k] = bb
+    for c in range(3):
+        J[k, c] = lin_a[c]
+        J[k, 6 + c] = lin_b[c]
+        sa = 0.0
+        sb = 0.0
+        for m in range(3):
+            sa += Ra[m, c] * angw_a[m]
+            sb += Rb_[m, c] * angw_b[m]
+        J[k, 3 + c] = sa
+        J[k, 9 + c] = sb
+
+
+@njit(cache=True)
+def _clear_row(k, b, E, kind, lo, hi, mu, rlink, Cpos):
+    b[k] = 0.0
+    E[k] = 0.0
+    kind[k] = BILATERAL
+    lo[k] = -1e300
+    hi[k] = 1e300
+    mu[k] = 0.0
+    rlink[k] = 0
+    Cpos[k] = 0.0
+
+
+@njit(cache=True)
+def _wrap_angle(a):
+    return a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))
+
+
+@njit(cache=True)
+def build_mate_rows(nr, h, vrec, pos, Rb,
+                    m_b1, m_b2, m_p1, m_p2, m_T1, m_T2, m_Q1, m_Q2, m_mask,
+                    m_k, m_c, m_rest, m_mmode, m_mval, m_mdval, m_angle, m_lid,
+                    m_P1w,
+                    ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
+    """Generic mate (Chrono ChLinkMateGeneric semantics, own derivation).
+
+    DOF k = 0..2: translation of marker 1 along axis k of the translation frame
+    of body 2, ``C = e_k·(P1 − P2)``.  DOF k = 3..5: rotation about axis k of the
+    rotation frame, locked with the dot-1 rows ``y1·z2``, ``z1·x2``, ``x1·y2``.
+    A constrained DOF gives a stabilised bilateral row ``b = clamp(C/h, ±v_rec)``.
+    A free DOF gets a motor row (position or speed) or, with stiffness k and
+    damping c, an implicit compliance row ``E = 1/(h(hk + c))``,
+    ``b = k(q − q0)/(hk + c)`` which is the backward-Euler spring-damper."""
+    nm = m_b1.shape[0]
+    for m in range(nm):
+        i1 = m_b1[m]
+        i2 = m_b2[m]
+        x1, R1 = _body_frame(i1, pos, Rb)
+        x2, R2 = _body_frame(i2, pos, Rb)
+        P1 = x1 + R1 @ m_p1[m]
+        P2 = x2 + R2 @ m_p2[m]
+        for c in range(3):
+            m_P1w[m, c] = P1[c]
+        T2 = R2 @ m_T2[m]
+        Q1 = R1 @ m_Q1[m]
+        Q2 = R2 @ m_Q2[m]
+        d = P1 - P2
+        r1 = P1 - x1
+        r12 = P1 - x2
+        # relative rotation of frame 1 in frame 2 and its (unwrapped) angles
+        Rrel = Q2.T @ Q1
+        rv = mat_to_rotvec(Rrel)
+        nfree_rot = 0
+        for k in range(3):
+            if m_mask[m, 3 + k] == 0:
+                nfree_rot += 1
+        for k in range(3):
+            if nfree_rot == 1 and m_mask[m, 3 + k] == 0:
+                # single free axis: exact angle with turn counting
+                if k == 0:
+                    raw = math.atan2(Rrel[2, 1], Rrel[1, 1])
+                elif k == 1:
+                    raw = math.atan2(Rrel[0, 2], Rrel[2, 2])
+                else:
+                    raw = math.atan2(Rrel[1, 0], Rrel[0, 0])
+                m_angle[m, k] = m_angle[m, k] + _wrap_angle(raw - m_angle[m, k])
+            else:
+                m_angle[m, k] = rv[k]
+        for k in range(6):
+            rigid = m_mask[m, k] != 0
+            mode = m_mmode[m, k]
+            kk = m_k[m, k]
+            cc = m_c[m, k]
+            if not rigid and mode == MOTOR_NONE and kk <= 0.0 and cc <= 0.0:
+                continue
+            _clear_row(nr, b, E, kind, lo, hi, mu, rlink, Cpos)
+            rlink[nr] = m_lid[m]
+            if k < 3:
+                e = T2[:, k].copy()
+                q = 0.0
+                for c in range(3):
+                    q += e[c] * d[c]
+                angw1 = cross(r1, e)
+                angw2 = -cross(r12, e)
+                _write_row(nr, i1, i2, e, angw1, -e, angw2, R1, R2, ra, rb, J)
+            else:
+                a = k - 3
+                if rigid:
+                    if a == 0:
+                        al = Q1[:, 1].copy()
+                        be = Q2[:, 2].copy()
+                    elif a == 1:
+                        al = Q1[:, 2].copy()
+                        be = Q2[:, 0].copy()
+                    else:
+                        al = Q1[:, 0].copy()
+                        be = Q2[:, 1].copy()
+                    q = 0.0
+                    for c in range(3):
+                        q += al[c] * be[c]
+                    ax = cross(al, be)
+                else:
+                    ax = Q2[:, a].copy()
+                    q = m_angle[m, a]
+                z3 = np.zeros(3)
+                _write_row(nr, i1, i2, z3, ax, z3, -ax, R1, R2, ra, rb, J)
+            if rigid:
+                Cpos[nr] = q
+                b[nr] = min(max(q / h, -vrec), vrec)
+            elif mode == MOTOR_POSITION:
+                b[nr] = (q - m_mval[m, k]) / h
+            elif mode == MOTOR_SPEED:
+                b[nr] = -m_mval[m, k]
+            else:
+                den = h * kk + cc
+                E[nr] = 1.0 / (h * den)
+                b[nr] = kk * (q - m_rest[m, k]) / den
+            nr += 1
+    return nr
+
+
+@njit(cache=True)
+def _distance_row(nr, i1, i2, p1, p2, pos, Rb, ra, rb, J):
+    """Row along the line P1−P2 (``J v = d‖P1 − P2‖/dt``); returns (l, P1)."""
+    x1, R1 = _body_frame(i1, pos, Rb)
+    x2, R2 = _body_frame(i2, pos, Rb)
+    P1 = x1 + R1 @ p1
+    P2 = x2 + R2 @ p2
+    dv = P1 - P2
+    l = math.sqrt(dv[0] ** 2 + dv[1] ** 2 + dv[2] ** 2)
+    if l < 1e-12:
+        n = np.array([0.0, 0.0, 1.0])
+    else:
+        n = dv / l
+    _write_row(nr, i1, i2, n, cross(P1 - x1, n), -n, -cross(P2 - x2, n), R1, R2, ra, rb, J)
+    return l, P1
+
+
+@njit(cache=True)
+def build_spring_rows(nr, h, pos, Rb, s_b1, s_b2, s_p1, s_p2, s_k, s_c, s_l0, s_f0,
+                      s_lid, s_P1w, s_len,
+                      ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
+    """Linear spring-damper (TSDA) F = f0 − k(l − l0) − c l̇ along P1−P2, as an
+    implicit compliance row: E = 1/(h(hk + c)), b = (k(l − l0) − f0)/(hk + c)."""
+    for m in range(s_b1.shape[0]):
+        kk = s_k[m]
+        cc = s_c[m]
+        den = h * kk + cc
+        _clear_row(nr, b, E, kind, lo, hi, mu, rlink, Cpos)
+        l, P1 = _distance_row(nr, s_b1[m], s_b2[m], s_p1[m], s_p2[m], pos, Rb, ra, rb, J)
+        s_len[m] = l
+        for c in range(3):
+            s_P1w[m, c] = P1[c]
+        if den <= 0.0:
+            continue  # pure preload: applied as an explicit force elsewhere
+        rlink[nr] = s_lid[m]
+        E[nr] = 1.0 / (h * den)
+        b[nr] = (kk * (l - s_l0[m]) - s_f0[m]) / den
+        nr += 1
+    return nr
+
+
+@njit(cache=True)
+def build_coulomb_rows(nr, h, pos, Rb, d_b1, d_b2, d_p1, d_p2, d_F, d_lid, d_P1w,
+                       ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
+    """Coulomb damper: friction force of magnitude ≤ F along P1−P2 as a boxed
+    velocity row, γ ∈ [−hF, hF], target relative speed 0."""
+    for m in range(d_b1.shape[0]):
+        _clear_row(nr, b, E, kind, lo, hi, mu, rlink, Cpos)
+        l, P1 = _distance_row(nr, d_b1[m], d_b2[m], d_p1[m], d_p2[m], pos, Rb, ra, rb, J)
+        for c in range(3):
+            d_P1w[m, c] = P1[c]
+        rlink[nr] = d_lid[m]
+        kind[nr] = BOXED
+        lo[nr] = -h * d_F[m]
+        hi[nr] = h * d_F[m]
+        nr += 1
+    return nr
+
+
+@njit(cache=True)
+def build_pulley_rows(nr, pos, Rb, p_b1, p_b2, p_a1, p_a2, p_r1, p_r2, p_lid, p_P1w,
+                      ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
+    """Pulley/belt: r1 ω1·a1 − r2 ω2·a2 = 0 (velocity-level bilateral row)."""
+    z3 = np.zeros(3)
+    for m in range(p_b1.shape[0]):
+        i1 = p_b1[m]
+        i2 = p_b2[m]
+        x1, R1 = _body_frame(i1, pos, Rb)
+        x2, R2 = _body_frame(i2, pos, Rb)
+        _clear_row(nr, b, E, kind, lo, hi, mu, rlink, Cpos)
+        a1 = R1 @ p_a1[m]
+        a2 = R2 @ p_a2[m]
+        _write_row(nr, i1, i2, z3, p_r1[m] * a1, z3, -p_r2[m] * a2, R1, R2, ra, rb, J)
+        for c in range(3):
+            p_P1w[m, c] = x1[c]
+        rlink[nr] = p_lid[m]
+        nr += 1
+    return nr
+
+
+@njit(cache=True)
+def build_imposed_rows(nr, Rb, imposed, ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
+    """Imposed body velocity components (world frame, NaN = free) as rheonomic
+    velocity rows ``e_k·v = v*`` / ``e_k·ω_world = ω*``."""
+    z3 = np.zeros(3)
+    I3 = np.eye(3)
+    for i in range(imposed.shape[0]):
+        for k in range(6):
+            val = imposed[i, k]
+            if math.isnan(val):
+                continue
+            _clear_row(nr, b, E, kind, lo, hi, mu, rlink, Cpos)
+            e = np.zeros(3)
+            e[k % 3] = 1.0
+            if k < 3:
+                _write_row(nr, i, -1, e, z3, z3, z3, Rb[i], I3, ra, rb, J)
+            else:
+                _write_row(nr, i, -1, z3, e, z3, z3, Rb[i], I3, ra, rb, J)
+            b[nr] = -val
+            rlink[nr] = LINK_IMPOSED
+            nr += 1
+    return nr
+
+
+@njit(cache=True)
+def tangent_basis(n):
+    """Two unit vectors u, w with (n, u, w) right-handed."""
+    if abs(n[0]) < 0.6:
+        a = np.array([1.0, 0.0, 0.0])
+    else:
+        a = np.array([0.0, 1.0, 0.0])
+    u = a - n * (a[0] * n[0] + a[1] * n[1] + a[2] * n[2])
+    u /= math.sqrt(u[0] ** 2 + u[1] ** 2 + u[2] ** 2)
+    w = cross(n, u)
+    return u, w
+
+
+@njit(cache=True)
+def build_contact_rows(nr, h, vrec, min_bounce, pos, Rb, vel6, nc, c_a, c_b, c_pt,
+                       c_n, c_gap, c_mu, c_e, c_row,
+                       ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
+    """Contact rows (normal from body a to body b; J_n v > 0 when separating).
+
+    b_n = max(Φ/h, −v_rec); Newton restitution b_n = e·v_n⁻ when the pre-step
+    approach speed exceeds the minimum bounce speed and the gap closes within
+    the step.  μ > 0 gives a FRIC_N/FRIC_T/FRIC_T triplet, μ = 0 a single
+    UNILATERAL row.  ``vel6`` = pre-step velocities (linear world, ω body)."""
+    for ci in range(nc):
+        a = c_a[ci]
+        bb = c_b[ci]
+        xa, Ra = _body_frame(a, pos, Rb)
+        xb, Rbb = _body_frame(bb, pos, Rb)
+        P = c_pt[ci]
+        n = c_n[ci].copy()
+        u, w = tangent_basis(n)
+        raa = P - xa
+        rbb = P - xb
+        c_row[ci] = nr
+        nrow = 3 if c_mu[ci] > 0.0 else 1
+        for r in range(nrow):
+            if r == 0:
+                e = n
+            elif r == 1:
+                e = u
+            else:
+                e = w
+            _clear_row(nr + r, b, E, kind, lo, hi, mu, rlink, Cpos)
+            _write_row(nr + r, a, bb, -e, -cross(raa, e), e, cross(rbb, e), Ra, Rbb, ra, rb, J)
+            rlink[nr + r] = -1
+            kind[nr + r] = FRIC_T
+        # pre-step normal velocity
+        vn = 0.0
+        if a >= 0:
+            for c in range(6):
+                vn += J[nr, c] * vel6[a, c]
+        if bb >= 0:
+            for c in range(6):
+                vn += J[nr, 6 + c] * vel6[bb, c]
+        gap = c_gap[ci]
+        e_rest = c_e[ci]
+        if e_rest > 0.0 and e_rest * vn < -min_bounce and gap + h * vn < 0.0:
+            b[nr] = e_rest * vn
+        else:
+            b[nr] = max(gap / h, -vrec)
+        Cpos[nr] = gap
+        if nrow == 3:
+            kind[nr] = FRIC_N
+            mu[nr] = c_mu[ci]
+        else:
+            kind[nr] = UNILATERAL
+        nr += nrow
+    return nr
+
+
+@njit(cache=True)
+def accumulate_row_forces(nr, ra, rb, J, gamma, inv_h, Rb, rlink, nlinks,
+                          c_force, c_torque, l_force, l_torque_c, nb, b_force, b_torque):
+    """Forces γ/h of the last step: per body contact force/torque (world, about
+    the centre) and per link the force/torque on body 1 (torque about body 1's
+    centre; converted to the link point by the caller)."""
+    c_force[:, :] = 0.0
+    c_torque[:, :] = 0.0
+    l_force[:, :] = 0.0
+    l_torque_c[:, :] = 0.0
+    for k in range(nr):
+        g = gamma[k] * inv_h
+        if g == 0.0:
+            continue
+        lk = rlink[k]
+        for side in range(2):
+            body = ra[k] if side == 0 else rb[k]
+            o = 6 * side
+            f = np.empty(3)
+            tb = np.empty(3)
+            for c in range(3):
+                f[c] = J[k, o + c] * g
+                tb[c] = J[k, o + 3 + c] * g
+            if body >= 0:
+                tw = Rb[body] @ tb
+            else:
+                tw = tb
+            if body >= 0:
+                for c in range(3):
+                    b_force[body, c] += f[c]
+                    b_torque[body, c] += tw[c]
+            if lk == -1 and body >= 0:
+                for c in range(3):
+                    c_force[body, c] += f[c]
+                    c_torque[body, c] += tw[c]
+            if lk >= 0 and side == 0:
+                for c in range(3):
+                    l_force[lk, c] += f[c]
+                    l_torque_c[lk, c] += tw[c]

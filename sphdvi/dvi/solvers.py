@@ -1,0 +1,502 @@
+"""Constraint rows, implicit Schur-complement products and the CCP solvers.
+
+The velocity-level cone complementarity problem of one Anitescu–Tasora step is
+
+    find γ ∈ K  with  u = N γ + r ∈ K*,  γ·u = 0,
+    N = D M⁻¹ Dᵀ + E,   r = D v_free + b,
+
+which is the optimality condition of ``min_{γ∈K} ½ γᵀNγ + rᵀγ``.  ``N`` is never
+formed: ``N x`` scatters ``M⁻¹ Jᵀ x`` into per-body velocity buffers and gathers
+``J w`` back (Chrono's ``SchurComplementProduct``).
+
+Row storage (one row per scalar constraint, contacts are 3 consecutive rows):
+
+* ``ra, rb``  int32 body indices, -1 = the world (no velocity).
+* ``J``       [nr, 12]: linear (world) and angular (body frame) parts for body a
+              then body b.  ``J v`` is the constraint velocity.
+* ``MiJ``     [nr, 12]: ``M⁻¹ Jᵀ`` per body (precomputed by :func:`prepare_rows`).
+* ``b``, ``E``  stabilisation/bias and compliance (diagonal) terms.
+* ``kind``    row kind (constants below); ``mu`` friction on FRIC_N rows;
+              ``lo, hi`` bounds of BOXED rows (impulses).
+
+Velocities are stored per body as ``v[nb, 6]`` = (linear world, angular body).
+
+Every solver returns ``(iterations, residual)``; the residual is the largest
+component of the natural map  ``D (γ - Π_K(γ - D⁻¹ (Nγ + r)))`` (D the Jacobi
+diagonal, averaged on friction triplets), which has units of velocity: on a
+bilateral row it is the constraint-velocity error, on a contact it is zero
+exactly at a CCP solution.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+BILATERAL = 0
+UNILATERAL = 1
+FRIC_N = 2
+FRIC_T = 3
+BOXED = 4
+
+SOLVER_PSOR = 0
+SOLVER_APGD = 1
+SOLVER_BB = 2
+SOLVER_NAMES = {"psor": SOLVER_PSOR, "apgd": SOLVER_APGD, "bb": SOLVER_BB}
+
+
+# ------------------------------------------------------------------ projection
+@njit(cache=True)
+def project_cone(gn, gu, gw, mu):
+    """Exact Euclidean projection onto the Coulomb cone ‖γ_t‖ ≤ μ γ_n.
+
+    Three branches: inside the cone (kept), inside the polar cone (to 0),
+    otherwise onto the cone surface: γ_n' = (γ_n + μ t)/(1 + μ²)."""
+    if mu <= 0.0:
+        return max(gn, 0.0), 0.0, 0.0
+    t = math.sqrt(gu * gu + gw * gw)
+    if t <= mu * gn:
+        return gn, gu, gw
+    if mu * t <= -gn:
+        return 0.0, 0.0, 0.0
+    gn2 = (gn + mu * t) / (1.0 + mu * mu)
+    f = mu * gn2 / t
+    return gn2, gu * f, gw * f
+
+
+@njit(cache=True)
+def project_all(x, kind, mu, lo, hi, scale):
+    """Project a (scaled) impulse vector onto K; ``scale`` multiplies the box
+    bounds (cones are invariant under the block-isotropic scaling)."""
+    nr = x.shape[0]
+    i = 0
+    while i < nr:
+        k = kind[i]
+        if k == FRIC_N:
+            a, bb, c = project_cone(x[i], x[i + 1], x[i + 2], mu[i])
+            x[i] = a
+            x[i + 1] = bb
+            x[i + 2] = c
+            i += 3
+            continue
+        if k == UNILATERAL:
+            if x[i] < 0.0:
+                x[i] = 0.0
+        elif k == BOXED:
+            l = lo[i] * scale[i]
+            hh = hi[i] * scale[i]
+            if x[i] < l:
+                x[i] = l
+            elif x[i] > hh:
+                x[i] = hh
+        i += 1
+
+
+# -------------------------------------------------------------- row products
+@njit(cache=True)
+def prepare_rows(nr, ra, rb, J, E, kind, invm3, invI, MiJ, gdiag):
+    """MiJ = M⁻¹ Jᵀ per body and the Jacobi diagonal J M⁻¹ Jᵀ + E (averaged
+    over the three rows of a friction triplet, as Chrono does)."""
+    for k in range(nr):
+        g = E[k]
+        for side in range(2):
+            body = ra[k] if side == 0 else rb[k]
+            o = 6 * side
+            if body < 0:
+                for c in range(6):
+                    MiJ[k, o + c] = 0.0
+                continue
+            for c in range(3):
+                MiJ[k, o + c] = invm3[body, c] * J[k, o + c]
+            for r in range(3):
+                s = 0.0
+                for c in range(3):
+                    s += invI[body, r, c] * J[k, o + 3 + c]
+                MiJ[k, o + 3 + r] = s
+            for c in range(6):
+                g += J[k, o + c] * MiJ[k, o + c]
+        gdiag[k] = g
+    i = 0
+    while i < nr:
+        if kind[i] == FRIC_N:
+            avg = (gdiag[i] + gdiag[i + 1] + gdiag[i + 2]) / 3.0
+            gdiag[i] = avg
+            gdiag[i + 1] = avg
+            gdiag[i + 2] = avg
+            i += 3
+        else:
+            i += 1
+    for k in range(nr):
+        if gdiag[k] <= 1e-300:
+            gdiag[k] = 1.0  # row touching only fixed bodies with E = 0
+    return
+
+
+@njit(cache=True)
+def rows_times_v(nr, ra, rb, J, v, out):
+    """out_k = J_k · v (constraint velocity)."""
+    for k in range(nr):
+        s = 0.0
+        a = ra[k]
+        if a >= 0:
+            for c in range(6):
+                s += J[k, c] * v[a, c]
+        bb = rb[k]
+        if bb >= 0:
+            for c in range(6):
+                s += J[k, 6 + c] * v[bb, c]
+        out[k] = s
+
+
+@njit(cache=True)
+def scatter_impulses(nr, ra, rb, MiJ, x, w):
+    """w += Σ_k M⁻¹ J_kᵀ x_k  (w is [nb, 6])."""
+    for k in range(nr):
+        xk = x[k]
+        if xk == 0.0:
+            continue
+        a = ra[k]
+        if a >= 0:
+            for c in range(6):
+                w[a, c] += MiJ[k, c] * xk
+        bb = rb[k]
+        if bb >= 0:
+            for c in range(6):
+                w[bb, c] += MiJ[k, 6 + c] * xk
+
+
+@njit(cache=True)
+def schur_product(nr, ra, rb, J, MiJ, E, x, w, out):
+    """out = N x = J M⁻¹ Jᵀ x + E x without forming N (w: [nb, 6] scratch)."""
+    w[:, :] = 0.0
+    scatter_impulses(nr, ra, rb, MiJ, x, w)
+    rows_times_v(nr, ra, rb, J, w, out)
+    for k in range(nr):
+        out[k] += E[k] * x[k]
+
+
+@njit(cache=True)
+def _schur_scaled(nr, ra, rb, J, MiJ, E, s, z, tmp, w, out):
+    """out = S⁻¹ N S⁻¹ z with S = diag(s)."""
+    for k in range(nr):
+        tmp[k] = z[k] / s[k]
+    schur_product(nr, ra, rb, J, MiJ, E, tmp, w, out)
+    for k in range(nr):
+        out[k] /= s[k]
+
+
+@njit(cache=True)
+def _natural_residual(z, g, s, kind, mu, lo, hi, tmp):
+    """max_k s_k |z - Π(z - g)|_k in the scaled variables (velocity units)."""
+    nr = z.shape[0]
+    for k in range(nr):
+        tmp[k] = z[k] - g[k]
+    project_all(tmp, kind, mu, lo, hi, s)
+    res = 0.0
+    for k in range(nr):
+        d = abs(z[k] - tmp[k]) * s[k]
+        if d > res:
+            res = d
+    return res
+
+
+# ----------------------------------------------------------------------- PSOR
+@njit(cache=True)
+def solve_psor(nr, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, v,
+               max_iter, tol, omega):
+    """Projected Gauss–Seidel (PSOR) with incremental velocity update.
+
+    ``v`` enters as the free velocity plus M⁻¹ Jᵀ γ of the warm start and leaves
+    as v⁺.  A friction triplet is updated jointly and projected on its cone."""
+    it = 0
+    res = 0.0
+    for it in range(1, max_iter + 1):
+        res = 0.0
+        i = 0
+        while i < nr:
+            a = ra[i]
+            bb = rb[i]
+            nrow = 3 if kind[i] == FRIC_N else 1
+            # constraint velocities of the block
+            u0 = 0.0
+            u1 = 0.0
+            u2 = 0.0
+            for r in range(nrow):
+                s = b[i + r] + E[i + r] * gamma[i + r]
+                if a >= 0:
+                    for c in range(6):
+                        s += J[i + r, c] * v[a, c]
+                if bb >= 0:
+                    for c in range(6):
+                        s += J[i + r, 6 + c] * v[bb, c]
+                if r == 0:
+                    u0 = s
+                elif r == 1:
+                    u1 = s
+                else:
+                    u2 = s
+            gi = gdiag[i]
+            g0 = gamma[i] - omega * u0 / gi
+            if nrow == 3:
+                g1 = gamma[i + 1] - omega * u1 / gi
+                g2 = gamma[i + 2] - omega * u2 / gi
+                g0, g1, g2 = project_cone(g0, g1, g2, mu[i])
+            else:
+                g1 = 0.0
+                g2 = 0.0
+                kk = kind[i]
+                if kk == UNILATERAL:
+                    if g0 < 0.0:
+                        g0 = 0.0
+                elif kk == BOXED:
+                    if g0 < lo[i]:
+                        g0 = lo[i]
+                    elif g0 > hi[i]:
+                        g0 = hi[i]
+            for r in range(nrow):
+                if r == 0:
+                    d = g0 - gamma[i]
+                    gamma[i] = g0
+                elif r == 1:
+                    d = g1 - gamma[i + 1]
+                    gamma[i + 1] = g1
+                else:
+                    d = g2 - gamma[i + 2]
+                    gamma[i + 2] = g2
+                if d != 0.0:
+                    if a >= 0:
+                        for c in range(6):
+                            v[a, c] += MiJ[i + r, c] * d
+                    if bb >= 0:
+                        for c in range(6):
+                            v[bb, c] += MiJ[i + r, 6 + c] * d
+                    ad = abs(d) * gdiag[i + r]
+                    if ad > res:
+                        res = ad
+            i += nrow
+        if res <= tol:
+            break
+    return it, res
+
+
+# ----------------------------------------------------------------------- APGD
+@njit(cache=True)
+def _quad(z, Nz, r):
+    s = 0.0
+    for k in range(z.shape[0]):
+        s += z[k] * (0.5 * Nz[k] + r[k])
+    return s
+
+
+@njit(cache=True)
+def solve_apgd(nr, nb, ra, rb, J, MiJ, r, E, kind, mu, lo, hi, gdiag, gamma,
+               max_iter, tol):
+    """Accelerated projected gradient (Nesterov/FISTA with adaptive Lipschitz
+    backtracking and gradient restart; Mazhar, Heyn, Negrut, Tasora 2015),
+    on the Jacobi-scaled problem z = √diag · γ.  Returns the best iterate."""
+    s = np.sqrt(gdiag)
+    rs = r / s
+    w = np.zeros((nb, 6))
+    tmp = np.empty(nr)
+    z = gamma * s
+    project_all(z, kind, mu, lo, hi, s)
+    Nz = np.empty(nr)
+    _schur_scaled(nr, ra, rb, J, MiJ, E, s, z, tmp, w, Nz)
+    # Lipschitz estimate from a perturbation
+    pert = z - 1.0
+    Np = np.empty(nr)
+    _schur_scaled(nr, ra, rb, J, MiJ, E, s, pert, tmp, w, Np)
+    dn = 0.0
+    nn = 0.0
+    for k in range(nr):
+        dn += (Nz[k] - Np[k]) ** 2
+        nn += 1.0
+    L = max(math.sqrt(dn / nn), 1e-3)
+    y = z.copy()
+    Ny = Nz.copy()
+    best = z.copy()
+    gtmp = np.empty(nr)
+    g = np.empty(nr)
+    for k in range(nr):
+        g[k] = Nz[k] + rs[k]
+    best_res = _natural_residual(z, g, s, kind, mu, lo, hi, tmp)
+    theta = 1.0
+    z1 = np.empty(nr)
+    Nz1 = np.empty(nr)
+    it = 0
+    if best_res <= tol:
+        gamma[:] = best / s
+        return 0, best_res
+    for it in range(1, max_iter + 1):
+        for k in range(nr):
+            g[k] = Ny[k] + rs[k]
+        fy = _quad(y, Ny, rs)
+        for _bt in range(60):
+            for k in range(nr):
+                z1[k] = y[k] - g[k] / L
+            project_all(z1, kind, mu, lo, hi, s)
+            _schur_scaled(nr, ra, rb, J, MiJ, E, s, z1, tmp, w, Nz1)
+            f1 = _quad(z1, Nz1, rs)
+            lin = 0.0
+            dd = 0.0
+            for k in range(nr):
+                d = z1[k] - y[k]
+                lin += g[k] * d
+                dd += d * d
+            if f1 <= fy + lin + 0.5 * L * dd + 1e-14 * abs(fy):
+                break
+            L *= 2.0
+        theta1 = 0.5 * (-theta * theta + theta * math.sqrt(theta * theta + 4.0))
+        beta = theta * (1.0 - theta) / (theta * theta + theta1)
+        # residual at z1
+        for k in range(nr):
+            gtmp[k] = Nz1[k] + rs[k]
+        res = _natural_residual(z1, gtmp, s, kind, mu, lo, hi, tmp)
+        if res < best_res:
+            best_res = res
+            best[:] = z1
+        restart = 0.0
+        for k in range(nr):
+            restart += g[k] * (z1[k] - z[k])
+        if restart > 0.0:
+            theta1 = 1.0
+            beta = 0.0
+        for k in range(nr):
+            y[k] = z1[k] + beta * (z1[k] - z[k])
+            Ny[k] = Nz1[k] + beta * (Nz1[k] - Nz[k])
+            z[k] = z1[k]
+            Nz[k] = Nz1[k]
+        theta = theta1
+        L *= 0.9
+        if best_res <= tol:
+            break
+    for k in range(nr):
+        gamma[k] = best[k] / s[k]
+    return it, best_res
+
+
+# ------------------------------------------------------------------------- BB
+@njit(cache=True)
+def solve_bb(nr, nb, ra, rb, J, MiJ, r, E, kind, mu, lo, hi, gdiag, gamma,
+             max_iter, tol):
+    """Spectral projected gradient (Barzilai–Borwein steps alternating BB1/BB2,
+    non-monotone Armijo search over the last 10 objective values; Birgin,
+    Martínez, Raydan 2000) on the Jacobi-scaled problem.  One N·x per iteration."""
+    s = np.sqrt(gdiag)
+    rs = r / s
+    w = np.zeros((nb, 6))
+    tmp = np.empty(nr)
+    z = gamma * s
+    project_all(z, kind, mu, lo, hi, s)
+    Nz = np.empty(nr)
+    _schur_scaled(nr, ra, rb, J, MiJ, E, s, z, tmp, w, Nz)
+    g = Nz + rs
+    f = _quad(z, Nz, rs)
+    hist = np.full(10, f)
+    best = z.copy()
+    best_res = _natural_residual(z, g, s, kind, mu, lo, hi, tmp)
+    alpha = 1.0
+    d = np.empty(nr)
+    Nd = np.empty(nr)
+    it = 0
+    if best_res <= tol:
+        gamma[:] = best / s
+        return 0, best_res
+    for it in range(1, max_iter + 1):
+        for k in range(nr):
+            d[k] = z[k] - alpha * g[k]
+        project_all(d, kind, mu, lo, hi, s)
+        for k in range(nr):
+            d[k] -= z[k]
+        _schur_scaled(nr, ra, rb, J, MiJ, E, s, d, tmp, w, Nd)
+        gd = 0.0
+        dNd = 0.0
+        for k in range(nr):
+            gd += g[k] * d[k]
+            dNd += d[k] * Nd[k]
+        if gd >= 0.0:
+            # no descent direction left: retry with a unit step once
+            if alpha != 1.0:
+                alpha = 1.0
+                continue
+            break
+        fmax = hist[0]
+        for q in range(1, 10):
+            if hist[q] > fmax:
+                fmax = hist[q]
+        lam = 1.0
+        fnew = f + gd + 0.5 * dNd
+        for _bt in range(20):
+            fnew = f + lam * gd + 0.5 * lam * lam * dNd
+            if fnew <= fmax + 1e-4 * lam * gd:
+                break
+            lq = -gd / dNd if dNd > 0.0 else 0.5 * lam
+            lam = min(max(lq, 0.1 * lam), 0.9 * lam)
+        sy = 0.0
+        ss = 0.0
+        yy = 0.0
+        for k in range(nr):
+            sk = lam * d[k]
+            yk = lam * Nd[k]
+            z[k] += sk
+            g[k] += yk
+            sy += sk * yk
+            ss += sk * sk
+            yy += yk * yk
+        f = fnew
+        hist[it % 10] = f
+        if sy <= 0.0:
+            alpha = 1.0
+        elif it % 2 == 0:
+            alpha = ss / sy
+        else:
+            alpha = sy / yy
+        alpha = min(max(alpha, 1e-13), 1e13)
+        res = _natural_residual(z, g, s, kind, mu, lo, hi, tmp)
+        if res < best_res:
+            best_res = res
+            best[:] = z
+        if best_res <= tol:
+            break
+    for k in range(nr):
+        gamma[k] = best[k] / s[k]
+    return it, best_res
+
+
+# ------------------------------------------------------------------ front-end
+@njit(cache=True)
+def solve_ccp(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag,
+              gamma, vfree, vout, max_iter, tol, omega):
+    """Solve one CCP; ``gamma`` holds the warm start on entry and the solution
+    on exit, ``vout`` receives v⁺ = v_free + M⁻¹ Dᵀ γ."""
+    vout[:, :] = vfree
+    if nr == 0:
+        return 0, 0.0
+    ra = ra[:nr]
+    rb = rb[:nr]
+    J = J[:nr]
+    MiJ = MiJ[:nr]
+    b = b[:nr]
+    E = E[:nr]
+    kind = kind[:nr]
+    mu = mu[:nr]
+    lo = lo[:nr]
+    hi = hi[:nr]
+    gdiag = gdiag[:nr]
+    gamma = gamma[:nr]
+    project_all(gamma, kind, mu, lo, hi, np.ones(nr))
+    if solver == SOLVER_PSOR:
+        scatter_impulses(nr, ra, rb, MiJ, gamma, vout)
+        return solve_psor(nr, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag,
+                          gamma, vout, max_iter, tol, omega)
+    r = np.empty(nr)
+    rows_times_v(nr, ra, rb, J, vfree, r)
+    for k in range(nr):
+        r[k] += b[k]
+    if solver == SOLVER_APGD:
+        it, res = solve_apgd(nr, nb, ra, rb, J, MiJ, r, E, kind, mu, lo, hi,
+                             gdiag, gamma, max_iter, tol)
+    else:
+        it, res = solve_bb(nr, nb, ra, rb, J, MiJ, r, E, kind, mu, lo, hi,
+                           gdiag, gamma, max_iter, tol)
+    scatter_impulses(nr, ra, rb, MiJ, gamma, vout)
+    return it, res

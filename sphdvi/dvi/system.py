@@ -1,0 +1,861 @@
+"""The multibody system: bodies, shapes, materials, links and the time step.
+
+One call to :meth:`System.step` performs one Anitescu–Tasora step
+(Chrono's EULER_IMPLICIT_LINEARIZED):
+
+1. free velocity  ``v_free = v + h M⁻¹ (f_ext + m g − ω×Jω)``;
+2. collision detection at the current pose, contact rows, joint rows,
+   compliance rows (springs, joint stiffness/damping), boxed rows
+   (Coulomb dampers), motor and imposed-velocity rows;
+3. one CCP solve (PSOR, APGD or BB) for the impulses γ, warm started;
+4. ``v⁺ = v_free + M⁻¹ Dᵀ γ``, then ``x += h v⁺``, ``q ← q ⊗ exp(h ω⁺_body)``.
+"""
+import math
+
+import numpy as np
+
+from . import collision as col
+from . import rows as rw
+from ._math import (body_rotations, frame_from_axis, integrate_bodies, np_mat_to_quat,
+                    np_quat_to_mat)
+from ._kernels import apply_dof_masks, free_velocity, link_point_torques
+from .solvers import SOLVER_NAMES, solve_ccp, prepare_rows
+
+FLOATING = 0
+FIXED = 1
+MOVING = 2
+_BODY_KINDS = {"floating": FLOATING, "free": FLOATING, "fixed": FIXED, "moving": MOVING}
+
+_MATE_MASKS = {
+    # (tx, ty, tz, rx, ry, rz) constrained = 1; the free axis of a joint is z
+    "fixed": (1, 1, 1, 1, 1, 1),
+    "lock": (1, 1, 1, 1, 1, 1),
+    "spherical": (1, 1, 1, 0, 0, 0),
+    "spheric": (1, 1, 1, 0, 0, 0),
+    "hinge": (1, 1, 1, 1, 1, 0),
+    "revolute": (1, 1, 1, 1, 1, 0),
+    "slider": (1, 1, 0, 1, 1, 1),
+    "prismatic": (1, 1, 0, 1, 1, 1),
+    "cylindrical": (1, 1, 0, 1, 1, 0),
+    "hingedslider": (1, 1, 0, 1, 1, 0),
+    "pointline": (1, 1, 0, 0, 0, 0),
+    "pointplane": (0, 0, 1, 0, 0, 0),
+    "planar": (0, 0, 1, 1, 1, 0),
+}
+
+
+def _as_table(v):
+    """A constant, a callable f(t) or a table [[t, value], ...] -> callable or float."""
+    if v is None:
+        return 0.0
+    if callable(v):
+        return v
+    a = np.asarray(v, dtype=np.float64)
+    if a.ndim == 0:
+        return float(a)
+    a = a.reshape(-1, 2)
+    return lambda t, a=a: float(np.interp(t, a[:, 0], a[:, 1]))
+
+
+def _eval(v, t):
+    return v(t) if callable(v) else v
+
+
+class System:
+    """A rigid multibody system (no fluid).
+
+    Parameters
+    ----------
+    gravity : 3 floats (world).
+    solver : "psor" | "apgd" | "bb".
+    max_iter, tol : iteration limit and residual tolerance (m/s, see
+        :mod:`sphdvi.dvi.solvers`).
+    omega : PSOR relaxation.
+    recovery_speed : max penetration/violation recovery speed (m/s).
+    envelope : collision envelope (m): contacts are created for gaps below it.
+    min_bounce_speed : restitution applies only above this approach speed (m/s).
+    contactmethod : "nsc" (complementarity) or "smc" (penalty, Hertz/Hooke).
+    smc_model : "hertz" or "hooke".
+    """
+
+    def __init__(self, gravity=(0.0, 0.0, -9.81), solver="psor", max_iter=100, tol=0.0,
+                 omega=1.0, recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.01,
+                 contactmethod="nsc", smc_model="hertz"):
+        self.gravity = np.asarray(gravity, dtype=np.float64)
+        self.solver = solver
+        self.max_iter = int(max_iter)
+        self.tol = float(tol)
+        self.omega = float(omega)
+        self.recovery_speed = float(recovery_speed)
+        self.envelope = float(envelope)
+        self.min_bounce_speed = float(min_bounce_speed)
+        self.contactmethod = contactmethod
+        self.smc_model = smc_model
+        self.time = 0.0
+        self.last_iterations = 0
+        self.last_residual = 0.0
+        self.n_contacts = 0
+        # bodies
+        self.names = []
+        self.kind = np.zeros(0, np.int32)
+        self.mass = np.zeros(0)
+        self.inv_mass = np.zeros(0)
+        self.I_b = np.zeros((0, 3, 3))
+        self.inv_I_b = np.zeros((0, 3, 3))
+        self.pos = np.zeros((0, 3))
+        self.quat = np.zeros((0, 4))
+        self.vel = np.zeros((0, 3))
+        self.omega_b = np.zeros((0, 3))
+        self.f_ext = np.zeros((0, 3))
+        self.t_ext = np.zeros((0, 3))
+        self.dof_mask = np.zeros((0, 6))
+        self.imposed = np.zeros((0, 6))
+        self._motion = []
+        self._imposed_fn = []
+        # materials (index 0 = default)
+        self.mat_names = ["default"]
+        self.mat_mu = np.array([0.3])
+        self.mat_e = np.array([0.0])
+        self.mat_E = np.array([1e7])
+        self.mat_nu = np.array([0.3])
+        # shapes
+        self.sh_body = np.zeros(0, np.int32)
+        self.sh_type = np.zeros(0, np.int32)
+        self.sh_pos = np.zeros((0, 3))
+        self.sh_R = np.zeros((0, 3, 3))
+        self.sh_dims = np.zeros((0, 3))
+        self.sh_mat = np.zeros(0, np.int32)
+        self.sh_rad = np.zeros(0)
+        self.samp_off = np.zeros(0, np.int32)
+        self.samp_cnt = np.zeros(0, np.int32)
+        self.samp_rad = np.zeros(0)
+        self.samp_pts = np.zeros((0, 3))
+        self.pl_off = np.zeros(0, np.int32)
+        self.pl_cnt = np.zeros(0, np.int32)
+        self.planes = np.zeros((0, 4))
+        # links
+        self.links = []          # python records, index = link id
+        self._mates = []
+        self._springs = []
+        self._dampers = []
+        self._pulleys = []
+        self._packed = False
+        # warm start and results
+        self._prev_keys = np.zeros(0, np.int64)
+        self._prev_g3 = np.zeros((0, 3))
+        self._prev_link_gamma = np.zeros(0)
+        self._cap_rows = 0
+        self._cap_contacts = 256
+        self._cap_pairs = 1024
+        self.contact_force = np.zeros((0, 3))
+        self.contact_torque = np.zeros((0, 3))
+        self.total_force = np.zeros((0, 3))
+        self.total_torque = np.zeros((0, 3))
+        self.link_force = np.zeros((0, 3))
+        self.link_torque = np.zeros((0, 3))
+
+    # ------------------------------------------------------------- bodies
+    @property
+    def nb(self):
+        return self.mass.shape[0]
+
+    def add_body(self, mass=1.0, inertia=(1.0, 1.0, 1.0), pos=(0, 0, 0), quat=(1, 0, 0, 0),
+                 vel=(0, 0, 0), omega=(0, 0, 0), kind="floating", translation_dof=(1, 1, 1),
+                 rotation_dof=(1, 1, 1), motion=None, imposed_velocity=None, name=None,
+                 force=(0, 0, 0), torque=(0, 0, 0)):
+        """Add a rigid body and return its index.
+
+        inertia: principal values (3,) or a full tensor (3, 3) about the centre
+        of mass, in the body frame.  pos/quat: centre of mass and orientation
+        (w, x, y, z).  vel, omega: initial velocities (world frame).
+        kind: "floating", "fixed" or "moving" (kinematic: velocities from
+        ``motion(t) -> (v_world, omega_world)`` or kept constant).
+        translation_dof/rotation_dof: 1 = free, 0 = locked (world axes).
+        imposed_velocity: 6 values (v, ω world), None/NaN = free component;
+        or a callable t -> 6 values.  force/torque: constant external load
+        (world; torque about the centre)."""
+        k = _BODY_KINDS[kind] if isinstance(kind, str) else int(kind)
+        I = np.asarray(inertia, dtype=np.float64)
+        if I.ndim == 1:
+            I = np.diag(I)
+        q = np.asarray(quat, dtype=np.float64)
+        q = q / np.linalg.norm(q)
+        R = np_quat_to_mat(q)
+        dyn = k == FLOATING
+        self.kind = np.append(self.kind, np.int32(k)).astype(np.int32)
+        self.mass = np.append(self.mass, float(mass))
+        self.inv_mass = np.append(self.inv_mass, 1.0 / mass if dyn and mass > 0 else 0.0)
+        self.I_b = np.concatenate([self.I_b, I[None]])
+        self.inv_I_b = np.concatenate([self.inv_I_b, (np.linalg.inv(I) if dyn else np.zeros((3, 3)))[None]])
+        self.pos = np.vstack([self.pos, np.asarray(pos, float)[None]])
+        self.quat = np.vstack([self.quat, q[None]])
+        mask = np.concatenate([np.asarray(translation_dof, float), np.asarray(rotation_dof, float)])
+        v = np.asarray(vel, float) * (mask[:3] if dyn else 1.0)
+        w = np.asarray(omega, float) * (mask[3:] if dyn else 1.0)
+        self.vel = np.vstack([self.vel, v[None]])
+        self.omega_b = np.vstack([self.omega_b, (R.T @ w)[None]])
+        self.f_ext = np.vstack([self.f_ext, np.asarray(force, float)[None]])
+        self.t_ext = np.vstack([self.t_ext, np.asarray(torque, float)[None]])
+        self.dof_mask = np.vstack([self.dof_mask, mask[None]])
+        imp = np.full(6, np.nan)
+        fn = None
+        if callable(imposed_velocity):
+            fn = imposed_velocity
+        elif imposed_velocity is not None:
+            imp = np.array([np.nan if c is None else float(c) for c in imposed_velocity])
+        self.imposed = np.vstack([self.imposed, imp[None]])
+        self._imposed_fn.append(fn)
+        self._motion.append(motion)
+        self.names.append(name if name is not None else f"body{self.nb - 1}")
+        for a in ("contact_force", "contact_torque", "total_force", "total_torque"):
+            setattr(self, a, np.zeros((self.nb, 3)))
+        return self.nb - 1
+
+    def set_external_load(self, body, force=None, torque=None):
+        """Set the persistent external force/torque (world; torque about centre)."""
+        if force is not None:
+            self.f_ext[body] = force
+        if torque is not None:
+            self.t_ext[body] = torque
+
+    # ---------------------------------------------------------- materials
+    def add_material(self, name=None, friction=0.3, restitution=0.0, young=1e7, poisson=0.3):
+        """Add a contact material; returns its index.  Pair rule: the friction
+        and the restitution of a contact are the minimum of the two values;
+        SMC combines Young's moduli and Poisson ratios into E*."""
+        self.mat_names.append(name or f"mat{len(self.mat_names)}")
+        self.mat_mu = np.append(self.mat_mu, float(friction))
+        self.mat_e = np.append(self.mat_e, float(restitution))
+        self.mat_E = np.append(self.mat_E, float(young))
+        self.mat_nu = np.append(self.mat_nu, float(poisson))
+        return len(self.mat_names) - 1
+
+    def material_index(self, m):
+        if m is None:
+            return 0
+        if isinstance(m, str):
+            return self.mat_names.index(m)
+        return int(m)
+
+    # -------------------------------------------------------------- shapes
+    def add_shape(self, body, shape, size=(0, 0, 0), pos=(0, 0, 0), quat=(1, 0, 0, 0),
+                  material=None, points=None, radius=0.0, local=True):
+        """Attach a collision shape to ``body`` (-1: the world).
+
+        shape: "sphere" (size=(r,)), "box" (size = half extents), "capsule"
+        (r, half length along local z), "cylinder" (r, half length along z),
+        "plane" (solid below local z = 0; use :meth:`add_plane`), "hull"
+        (``points`` = vertices of a mesh, convex hull taken), "cloud"
+        (``points`` = sphere centres, ``radius``).  pos/quat: shape pose in
+        the body frame (``local=True``) or in the world frame."""
+        t = col.SHAPE_NAMES[shape] if isinstance(shape, str) else int(shape)
+        size = np.zeros(3) + np.asarray(size, float).ravel()[:3] if np.size(size) < 3 else np.asarray(size, float).ravel()[:3]
+        dims = np.zeros(3)
+        dims[: len(size)] = size
+        q = np.asarray(quat, float)
+        Rl = np_quat_to_mat(q / np.linalg.norm(q))
+        p = np.asarray(pos, float)
+        if not local and body >= 0:
+            Rb = np_quat_to_mat(self.quat[body])
+            p = Rb.T @ (p - self.pos[body])
+            Rl = Rb.T @ Rl
+        samples = np.zeros((0, 3))
+        srad = 0.0
+        planes = np.zeros((0, 4))
+        if t == col.SPHERE:
+            samples = np.zeros((1, 3))
+            srad = dims[0]
+            crad = dims[0]
+        elif t == col.BOX:
+            s = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float)
+            samples = s * dims
+            crad = float(dims.min())
+        elif t == col.CAPSULE:
+            samples = np.array([[0, 0, -dims[1]], [0, 0, 0], [0, 0, dims[1]]], float)
+            srad = dims[0]
+            crad = dims[0]
+        elif t == col.CYLINDER:
+            a = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+            ring = np.column_stack([dims[0] * np.cos(a), dims[0] * np.sin(a), np.zeros_like(a)])
+            samples = np.vstack([ring + [0, 0, -dims[1]], ring + [0, 0, dims[1]]])
+            crad = dims[0]
+        elif t == col.PLANE:
+            crad = 1e6
+        elif t == col.HULL:
+            from scipy.spatial import ConvexHull
+            pts = np.asarray(points, float)
+            hull = ConvexHull(pts)
+            samples = pts[hull.vertices]
+            planes = self._merge_facets(hull.equations)
+            crad = 0.5 * float(np.min(samples.max(0) - samples.min(0)))
+        elif t == col.CLOUD:
+            samples = np.asarray(points, float).reshape(-1, 3)
+            dims[0] = radius if radius > 0 else dims[0]
+            srad = dims[0]
+            crad = dims[0]
+        else:
+            raise ValueError(f"unknown shape {shape!r}")
+        self.sh_body = np.append(self.sh_body, np.int32(body)).astype(np.int32)
+        self.sh_type = np.append(self.sh_type, np.int32(t)).astype(np.int32)
+        self.sh_pos = np.vstack([self.sh_pos, p[None]])
+        self.sh_R = np.concatenate([self.sh_R, Rl[None]])
+        self.sh_dims = np.vstack([self.sh_dims, dims[None]])
+        self.sh_mat = np.append(self.sh_mat, np.int32(self.material_index(material))).astype(np.int32)
+        self.sh_rad = np.append(self.sh_rad, crad)
+        self.samp_off = np.append(self.samp_off, np.int32(self.samp_pts.shape[0])).astype(np.int32)
+        self.samp_cnt = np.append(self.samp_cnt, np.int32(samples.shape[0])).astype(np.int32)
+        self.samp_rad = np.append(self.samp_rad, srad)
+        self.samp_pts = np.vstack([self.samp_pts, samples])
+        self.pl_off = np.append(self.pl_off, np.int32(self.planes.shape[0])).astype(np.int32)
+        self.pl_cnt = np.append(self.pl_cnt, np.int32(planes.shape[0])).astype(np.int32)
+        self.planes = np.vstack([self.planes, planes])
+        return self.sh_type.shape[0] - 1
+
+    @staticmethod
+    def _merge_facets(eq):
+        out = []
+        for e in eq:
+            if not any(np.allclose(e, o, atol=1e-9) for o in out):
+                out.append(e)
+        return np.array(out)
+
+    def add_sphere(self, body, radius, **kw):
+        return self.add_shape(body, "sphere", (radius,), **kw)
+
+    def add_box(self, body, half_extents, **kw):
+        return self.add_shape(body, "box", half_extents, **kw)
+
+    def add_capsule(self, body, radius, half_length, **kw):
+        return self.add_shape(body, "capsule", (radius, half_length), **kw)
+
+    def add_cylinder(self, body, radius, half_length, **kw):
+        return self.add_shape(body, "cylinder", (radius, half_length), **kw)
+
+    def add_hull(self, body, vertices, **kw):
+        return self.add_shape(body, "hull", points=vertices, **kw)
+
+    def add_cloud(self, body, points, radius, **kw):
+        return self.add_shape(body, "cloud", points=points, radius=radius, **kw)
+
+    def add_plane(self, point=(0, 0, 0), normal=(0, 0, 1), body=-1, material=None):
+        """Half-space (solid on the side opposite to ``normal``), world frame."""
+        F = frame_from_axis(normal)
+        q = np_mat_to_quat(F)
+        return self.add_shape(body, "plane", pos=point, quat=q, material=material, local=False) \
+            if body >= 0 else self.add_shape(-1, "plane", pos=point, quat=q, material=material)
+
+    # --------------------------------------------------------------- links
+    def _body_pose(self, i):
+        if i < 0:
+            return np.zeros(3), np.eye(3)
+        return self.pos[i].copy(), np_quat_to_mat(self.quat[i])
+
+    def add_link(self, kind, body1, body2=-1, **kw):
+        """Add a link between body1 and body2 (-1 = ground); returns the link id.
+
+        kind: "fixed", "spherical", "hinge"/"revolute", "slider"/"prismatic",
+        "cylindrical"/"hingedslider", "pointline", "pointplane", "planar",
+        "generic" (keyword ``mask`` = 6 flags tx ty tz rx ry rz), "spring"
+        (TSDA), "coulombdamper", "pulley".  See :meth:`add_mate`,
+        :meth:`add_spring`, :meth:`add_coulomb_damper`, :meth:`add_pulley`."""
+        k = kind.lower().replace("link_", "").replace("_", "")
+        if k in ("spring", "tsda", "linearspring"):
+            return self.add_spring(body1, body2, **kw)
+        if k in ("coulombdamper", "coulombdamping"):
+            return self.add_coulomb_damper(body1, body2, **kw)
+        if k == "pulley":
+            return self.add_pulley(body1, body2, **kw)
+        if k == "generic":
+            mask = kw.pop("mask")
+            return self.add_mate(body1, body2, mask=mask, **kw)
+        return self.add_mate(body1, body2, mask=_MATE_MASKS[k], kind=k, **kw)
+
+    def add_mate(self, body1, body2=-1, point=(0, 0, 0), axis=(0, 0, 1), mask=(1, 1, 1, 1, 1, 1),
+                 point2=None, frame=None, rot_axis=None, rot_axis2=None, stiffness=0.0,
+                 damping=0.0, rest=0.0, motor=None, motor_dof=None, motor_target=0.0,
+                 kind="generic", name=None):
+        """Generic joint between frame 1 on body1 and frame 2 on body2.
+
+        point: world position of the joint (both markers coincide unless
+        ``point2`` is given); axis: world z axis of the joint frame (hinge
+        axis, slider direction, point-line line); frame: full world frame (3x3,
+        columns) instead of ``axis``.  mask: constrained DOFs (tx, ty, tz, rx,
+        ry, rz) in the joint frame.  For "pointline" the rotations are free
+        unless ``rot_axis`` (DualSPHysics ``rotvector``: only rotation about it
+        allowed) and optionally ``rot_axis2`` (``rotvector2``: a second free
+        rotation axis) are given.
+        stiffness/damping: on the free DOFs, scalar (all free DOFs), 6 values,
+        or per-DOF callables/tables (t -> value); rest: rest coordinate(s).
+        Coordinates are frame-1-in-frame-2 (rotation angles, unwrapped on
+        single-axis joints).  motor: "angle"/"position" or "speed" applied to
+        ``motor_dof`` (default: rotation z for hinges, translation z for
+        sliders) with ``motor_target`` a constant, table or callable f(t)."""
+        F = np.asarray(frame, float) if frame is not None else frame_from_axis(axis)
+        Frot = F
+        mask = [int(m) for m in mask]
+        if kind == "pointline" and rot_axis is not None:
+            if rot_axis2 is None:
+                Frot = frame_from_axis(rot_axis)
+                mask[3:] = [1, 1, 0]
+            else:
+                Frot = frame_from_axis(rot_axis, hint=rot_axis2)
+                mask[3:] = [0, 1, 0]  # free about rotvector (z) and rotvector2 (x)
+        P = np.asarray(point, float)
+        P2 = np.asarray(point2, float) if point2 is not None else P
+        x1, R1 = self._body_pose(body1)
+        x2, R2 = self._body_pose(body2)
+        lid = len(self.links)
+        stiff = self._per_dof(stiffness)
+        damp = self._per_dof(damping)
+        restv = np.zeros(6) + (np.asarray(rest, float) if np.ndim(rest) else 0.0)
+        if np.ndim(rest) == 0 and rest != 0.0:
+            for k in range(6):
+                if mask[k] == 0:
+                    restv[k] = rest
+        mmode = np.zeros(6, np.int32)
+        mtarget = [0.0] * 6
+        if motor is not None:
+            if motor_dof is None:
+                motor_dof = 5 if mask[5] == 0 else 2
+            mmode[motor_dof] = rw.MOTOR_POSITION if motor in ("angle", "position") else rw.MOTOR_SPEED
+            mtarget[motor_dof] = _as_table(motor_target)
+        rec = dict(type="mate", kind=kind, lid=lid, b1=body1, b2=body2,
+                   p1=R1.T @ (P - x1), p2=R2.T @ (P2 - x2), T1=R1.T @ F, T2=R2.T @ F,
+                   Q1=R1.T @ Frot, Q2=R2.T @ Frot, mask=np.array(mask, np.int8),
+                   k=stiff, c=damp, rest=restv, mmode=mmode, mtarget=mtarget,
+                   name=name or f"{kind}{lid}")
+        self.links.append(rec)
+        self._mates.append(rec)
+        self._packed = False
+        return lid
+
+    @staticmethod
+    def _per_dof(v):
+        if isinstance(v, (list, tuple)) and len(v) == 6:
+            return [_as_table(x) for x in v]
+        t = _as_table(v)
+        return [t] * 6
+
+    def add_spring(self, body1, body2=-1, point1=(0, 0, 0), point2=(0, 0, 0), stiffness=0.0,
+                   damping=0.0, rest_length=None, preload=0.0, name=None):
+        """Linear spring-damper (TSDA) between world points point1 (on body1)
+        and point2 (on body2): F = f0 − k(l − l0) − c l̇ along the line,
+        positive pushing the bodies apart; treated implicitly (compliance row).
+        k and c may be constants, tables [[t, v], ...] or callables."""
+        P1 = np.asarray(point1, float)
+        P2 = np.asarray(point2, float)
+        x1, R1 = self._body_pose(body1)
+        x2, R2 = self._body_pose(body2)
+        l0 = float(np.linalg.norm(P1 - P2)) if rest_length is None else float(rest_length)
+        lid = len(self.links)
+        rec = dict(type="spring", lid=lid, b1=body1, b2=body2, p1=R1.T @ (P1 - x1),
+                   p2=R2.T @ (P2 - x2), k=_as_table(stiffness), c=_as_table(damping),
+                   l0=l0, f0=float(preload), name=name or f"spring{lid}")
+        self.links.append(rec)
+        self._springs.append(rec)
+        self._packed = False
+        return lid
+
+    def add_coulomb_damper(self, body1, body2=-1, point1=(0, 0, 0), point2=(0, 0, 0),
+                           force=0.0, name=None):
+        """Coulomb damper: a friction force of constant magnitude ``force``
+        opposing the relative speed along point1–point2 (boxed row)."""
+        P1 = np.asarray(point1, float)
+        P2 = np.asarray(point2, float)
+        x1, R1 = self._body_pose(body1)
+        x2, R2 = self._body_pose(body2)
+        lid = len(self.links)
+        rec = dict(type="coulomb", lid=lid, b1=body1, b2=body2, p1=R1.T @ (P1 - x1),
+                   p2=R2.T @ (P2 - x2), F=float(force), name=name or f"coulombdamper{lid}")
+        self.links.append(rec)
+        self._dampers.append(rec)
+        self._packed = False
+        return lid
+
+    def add_pulley(self, body1, body2, axis=(0, 0, 1), axis2=None, radius=1.0, radius2=1.0,
+                   name=None):
+        """Pulley/belt: r1 ω1·a1 = r2 ω2·a2 (world axes at creation)."""
+        a1 = np.asarray(axis, float) / np.linalg.norm(axis)
+        a2 = a1 if axis2 is None else np.asarray(axis2, float) / np.linalg.norm(axis2)
+        _, R1 = self._body_pose(body1)
+        _, R2 = self._body_pose(body2)
+        lid = len(self.links)
+        rec = dict(type="pulley", lid=lid, b1=body1, b2=body2, a1=R1.T @ a1, a2=R2.T @ a2,
+                   r1=float(radius), r2=float(radius2), name=name or f"pulley{lid}")
+        self.links.append(rec)
+        self._pulleys.append(rec)
+        self._packed = False
+        return lid
+
+    # ------------------------------------------------------------- packing
+    def _pack(self):
+        M = self._mates
+        nm = len(M)
+        self.m_b1 = np.array([m["b1"] for m in M], np.int32)
+        self.m_b2 = np.array([m["b2"] for m in M], np.int32)
+        self.m_p1 = np.array([m["p1"] for m in M], float).reshape(nm, 3)
+        self.m_p2 = np.array([m["p2"] for m in M], float).reshape(nm, 3)
+        self.m_T1 = np.array([m["T1"] for m in M], float).reshape(nm, 3, 3)
+        self.m_T2 = np.array([m["T2"] for m in M], float).reshape(nm, 3, 3)
+        self.m_Q1 = np.array([m["Q1"] for m in M], float).reshape(nm, 3, 3)
+        self.m_Q2 = np.array([m["Q2"] for m in M], float).reshape(nm, 3, 3)
+        self.m_mask = np.array([m["mask"] for m in M], np.int8).reshape(nm, 6)
+        self.m_k = np.zeros((nm, 6))
+        self.m_c = np.zeros((nm, 6))
+        self.m_rest = np.array([m["rest"] for m in M], float).reshape(nm, 6)
+        self.m_mmode = np.array([m["mmode"] for m in M], np.int32).reshape(nm, 6)
+        self.m_mval = np.zeros((nm, 6))
+        self.m_mdval = np.zeros((nm, 6))
+        if not hasattr(self, "m_angle") or self.m_angle.shape[0] != nm:
+            self.m_angle = np.zeros((nm, 3))
+        self.m_lid = np.array([m["lid"] for m in M], np.int32)
+        self.m_P1w = np.zeros((nm, 3))
+        self._mate_timedep = [(i, k) for i, m in enumerate(M) for k in range(6)
+                              if callable(m["k"][k]) or callable(m["c"][k])]
+        for i, m in enumerate(M):
+            for k in range(6):
+                self.m_k[i, k] = 0.0 if callable(m["k"][k]) else m["k"][k]
+                self.m_c[i, k] = 0.0 if callable(m["c"][k]) else m["c"][k]
+        self._motors = [(i, k) for i, m in enumerate(M) for k in range(6) if m["mmode"][k] != 0]
+        S = self._springs
+        ns = len(S)
+        self.s_b1 = np.array([s["b1"] for s in S], np.int32)
+        self.s_b2 = np.array([s["b2"] for s in S], np.int32)
+        self.s_p1 = np.array([s["p1"] for s in S], float).reshape(ns, 3)
+        self.s_p2 = np.array([s["p2"] for s in S], float).reshape(ns, 3)
+        self.s_k = np.array([0.0 if callable(s["k"]) else s["k"] for s in S], float)
+        self.s_c = np.array([0.0 if callable(s["c"]) else s["c"] for s in S], float)
+        self.s_l0 = np.array([s["l0"] for s in S], float)
+        self.s_f0 = np.array([s["f0"] for s in S], float)
+        self.s_lid = np.array([s["lid"] for s in S], np.int32)
+        self.s_P1w = np.zeros((ns, 3))
+        self.s_len = np.zeros(ns)
+        D = self._dampers
+        nd = len(D)
+        self.d_b1 = np.array([s["b1"] for s in D], np.int32)
+        self.d_b2 = np.array([s["b2"] for s in D], np.int32)
+        self.d_p1 = np.array([s["p1"] for s in D], float).reshape(nd, 3)
+        self.d_p2 = np.array([s["p2"] for s in D], float).reshape(nd, 3)
+        self.d_F = np.array([s["F"] for s in D], float)
+        self.d_lid = np.array([s["lid"] for s in D], np.int32)
+        self.d_P1w = np.zeros((nd, 3))
+        P = self._pulleys
+        npu = len(P)
+        self.p_b1 = np.array([s["b1"] for s in P], np.int32)
+        self.p_b2 = np.array([s["b2"] for s in P], np.int32)
+        self.p_a1 = np.array([s["a1"] for s in P], float).reshape(npu, 3)
+        self.p_a2 = np.array([s["a2"] for s in P], float).reshape(npu, 3)
+        self.p_r1 = np.array([s["r1"] for s in P], float)
+        self.p_r2 = np.array([s["r2"] for s in P], float)
+        self.p_lid = np.array([s["lid"] for s in P], np.int32)
+        self.p_P1w = np.zeros((npu, 3))
+        self.link_force = np.zeros((len(self.links), 3))
+        self.link_torque = np.zeros((len(self.links), 3))
+        self._link_P1w = np.zeros((len(self.links), 3))
+        self._packed = True
+
+    def _update_time_dependent(self, t_next):
+        M = self._mates
+        for i, k in self._mate_timedep:
+            self.m_k[i, k] = _eval(M[i]["k"][k], t_next)
+            self.m_c[i, k] = _eval(M[i]["c"][k], t_next)
+        for i, k in self._motors:
+            self.m_mval[i, k] = _eval(M[i]["mtarget"][k], t_next)
+        for j, s in enumerate(self._springs):
+            if callable(s["k"]):
+                self.s_k[j] = s["k"](t_next)
+            if callable(s["c"]):
+                self.s_c[j] = s["c"](t_next)
+
+    # -------------------------------------------------------------- rows
+    def _ensure_rows(self, n):
+        if n <= self._cap_rows:
+            return
+        cap = max(int(n * 1.5), 64)
+        self._cap_rows = cap
+        self.r_a = np.zeros(cap, np.int32)
+        self.r_b = np.zeros(cap, np.int32)
+        self.r_J = np.zeros((cap, 12))
+        self.r_MiJ = np.zeros((cap, 12))
+        self.r_bias = np.zeros(cap)
+        self.r_E = np.zeros(cap)
+        self.r_kind = np.zeros(cap, np.int8)
+        self.r_lo = np.zeros(cap)
+        self.r_hi = np.zeros(cap)
+        self.r_mu = np.zeros(cap)
+        self.r_link = np.zeros(cap, np.int32)
+        self.r_C = np.zeros(cap)
+        self.r_g = np.zeros(cap)
+        self.r_gamma = np.zeros(cap)
+
+    def _row_args(self):
+        return (self.r_a, self.r_b, self.r_J, self.r_bias, self.r_E, self.r_kind, self.r_lo,
+                self.r_hi, self.r_mu, self.r_link, self.r_C)
+
+    def _build_link_rows(self, h, R):
+        nr = 0
+        nr = rw.build_mate_rows(nr, h, self.recovery_speed, self.pos, R, self.m_b1, self.m_b2,
+                                self.m_p1, self.m_p2, self.m_T1, self.m_T2, self.m_Q1, self.m_Q2,
+                                self.m_mask, self.m_k, self.m_c, self.m_rest, self.m_mmode,
+                                self.m_mval, self.m_mdval, self.m_angle, self.m_lid, self.m_P1w,
+                                *self._row_args())
+        nr = rw.build_spring_rows(nr, h, self.pos, R, self.s_b1, self.s_b2, self.s_p1, self.s_p2,
+                                  self.s_k, self.s_c, self.s_l0, self.s_f0, self.s_lid,
+                                  self.s_P1w, self.s_len, *self._row_args())
+        nr = rw.build_coulomb_rows(nr, h, self.pos, R, self.d_b1, self.d_b2, self.d_p1,
+                                   self.d_p2, self.d_F, self.d_lid, self.d_P1w, *self._row_args())
+        nr = rw.build_pulley_rows(nr, self.pos, R, self.p_b1, self.p_b2, self.p_a1, self.p_a2,
+                                  self.p_r1, self.p_r2, self.p_lid, self.p_P1w, *self._row_args())
+        nr = rw.build_imposed_rows(nr, R, self._imposed_now, *self._row_args())
+        return nr
+
+    def _max_link_rows(self):
+        return 6 * len(self._mates) + len(self._springs) + len(self._dampers) + \
+            len(self._pulleys) + 6 * self.nb
+
+    # ---------------------------------------------------------- collisions
+    def _collide(self, R):
+        ns = self.sh_type.shape[0]
+        self.n_contacts = 0
+        if ns < 2:
+            return 0
+        w_pos = np.empty((ns, 3))
+        w_R = np.empty((ns, 3, 3))
+        col.shape_world_poses(self.sh_body, self.sh_pos, self.sh_R, self.pos, R, w_pos, w_R)
+        lo = np.empty((ns, 3))
+        hi = np.empty((ns, 3))
+        col.shape_aabbs(self.sh_type, self.sh_dims, self.samp_off, self.samp_cnt, self.samp_pts,
+                        self.samp_rad, w_pos, w_R, self.envelope, lo, hi)
+        active = self.kind == FLOATING
+        while True:
+            pairs = np.empty((self._cap_pairs, 2), np.int64)
+            npair = col.broad_phase(lo, hi, self.sh_body, self.sh_type, active, pairs)
+            if npair <= self._cap_pairs:
+                break
+            self._cap_pairs = int(npair * 1.5)
+        while True:
+            cap = self._cap_contacts
+            c = dict(a=np.empty(cap, np.int32), b=np.empty(cap, np.int32),
+                     sa=np.empty(cap, np.int32), sb=np.empty(cap, np.int32),
+                     pt=np.empty((cap, 3)), n=np.empty((cap, 3)), gap=np.empty(cap),
+                     key=np.empty(cap, np.int64))
+            nc = col.narrow_phase(npair, pairs, self.envelope, self.sh_body, self.sh_type,
+                                  self.sh_dims, self.samp_off, self.samp_cnt, self.samp_pts,
+                                  self.samp_rad, self.pl_off, self.pl_cnt, self.planes, w_pos,
+                                  w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
+                                  c["n"], c["gap"], c["key"])
+            if nc <= cap:
+                break
+            self._cap_contacts = int(nc * 1.5)
+        self._c = c
+        self.n_contacts = nc
+        return nc
+
+    # ---------------------------------------------------------------- step
+    def step(self, dt, forces=None, torques=None):
+        """Advance the system by ``dt``.
+
+        forces, torques: optional (nb, 3) world-frame external loads for this
+        step only (torque about each body's centre), added to gravity and the
+        persistent loads — this is how a fluid solver drives the bodies.
+        Returns (pos, quat, vel, omega_world) views/arrays after the step."""
+        h = float(dt)
+        nb = self.nb
+        if not self._packed:
+            self._pack()
+        t_next = self.time + h
+        self._update_time_dependent(t_next)
+        R = body_rotations(self.quat)
+        # imposed velocities (rows) and moving bodies (kinematic)
+        imp = self.imposed.copy()
+        for i, fn in enumerate(self._imposed_fn):
+            if fn is not None:
+                imp[i] = [np.nan if c is None else c for c in fn(t_next)]
+        self._imposed_now = imp
+        for i, mo in enumerate(self._motion):
+            if mo is not None and self.kind[i] == MOVING:
+                v, w = mo(t_next)
+                self.vel[i] = v
+                self.omega_b[i] = R[i].T @ np.asarray(w, float)
+        # applied loads
+        F = self.f_ext.copy()
+        T = self.t_ext.copy()
+        if forces is not None:
+            F += np.asarray(forces, float).reshape(nb, 3)
+        if torques is not None:
+            T += np.asarray(torques, float).reshape(nb, 3)
+        F += self.mass[:, None] * self.gravity[None, :] * (self.kind == FLOATING)[:, None]
+        # explicit preloads of springs without stiffness/damping
+        self._spring_preloads(R, F, T)
+        nc = self._collide(R)
+        smc = self.contactmethod.lower() == "smc"
+        self._smc_f = np.zeros((nb, 3))
+        self._smc_t = np.zeros((nb, 3))
+        if smc and nc > 0:
+            c = self._c
+            col.smc_forces(nc, c["a"], c["b"], c["sa"], c["sb"], c["pt"], c["n"], c["gap"],
+                           self.sh_mat, self.sh_rad, self.mat_mu, self.mat_e, self.mat_E,
+                           self.mat_nu, self.pos, R, self.vel, self.omega_b, self.inv_mass,
+                           self._smc_f, self._smc_t, self.smc_model.lower() != "hooke")
+            F += self._smc_f
+            T += self._smc_t
+        self._applied_F = F
+        self._applied_T = T
+        invm3, invI = apply_dof_masks(self.inv_mass, self.inv_I_b, self.dof_mask, R)
+        vel6 = np.empty((nb, 6))
+        vel6[:, :3] = self.vel
+        vel6[:, 3:] = self.omega_b
+        vfree = free_velocity(h, self.kind, invm3, invI, self.I_b, R, vel6, F, T)
+        # rows
+        ncr = 0 if smc else nc
+        self._ensure_rows(self._max_link_rows() + 3 * ncr)
+        nl_rows = self._build_link_rows(h, R)
+        g = self.r_gamma
+        g[:] = 0.0
+        if self._prev_link_gamma.shape[0] == nl_rows:
+            g[:nl_rows] = self._prev_link_gamma
+        nr = nl_rows
+        if ncr > 0:
+            c = self._c
+            c_mu = np.empty(nc)
+            c_e = np.empty(nc)
+            col.contact_materials(nc, c["sa"], c["sb"], self.sh_mat, self.mat_mu, self.mat_e,
+                                  c_mu, c_e)
+            c_row = np.empty(nc, np.int64)
+            nr = rw.build_contact_rows(nr, h, self.recovery_speed, self.min_bounce_speed,
+                                       self.pos, R, vel6, nc, c["a"], c["b"], c["pt"], c["n"],
+                                       c["gap"], c_mu, c_e, c_row, *self._row_args())
+            g3 = np.zeros((nc, 3))
+            col.match_warm_start(nc, c["key"], self._prev_keys, self._prev_g3, g3)
+            _scatter_warm(g, c_row, c_mu, g3)
+            self._c_row = c_row
+            self._c_mu = c_mu
+        prepare_rows(nr, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
+                     self.r_MiJ, self.r_g)
+        vout = np.empty((nb, 6))
+        it, res = solve_ccp(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
+                            self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind, self.r_mu,
+                            self.r_lo, self.r_hi, self.r_g, g, vfree, vout, self.max_iter,
+                            self.tol, self.omega)
+        self.last_iterations = int(it)
+        self.last_residual = float(res)
+        self.n_rows = nr
+        # warm-start caches
+        self._prev_link_gamma = g[:nl_rows].copy()
+        if ncr > 0:
+            keys = self._c["key"][:nc]
+            order = np.argsort(keys)
+            g3 = _gather_warm(g, self._c_row, self._c_mu)
+            self._prev_keys = keys[order].copy()
+            self._prev_g3 = g3[order]
+        else:
+            self._prev_keys = np.zeros(0, np.int64)
+            self._prev_g3 = np.zeros((0, 3))
+        # reactions
+        self._accumulate(nr, h, R)
+        # state update
+        self.vel[:] = vout[:, :3]
+        self.omega_b[:] = vout[:, 3:]
+        integrate_bodies(self.pos, self.quat, self.vel, self.omega_b, self.kind, h)
+        self.time = t_next
+        return self.pos, self.quat, self.vel, self.omega_world
+
+    def _spring_preloads(self, R, F, T):
+        for s in self._springs:
+            if _eval(s["k"], self.time) > 0 or _eval(s["c"], self.time) > 0 or s["f0"] == 0:
+                continue
+            x1, R1 = (self.pos[s["b1"]], R[s["b1"]]) if s["b1"] >= 0 else (np.zeros(3), np.eye(3))
+            x2, R2 = (self.pos[s["b2"]], R[s["b2"]]) if s["b2"] >= 0 else (np.zeros(3), np.eye(3))
+            P1 = x1 + R1 @ s["p1"]
+            P2 = x2 + R2 @ s["p2"]
+            d = P1 - P2
+            n = d / max(np.linalg.norm(d), 1e-300)
+            f = s["f0"] * n
+            if s["b1"] >= 0:
+                F[s["b1"]] += f
+                T[s["b1"]] += np.cross(P1 - x1, f)
+            if s["b2"] >= 0:
+                F[s["b2"]] -= f
+                T[s["b2"]] -= np.cross(P2 - x2, f)
+
+    def _accumulate(self, nr, h, R):
+        nb = self.nb
+        nl = len(self.links)
+        cf = np.zeros((nb, 3))
+        ct = np.zeros((nb, 3))
+        bf = np.zeros((nb, 3))
+        bt = np.zeros((nb, 3))
+        lf = np.zeros((nl, 3))
+        ltc = np.zeros((nl, 3))
+        rw.accumulate_row_forces(nr, self.r_a, self.r_b, self.r_J, self.r_gamma, 1.0 / h, R,
+                                 self.r_link, nl, cf, ct, lf, ltc, nb, bf, bt)
+        self.contact_force = cf + self._smc_f
+        self.contact_torque = ct + self._smc_t
+        self.total_force = self._applied_F + bf
+        self.total_torque = self._applied_T + bt
+        # link torque about the link point on body 1
+        P1w = self._link_P1w
+        for arr, lids in ((self.m_P1w, self.m_lid), (self.s_P1w, self.s_lid),
+                          (self.d_P1w, self.d_lid), (self.p_P1w, self.p_lid)):
+            if lids.shape[0]:
+                P1w[lids] = arr
+        b1 = np.array([l["b1"] for l in self.links], np.int64)
+        self.link_force = lf
+        self.link_torque = link_point_torques(lf, ltc, P1w, b1, self.pos)
+
+    # ------------------------------------------------------------ accessors
+    @property
+    def omega_world(self):
+        R = body_rotations(self.quat)
+        return np.einsum("nij,nj->ni", R, self.omega_b)
+
+    def set_velocity(self, body, vel=None, omega=None):
+        """Set a body's linear and/or angular velocity (world frame)."""
+        if vel is not None:
+            self.vel[body] = vel
+        if omega is not None:
+            self.omega_b[body] = np_quat_to_mat(self.quat[body]).T @ np.asarray(omega, float)
+
+    def kinetic_energy(self):
+        wb = self.omega_b
+        lin = 0.5 * self.mass * np.einsum("ni,ni->n", self.vel, self.vel)
+        rot = 0.5 * np.einsum("ni,nij,nj->n", wb, self.I_b, wb)
+        e = (lin + rot) * (self.kind == FLOATING)
+        return float(e.sum())
+
+    def potential_energy(self):
+        e = -self.mass * (self.pos @ self.gravity) * (self.kind == FLOATING)
+        return float(e.sum())
+
+    def angular_momentum_world(self, body):
+        R = np_quat_to_mat(self.quat[body])
+        return R @ (self.I_b[body] @ self.omega_b[body])
+
+    def constraint_violation(self):
+        """Max |C| over the rigid (position-level) joint rows at the current pose."""
+        if not self._packed:
+            self._pack()
+        R = body_rotations(self.quat)
+        self._imposed_now = np.full((self.nb, 6), np.nan)
+        self._ensure_rows(self._max_link_rows())
+        ang = self.m_angle.copy()
+        nr = self._build_link_rows(1.0, R)
+        self.m_angle[:] = ang
+        return float(np.abs(self.r_C[:nr]).max()) if nr else 0.0
+
+
+def _scatter_warm(g, c_row, c_mu, g3):
+    rows = c_row
+    g[rows] = g3[:, 0]
+    fr = c_mu > 0
+    g[rows[fr] + 1] = g3[fr, 1]
+    g[rows[fr] + 2] = g3[fr, 2]
+
+
+def _gather_warm(g, c_row, c_mu):
+    g3 = np.zeros((c_row.shape[0], 3))
+    g3[:, 0] = g[c_row]
+    fr = c_mu > 0
+    g3[fr, 1] = g[c_row[fr] + 1]
+    g3[fr, 2] = g[c_row[fr] + 2]
+    return g3
