@@ -103,7 +103,7 @@ def _to_python(text: str) -> str:
     s = s.replace("^", "**")
     s = re.sub(r"\btrue\b", "True", s)
     s = re.sub(r"\bfalse\b", "False", s)
-    return s
+    return s.strip()
 
 
 class Variables:
@@ -174,12 +174,30 @@ class Variables:
 
     def interpolate(self, text: str) -> str:
         """Replace every ``[expression]`` in a string by its value."""
-        def repl(match):
-            value = self.evaluate(match.group(1))
-            if isinstance(value, float) and value.is_integer() and abs(value) < 1e15:
-                return str(int(value))
-            return str(value)
-        return re.sub(r"\[([^\[\]]+)\]", repl, str(text))
+        text = str(text)
+        out, i = [], 0
+        while i < len(text):
+            if text[i] != "[":
+                out.append(text[i])
+                i += 1
+                continue
+            depth, j = 0, i
+            while j < len(text):
+                depth += {"[": 1, "]": -1}.get(text[j], 0)
+                if depth == 0:
+                    break
+                j += 1
+            if depth:
+                raise ExpressionError(f"unbalanced '[' in '{text}'")
+            out.append(self._format(self.evaluate(text[i + 1:j])))
+            i = j + 1
+        return "".join(out)
+
+    @staticmethod
+    def _format(value) -> str:
+        if isinstance(value, float) and value.is_integer() and abs(value) < 1e15:
+            return str(int(value))
+        return str(value)
 
     def _eval(self, node):
         if isinstance(node, ast.Constant):

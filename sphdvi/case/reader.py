@@ -17,6 +17,7 @@ from ..errors import CaseError
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
 from .parameters import PARAMETERS, DEPRECATED, closest_key, coerce, default_parameters
+from .schema import validate_structure
 from .xmldoc import CaseReader, load_xml, strip_disabled
 
 CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initials", "motion",
@@ -45,6 +46,7 @@ def open_case(path: str, warnings=None):
     """
     root, text = load_xml(path)
     strip_disabled(root)
+    validate_structure(root, path)
     reader = CaseReader(path, warnings=warnings)
     reader.mark(root)
     casedef = root.find("casedef")

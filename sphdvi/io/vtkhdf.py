@@ -1,0 +1,171 @@
+"""Temporal VTKHDF PolyData particle files (one file per run), written with h5py.
+
+Layout (``../shared/design/conventions.md`` §3.4, verified against vtkHDFReader 9.7):
+points of all steps are concatenated; each step is one partition of N_s vertices;
+the vertex topology 0..Nmax-1 is stored once and reused by every step (CellOffsets
+= 0), which is valid because live particles are compacted first.
+
+Crash safety: a step's arrays are appended first, then the ``Steps`` metadata
+that makes them visible, then the file is flushed. Rows written after the last
+complete step are ignored and cut on the next append (see :meth:`truncate_to`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+TOPOLOGIES = ("Vertices", "Lines", "Polygons", "Strips")
+
+
+class VTKHDFParticleWriter:
+    """Append particle snapshots to ``path`` (created, or opened for appending)."""
+
+    def __init__(self, path: str, point_arrays: dict[str, tuple[np.dtype, int]], append: bool = False):
+        import h5py
+        self.path = path
+        self.arrays = dict(point_arrays)
+        mode = "a" if append else "w"
+        self.f = h5py.File(path, mode)
+        if not append or "VTKHDF" not in self.f:
+            self._create()
+        self.root = self.f["VTKHDF"]
+
+    # -- layout -----------------------------------------------------------------------
+    def _create(self):
+        import h5py
+        root = self.f.create_group("VTKHDF")
+        root.attrs["Version"] = np.array([2, 2], dtype=np.int64)
+        t = "PolyData"
+        root.attrs.create("Type", np.bytes_(t), dtype=h5py.string_dtype("ascii", len(t)))
+        chunk = 1 << 16
+
+        def grow(group, name, shape, dtype):
+            maxshape = (None,) + tuple(shape[1:])
+            chunks = (min(chunk, max(1, chunk // max(1, int(np.prod(shape[1:]))))),) + tuple(shape[1:])
+            group.create_dataset(name, shape=shape, maxshape=maxshape, dtype=dtype, chunks=chunks)
+
+        grow(root, "NumberOfPoints", (0,), np.int64)
+        grow(root, "Points", (0, 3), np.float64)
+        for topo in TOPOLOGIES:
+            g = root.create_group(topo)
+            grow(g, "NumberOfCells", (0,), np.int64)
+            grow(g, "NumberOfConnectivityIds", (0,), np.int64)
+            grow(g, "Offsets", (1,), np.int64)
+            grow(g, "Connectivity", (0,), np.int64)
+        pd = root.create_group("PointData")
+        for name, (dtype, ncomp) in self.arrays.items():
+            grow(pd, name, (0,) if ncomp == 1 else (0, ncomp), dtype)
+        steps = root.create_group("Steps")
+        steps.attrs["NSteps"] = np.int64(0)
+        for name in ("Values",):
+            grow(steps, name, (0,), np.float64)
+        for name in ("PartOffsets", "NumberOfParts", "PointOffsets"):
+            grow(steps, name, (0,), np.int64)
+        grow(steps, "CellOffsets", (0, 4), np.int64)
+        grow(steps, "ConnectivityIdOffsets", (0, 4), np.int64)
+        pdo = steps.create_group("PointDataOffsets")
+        for name in self.arrays:
+            grow(pdo, name, (0,), np.int64)
+        self.f.flush()
+
+    # -- state ------------------------------------------------------------------------
+    @property
+    def nsteps(self) -> int:
+        return int(self.root["Steps"].attrs["NSteps"])
+
+    def times(self) -> np.ndarray:
+        return self.root["Steps/Values"][: self.nsteps]
+
+    def truncate_to(self, nsteps: int) -> None:
+        """Keep the first ``nsteps`` steps and cut every array after them."""
+        root = self.root
+        steps = root["Steps"]
+        nsteps = min(nsteps, int(steps.attrs["NSteps"]))
+        npts = int(steps["PointOffsets"][nsteps - 1] + root["NumberOfPoints"][nsteps - 1]) if nsteps else 0
+        for name in ("Values", "PartOffsets", "NumberOfParts", "PointOffsets", "CellOffsets",
+                     "ConnectivityIdOffsets"):
+            steps[name].resize(nsteps, axis=0)
+        for name in self.arrays:
+            steps["PointDataOffsets"][name].resize(nsteps, axis=0)
+            root["PointData"][name].resize(npts, axis=0)
+        root["NumberOfPoints"].resize(nsteps, axis=0)
+        root["Points"].resize(npts, axis=0)
+        for topo in TOPOLOGIES:
+            root[topo]["NumberOfCells"].resize(nsteps, axis=0)
+            root[topo]["NumberOfConnectivityIds"].resize(nsteps, axis=0)
+        steps.attrs["NSteps"] = np.int64(nsteps)
+        self.f.flush()
+
+    # -- append -----------------------------------------------------------------------
+    def append(self, time: float, points: np.ndarray, point_data: dict[str, np.ndarray]) -> None:
+        """Write one step: ``points`` (N,3) of live particles and their arrays."""
+        root = self.root
+        steps = root["Steps"]
+        s = int(steps.attrs["NSteps"])
+        if root["NumberOfPoints"].shape[0] != s:   # leftovers of an interrupted append
+            self.truncate_to(s)
+        n = int(points.shape[0])
+        start = int(root["Points"].shape[0])
+        self._extend(root["Points"], np.asarray(points, dtype=np.float64))
+        for name, (dtype, ncomp) in self.arrays.items():
+            self._extend(root["PointData"][name], np.asarray(point_data[name], dtype=dtype))
+        vert = root["Vertices"]
+        if vert["Connectivity"].shape[0] < n:           # topology 0..n-1 stored once, grown on demand
+            old = vert["Connectivity"].shape[0]
+            vert["Connectivity"].resize(n, axis=0)
+            vert["Connectivity"][old:] = np.arange(old, n, dtype=np.int64)
+            vert["Offsets"].resize(n + 1, axis=0)
+            vert["Offsets"][old + 1:] = np.arange(old + 1, n + 1, dtype=np.int64)
+        for topo in TOPOLOGIES:
+            g = root[topo]
+            count = n if topo == "Vertices" else 0
+            self._extend(g["NumberOfCells"], np.array([count], np.int64))
+            self._extend(g["NumberOfConnectivityIds"], np.array([count], np.int64))
+        self._extend(root["NumberOfPoints"], np.array([n], np.int64))
+        self._extend(steps["Values"], np.array([time], np.float64))
+        self._extend(steps["PartOffsets"], np.array([s], np.int64))
+        self._extend(steps["NumberOfParts"], np.array([1], np.int64))
+        self._extend(steps["PointOffsets"], np.array([start], np.int64))
+        self._extend(steps["CellOffsets"], np.zeros((1, 4), np.int64))
+        self._extend(steps["ConnectivityIdOffsets"], np.zeros((1, 4), np.int64))
+        for name in self.arrays:
+            self._extend(steps["PointDataOffsets"][name], np.array([start], np.int64))
+        steps.attrs["NSteps"] = np.int64(s + 1)
+        self.f.flush()
+
+    @staticmethod
+    def _extend(ds, data):
+        old = ds.shape[0]
+        ds.resize(old + data.shape[0], axis=0)
+        ds[old:] = data
+
+    def close(self):
+        if self.f:
+            self.f.flush()
+            self.f.close()
+            self.f = None
+
+
+def read_step(path: str, step: int) -> dict:
+    """Read one step of a particle VTKHDF file: time, points and point arrays."""
+    import h5py
+    with h5py.File(path, "r") as f:
+        root = f["VTKHDF"]
+        steps = root["Steps"]
+        nsteps = int(steps.attrs["NSteps"])
+        if not -nsteps <= step < nsteps:
+            raise IndexError(f"step {step} of {nsteps}")
+        step %= nsteps
+        off = int(steps["PointOffsets"][step])
+        n = int(root["NumberOfPoints"][step])
+        out = {"time": float(steps["Values"][step]), "points": root["Points"][off:off + n]}
+        for name in root["PointData"]:
+            o = int(steps["PointDataOffsets"][name][step])
+            out[name] = root["PointData"][name][o:o + n]
+        return out
+
+
+def step_times(path: str) -> np.ndarray:
+    import h5py
+    with h5py.File(path, "r") as f:
+        steps = f["VTKHDF"]["Steps"]
+        return steps["Values"][: int(steps.attrs["NSteps"])]

@@ -1,0 +1,265 @@
+"""Case reader: constants, parameters, special sections, materials, errors with file:line."""
+import math
+
+import numpy as np
+import pytest
+from lxml import etree
+
+from casetext import CONSTANTS, TANK_2D, case_xml, write_case
+from sphdvi.case.constants import resolve_constants
+from sphdvi.case.gencase import build_case
+from sphdvi.case.model import ConstantsDef
+from sphdvi.case.xmldoc import CaseReader, parse_xml_text, strip_disabled
+from sphdvi.errors import CaseError
+
+
+def build(tmp_path, **kw):
+    return build_case(write_case(tmp_path, case_xml(**kw)), str(tmp_path / "out"))
+
+
+# -- constants -----------------------------------------------------------------
+def test_dambreak_2d_constants_match_gencase(tmp_path):
+    """DualSPHysics GenCase on CaseDambreakVal2D at dp=0.02: 5000 fluid, 501 boundary,
+    h = 0.0282843 m, B = 1 109 931 Pa."""
+    r = build(tmp_path)
+    t = r.particles["type"]
+    assert int((t == 3).sum()) == 5000
+    assert int((t != 3).sum()) == 501
+    assert r.constants.h == pytest.approx(0.0282843, abs=5e-8)
+    assert round(r.constants.b) == 1109931
+    assert r.constants.hswl == pytest.approx(1.98)
+    assert r.constants.massfluid == pytest.approx(0.4)
+    assert r.constants.is2d
+
+
+def test_resolve_constants_rules():
+    cdef = ConstantsDef(coefh=1.2, coefsound=10.0)
+    c = resolve_constants(cdef, 0.05, False, 0.0, np.array([0.0, 0.5, 1.0]))
+    assert c.h == pytest.approx(1.2 * math.sqrt(3) * 0.05)
+    assert c.cs0 == pytest.approx(10 * math.sqrt(9.81 * 1.0))
+    assert c.b == pytest.approx(c.cs0 ** 2 * 1000 / 7)
+    assert c.massfluid == pytest.approx(1000 * 0.05 ** 3)
+    cdef = ConstantsDef(hdp=2.0, speedsound=50.0, b=1e5, hswl=3.0)
+    c = resolve_constants(cdef, 0.1, True, 0.0, np.array([0.0]))
+    assert c.h == pytest.approx(0.2) and c.cs0 == 50.0 and c.b == 1e5 and c.hswl == 3.0
+    assert c.massbound == pytest.approx(1000 * 0.01)
+
+
+def test_explicit_constants_and_expressions(tmp_path):
+    consts = CONSTANTS.replace('<coefh value="1.0" />', '<hdp value="#1.5*2/2" />').replace(
+        '<speedsound value="0" auto="true" />', '<speedsound value="#Rhop0/20" />')
+    r = build(tmp_path, constants=consts)
+    assert r.constants.h == pytest.approx(1.5 * 0.02)
+    assert r.constants.cs0 == pytest.approx(50.0)
+
+
+def test_hydrostatic_initial_density(tmp_path):
+    """rhopgradient 2: ρ = ρ0 (1 + ρ0 g (z_top − z)/B)^(1/γ) down each water column."""
+    r = build(tmp_path)
+    p, c = r.particles, r.constants
+    fluid = p["type"] == 3
+    z = p["pos"][fluid, 2]
+    expected = c.rhop0 * (1 + c.rhop0 * 9.81 * (2.0 - z) / c.b) ** (1 / 7)
+    assert np.allclose(p["rhop"][fluid], expected, rtol=1e-12)
+    assert np.all(p["rhop"][~fluid] == 1000.0)
+
+
+def test_rhopgradient_1_is_uniform(tmp_path):
+    consts = CONSTANTS.replace("<gamma", '<rhopgradient value="1" /><gamma')
+    r = build(tmp_path, constants=consts)
+    assert np.all(r.particles["rhop"] == 1000.0)
+
+
+# -- ordering, mk, types ---------------------------------------------------------
+def test_particle_order_types_and_mk(tmp_path):
+    r = build(tmp_path)
+    t, mk = r.particles["type"], r.particles["mk"]
+    assert np.all(np.diff(t.astype(int)) >= 0)
+    assert set(mk[t == 3]) == {1} and set(mk[t == 0]) == {10}
+    assert np.array_equal(r.particles["idp"], np.arange(t.size))
+
+
+# -- parameters ---------------------------------------------------------------------
+def test_parameters_defaults_and_values(tmp_path):
+    r = build(tmp_path, parameters='<parameter key="Visco" value="0.02"/><parameter key="#Shifting" value="9"/>'
+                                   '<parameter key="TimeMax" value="#2*Dp"/>')
+    p = r.case.parameters
+    assert p["Visco"] == 0.02 and p["Shifting"] == 0 and p["TimeMax"] == pytest.approx(0.04)
+    assert p["StepAlgorithm"] == 1 and p["VerletSteps"] == 40 and p["RhopOutMin"] == 700
+    assert r.case.parameters_set == ["Visco", "TimeMax"]
+
+
+@pytest.mark.parametrize("param, fragment", [
+    ('<parameter key="Visc" value="0.1"/>', "unknown parameter key 'Visc'; expected 'Visco'"),
+    ('<parameter key="Kernel" value="5"/>', "Kernel: 5 is not one of 1, 2"),
+    ('<parameter key="StepAlgorithm" value="1.5"/>', "is not an integer"),
+    ('<parameter key="TimeMax" value="abc"/>', "is not a number"),
+    ('<parameter key="TimeOut" value="-1"/>', "below"),
+    ('<parameter key="RhopOutMin" value="1400"/>', "RhopOutMin (1400.0) >= RhopOutMax"),
+])
+def test_parameter_errors(tmp_path, param, fragment):
+    with pytest.raises(CaseError) as err:
+        build(tmp_path, parameters=param)
+    assert fragment in str(err.value)
+    assert "Case_Def.xml:" in str(err.value)
+
+
+def test_simulation_domain(tmp_path):
+    r = build(tmp_path, parameters='<simulationdomain><posmin x="default - 10%" z="-0.5"/>'
+                                   '<posmax z="default + 50%"/></simulationdomain>')
+    assert r.domain["posmin"][0] == pytest.approx(-0.4)
+    assert r.domain["posmin"][2] == pytest.approx(-0.5)
+    assert r.domain["posmax"][2] == pytest.approx(4.5)
+
+
+# -- special sections ----------------------------------------------------------------
+CHRONO_BODIES = """
+    <setmkbound mk="50" />
+    <drawbox><boxfill>solid</boxfill><point x="2" y="-1" z="0.5" /><size x="0.2" y="2" z="0.2" /></drawbox>"""
+FLOATINGS = '<floatings><floating mkbound="50" rhopbody="500" property="steel"/></floatings>'
+PROPS = ('<properties><property name="steel"><Young_Modulus value="2.1e11"/><PoissonRatio value="0.3"/>'
+         '<Restitution_Coefficient value="0.8"/><Kfric value="0.45"/></property>'
+         '<links><link mkbound="0" property="steel"/></links></properties>')
+
+
+def chrono(links=""):
+    return ('<chrono><savedata value="0.05"/><collision activate="true"><distancedp value="0.5"/>'
+            '<contactmethod value="0"/></collision><bodyfixed id="tank" mkbound="0" modelfile="AutoActual"/>'
+            f'<bodyfloating id="box" mkbound="50" modelfile="AutoActual"/>{links}</chrono>')
+
+
+def test_chrono_section(tmp_path):
+    links = ('<link_hinge idbody1="box" idbody2="tank"><rotpoint x="2" y="0" z="0.6"/>'
+             '<rotvector x="0" y="1" z="0"/><stiffness value="#100*2"/><damping value="5"/></link_hinge>'
+             '<link_linearspring idbody1="tank" idbody2="box"><point_fb1 x="2" y="0" z="0"/>'
+             '<point_fb2 x="2" y="0" z="0.5"/><stiffness value="100"/><damping value="5"/>'
+             '<rest_length value="0.4"/></link_linearspring>')
+    r = build(tmp_path, commands=TANK_2D + CHRONO_BODIES, casedef_extra=FLOATINGS + PROPS,
+              special=chrono(links), parameters='<parameter key="RigidAlgorithm" value="3"/>')
+    ch = r.case.special["chrono"]
+    assert ch["collision"] == {"activate": True, "distancedp": 0.5, "contactmethod": 0}
+    assert [b["id"] for b in ch["bodies"]] == ["tank", "box"]
+    hinge, spring = ch["links"]
+    assert hinge["type"] == "hinge" and hinge["stiffness"] == 200.0 and hinge["rotvector"] == [0, 1, 0]
+    assert spring["type"] == "linearspring" and spring["rest_length"] == 0.4
+    assert r.case.materials["steel"].young == 2.1e11 and r.case.materials["steel"].kfric == 0.45
+
+
+def test_link_naming_unknown_body(tmp_path):
+    links = '<link_spheric idbody1="box" idbody2="ghost"><rotpoint x="2" y="0" z="0.6"/></link_spheric>'
+    with pytest.raises(CaseError) as err:
+        build(tmp_path, commands=TANK_2D + CHRONO_BODIES,
+              casedef_extra=FLOATINGS + PROPS, special=chrono(links))
+    msg = str(err.value)
+    assert "idbody2='ghost' names no body" in msg and "<link_spheric>" in msg and "expected one of box, tank" in msg
+
+
+def test_floating_mass_from_particles(tmp_path):
+    """rhopbody 500, box 0.2 x 0.2 (2D) at dp 0.02: 11 x 11 particles, mass = 500·dp²·121,
+    centre at the particle mean; the analytic mass 500·0.04 = 20 is reported beside it."""
+    r = build(tmp_path, commands=TANK_2D + CHRONO_BODIES, casedef_extra=FLOATINGS + PROPS)
+    (b,) = r.bodies
+    assert b.count == 121
+    assert b.mass == pytest.approx(500 * 0.02 ** 2 * 121)
+    assert b.masspart == pytest.approx(500 * 0.02 ** 2)
+    assert b.center == pytest.approx([2.1, 0.0, 0.6])
+    side = np.arange(11) * 0.02 - 0.1
+    iyy = b.mass / 121 * 2 * 11 * np.sum(side ** 2)
+    assert b.inertia[1][1] == pytest.approx(iyy)
+    assert b.analytic["mass"] == pytest.approx(20.0)
+    assert b.analytic["inertia"][1][1] == pytest.approx(20.0 * (0.04 + 0.04) / 12)
+
+
+def test_floating_without_particles(tmp_path):
+    with pytest.raises(CaseError, match="floating mkbound 50 has no particles"):
+        build(tmp_path, casedef_extra=FLOATINGS + PROPS)
+
+
+def test_unknown_material(tmp_path):
+    props = '<properties><links><link mkbound="0" property="wood"/></links></properties>'
+    with pytest.raises(CaseError, match="property 'wood' is not defined"):
+        build(tmp_path, casedef_extra=props)
+
+
+def test_gauges_wavepaddles_damping(tmp_path):
+    special = ('<gauges><default><computedt value="0.01"/></default><velocity name="v1"><point x="0.5" y="0" z="0.5"/>'
+               '</velocity><swl name="s1"><point0 x="0.2" y="0" z="0"/><point2 x="0.2" y="0" z="2"/>'
+               '<pointdp coefdp="0.5"/></swl></gauges>'
+               '<damping><dampingzone><limitmin x="3" y="0" z="0"/><limitmax x="3.9" y="0" z="0"/>'
+               '<redumax value="20"/></dampingzone></damping>')
+    r = build(tmp_path, special=special)
+    g = r.case.special["gauges"]
+    assert g["default"]["computedt"] == 0.01
+    assert [i["name"] for i in g["items"]] == ["v1", "s1"] and g["items"][0]["point"] == [0.5, 0, 0.5]
+    assert r.case.special["damping"][0]["redumax"] == 20 and r.case.special["damping"][0]["overlimit"] == 0
+
+
+def test_wavepaddle_needs_motion(tmp_path):
+    special = ('<wavepaddles><piston><mkbound value="0"/><depth value="1"/><waveheight value="0.1"/>'
+               '<waveperiod value="1"/></piston></wavepaddles>')
+    with pytest.raises(CaseError, match="wave paddle mkbound 0 has no <motion> object"):
+        build(tmp_path, special=special)
+
+
+def test_motion_chain(tmp_path):
+    motion = ('<motion><objreal ref="0"><begin mov="1" start="0"/><mvrect id="1" duration="0.5" next="2">'
+              '<vel x="1" y="0" z="0"/></mvrect><mvrotsinu id="2" duration="-1" anglesunits="degrees">'
+              '<freq v="1"/><ampl v="10"/><phase v="0"/><axisp1 x="0" y="0" z="0"/><axisp2 x="0" y="1" z="0"/>'
+              '</mvrotsinu></objreal></motion>')
+    r = build(tmp_path, casedef_extra=motion)
+    (m,) = r.case.motions
+    assert [x["type"] for x in m["movements"]] == ["mvrect", "mvrotsinu"]
+    assert m["movements"][0]["next"] == 2 and m["movements"][1]["ampl"] == 10
+    assert set(r.particles["type"][r.particles["type"] != 3]) == {1}
+
+
+def test_motion_next_missing(tmp_path):
+    motion = ('<motion><objreal ref="0"><begin mov="1"/><mvrect id="1" duration="1" next="7">'
+              '<vel x="1"/></mvrect></objreal></motion>')
+    with pytest.raises(CaseError, match="next=7, which does not exist"):
+        build(tmp_path, casedef_extra=motion)
+
+
+def test_initials(tmp_path):
+    initials = ('<initials><velocity mkfluid="0" x="1" y="0" z="-0.5"/>'
+                '<densityuniform mkfluid="0" rhop="1001"><onlypos><posmax z="0.5"/></onlypos></densityuniform>'
+                '</initials>')
+    r = build(tmp_path, casedef_extra=initials)
+    p = r.particles
+    fluid = p["type"] == 3
+    assert np.all(p["vel"][fluid] == [1, 0, -0.5]) and np.all(p["vel"][~fluid] == 0)
+    low = fluid & (p["pos"][:, 2] <= 0.5)
+    assert np.all(p["rhop"][low] == 1001) and np.all(p["rhop"][fluid & ~low] != 1001)
+
+
+# -- XML leniency, disabled elements, warnings --------------------------------------------
+def test_tinyxml_leniency():
+    root = parse_xml_text('\n\n<?xml version="1.0"?>\n<case><abort if="Dp<0.1 && 1"/>% stray text\n<b/></case>', "f.xml")
+    assert root[0].get("if") == "Dp<0.1 && 1" and root[1].sourceline == 5
+
+
+def test_disabled_elements_removed():
+    root = parse_xml_text('<case><_a/><b active="false"><c/></b><d active="true"/><e active="0"/></case>', "f")
+    strip_disabled(root)
+    assert [c.tag for c in root] == ["d"]
+
+
+def test_unknown_attribute_warns(tmp_path):
+    text = case_xml(parameters='<parameter key="Visco" value="0.1" colour="red"/>')
+    r = build_case(write_case(tmp_path, text), str(tmp_path / "out"))
+    assert any("unknown attribute 'colour'" in w and "<parameter>" in w for w in r.warnings)
+
+
+def test_reader_typed_errors(tmp_path):
+    root = etree.fromstring('<a n="x" i="1.5" b="maybe" v="#1/0"/>')
+    rd = CaseReader(str(tmp_path / "c.xml"))
+    with pytest.raises(CaseError, match="n='x' is not a number"):
+        rd.num(root, "n")
+    with pytest.raises(CaseError, match="is not an integer"):
+        rd.integer(root, "i")
+    with pytest.raises(CaseError, match="is not a boolean"):
+        rd.boolean(root, "b")
+    with pytest.raises(CaseError, match="division by zero"):
+        rd.num(root, "v")
+    with pytest.raises(CaseError, match="missing attribute 'q'"):
+        rd.num(root, "q")

@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# Install sphdvi and run the 2D dam-break example end to end (README, command 1).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+python -m pip install -e ".[test]"
+sphdvi gencase cases/dambreak2d/CaseDambreakVal2D_Def.xml -o out/dambreak2d
