@@ -1,0 +1,66 @@
+"""GenCase drawing: the ``<geometry>`` section of a case turned into particles.
+
+Entry point: :func:`run_geometry` (returns a :class:`Drawing`).
+
+Lattice
+    Nodes at ``origin + k*dp``; ``origin`` = ``pointmin``, or with
+    ``<pointref>`` the first node >= ``pointmin`` of the lattice through
+    ``pointref`` (not along y in 2D). Only nodes in ``[pointmin, pointmax]``
+    exist; in 2D (``pointmin.y == pointmax.y``) every node has
+    ``y = pointmin.y``. The lattice is a dense ``uint16`` canvas (at most
+    ``max_nodes`` nodes); a later drawing overwrites earlier ones, void erases.
+
+Pen
+    ``setmkfluid``/``setmkbound``/``setmkvoid`` choose what is written (drawing
+    before any of them is an error). Transforms (``move``, ``rotate``,
+    ``rotateline``, ``scale``) multiply the current matrix on the right
+    (OpenGL order); ``matrixsave/load`` and ``statesave/load`` are stacks.
+
+Draw modes (``setdrawmode``)
+    ``full`` = volume including its surface, ``solid`` = volume (nodes inside,
+    boundary within 1e-6 dp included), ``face`` = surface only, ``wire`` =
+    edges (polyhedra; curved shapes draw their surface).
+    ``drawbox`` with ``<boxfill>`` ignores the mode: ``solid`` = volume,
+    ``all`` or any of ``bottom|top|left|right|front|back`` = those faces
+    (left/right = x min/max, front/back = y min/max, bottom/top = z min/max).
+    Planar shapes (triangle, quadri, strips, fans, polygon, triangles) are
+    surfaces in every mode but ``wire``. Mesh files draw their surface, plus
+    the inside (even-odd rule) with ``autofill="true"``.
+
+Surfaces (see :mod:`.raster`)
+    Planar faces: nodes whose distance to the plane is in (-dp/2, dp/2] and
+    whose projection lies within dp/2 of the face (for an axis-aligned box face:
+    the node layer nearest the plane over the face's extent rounded to the
+    nearest nodes). Curved surfaces: the inner shell (inside nodes with an
+    outside face-neighbour). Both are closed against face-connected leaks.
+
+Masks
+    ``mask`` is a bit set (values joined by ``|`` are OR-ed): bit ``2**i``
+    hides face ``i``. Cylinder: 1 = cover at the first point, 2 = cover at
+    the second point, 4 = side. Prism (base points, then top points): 1 = base,
+    2 = top, 4, 8, ... = sides (side i joins base points i and i+1). Pyramid
+    (apex, then base points): 1 = base, 2, 4, ... = sides.
+
+Ellipsoid
+    ``<point>`` (or ``<center>``) + ``<radius x y z>`` (or ``<size>``):
+    semi-axes along x, y, z; or the GenCase template form ``radius`` + two
+    ``<point>``: the ellipsoid of revolution with those foci and semi-major
+    axis ``radius`` (|p-f1| + |p-f2| <= 2 radius).
+
+Fills (``fillpoint``, ``fillvoidpoint``, ``fillbox``)
+    From the node nearest the seed, a 6-connected (4 in 2D) flood through
+    nodes whose kind is listed in ``<modefill>`` (void, fluid, bound; the
+    ``mkfluid``/``mkbound`` attributes restrict fluid/bound nodes to that mk;
+    ``border`` alone means void, GenCase users see no difference), limited to
+    the lattice or to the nodes inside the ``fillbox`` box. Every reached node
+    gets the current pen. A seed outside, or on a node of another kind, fills
+    nothing (warning).
+
+``shapeout``
+    Writes the shapes drawn since the last reset as triangles into
+    ``outdir/<casename>_<base name>.<format>`` (vtk, vtp, vtu, stl); the file
+    attribute is reduced to its base name. Nothing is written when outdir is None.
+"""
+from .commands import UNSUPPORTED, Drawing, run_geometry
+
+__all__ = ["Drawing", "run_geometry", "UNSUPPORTED"]

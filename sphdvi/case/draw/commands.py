@@ -1,0 +1,875 @@
+"""The GenCase command interpreter: ``<geometry>`` -> particles.
+
+See the package docstring (:mod:`sphdvi.case.draw`) for the drawing rules.
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import CaseError
+from ..expressions import ExpressionError
+from . import raster, shapes
+from . import transform as tf
+from .lattice import Canvas, Lattice, ceil_idx, floor_idx, round_idx
+from .shapeout import FORMATS, write_shapes
+
+MAX_COMMANDS = 1_000_000      # commands executed in all (runlist loops included)
+MAX_LIST_DEPTH = 64
+MAX_POINTS = 1_000_000        # points or triangles written inline in one command
+DRAW_MODES = {"full", "face", "solid", "wire"}
+BOX_TOKENS = {"solid", "all", "bottom", "top", "left", "right", "front", "back"}
+FILL_TOKENS = {"void", "border", "fluid", "bound"}
+SKIPPED_ATTRS = {"comment", "units_comment", "comment2", "rem", "active"}
+
+#: commands of GenCase that sphdvi does not implement
+UNSUPPORTED = {
+    "drawbathymetry", "drawwave", "drawbeach", "drawextrude", "drawfilevtm", "drawfilecsv",
+    "redraw", "redrawbox", "redrawnear", "redrawnearbox", "clipdomain", "clipplane", "clipbox",
+    "clipreset", "setpattern", "patterns", "fillfigure", "fillprism", "setboxlimitmode",
+    "setmknextfluid", "setmknextbound", "setmknextauto", "setmkbackvoid", "setmkbackfluid",
+    "setmkbackbound", "setmkbackclear", "setfrdrawmode", "resetdraw", "rotateadv",
+}
+#: commands accepted without effect (they tune GenCase's own output or sampling)
+NO_EFFECT = {"setdpctes", "dpctessave", "dpctesload", "dpctesreset", "setshapemode",
+             "setnormalinvert", "exportvar", "debugout", "cellsout", "pointsmkout"}
+
+
+@dataclass
+class Drawing:
+    """Result of the ``<geometry>`` section: the particles and what was drawn."""
+
+    dp: float
+    pointmin: np.ndarray
+    pointmax: np.ndarray
+    pointref: np.ndarray
+    is2d: bool
+    posy2d: float
+    pos: np.ndarray
+    is_fluid: np.ndarray
+    mk: np.ndarray
+    primitives: list = field(default_factory=list)
+    shape_files: list = field(default_factory=list)
+    messages: list = field(default_factory=list)
+    origin: np.ndarray | None = None   # first lattice node (pointmin, or pointref-aligned)
+
+    @property
+    def count_fluid(self) -> int:
+        return int(np.count_nonzero(self.is_fluid))
+
+    @property
+    def count_bound(self) -> int:
+        return int(self.is_fluid.size - np.count_nonzero(self.is_fluid))
+
+
+@dataclass
+class DrawState:
+    """The pen: what is drawn (kind + mk), how (mode), where (matrix)."""
+
+    kind: str | None = None      # "fluid", "bound", "void" or None (nothing set yet)
+    mk: int = 0
+    mode: str = "full"
+    matrix: np.ndarray = field(default_factory=tf.identity)
+    draw_points: bool = True
+    draw_shapes: bool = True
+
+    def copy(self) -> "DrawState":
+        return DrawState(self.kind, self.mk, self.mode, self.matrix.copy(), self.draw_points,
+                         self.draw_shapes)
+
+
+def _attr_items(el):
+    """User attributes of a variable command (name, value), skipping comments and _private ones."""
+    return [(k, v) for k, v in el.attrib.items()
+            if k not in SKIPPED_ATTRS and not k.startswith("_") and not k.endswith("_comment")]
+
+
+class GeometryRunner:
+    """Executes the command lists of ``<geometry>`` on a canvas."""
+
+    def __init__(self, reader, lattice: Lattice | None, casename: str, outdir: str | None):
+        self.reader = reader
+        self.vars = reader.vars
+        self.lat = lattice
+        self.canvas = Canvas(lattice) if lattice is not None else None
+        self.casename = casename
+        self.outdir = outdir
+        self.state = DrawState()
+        self.saved_matrices: list[np.ndarray] = []
+        self.saved_states: list[DrawState] = []
+        self.saved_mk: tuple | None = None
+        self.saved_vars: list = []
+        self.lists: dict = {}
+        self.call_stack: list[str] = []
+        self.executed = 0
+        self.line_begin = None
+        self.primitives: list = []
+        self.shapes: list = []
+        self.shape_files: list = []
+        self.messages: list = []
+        self.handlers = self._handler_table()
+
+    # ------------------------------------------------------------ dispatch
+    def _handler_table(self):
+        names = ["newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",
+                 "delvar", "varssave", "varsload", "printf", "abort", "runlist",
+                 "setmkfluid", "setmkbound", "setmkvoid", "mksave", "mkload", "setdrawmode",
+                 "setactive", "move", "scale", "rotate", "rotateline", "matrixreset",
+                 "matrixsave", "matrixload", "statesave", "stateload",
+                 "drawpoint", "drawpoints", "drawline", "drawlines", "setlinebegin", "drawlineto",
+                 "drawtriangle", "drawquadri", "drawtrianglesstrip", "drawtrianglesfan",
+                 "drawpolygon", "drawtriangles", "drawfigure", "drawbox", "drawsphere",
+                 "drawellipsoid", "drawcylinder", "drawprism", "drawpyramid", "drawfilestl",
+                 "drawfileply", "drawfilevtk", "fillpoint", "fillvoidpoint", "fillbox", "shapeout"]
+        return {n: getattr(self, "cmd_" + n) for n in names}
+
+    def run_commands(self, container, only_variables: bool = False) -> None:
+        """Execute every command element of a list, in order."""
+        for el in self.reader.children(container):
+            self.run_command(el, only_variables)
+
+    def run_command(self, el, only_variables: bool = False) -> None:
+        self.executed += 1
+        if self.executed > MAX_COMMANDS:
+            raise self.reader.error(el, f"more than {MAX_COMMANDS} commands executed "
+                                        "(runlist loop?)", "fewer runlist repetitions")
+        tag = el.tag
+        if only_variables and tag not in VARIABLE_COMMANDS:
+            raise self.reader.error(el, f"<{tag}> is not allowed in <predefinition>",
+                                    "variable commands only: " + ", ".join(sorted(VARIABLE_COMMANDS)))
+        if tag in UNSUPPORTED:
+            raise self.reader.error(el, f"GenCase command <{tag}> is not supported by sphdvi",
+                                    "a supported drawing command (see sphdvi.case.draw)")
+        if tag in NO_EFFECT:
+            self.reader.mark(el, *el.attrib.keys())
+            return
+        handler = self.handlers.get(tag)
+        if handler is None:
+            raise self.reader.error(el, f"unknown command <{tag}>",
+                                    "one of " + ", ".join(sorted(self.handlers)))
+        try:
+            handler(el)
+        except ExpressionError as exc:
+            raise self.reader.error(el, str(exc)) from None
+
+    # ------------------------------------------------------------ small readers
+    def _points(self, el, tag: str = "point", least: int = 0, exact: int | None = None):
+        kids = self.reader.children(el, tag)
+        if len(kids) > MAX_POINTS:
+            raise self.reader.error(el, f"{len(kids)} <{tag}> elements", f"at most {MAX_POINTS}")
+        if exact is not None and len(kids) != exact:
+            raise self.reader.error(el, f"{len(kids)} <{tag}> elements", f"exactly {exact}")
+        if len(kids) < least:
+            raise self.reader.error(el, f"{len(kids)} <{tag}> elements", f"at least {least}")
+        return np.array([self.reader.vec3(k) for k in kids], dtype=np.float64).reshape(-1, 3)
+
+    def _check(self, el, allowed) -> None:
+        self.reader.check_children(el, set(allowed) | {"rem"}, "child element")
+
+    def _need_pen(self, el) -> None:
+        if self.state.kind is None:
+            raise self.reader.error(el, "nothing to draw with: no mk selected",
+                                    "<setmkfluid>, <setmkbound> or <setmkvoid> before drawing")
+
+    def _code(self) -> int:
+        s = self.state
+        if s.kind == "void":
+            return 0
+        return self.canvas.code_for(s.kind == "fluid", s.mk)
+
+    def _paint(self, el, pieces) -> int:
+        """Paint pieces with the current pen; returns the number of nodes written."""
+        if not self.state.draw_points:
+            return 0
+        code = self._code()
+        n = 0
+        for p in pieces:
+            p.paint(self.canvas, code)
+            n += p.count()
+        return n
+
+    def _record(self, el, shape: str, params: dict, tris, solid: bool, nodes: int) -> None:
+        s = self.state
+        prim = {"shape": shape, "fluid": s.kind == "fluid", "void": s.kind == "void",
+                "mk": int(s.mk) if s.kind in ("fluid", "bound") else -1, "solid": bool(solid),
+                "mode": s.mode, "nodes": nodes, "line": el.sourceline, "params": params}
+        self.primitives.append(prim)
+        if s.draw_shapes and tris is not None:
+            self.shapes.append({"triangles": np.asarray(tris), "mk": prim["mk"],
+                                "fluid": prim["fluid"]})
+
+    def _mask(self, el) -> int:
+        """The ``mask`` attribute: integers combined with ``|`` (bitwise OR)."""
+        text = self.reader.text_attr(el, "mask", "0")
+        value = 0
+        for tok in str(text).split("|"):
+            tok = tok.strip()
+            if not tok:
+                continue
+            try:
+                v = float(self.vars.number(tok[1:] if tok.startswith("#") else tok))
+            except ExpressionError:
+                raise self.reader.error(el, f"mask={text!r} is not valid",
+                                        "integers joined by |, e.g. mask=\"1 | 2\"") from None
+            if v != int(v) or v < 0 or v > 2**31:
+                raise self.reader.error(el, f"mask={text!r} is not valid",
+                                        "non-negative integers joined by |")
+            value |= int(v)
+        return value
+
+    def _mode_flags(self):
+        """(solid, surface, wire) for the current draw mode."""
+        m = self.state.mode
+        return m in ("full", "solid"), m in ("full", "face"), m == "wire"
+
+    # ------------------------------------------------------------ variables
+    def _define_vars(self, el, constant: bool, redefine: bool, text: bool) -> None:
+        for name, value in _attr_items(el):
+            self.reader.mark(el, name)
+            raw = value.strip()
+            try:
+                if text:
+                    val = self.vars.interpolate(value)
+                else:
+                    val = self.vars.evaluate(raw[1:] if raw.startswith("#") else raw)
+                    if isinstance(val, float) and not math.isfinite(val):
+                        raise ExpressionError(f"{name}={value!r} is not finite")
+                if not redefine and name not in self.vars.values:
+                    raise ExpressionError(f"variable '{name}' does not exist "
+                                          f"({el.tag} changes existing variables)")
+                self.vars.define(name, val, constant=constant)
+            except ExpressionError as exc:
+                raise self.reader.error(el, f"{name}: {exc}") from None
+
+    def cmd_newvar(self, el):
+        self._define_vars(el, False, True, False)
+
+    def cmd_newvarcte(self, el):
+        self._define_vars(el, True, True, False)
+
+    def cmd_setvar(self, el):
+        self._define_vars(el, False, False, False)
+
+    def cmd_newvarstr(self, el):
+        self._define_vars(el, False, True, True)
+
+    def cmd_newvarstrcte(self, el):
+        self._define_vars(el, True, True, True)
+
+    def cmd_setvarstr(self, el):
+        self._define_vars(el, False, False, True)
+
+    def cmd_delvar(self, el):
+        for pat in self.reader.text_attr(el, "vars").split(","):
+            if pat.strip():
+                self.vars.delete(pat.strip())
+
+    def cmd_varssave(self, el):
+        self.saved_vars.append(self.vars.copy())
+
+    def cmd_varsload(self, el):
+        if not self.saved_vars:
+            raise self.reader.error(el, "no variables saved", "a <varssave> before <varsload>")
+        saved = self.saved_vars[-1]
+        self.vars.values = dict(saved.values)
+        self.vars.constant = set(saved.constant)
+
+    def _condition(self, el) -> bool:
+        cond = el.get("if")
+        self.reader.mark(el, "if")
+        if cond is None:
+            return True
+        c = cond.strip()
+        return bool(self.vars.evaluate(c[1:] if c.startswith("#") else c))
+
+    def _text(self, el) -> str:
+        raw = el.get("text", "")
+        self.reader.mark(el, "text")
+        return self.vars.interpolate(raw).replace("\\n", "\n")
+
+    def cmd_printf(self, el):
+        if self._condition(el):
+            msg = self._text(el)
+            self.messages.append(msg)
+            print(msg)
+
+    def cmd_abort(self, el):
+        if self._condition(el):
+            msg = self._text(el) or "execution aborted"
+            raise self.reader.error(el, f"<abort>: {msg}")
+
+    def cmd_runlist(self, el):
+        name = self.reader.text_attr(el, "name")
+        times = self.reader.integer(el, "times", 1, lo=0, hi=MAX_COMMANDS)
+        target = self.lists.get(name)
+        if target is None:
+            raise self.reader.error(el, f"no <list name=\"{name}\">",
+                                    "one of: " + (", ".join(sorted(self.lists)) or "(no lists)"))
+        if name in self.call_stack or len(self.call_stack) >= MAX_LIST_DEPTH:
+            chain = " -> ".join(self.call_stack + [name])
+            raise self.reader.error(el, f"recursive runlist ({chain})", "lists that do not call "
+                                    "themselves")
+        self.call_stack.append(name)
+        try:
+            for _ in range(times):
+                self.run_commands(target)
+        finally:
+            self.call_stack.pop()
+
+    # ------------------------------------------------------------ pen state
+    def cmd_setmkfluid(self, el):
+        self.state.kind, self.state.mk = "fluid", self.reader.integer(el, "mk", lo=0, hi=65535)
+
+    def cmd_setmkbound(self, el):
+        self.state.kind, self.state.mk = "bound", self.reader.integer(el, "mk", lo=0, hi=65535)
+
+    def cmd_setmkvoid(self, el):
+        self.state.kind, self.state.mk = "void", 0
+
+    def cmd_mksave(self, el):
+        self.saved_mk = (self.state.kind, self.state.mk)
+
+    def cmd_mkload(self, el):
+        if self.saved_mk is None:
+            raise self.reader.error(el, "no mk saved", "a <mksave> before <mkload>")
+        self.state.kind, self.state.mk = self.saved_mk
+
+    def cmd_setdrawmode(self, el):
+        self.state.mode = self.reader.text_attr(el, "mode", choices=DRAW_MODES).lower()
+
+    def cmd_setactive(self, el):
+        self.state.draw_points = self.reader.boolean(el, "drawpoints", self.state.draw_points)
+        self.state.draw_shapes = self.reader.boolean(el, "drawshapes", self.state.draw_shapes)
+        self.reader.boolean(el, "vtkout", True)
+
+    # ------------------------------------------------------------ transforms
+    def _compose(self, el, m) -> None:
+        new = self.state.matrix @ m
+        try:
+            tf.inverse(new)
+        except ValueError as exc:
+            raise self.reader.error(el, str(exc), "a non-degenerate transformation") from None
+        self.state.matrix = new
+
+    def cmd_move(self, el):
+        self._compose(el, tf.translation(self.reader.vec3(el)))
+
+    def cmd_scale(self, el):
+        if not any(el.get(n) is not None for n in "xyz"):
+            raise self.reader.error(el, "missing scale factors", "x, y and z")
+        v = np.array([self.reader.num(el, n, 1.0) for n in "xyz"])
+        if np.any(v == 0):
+            raise self.reader.error(el, "a scale factor is 0", "non-zero x, y, z")
+        self._compose(el, tf.scaling(v))
+
+    def cmd_rotate(self, el):
+        ang = self.reader.num(el, "ang")
+        axis = self.reader.vec3(el)
+        if not np.linalg.norm(axis) > 0:
+            raise self.reader.error(el, "rotation axis (x, y, z) is zero", "a non-zero axis")
+        self._compose(el, tf.rotation_axis(ang, axis))
+
+    def cmd_rotateline(self, el):
+        self._check(el, {"point"})
+        ang = self.reader.num(el, "ang")
+        p = self._points(el, exact=2)
+        if not np.linalg.norm(p[1] - p[0]) > 0:
+            raise self.reader.error(el, "the two points of the line coincide", "distinct points")
+        self._compose(el, tf.rotation_line(ang, p[0], p[1]))
+
+    def cmd_matrixreset(self, el):
+        self.state.matrix = tf.identity()
+
+    def cmd_matrixsave(self, el):
+        self.saved_matrices.append(self.state.matrix.copy())
+
+    def cmd_matrixload(self, el):
+        if not self.saved_matrices:
+            raise self.reader.error(el, "no matrix saved", "a <matrixsave> before <matrixload>")
+        self.state.matrix = self.saved_matrices.pop().copy()
+
+    def cmd_statesave(self, el):
+        self.saved_states.append(self.state.copy())
+
+    def cmd_stateload(self, el):
+        if not self.saved_states:
+            raise self.reader.error(el, "no state saved", "a <statesave> before <stateload>")
+        self.state = self.saved_states.pop()
+
+    # ------------------------------------------------------------ points and lines
+    def _world(self, pts):
+        return tf.apply(self.state.matrix, pts)
+
+    def cmd_drawpoint(self, el):
+        self._need_pen(el)
+        p = self._world(self.reader.vec3(el)[None, :])
+        n = self._paint(el, raster.point_pieces(self.lat, p))
+        self._record(el, "point", {"points": p.tolist()}, None, False, n)
+
+    def cmd_drawpoints(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._world(self._points(el, least=1))
+        n = self._paint(el, raster.point_pieces(self.lat, p))
+        self._record(el, "points", {"points": p.tolist()}, None, False, n)
+
+    def _draw_polyline(self, el, pts, shape):
+        w = self._world(pts)
+        segs = np.stack([w[:-1], w[1:]], axis=1)
+        n = self._paint(el, raster.segment_pieces(self.lat, segs))
+        self._record(el, shape, {"points": w.tolist()}, None, False, n)
+        self.line_begin = pts[-1]
+
+    def cmd_drawline(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        self._draw_polyline(el, self._points(el, exact=2), "line")
+
+    def cmd_drawlines(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        self._draw_polyline(el, self._points(el, least=2), "lines")
+
+    def cmd_setlinebegin(self, el):
+        self.line_begin = self.reader.vec3(el)
+
+    def cmd_drawlineto(self, el):
+        self._need_pen(el)
+        if self.line_begin is None:
+            raise self.reader.error(el, "no line start", "a <setlinebegin> or a line before")
+        self._draw_polyline(el, np.array([self.line_begin, self.reader.vec3(el)]), "line")
+
+    # ------------------------------------------------------------ planar surfaces
+    def _draw_surface(self, el, tris_local, shape, params=None):
+        """Draw open triangles: the surface in full/face/solid modes, the edges in wire mode."""
+        tris = self._world(tris_local)
+        if self.state.mode == "wire":
+            segs = np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]])
+            pieces = raster.segment_pieces(self.lat, segs)
+        else:
+            pieces = raster.triangle_pieces(self.lat, tris)
+        n = self._paint(el, pieces)
+        p = {"triangles": len(tris)}
+        p.update(params or {})
+        self._record(el, shape, p, tris, False, n)
+
+    def cmd_drawtriangle(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, exact=3)
+        self._draw_surface(el, p[None], "triangle", {"vertices": self._world(p).tolist()})
+
+    def cmd_drawquadri(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, exact=4)
+        self._draw_surface(el, np.array([p[[0, 1, 2]], p[[0, 2, 3]]]), "quadri",
+                           {"vertices": self._world(p).tolist()})
+
+    def cmd_drawtrianglesstrip(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, least=3)
+        tris = np.array([p[[i, i + 1, i + 2]] for i in range(len(p) - 2)])
+        self._draw_surface(el, tris, "trianglesstrip")
+
+    def cmd_drawtrianglesfan(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, least=3)
+        tris = np.array([p[[0, i, i + 1]] for i in range(1, len(p) - 1)])
+        self._draw_surface(el, tris, "trianglesfan")
+
+    def cmd_drawpolygon(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, least=3)
+        tris = shapes.faces_to_triangles(p, [tuple(range(len(p)))])
+        if len(tris) == 0:
+            raise self.reader.error(el, "the polygon has no area", "at least 3 non-collinear points")
+        self._draw_surface(el, tris, "polygon", {"vertices": self._world(p).tolist()})
+
+    def cmd_drawtriangles(self, el):
+        self._need_pen(el)
+        self._check(el, {"points", "triangles"})
+        pts_el = self.reader.child(el, "points", required=True)
+        tri_el = self.reader.child(el, "triangles", required=True)
+        self._check(pts_el, {"point"})
+        self._check(tri_el, {"triangle"})
+        pts = self._points(pts_el, least=3)
+        kids = self.reader.children(tri_el, "triangle")
+        if not kids or len(kids) > MAX_POINTS:
+            raise self.reader.error(tri_el, f"{len(kids)} <triangle> elements",
+                                    f"1 to {MAX_POINTS}")
+        idx = np.array([[self.reader.integer(k, n, lo=0, hi=len(pts) - 1) for n in "xyz"]
+                        for k in kids], dtype=np.int64)
+        self._draw_surface(el, pts[idx], el.tag[4:])
+
+    cmd_drawfigure = cmd_drawtriangles
+
+    # ------------------------------------------------------------ box
+    def _box_extent(self, el):
+        """(point, size) from <point> and <size> or <endpoint>; size may be negative."""
+        p_el = self.reader.child(el, "point", required=True)
+        point = self.reader.vec3(p_el)
+        s_el = self.reader.child(el, "size")
+        e_el = self.reader.child(el, "endpoint")
+        if (s_el is None) == (e_el is None):
+            raise self.reader.error(el, "needs exactly one of <size> and <endpoint>",
+                                    "<point> with <size> or <endpoint>")
+        size = self.reader.vec3(s_el) if s_el is not None else self.reader.vec3(e_el) - point
+        # a negative size extends the box the other way
+        lo = np.minimum(point, point + size)
+        return lo, np.abs(size)
+
+    def _box_fill(self, el):
+        """(solid, faces) from <boxfill>; without it the draw mode decides."""
+        bf = self.reader.child(el, "boxfill")
+        if bf is None:
+            solid, surface, wire = self._mode_flags()
+            return solid, (list(raster.FACE_AXIS) if surface else []), wire
+        tokens = [t.strip().lower() for t in self.reader.element_text(bf).split("|") if t.strip()]
+        bad = [t for t in tokens if t not in BOX_TOKENS]
+        if bad or not tokens:
+            raise self.reader.error(bf, f"invalid boxfill '{self.reader.element_text(bf)}'",
+                                    "solid, all, or faces bottom | top | left | right | front | back")
+        faces = list(raster.FACE_AXIS) if "all" in tokens else \
+            [f for f in raster.FACE_AXIS if f in tokens]
+        return "solid" in tokens, faces, False
+
+    def cmd_drawbox(self, el):
+        self._need_pen(el)
+        self._check(el, {"boxfill", "point", "size", "endpoint", "angles", "layers"})
+        if self.reader.child(el, "layers") is not None:
+            raise self.reader.error(self.reader.child(el, "layers"),
+                                    "<layers> of <drawbox> is not supported by sphdvi",
+                                    "one box per layer")
+        point, size = self._box_extent(el)
+        ang_el = self.reader.child(el, "angles")
+        angles = self.reader.vec3(ang_el) if ang_el is not None else None
+        solid, faces, wire = self._box_fill(el)
+        pieces, params, tris = shapes.draw_box(self.lat, self.state.matrix, point, size, angles,
+                                               solid=solid, faces=faces, wire=wire)
+        params["faces"] = faces
+        n = self._paint(el, pieces)
+        self._record(el, "box", params, tris, solid, n)
+
+    # ------------------------------------------------------------ curved shapes
+    def _curved_flags(self):
+        """(solid, shell): full and solid fill the volume; face and wire draw the inner shell."""
+        mode = self.state.mode
+        return mode in ("full", "solid"), mode in ("face", "wire")
+
+    def _layers_unsupported(self, el):
+        lay = self.reader.child(el, "layers")
+        if lay is not None:
+            raise self.reader.error(lay, f"<layers> of <{el.tag}> is not supported by sphdvi",
+                                    "one shape per layer")
+
+    def cmd_drawsphere(self, el):
+        self._need_pen(el)
+        self._check(el, {"point", "layers"})
+        self._layers_unsupported(el)
+        r = self.reader.num(el, "radius", positive=True)
+        c = self._points(el, exact=1)[0]
+        solid, shell = self._curved_flags()
+        pieces, params, tris = shapes.draw_sphere(self.lat, self.state.matrix, c, r,
+                                                  solid=solid, shell=shell)
+        n = self._paint(el, pieces)
+        self._record(el, "sphere", params, tris, solid, n)
+
+    def cmd_drawellipsoid(self, el):
+        self._need_pen(el)
+        self._check(el, {"point", "center", "radius", "size", "layers"})
+        self._layers_unsupported(el)
+        solid, shell = self._curved_flags()
+        radii_el = self.reader.child(el, "radius")
+        if radii_el is None:
+            radii_el = self.reader.child(el, "size")
+        frame = None
+        if radii_el is not None:
+            c_el = self.reader.child(el, "center")
+            c = self.reader.vec3(c_el) if c_el is not None else self._points(el, exact=1)[0]
+            radii = self.reader.vec3(radii_el)
+            if not np.all(radii > 0):
+                raise self.reader.error(radii_el, "semi-axes must be positive", "x, y, z > 0")
+        else:
+            pts = self._points(el, exact=2)
+            r = self.reader.num(el, "radius", positive=True)
+            try:
+                c, frame, radii = shapes.foci_ellipsoid(pts[0], pts[1], r)
+            except ValueError as exc:
+                raise self.reader.error(el, str(exc), "radius > half the distance between the "
+                                        "two focus points") from None
+        pieces, params, tris = shapes.draw_ellipsoid_axes(self.lat, self.state.matrix, c, radii,
+                                                          solid=solid, shell=shell, frame=frame)
+        n = self._paint(el, pieces)
+        self._record(el, "ellipsoid", params, tris, solid, n)
+
+    def cmd_drawcylinder(self, el):
+        self._need_pen(el)
+        self._check(el, {"point", "layers"})
+        self._layers_unsupported(el)
+        r = self.reader.num(el, "radius", positive=True)
+        p = self._points(el, exact=2)
+        mask = self._mask(el)
+        solid, shell = self._curved_flags()
+        try:
+            pieces, params, tris = shapes.draw_cylinder(self.lat, self.state.matrix, p[0], p[1], r,
+                                                        solid=solid, shell=shell, mask=mask)
+        except ValueError as exc:
+            raise self.reader.error(el, str(exc), "two distinct axis points") from None
+        params["mask"] = mask
+        n = self._paint(el, pieces)
+        self._record(el, "cylinder", params, tris, solid, n)
+
+    # ------------------------------------------------------------ polyhedra
+    def _draw_polyhedron(self, el, verts, faces, shape):
+        mask = self._mask(el)
+        solid, surface, wire = self._mode_flags()
+        pieces, params, tris = shapes.draw_polyhedron(self.lat, self.state.matrix, verts, faces,
+                                                      solid=solid, surface=surface, wire=wire,
+                                                      mask=mask)
+        params["mask"] = mask
+        n = self._paint(el, pieces)
+        self._record(el, shape, params, tris, solid, n)
+
+    def cmd_drawprism(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, least=6)
+        if len(p) % 2 or len(p) > 2 * 64:
+            raise self.reader.error(el, f"{len(p)} points", "an even number (base then top), "
+                                    "6 or 8 typically")
+        self._draw_polyhedron(el, p, shapes.prism_faces(len(p) // 2), "prism")
+
+    def cmd_drawpyramid(self, el):
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, least=4)
+        if len(p) > 65:
+            raise self.reader.error(el, f"{len(p)} points", "apex + at most 64 base points")
+        self._draw_polyhedron(el, p, shapes.pyramid_faces(len(p) - 1), "pyramid")
+
+    # ------------------------------------------------------------ mesh files
+    def _draw_file(self, el, kind):
+        from . import meshfile
+        self._need_pen(el)
+        self._check(el, {"drawmove", "drawrotate", "drawscale", "depth", "polyselec"})
+        for tag in ("depth", "polyselec"):
+            if self.reader.child(el, tag) is not None:
+                raise self.reader.error(self.reader.child(el, tag),
+                                        f"<{tag}> is not supported by sphdvi", "a plain mesh file")
+        if self.reader.boolean(el, "advanced", False):
+            raise self.reader.error(el, "advanced=\"true\" is not supported by sphdvi",
+                                    "advanced=\"false\"")
+        path = self.reader.resolve_path(el, "file")
+        autofill = self.reader.boolean(el, "autofill", False)
+        self.reader.boolean(el, "reverse", False)
+        local = tf.identity()
+        mv = self.reader.child(el, "drawmove")
+        rot = self.reader.child(el, "drawrotate")
+        sc = self.reader.child(el, "drawscale")
+        if sc is not None:
+            s = np.array([self.reader.num(sc, n, 1.0) for n in "xyz"])
+            if np.any(s == 0):
+                raise self.reader.error(sc, "a scale factor is 0", "non-zero x, y, z")
+            local = tf.scaling(s) @ local
+        if rot is not None:
+            ang = [self.reader.num(rot, n, 0.0) for n in ("angx", "angy", "angz")]
+            local = tf.rotation_xyz(ang) @ local
+        if mv is not None:
+            local = tf.translation(self.reader.vec3(mv)) @ local
+        try:
+            tris_local = meshfile.read_triangles(path, kind)
+        except (meshfile.MeshError, OSError) as exc:
+            raise self.reader.error(el, f"cannot read '{os.path.basename(path)}': {exc}",
+                                    f"a valid {kind.upper()} triangle mesh") from None
+        tris = tf.apply(self.state.matrix @ local, tris_local)
+        pieces = raster.triangle_pieces(self.lat, tris, surface=True, solid=autofill)
+        n = self._paint(el, pieces)
+        params = {"file": path, "triangles": int(len(tris)),
+                  "min": tris.reshape(-1, 3).min(axis=0).tolist(),
+                  "max": tris.reshape(-1, 3).max(axis=0).tolist(), "autofill": autofill}
+        self._record(el, "mesh", params, tris, autofill, n)
+
+    def cmd_drawfilestl(self, el):
+        self._draw_file(el, "stl")
+
+    def cmd_drawfileply(self, el):
+        self._draw_file(el, "ply")
+
+    def cmd_drawfilevtk(self, el):
+        self._draw_file(el, "vtk")
+
+    # ------------------------------------------------------------ fills
+    def _fill_modes(self, el):
+        mf = self.reader.child(el, "modefill")
+        if mf is None:
+            return {"void"}
+        tokens = {t.strip().lower() for t in self.reader.element_text(mf).split("|") if t.strip()}
+        if not tokens or tokens - FILL_TOKENS:
+            raise self.reader.error(mf, f"invalid modefill '{self.reader.element_text(mf)}'",
+                                    "void, border, fluid, bound joined by |")
+        if tokens == {"border"}:
+            tokens = {"void"}
+        return tokens
+
+    def _fill(self, el, seed, modes, lo, hi, shape):
+        self._need_pen(el)
+        mkfluid = self.reader.integer(el, "mkfluid", None, lo=0)
+        mkbound = self.reader.integer(el, "mkbound", None, lo=0)
+        code = self._code()
+        labels = self.canvas.labels
+        fillable = np.zeros(len(labels), dtype=np.bool_)
+        fillable[0] = "void" in modes
+        for c, (is_fluid, mk) in enumerate(labels[1:], start=1):
+            if is_fluid:
+                fillable[c] = "fluid" in modes and (mkfluid is None or mk == mkfluid)
+            else:
+                fillable[c] = "bound" in modes and (mkbound is None or mk == mkbound)
+        s = np.array([round_idx(v) for v in self.lat.to_index(seed)], dtype=np.int64)
+        r = self.lat.clip_range(lo, hi)
+        n = 0
+        if r is None or np.any(s < r[0]) or np.any(s > r[1]):
+            self.reader.warn(el, "the seed point is outside the lattice (or the fill box); "
+                                 "nothing filled")
+        elif not self.state.draw_points:
+            pass
+        else:
+            from .kernels import seed_fill
+            n = int(seed_fill(self.canvas.codes, fillable, s, r[0], r[1], code))
+            if n == 0:
+                self.reader.warn(el, "the seed node is not of a kind listed in <modefill>; "
+                                     "nothing filled")
+        self._record(el, shape, {"seed": seed.tolist(), "modes": sorted(modes)}, None, False, n)
+
+    def cmd_fillpoint(self, el):
+        self._check(el, {"modefill"})
+        seed = self._world(self.reader.vec3(el)[None])[0]
+        big = 2**40
+        self._fill(el, seed, self._fill_modes(el), [-big] * 3, [big] * 3, "fillpoint")
+
+    def cmd_fillvoidpoint(self, el):
+        self._check(el, set())
+        seed = self._world(self.reader.vec3(el)[None])[0]
+        big = 2**40
+        self._fill(el, seed, {"void"}, [-big] * 3, [big] * 3, "fillpoint")
+
+    def cmd_fillbox(self, el):
+        self._check(el, {"modefill", "point", "size", "endpoint"})
+        if not tf.is_axis_aligned(self.state.matrix):
+            raise self.reader.error(el, "<fillbox> under a rotation is not supported by sphdvi",
+                                    "no rotation (matrixreset) before fillbox")
+        seed = self._world(self.reader.vec3(el)[None])[0]
+        point, size = self._box_extent(el)
+        corners = self._world(np.array([point, point + size]))
+        a = self.lat.to_index(corners.min(axis=0))
+        b = self.lat.to_index(corners.max(axis=0))
+        lo = [ceil_idx(v) for v in a]
+        hi = [floor_idx(v) for v in b]
+        if self.lat.is2d:
+            lo[1] = hi[1] = 0
+        self._fill(el, seed, self._fill_modes(el), lo, hi, "fillbox")
+
+    # ------------------------------------------------------------ shape output
+    def cmd_shapeout(self, el):
+        value = self.reader.text_attr(el, "file")
+        fmt = self.reader.text_attr(el, "format", "vtk", choices=set(FORMATS)).lower()
+        reset = self.reader.boolean(el, "reset", True)
+        self.reader.num(el, "savenormal", 0.0)
+        base = os.path.basename(value.replace("\\", "/"))
+        if base.lower().endswith("." + fmt):
+            base = base[: -len(fmt) - 1]
+        if not base or base in (".", "..") or not re.fullmatch(r"[A-Za-z0-9_.\-]+", base):
+            raise self.reader.error(el, f"file={value!r} is not a usable file name",
+                                    "a plain name of letters, digits, '_', '-', '.'")
+        if self.outdir is not None:
+            name = f"{self.casename}_{base}.{fmt}" if self.casename else f"{base}.{fmt}"
+            path = os.path.join(self.outdir, name)
+            try:
+                write_shapes(path, self.shapes, fmt)
+            except OSError as exc:
+                raise self.reader.error(el, f"cannot write {path}: {exc.strerror}") from None
+            self.shape_files.append(path)
+        if reset:
+            self.shapes = []
+
+
+VARIABLE_COMMANDS = {"newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",
+                     "delvar", "printf", "abort", "varssave", "varsload", "exportvar"}
+
+
+# ---------------------------------------------------------------- entry point
+def _define_builtin(vars_, name, value) -> None:
+    vars_.delete(name)
+    vars_.define(name, value, constant=True)
+
+
+def _read_definition(reader, geometry_el):
+    d = reader.child(geometry_el, "definition", required=True)
+    reader.check_children(d, {"pointref", "pointmin", "pointmax", "rem"}, "child element")
+    dp = reader.num(d, "dp", positive=True)
+    pmin = reader.vec3(reader.child(d, "pointmin", required=True))
+    pmax_el = reader.child(d, "pointmax", required=True)
+    pmax = reader.vec3(pmax_el)
+    ref_el = reader.child(d, "pointref")
+    pref = reader.vec3(ref_el) if ref_el is not None else None
+    if np.any(pmax < pmin):
+        raise reader.error(pmax_el, f"pointmax {pmax.tolist()} is below pointmin "
+                                    f"{pmin.tolist()}", "pointmax >= pointmin on every axis")
+    if not np.all(np.isfinite((pmax - pmin) / dp)):
+        raise reader.error(d, "domain size / dp is not finite", "a finite number of nodes")
+    return d, dp, pmin, pmax, pref
+
+
+def run_geometry(reader, geometry_el, *, casename: str, outdir: str | None,
+                 max_nodes: int = 200_000_000) -> Drawing:
+    """Execute ``<geometry>`` (predefinition, definition, commands) and return the particles."""
+    reader.check_children(geometry_el, {"predefinition", "definition", "commands", "rem"},
+                          "child element")
+    pre = reader.child(geometry_el, "predefinition")
+    runner = GeometryRunner(reader, None, casename, outdir)
+    if pre is not None:
+        runner.run_commands(pre, only_variables=True)
+    d, dp, pmin, pmax, pref = _read_definition(reader, geometry_el)
+    lat = Lattice(dp, pmin, pmax, pref)
+    if lat.node_count > max_nodes:
+        raise reader.error(d, f"domain has {lat.node_count:.4g} lattice nodes "
+                              f"({' x '.join(f'{c:.4g}' for c in lat.counts_float)}); "
+                              f"at most {max_nodes}",
+                           "a larger dp or a smaller pointmin..pointmax")
+    runner.lat = lat
+    runner.canvas = Canvas(lat)
+    v = reader.vars
+    _define_builtin(v, "Dp", dp)
+    for i, ax in enumerate("xyz"):
+        _define_builtin(v, f"PosMin_{ax}", float(pmin[i]))
+        _define_builtin(v, f"PosMax_{ax}", float(pmax[i]))
+    _define_builtin(v, "Data2D", 1.0 if lat.is2d else 0.0)
+    _define_builtin(v, "Data2DPosy", float(pmin[1]) if lat.is2d else 0.0)
+    if "CaseName" not in v.values:
+        v.define("CaseName", casename)
+    commands = reader.child(geometry_el, "commands")
+    if commands is not None:
+        reader.check_children(commands, {"list", "mainlist", "rem"}, "child element")
+        for lst in reader.children(commands, "list"):
+            name = reader.text_attr(lst, "name")
+            reader.boolean(lst, "printcall", True)
+            if name in runner.lists:
+                raise reader.error(lst, f"list '{name}' is defined twice", "unique list names")
+            runner.lists[name] = lst
+        mains = reader.children(commands, "mainlist")
+        if len(mains) > 1:
+            raise reader.error(mains[1], "more than one <mainlist>", "a single <mainlist>")
+        if mains:
+            runner.run_commands(mains[0])
+    pos, is_fluid, mk = runner.canvas.extract()
+    return Drawing(dp=dp, pointmin=pmin, pointmax=pmax, pointref=lat.pointref, is2d=lat.is2d,
+                   posy2d=float(pmin[1]) if lat.is2d else 0.0, pos=pos, is_fluid=is_fluid,
+                   mk=mk, primitives=runner.primitives, shape_files=runner.shape_files,
+                   messages=runner.messages, origin=lat.origin)

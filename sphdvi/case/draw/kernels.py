@@ -1,0 +1,225 @@
+"""Compiled (numba) loops of the drawing: triangle surfaces, inside-by-parity and seed fill.
+
+All coordinates here are lattice coordinates (node ``k`` at ``k``). Each kernel
+works on a boolean sub-array ``out`` whose node (0,0,0) is lattice node ``lo``.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_EPS = 1e-6
+# tiny irrational offsets of the parity rays, so a ray never hits an edge or vertex exactly
+_RAY_DX = 3.14159265e-7
+_RAY_DY = 2.71828183e-7
+
+
+@njit(cache=True)
+def _seg_dist2(px, py, pz, ax, ay, az, bx, by, bz):
+    ux, uy, uz = bx - ax, by - ay, bz - az
+    L2 = ux * ux + uy * uy + uz * uz
+    t = 0.0
+    if L2 > 0.0:
+        t = ((px - ax) * ux + (py - ay) * uy + (pz - az) * uz) / L2
+        if t < 0.0:
+            t = 0.0
+        elif t > 1.0:
+            t = 1.0
+    dx = px - (ax + t * ux)
+    dy = py - (ay + t * uy)
+    dz = pz - (az + t * uz)
+    return dx * dx + dy * dy + dz * dz
+
+
+@njit(cache=True)
+def raster_triangles(tri, lo, out):
+    """Mark the surface nodes of triangles (T,3,3).
+
+    A node is on a triangle when its signed distance ``w`` to the triangle's
+    plane is in (-1/2, 1/2] (one node layer, never a gap a 6-connected path can
+    cross) and its projection lies within 1/2 of the triangle (edges therefore
+    reach the nearest node, like box faces).
+    """
+    nx, ny, nz = out.shape
+    h = 0.5 + _EPS
+    for t in range(tri.shape[0]):
+        ax, ay, az = tri[t, 0, 0], tri[t, 0, 1], tri[t, 0, 2]
+        bx, by, bz = tri[t, 1, 0], tri[t, 1, 1], tri[t, 1, 2]
+        cx, cy, cz = tri[t, 2, 0], tri[t, 2, 1], tri[t, 2, 2]
+        e1x, e1y, e1z = bx - ax, by - ay, bz - az
+        e2x, e2y, e2z = cx - ax, cy - ay, cz - az
+        nxv = e1y * e2z - e1z * e2y
+        nyv = e1z * e2x - e1x * e2z
+        nzv = e1x * e2y - e1y * e2x
+        nn = np.sqrt(nxv * nxv + nyv * nyv + nzv * nzv)
+        if not nn > 1e-12:
+            continue
+        nxv /= nn
+        nyv /= nn
+        nzv /= nn
+        i0 = int(np.ceil(min(ax, bx, cx) - h)) - lo[0]
+        i1 = int(np.floor(max(ax, bx, cx) + h)) - lo[0]
+        j0 = int(np.ceil(min(ay, by, cy) - h)) - lo[1]
+        j1 = int(np.floor(max(ay, by, cy) + h)) - lo[1]
+        k0 = int(np.ceil(min(az, bz, cz) - h)) - lo[2]
+        k1 = int(np.floor(max(az, bz, cz) + h)) - lo[2]
+        i0 = max(i0, 0)
+        j0 = max(j0, 0)
+        k0 = max(k0, 0)
+        i1 = min(i1, nx - 1)
+        j1 = min(j1, ny - 1)
+        k1 = min(k1, nz - 1)
+        # barycentric set-up
+        d00 = e1x * e1x + e1y * e1y + e1z * e1z
+        d01 = e1x * e2x + e1y * e2y + e1z * e2z
+        d11 = e2x * e2x + e2y * e2y + e2z * e2z
+        den = d00 * d11 - d01 * d01
+        for i in range(i0, i1 + 1):
+            px = float(i + lo[0])
+            for j in range(j0, j1 + 1):
+                py = float(j + lo[1])
+                for k in range(k0, k1 + 1):
+                    pz = float(k + lo[2])
+                    w = (px - ax) * nxv + (py - ay) * nyv + (pz - az) * nzv
+                    if w <= -0.5 + _EPS or w > h:
+                        continue
+                    qx, qy, qz = px - w * nxv, py - w * nyv, pz - w * nzv
+                    vx, vy, vz = qx - ax, qy - ay, qz - az
+                    d20 = vx * e1x + vy * e1y + vz * e1z
+                    d21 = vx * e2x + vy * e2y + vz * e2z
+                    v = (d11 * d20 - d01 * d21) / den
+                    u = (d00 * d21 - d01 * d20) / den
+                    if v >= 0.0 and u >= 0.0 and u + v <= 1.0:
+                        out[i, j, k] = True
+                        continue
+                    d2 = _seg_dist2(qx, qy, qz, ax, ay, az, bx, by, bz)
+                    d2 = min(d2, _seg_dist2(qx, qy, qz, bx, by, bz, cx, cy, cz))
+                    d2 = min(d2, _seg_dist2(qx, qy, qz, cx, cy, cz, ax, ay, az))
+                    if d2 <= h * h:
+                        out[i, j, k] = True
+
+
+@njit(cache=True)
+def _ray_hit(px, py, ax, ay, bx, by, cx, cy):
+    """Does the vertical ray at (px, py) cross the xy-projection of the triangle?"""
+    d1 = (bx - ax) * (py - ay) - (by - ay) * (px - ax)
+    d2 = (cx - bx) * (py - by) - (cy - by) * (px - bx)
+    d3 = (ax - cx) * (py - cy) - (ay - cy) * (px - cx)
+    return (d1 > 0 and d2 > 0 and d3 > 0) or (d1 < 0 and d2 < 0 and d3 < 0)
+
+
+@njit(cache=True)
+def _column_crossings(tri, lo, nx, ny, counts, start, zs, record):
+    """Count (record=False) or store (record=True) the z crossings of every node column."""
+    fill = np.zeros(nx * ny, dtype=np.int64)
+    for t in range(tri.shape[0]):
+        ax, ay, az = tri[t, 0, 0], tri[t, 0, 1], tri[t, 0, 2]
+        bx, by, bz = tri[t, 1, 0], tri[t, 1, 1], tri[t, 1, 2]
+        cx, cy, cz = tri[t, 2, 0], tri[t, 2, 1], tri[t, 2, 2]
+        e1x, e1y, e1z = bx - ax, by - ay, bz - az
+        e2x, e2y, e2z = cx - ax, cy - ay, cz - az
+        nzv = e1x * e2y - e1y * e2x
+        if nzv == 0.0:
+            continue
+        nxv = e1y * e2z - e1z * e2y
+        nyv = e1z * e2x - e1x * e2z
+        i0 = max(int(np.floor(min(ax, bx, cx))) - lo[0], 0)
+        i1 = min(int(np.ceil(max(ax, bx, cx))) - lo[0], nx - 1)
+        j0 = max(int(np.floor(min(ay, by, cy))) - lo[1], 0)
+        j1 = min(int(np.ceil(max(ay, by, cy))) - lo[1], ny - 1)
+        for i in range(i0, i1 + 1):
+            px = float(i + lo[0]) + _RAY_DX
+            for j in range(j0, j1 + 1):
+                py = float(j + lo[1]) + _RAY_DY
+                if not _ray_hit(px, py, ax, ay, bx, by, cx, cy):
+                    continue
+                c = i * ny + j
+                if record:
+                    zs[start[c] + fill[c]] = az - (nxv * (px - ax) + nyv * (py - ay)) / nzv
+                    fill[c] += 1
+                else:
+                    counts[c] += 1
+
+
+@njit(cache=True)
+def parity_inside(tri, lo, out):
+    """Mark nodes inside a closed triangle mesh (even-odd rule along z rays).
+
+    Each (x, y) node column casts a ray along z; crossings are sorted and the
+    nodes between crossing pairs (within 1e-6 of them) are inside. Columns with
+    an odd number of crossings (an open mesh) fill only complete pairs.
+    """
+    nx, ny, nz = out.shape
+    counts = np.zeros(nx * ny, dtype=np.int64)
+    start = np.zeros(nx * ny + 1, dtype=np.int64)
+    zs = np.empty(0, dtype=np.float64)
+    _column_crossings(tri, lo, nx, ny, counts, start, zs, False)
+    for c in range(nx * ny):
+        start[c + 1] = start[c] + counts[c]
+    zs = np.empty(start[nx * ny], dtype=np.float64)
+    _column_crossings(tri, lo, nx, ny, counts, start, zs, True)
+    for c in range(nx * ny):
+        m = counts[c]
+        if m < 2:
+            continue
+        i = c // ny
+        j = c % ny
+        col = np.sort(zs[start[c]:start[c] + m])
+        for p in range(0, m - 1, 2):
+            k0 = max(int(np.ceil(col[p] - _EPS)) - lo[2], 0)
+            k1 = min(int(np.floor(col[p + 1] + _EPS)) - lo[2], nz - 1)
+            for k in range(k0, k1 + 1):
+                out[i, j, k] = True
+
+
+@njit(cache=True)
+def seed_fill(codes, fillable, seed, lo, hi, newcode):
+    """Flood fill (6-connected) from ``seed`` through nodes whose code is fillable.
+
+    Only nodes within the inclusive index box lo..hi are visited. Every
+    reached node gets ``newcode``. Returns the number of nodes filled.
+    """
+    nx, ny, nz = codes.shape
+    if not fillable[codes[seed[0], seed[1], seed[2]]]:
+        return 0
+    visited = np.zeros((hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1), dtype=np.bool_)
+    cap = 1024
+    stack = np.empty((cap, 3), dtype=np.int64)
+    stack[0, 0], stack[0, 1], stack[0, 2] = seed[0], seed[1], seed[2]
+    top = 1
+    visited[seed[0] - lo[0], seed[1] - lo[1], seed[2] - lo[2]] = True
+    filled = 0
+    while top > 0:
+        top -= 1
+        i, j, k = stack[top, 0], stack[top, 1], stack[top, 2]
+        codes[i, j, k] = newcode
+        filled += 1
+        for d in range(6):
+            a, b, c = i, j, k
+            if d == 0:
+                a -= 1
+            elif d == 1:
+                a += 1
+            elif d == 2:
+                b -= 1
+            elif d == 3:
+                b += 1
+            elif d == 4:
+                c -= 1
+            else:
+                c += 1
+            if a < lo[0] or a > hi[0] or b < lo[1] or b > hi[1] or c < lo[2] or c > hi[2]:
+                continue
+            if visited[a - lo[0], b - lo[1], c - lo[2]]:
+                continue
+            if not fillable[codes[a, b, c]]:
+                continue
+            visited[a - lo[0], b - lo[1], c - lo[2]] = True
+            if top == cap:
+                cap *= 2
+                bigger = np.empty((cap, 3), dtype=np.int64)
+                bigger[:top] = stack[:top]
+                stack = bigger
+            stack[top, 0], stack[top, 1], stack[top, 2] = a, b, c
+            top += 1
+    return filled

@@ -1,0 +1,299 @@
+"""Primitive shapes: their nodes (via :mod:`raster`), world-frame parameters and a
+triangle tessellation (for ``<shapeout>``).
+
+Every builder takes the current transformation matrix ``m`` and returns
+``(pieces, params, triangles)``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import raster
+from . import transform as tf
+from .lattice import EPS, Lattice
+
+NSIDES = 24
+
+
+# ---------------------------------------------------------------- helpers
+def polygon_triangles(pts: np.ndarray) -> list[tuple[int, int, int]]:
+    """Triangulate a planar simple polygon (ear clipping); falls back to a fan."""
+    n = len(pts)
+    if n < 3:
+        return []
+    # Newell normal, then project on the dominant plane
+    nrm = np.zeros(3)
+    for i in range(n):
+        a, b = pts[i], pts[(i + 1) % n]
+        nrm += np.array([(a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]),
+                         (a[0] - b[0]) * (a[1] + b[1])])
+    if not np.linalg.norm(nrm) > 0:
+        return []
+    drop = int(np.argmax(np.abs(nrm)))
+    keep = [i for i in range(3) if i != drop]
+    p2 = pts[:, keep]
+    if nrm[drop] < 0:
+        p2 = p2[:, ::-1]
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    idx = list(range(n))
+    tris = []
+    guard = 0
+    while len(idx) > 3 and guard < 10 * n * n:
+        guard += 1
+        m = len(idx)
+        for k in range(m):
+            i0, i1, i2 = idx[(k - 1) % m], idx[k], idx[(k + 1) % m]
+            if cross(p2[i0], p2[i1], p2[i2]) <= 0:
+                continue
+            ear = True
+            for j in idx:
+                if j in (i0, i1, i2):
+                    continue
+                if (cross(p2[i0], p2[i1], p2[j]) >= 0 and cross(p2[i1], p2[i2], p2[j]) >= 0
+                        and cross(p2[i2], p2[i0], p2[j]) >= 0):
+                    ear = False
+                    break
+            if ear:
+                tris.append((i0, i1, i2))
+                idx.pop(k)
+                break
+        else:
+            break
+    if len(idx) == 3:
+        tris.append(tuple(idx))
+    elif len(idx) > 3:  # not simple: fan the rest
+        tris.extend((idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1))
+    return tris
+
+
+def faces_to_triangles(verts: np.ndarray, faces) -> np.ndarray:
+    tris = []
+    for f in faces:
+        for t in polygon_triangles(verts[list(f)]):
+            tris.append(verts[[f[t[0]], f[t[1]], f[t[2]]]])
+    return np.array(tris, dtype=np.float64).reshape(-1, 3, 3)
+
+
+def face_edges(faces):
+    edges = set()
+    for f in faces:
+        for i in range(len(f)):
+            a, b = f[i], f[(i + 1) % len(f)]
+            edges.add((min(a, b), max(a, b)))
+    return sorted(edges)
+
+
+def local_tol(m: np.ndarray, dp: float) -> float:
+    """EPS lattice units expressed in the shape's own frame."""
+    sv = np.linalg.svd(m[:3, :3], compute_uv=False)
+    return EPS * dp / max(float(sv.min()), 1e-300)
+
+
+def mask_bits(mask: int, count: int) -> list[bool]:
+    """Which of ``count`` faces are drawn: face i is hidden when bit 2**i is set in mask."""
+    return [not (mask >> i) & 1 for i in range(count)]
+
+
+# ---------------------------------------------------------------- box
+BOX_FACES = {  # local corners of each face, outward order
+    "left": (0, 2, 3, 1), "right": (4, 5, 7, 6), "front": (0, 1, 5, 4),
+    "back": (2, 6, 7, 3), "bottom": (0, 4, 6, 2), "top": (1, 3, 7, 5)}
+
+
+def box_corners(size) -> np.ndarray:
+    sx, sy, sz = size
+    return np.array([[x, y, z] for x in (0.0, sx) for y in (0.0, sy) for z in (0.0, sz)])
+
+
+def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: bool):
+    """A box with a corner at ``point`` and edges ``size`` (rotated by ``angles`` about ``point``)."""
+    full = m @ tf.translation(point)
+    if angles is not None and np.any(angles != 0):
+        full = full @ tf.rotation_xyz(angles)
+    verts = tf.apply(full, box_corners(size))
+    pieces = []
+    if tf.is_axis_aligned(full):
+        # map local face names to world faces (a negative scale swaps them)
+        sgn = np.sign(np.diag(full[:3, :3]))
+        world_faces = []
+        for f in faces:
+            axis, side = raster.FACE_AXIS[f]
+            if sgn[axis] < 0:
+                side = 1 - side
+            world_faces.append([n for n, (a, s) in raster.FACE_AXIS.items()
+                                if a == axis and s == side][0])
+        pieces = raster.aligned_box_pieces(lat, verts.min(axis=0), verts.max(axis=0),
+                                           solid, world_faces, wire)
+    else:
+        if solid:
+            tol = local_tol(full, lat.dp)
+            lo, hi = np.zeros(3), np.asarray(size, dtype=np.float64)
+
+            def cons(qx, qy, qz):
+                return [(qx >= lo[0] - tol) & (qx <= hi[0] + tol) & (qy >= lo[1] - tol)
+                        & (qy <= hi[1] + tol) & (qz >= lo[2] - tol) & (qz <= hi[2] + tol)]
+            pieces += raster.analytic_pieces(lat, full, lo, hi, cons, solid=True, shell_faces=())
+        if faces:
+            tris = faces_to_triangles(verts, [BOX_FACES[f] for f in faces])
+            pieces += raster.triangle_pieces(lat, tris)
+        if wire:
+            segs = [verts[[a, b]] for a, b in face_edges(BOX_FACES.values())]
+            pieces += raster.segment_pieces(lat, segs)
+    params = {"vertices": verts.tolist(), "center": verts.mean(axis=0).tolist(),
+              "size": [abs(float(v)) for v in size], "matrix": full.tolist(),
+              "axis_aligned": tf.is_axis_aligned(full)}
+    if params["axis_aligned"]:
+        params["min"] = verts.min(axis=0).tolist()
+        params["max"] = verts.max(axis=0).tolist()
+    tris = faces_to_triangles(verts, list(BOX_FACES.values()))
+    return pieces, params, tris
+
+
+# ---------------------------------------------------------------- sphere / ellipsoid
+def unit_sphere_triangles(n: int = NSIDES) -> np.ndarray:
+    th = np.linspace(0, math.pi, n // 2 + 1)
+    ph = np.linspace(0, 2 * math.pi, n + 1)
+    P = np.stack([np.sin(th)[:, None] * np.cos(ph)[None, :],
+                  np.sin(th)[:, None] * np.sin(ph)[None, :],
+                  np.cos(th)[:, None] * np.ones_like(ph)[None, :]], axis=-1)
+    tris = []
+    for i in range(len(th) - 1):
+        for j in range(len(ph) - 1):
+            a, b, c, d = P[i, j], P[i + 1, j], P[i + 1, j + 1], P[i, j + 1]
+            if i > 0:
+                tris.append([a, b, d])
+            if i < len(th) - 2:
+                tris.append([b, c, d])
+    return np.array(tris)
+
+
+def draw_ellipsoid(lat: Lattice, m, center, radii, *, solid: bool, shell: bool, frame=None):
+    """An ellipsoid with semi-axes ``radii`` along the axes of ``frame`` (default: x, y, z)."""
+    center = np.asarray(center, dtype=np.float64)
+    radii = np.asarray(radii, dtype=np.float64)
+    full = m @ tf.translation(center) @ (frame if frame is not None else np.eye(4)) \
+        @ tf.scaling(radii)
+    tol = local_tol(full, lat.dp)
+
+    def cons(qx, qy, qz):
+        return [qx * qx + qy * qy + qz * qz <= (1.0 + tol) ** 2]
+    pieces = raster.analytic_pieces(lat, full, -np.ones(3), np.ones(3), cons, solid=solid,
+                                    shell_faces=(0,) if shell else ())
+    tris = tf.apply(full, unit_sphere_triangles())
+    return pieces, full, tris
+
+
+def draw_sphere(lat, m, center, radius, *, solid, shell):
+    pieces, full, tris = draw_ellipsoid(lat, m, center, [radius] * 3, solid=solid, shell=shell)
+    s = tf.uniform_scale(m)
+    params = {"center": tf.apply(m, center).tolist(),
+              "radius": float(radius * s) if s is not None else None,
+              "local_radius": float(radius), "matrix": m.tolist()}
+    return pieces, params, tris
+
+
+def draw_ellipsoid_axes(lat, m, center, radii, *, solid, shell, frame=None):
+    pieces, full, tris = draw_ellipsoid(lat, m, center, radii, solid=solid, shell=shell,
+                                        frame=frame)
+    params = {"center": tf.apply(m, center).tolist(), "radii": [float(r) for r in radii],
+              "axes": (full[:3, :3] / np.asarray(radii)).T.tolist(), "matrix": full.tolist()}
+    return pieces, params, tris
+
+
+def frame_x_to(u) -> np.ndarray:
+    """A rotation matrix taking the x axis onto the unit vector u."""
+    u = np.asarray(u, dtype=np.float64)
+    v = np.cross([1.0, 0.0, 0.0], u)
+    s, cth = float(np.linalg.norm(v)), float(u[0])
+    if s > 1e-15:
+        return tf.rotation_axis(math.degrees(math.atan2(s, cth)), v)
+    return tf.rotation_axis(180.0, (0, 0, 1)) if cth < 0 else np.eye(4)
+
+
+def foci_ellipsoid(f1, f2, radius):
+    """Centre, frame and semi-axes of the ellipsoid of revolution |p-f1|+|p-f2| <= 2*radius."""
+    f1, f2 = np.asarray(f1, dtype=np.float64), np.asarray(f2, dtype=np.float64)
+    c = 0.5 * float(np.linalg.norm(f2 - f1))
+    if not radius > c:
+        raise ValueError(f"radius {radius:g} must exceed half the distance between the two "
+                         f"points ({c:g})")
+    b = math.sqrt(radius * radius - c * c)
+    frame = frame_x_to((f2 - f1) / (2 * c)) if c > 0 else np.eye(4)
+    return 0.5 * (f1 + f2), frame, np.array([radius, b, b])
+
+
+# ---------------------------------------------------------------- cylinder
+def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, mask: int):
+    """Cylinder of axis p1->p2. Faces (mask bits): 1 = cover at p1, 2 = cover at p2, 4 = side."""
+    p1, p2 = np.asarray(p1, dtype=np.float64), np.asarray(p2, dtype=np.float64)
+    L = float(np.linalg.norm(p2 - p1))
+    if not L > 0:
+        raise ValueError("the two points of the cylinder axis coincide")
+    local = tf.translation(p1) @ frame_x_to((p2 - p1) / L)  # local x in [0, L] along the axis
+    full = m @ local
+    tol = local_tol(full, lat.dp)
+
+    def cons(qx, qy, qz):
+        return [qx >= -tol, qx <= L + tol, qy * qy + qz * qz <= (radius + tol) ** 2]
+    drawn = mask_bits(mask, 3)
+    shell_faces = tuple(i for i in range(3) if drawn[i]) if shell else ()
+    pieces = raster.analytic_pieces(lat, full, np.array([0.0, -radius, -radius]),
+                                    np.array([L, radius, radius]), cons, solid=solid,
+                                    shell_faces=shell_faces)
+    ang = np.linspace(0, 2 * math.pi, NSIDES + 1)
+    ring = np.stack([np.zeros_like(ang), radius * np.cos(ang), radius * np.sin(ang)], axis=1)
+    tris = []
+    for i in range(NSIDES):
+        a0, a1 = ring[i], ring[i + 1]
+        b0, b1 = a0 + [L, 0, 0], a1 + [L, 0, 0]
+        tris += [[a0, b0, b1], [a0, b1, a1], [[0, 0, 0], a1, a0], [[L, 0, 0], b0, b1]]
+    tris = tf.apply(full, np.array(tris))
+    s = tf.uniform_scale(m)
+    params = {"p1": tf.apply(m, p1).tolist(), "p2": tf.apply(m, p2).tolist(),
+              "radius": float(radius * s) if s is not None else None,
+              "local_radius": float(radius), "length": L * (s if s is not None else float("nan")),
+              "matrix": m.tolist()}
+    return pieces, params, tris
+
+
+# ---------------------------------------------------------------- polyhedra
+def prism_faces(n: int):
+    """Faces of a prism with base points 0..n-1 and top points n..2n-1."""
+    faces = [tuple(range(n - 1, -1, -1)), tuple(range(n, 2 * n))]
+    for i in range(n):
+        j = (i + 1) % n
+        faces.append((i, j, n + j, n + i))
+    return faces
+
+
+def pyramid_faces(n: int):
+    """Faces of a pyramid with apex 0 and base points 1..n."""
+    faces = [tuple(range(n, 0, -1))]
+    for i in range(1, n + 1):
+        j = i % n + 1
+        faces.append((0, i, j))
+    return faces
+
+
+def draw_polyhedron(lat: Lattice, m, verts, faces, *, solid: bool, surface: bool, wire: bool,
+                    mask: int):
+    """A closed polyhedron: inside by parity, faces (mask bits 2**i hide face i) by triangles."""
+    w = tf.apply(m, verts)
+    drawn = mask_bits(mask, len(faces))
+    all_tris = faces_to_triangles(w, faces)
+    pieces = []
+    if solid:
+        pieces += raster.triangle_pieces(lat, all_tris, surface=False, solid=True)
+    if surface:
+        shown = [f for f, d in zip(faces, drawn) if d]
+        if shown:
+            pieces += raster.triangle_pieces(lat, faces_to_triangles(w, shown))
+    if wire:
+        pieces += raster.segment_pieces(lat, [w[[a, b]] for a, b in face_edges(faces)])
+    params = {"vertices": w.tolist(), "faces": [list(f) for f in faces]}
+    return pieces, params, all_tris
