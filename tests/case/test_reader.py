@@ -263,3 +263,25 @@ def test_reader_typed_errors(tmp_path):
         rd.num(root, "v")
     with pytest.raises(CaseError, match="missing attribute 'q'"):
         rd.num(root, "q")
+
+
+def test_property_file_and_user_overrides(tmp_path):
+    (tmp_path / "Floating_Materials.xml").write_text(
+        '<?xml version="1.0"?><properties><materials>'
+        '<property name="pvc"><Young_Modulus value="3e9"/><PoissonRatio value="0.30"/>'
+        '<Restitution_Coefficient value="0.60"/><Kfric value="0.45"/></property>'
+        '<property name="steel"><Young_Modulus value="2.1e11"/><PoissonRatio value="0.3"/>'
+        '<Restitution_Coefficient value="0.8"/><Kfric value="0.45"/><Kfric_User value="0.2"/></property>'
+        '</materials></properties>')
+    props = ('<properties><propertyfile file="Floating_Materials.xml" path="materials"/>'
+             '<links><link mkbound="0" property="pvc"/></links></properties>')
+    r = build(tmp_path, casedef_extra=props)
+    assert r.case.materials["pvc"].young == 3e9 and r.case.materials["pvc"].restitution == 0.6
+    assert r.case.materials["steel"].kfric == 0.2
+    assert r.case.material_links[0]["mkbound"] == [0]
+
+
+def test_bad_material_values(tmp_path):
+    props = ('<properties><property name="x"><PoissonRatio value="0.7"/></property></properties>')
+    with pytest.raises(CaseError, match="PoissonRatio 0.7 out of range"):
+        build(tmp_path, casedef_extra=props)

@@ -1,0 +1,309 @@
+"""Imposed motion of boundary objects: DualSPHysics ``<motion>`` chains and wave paddles.
+
+Each moving mkbound gets, at time t, a rigid transform x = R x0 + d of its
+initial particle positions and a velocity field v(x) = V + Ω × (x − c).
+Positions are always placed by the exact transform (no accumulated drift).
+
+Movements (DualSPHysics ``JMotion``; times τ measured from the start of the movement):
+
+* ``wait``, ``mvnull``: no motion;
+* ``mvrect``: d = v τ;  ``mvrectace``: d = v0 τ + a τ²/2 (v0 defaults to the previous speed);
+* ``mvrot``: rotation by ω τ about the axis p1→p2; ``mvrotace``: ω0 τ + α τ²/2;
+* ``mvcir``: the object translates along the circle that ``ref`` describes when rotated about the axis;
+* ``mvrectsinu``: d = A [sin(2π f τ + φ) − sin φ] per component;
+  ``mvrotsinu``: angle A [sin(2π f τ + φ) − sin φ]; ``mvcirsinu`` likewise on a circle;
+* ``mvrectfile``/``mvrotfile``: positions or angles interpolated linearly from a file.
+
+A movement ends after ``duration`` (−1: never) and continues with ``next``; the
+chain starts at ``begin start`` and stops at ``finish``. Movements of enclosing
+``<obj>`` elements are applied after the object's own.
+
+Wave paddles (regular waves, Biesel transfer functions, Dean & Dalrymple 1991 §6):
+piston H/S = 2 (cosh 2kd − 1)/(sinh 2kd + 2kd); flap H/S = 4 sinh kd/kd ·
+(1 − cosh kd + kd sinh kd)/(sinh 2kd + 2kd); second-order piston term of
+Madsen (1971). A linear ramp over ``ramp`` periods starts the motion.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rotation matrix about a unit axis (Rodrigues)."""
+    k = axis / np.linalg.norm(axis)
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * (kx @ kx)
+
+
+class Rigid:
+    """x ↦ R x + d, with the velocity field v(x) = V + Ω × (x − c) at the current time."""
+
+    __slots__ = ("R", "d", "V", "W", "c")
+
+    def __init__(self, R=None, d=None, V=None, W=None, c=None):
+        self.R = np.eye(3) if R is None else R
+        self.d = np.zeros(3) if d is None else d
+        self.V = np.zeros(3) if V is None else V
+        self.W = np.zeros(3) if W is None else W
+        self.c = np.zeros(3) if c is None else c
+
+    def then(self, other: "Rigid") -> "Rigid":
+        """Apply ``self`` first, then ``other`` (velocities combine as frames in motion)."""
+        R = other.R @ self.R
+        d = other.R @ self.d + other.d
+        # velocity of a point x = T_other(y), y moving with self: v = R_o v_self(y) + v_other(x)
+        # expressed as V' + W' × (x − c'), with c' = T_other(c_self)
+        c = other.R @ self.c + other.d
+        W = other.R @ self.W + other.W
+        V = other.R @ self.V + other.V + np.cross(other.W, c - other.c)
+        return Rigid(R, d, V, W, c)
+
+    def apply(self, x0: np.ndarray):
+        """Positions and velocities of points with initial positions x0."""
+        x = x0 @ self.R.T + self.d
+        v = self.V + np.cross(self.W, x - self.c)
+        return x, v
+
+
+def _angle_units(m) -> float:
+    return math.pi / 180.0 if m.get("anglesunits", "degrees") == "degrees" else 1.0
+
+
+def _segment(m: dict, tau: float, state: dict) -> Rigid:
+    """Transform and velocity of one movement ``tau`` seconds after it started."""
+    kind = m["type"]
+    if kind in ("wait", "mvnull"):
+        state["v"] = np.zeros(3)
+        state["w"] = 0.0
+        return Rigid()
+    if kind in ("mvrect", "mvrectace"):
+        if kind == "mvrect":
+            v0, a = np.asarray(m["vel"], float), np.zeros(3)
+        else:
+            v0 = np.asarray(m["velini"], float) if "velini" in m else state.get("v", np.zeros(3))
+            a = np.asarray(m["ace"], float)
+        d = v0 * tau + 0.5 * a * tau * tau
+        v = v0 + a * tau
+        state["v"] = v
+        return Rigid(d=d, V=v)
+    if kind in ("mvrot", "mvrotace", "mvcir", "mvcirace"):
+        u = _angle_units(m)
+        if kind in ("mvrot", "mvcir"):
+            w0, al = m["vel"] * u, 0.0
+        else:
+            w0 = m["velini"] * u if "velini" in m else state.get("w", 0.0)
+            al = m["ace"] * u
+        angle = w0 * tau + 0.5 * al * tau * tau
+        w = w0 + al * tau
+        state["w"] = w
+        return _rotational(m, angle, w, circular=kind.startswith("mvcir"))
+    if kind == "mvrectsinu":
+        f, A = np.asarray(m["freq"], float), np.asarray(m["ampl"], float)
+        ph = np.asarray(m.get("phase", [0.0, 0.0, 0.0]), float) * _angle_units(m)
+        arg = 2 * math.pi * f * tau + ph
+        d = A * (np.sin(arg) - np.sin(ph))
+        return Rigid(d=d, V=A * 2 * math.pi * f * np.cos(arg))
+    if kind in ("mvrotsinu", "mvcirsinu"):
+        u = _angle_units(m)
+        f, A, ph = m["freq"], m["ampl"] * u, m.get("phase", 0.0) * u
+        arg = 2 * math.pi * f * tau + ph
+        angle = A * (math.sin(arg) - math.sin(ph))
+        w = A * 2 * math.pi * f * math.cos(arg)
+        return _rotational(m, angle, w, circular=kind == "mvcirsinu")
+    if kind in ("mvrectfile", "mvrotfile"):
+        return _from_file(m, tau)
+    raise ValueError(f"unsupported movement {kind}")
+
+
+def _rotational(m, angle, w, circular) -> Rigid:
+    p1, p2 = np.asarray(m["axisp1"], float), np.asarray(m["axisp2"], float)
+    axis = (p2 - p1) / np.linalg.norm(p2 - p1)
+    R = _rotation(axis, angle)
+    if not circular:
+        return Rigid(R=R, d=p1 - R @ p1, W=w * axis, c=p1)
+    ref = np.asarray(m["ref"], float)
+    moved = R @ (ref - p1) + p1
+    vel = np.cross(w * axis, moved - p1)
+    return Rigid(d=moved - ref, V=vel)
+
+
+_FILE_CACHE: dict = {}
+
+
+def _load_table(m):
+    key = (m["file"], tuple(sorted(m.get("fields", {}).items())))
+    if key not in _FILE_CACHE:
+        data = np.genfromtxt(m["file"], delimiter=";" if open(m["file"]).read(4096).count(";") else None,
+                             comments="#", invalid_raise=False)
+        data = data[~np.isnan(data).any(axis=1)] if data.ndim == 2 else data
+        _FILE_CACHE[key] = data
+    return _FILE_CACHE[key]
+
+
+def _from_file(m, tau) -> Rigid:
+    data = _load_table(m)
+    fields = m.get("fields", {})
+    t = data[:, fields.get("fieldtime", 0)]
+    if m["type"] == "mvrectfile":
+        d = np.zeros(3)
+        v = np.zeros(3)
+        for k, name in enumerate(("fieldx", "fieldy", "fieldz")):
+            if name in fields:
+                col = data[:, fields[name]]
+                d[k] = np.interp(tau, t, col) - col[0]
+                v[k] = np.interp(tau, t, np.gradient(col, t))
+        return Rigid(d=d, V=v)
+    col = data[:, fields.get("fieldang", 1)] * _angle_units(m)
+    angle = np.interp(tau, t, col) - col[0]
+    w = np.interp(tau, t, np.gradient(col, t))
+    return _rotational(m, angle, w, circular=False)
+
+
+def chain_transform(chain: dict, t: float) -> Rigid:
+    """Accumulated transform of a movement chain at time t."""
+    begin = chain.get("begin")
+    if not begin:
+        return Rigid()
+    movs = {m["id"]: m for m in chain["movements"]}
+    start, finish = begin["start"], begin.get("finish")
+    if t <= start:
+        return Rigid()
+    t_end = t if finish is None else min(t, finish)
+    total = Rigid()
+    state: dict = {}
+    current, t0 = movs.get(begin["mov"]), start
+    for _ in range(1_000_000):
+        if current is None:
+            break
+        dur = current["duration"]
+        t1 = math.inf if dur < 0 else t0 + dur
+        if t_end < t1:
+            seg = _segment(current, t_end - t0, state)
+            total = total.then(seg)
+            if finish is not None and t >= finish:
+                total = Rigid(total.R, total.d, c=total.c)
+            return total
+        seg = _segment(current, t1 - t0, state)
+        total = total.then(Rigid(seg.R, seg.d, c=seg.c))
+        t0 = t1
+        current = movs.get(current["next"]) if current.get("next") is not None else None
+    return Rigid(total.R, total.d, c=total.c)   # chain over: at rest
+
+
+def motion_transform(motion: dict, t: float) -> Rigid:
+    """Transform of one ``objreal`` including its parent ``<obj>`` chains."""
+    total = chain_transform(motion, t)
+    for parent in reversed(motion.get("parents", [])):
+        total = total.then(chain_transform(parent, t))
+    return total
+
+
+# ---------------------------------------------------------------------------
+# wave paddles
+# ---------------------------------------------------------------------------
+def wave_number(period: float, depth: float, g: float = 9.81) -> float:
+    """k from ω² = g k tanh(k d) (Newton iterations)."""
+    omega = 2 * math.pi / period
+    k = max(omega * omega / g, omega / math.sqrt(g * depth))
+    for _ in range(100):
+        t = math.tanh(k * depth)
+        f = g * k * t - omega * omega
+        df = g * t + g * k * depth * (1 - t * t)
+        dk = f / df
+        k -= dk
+        if abs(dk) < 1e-15 * k:
+            break
+    return k
+
+
+def piston_height_to_stroke(k: float, d: float) -> float:
+    """Biesel transfer function of a piston: H/S."""
+    return 2 * (math.cosh(2 * k * d) - 1) / (math.sinh(2 * k * d) + 2 * k * d)
+
+
+def flap_height_to_stroke(k: float, d: float) -> float:
+    """Biesel transfer function of a flap hinged at the bottom: H/S (S at the free surface)."""
+    kd = k * d
+    return 4 * math.sinh(kd) / kd * (1 - math.cosh(kd) + kd * math.sinh(kd)) / (math.sinh(2 * kd) + 2 * kd)
+
+
+class WavePaddle:
+    """A piston (displacement along ``pistondir``) or flap (rotation about its axis)."""
+
+    def __init__(self, spec: dict, g: float = 9.81):
+        self.spec = spec
+        self.kind = spec["type"]
+        d, H, T = spec["depth"], spec["waveheight"], spec["waveperiod"]
+        self.omega = 2 * math.pi / T
+        self.k = wave_number(T, d, g)
+        self.phase = spec.get("phase", 0.0) * math.pi
+        self.gain = spec.get("gainstroke", 1.0)
+        self.ramp_time = spec.get("ramp", 0.0) * T
+        self.start = spec.get("start", 0.0)
+        self.duration = spec.get("duration", 0.0)
+        if self.kind == "piston":
+            m1 = piston_height_to_stroke(self.k, d)
+            self.stroke = H / m1 * self.gain
+            self.second = 0.0
+            if spec.get("waveorder", 1) == 2:
+                kd = self.k * d
+                self.second = (H * H / (32 * d)) * (3 * math.cosh(kd) / math.sinh(kd) ** 3 - 2 / m1) * self.gain
+            direction = np.asarray(spec.get("pistondir", [1, 0, 0]), float)
+            self.direction = direction / np.linalg.norm(direction)
+        else:
+            m1 = flap_height_to_stroke(self.k, d)
+            self.stroke = H / m1 * self.gain
+            self.second = 0.0
+            self.hinge_depth = d + spec.get("variabledraft", 0.0)
+            p0, p1 = np.asarray(spec["flapaxis0"], float), np.asarray(spec["flapaxis1"], float)
+            self.p0, self.axis = p0, (p1 - p0) / np.linalg.norm(p1 - p0)
+
+    def _ramp(self, tau):
+        if self.ramp_time <= 0 or tau >= self.ramp_time:
+            return 1.0, 0.0
+        return tau / self.ramp_time, 1.0 / self.ramp_time
+
+    def stroke_position(self, t: float):
+        """Paddle displacement at the free surface and its rate (m, m/s)."""
+        tau = t - self.start
+        if tau <= 0 or (self.duration > 0 and tau > self.duration):
+            tau = 0.0 if tau <= 0 else self.duration
+            if tau == 0.0:
+                return 0.0, 0.0
+        r, dr = self._ramp(tau)
+        a = self.omega * tau + self.phase
+        x1 = 0.5 * self.stroke * (math.sin(a) - math.sin(self.phase))
+        v1 = 0.5 * self.stroke * self.omega * math.cos(a)
+        x2 = self.second * (math.sin(2 * a) - math.sin(2 * self.phase))
+        v2 = self.second * 2 * self.omega * math.cos(2 * a)
+        x, v = x1 + x2, v1 + v2
+        return r * x, r * v + dr * x
+
+    def transform(self, t: float) -> Rigid:
+        x, v = self.stroke_position(t)
+        if self.kind == "piston":
+            return Rigid(d=x * self.direction, V=v * self.direction)
+        angle = math.atan2(x, self.hinge_depth)
+        w = v * self.hinge_depth / (self.hinge_depth ** 2 + x * x)
+        R = _rotation(self.axis, angle)
+        return Rigid(R=R, d=self.p0 - R @ self.p0, W=w * self.axis, c=self.p0)
+
+
+class MotionSet:
+    """All imposed motions of a case: ``transforms(t)`` → {mkbound: Rigid}."""
+
+    def __init__(self, motions: list, wavepaddles: list | None = None, g: float = 9.81):
+        self.motions = {m["ref"]: m for m in motions}
+        self.paddles = {p["mkbound"]: WavePaddle(p, g) for p in (wavepaddles or [])}
+
+    @property
+    def mkbounds(self):
+        return sorted(set(self.motions) | set(self.paddles))
+
+    def transform(self, mkbound: int, t: float) -> Rigid:
+        base = motion_transform(self.motions[mkbound], t) if mkbound in self.motions else Rigid()
+        if mkbound in self.paddles:
+            base = base.then(self.paddles[mkbound].transform(t))
+        return base
