@@ -53,6 +53,8 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     """Read, draw and assemble a case (nothing is written)."""
     warnings = warnings if warnings is not None else Warnings()
     root, reader, text = open_case(path, warnings)
+    if outdir is not None:
+        os.makedirs(outdir, exist_ok=True)
     casename = case_name_from_path(path)
     casedef = root.find("casedef")
     cdef = read_constantsdef(reader, casedef)
@@ -468,7 +470,7 @@ def summary(result: GenCaseResult) -> str:
     lines.append("")
     lines.append(f"Particles: {n} total = {counts[0]} fixed + {counts[1]} moving + {counts[2]} floating "
                  f"(boundary {counts[0] + counts[1] + counts[2]}) + {counts[3]} fluid")
-    lines.append(f"h = {c.h:.7g} m   (coefh = {c.coefh:.6g})")
+    lines.append(f"h = {c.h:.6g} m   (coefh = {c.coefh:.6g})")
     lines.append(f"c0 = {c.cs0:.7g} m/s   (speedsystem {c.speedsystem:.6g} m/s, hswl {c.hswl:.6g} m)")
     lines.append(f"B = {c.b:.7g} Pa   gamma = {c.gamma:g}   rhop0 = {c.rhop0:g} kg/m3")
     unit = "kg/m" if c.is2d else "kg"

@@ -562,7 +562,7 @@ def read_parameters(reader, execution):
             continue
         if p.tag != "parameter":
             raise reader.error(p, f"unknown element <{p.tag}> in <parameters>", "<parameter key value> or <simulationdomain>")
-        key = reader.text_attr(p, "key")
+        key = str(reader.raw(p, "key")).strip()
         if key.startswith("#"):
             reader.mark(p, "value")
             continue

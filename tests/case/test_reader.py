@@ -47,7 +47,7 @@ def test_resolve_constants_rules():
 
 def test_explicit_constants_and_expressions(tmp_path):
     consts = CONSTANTS.replace('<coefh value="1.0" />', '<hdp value="#1.5*2/2" />').replace(
-        '<speedsound value="0" auto="true" />', '<speedsound value="#Rhop0/20" />')
+        '<speedsound value="0" auto="true" />', '<speedsound value="#1000/20" />')
     r = build(tmp_path, constants=consts)
     assert r.constants.h == pytest.approx(1.5 * 0.02)
     assert r.constants.cs0 == pytest.approx(50.0)
