@@ -32,16 +32,17 @@ def _seg_dist2(px, py, pz, ax, ay, az, bx, by, bz):
 
 
 @njit(cache=True)
-def raster_triangles(tri, lo, out):
-    """Mark the surface nodes of triangles (T,3,3).
+def raster_triangles(tri, lo, out, wlo, whi, dmax):
+    """Mark the nodes near triangles (T,3,3).
 
-    A node is on a triangle when its signed distance ``w`` to the triangle's
-    plane is in (-1/2, 1/2] (one node layer, never a gap a 6-connected path can
-    cross) and its projection lies within 1/2 of the triangle (edges therefore
-    reach the nearest node, like box faces).
+    A node is marked when its signed distance ``w`` to the triangle's plane is
+    in (wlo, whi] and its projection lies within ``dmax`` of the triangle.
+    Surfaces use (-1/2, 1/2] and 1/2 (one node layer, never a gap a 6-connected
+    path can cross; edges reach the nearest node, like box faces); "on the
+    surface" tests use a band of a few 1e-6.
     """
     nx, ny, nz = out.shape
-    h = 0.5 + _EPS
+    h = max(dmax, -wlo, whi)
     for t in range(tri.shape[0]):
         ax, ay, az = tri[t, 0, 0], tri[t, 0, 1], tri[t, 0, 2]
         bx, by, bz = tri[t, 1, 0], tri[t, 1, 1], tri[t, 1, 2]
@@ -81,7 +82,7 @@ def raster_triangles(tri, lo, out):
                 for k in range(k0, k1 + 1):
                     pz = float(k + lo[2])
                     w = (px - ax) * nxv + (py - ay) * nyv + (pz - az) * nzv
-                    if w <= -0.5 + _EPS or w > h:
+                    if w <= wlo or w > whi:
                         continue
                     qx, qy, qz = px - w * nxv, py - w * nyv, pz - w * nzv
                     vx, vy, vz = qx - ax, qy - ay, qz - az
@@ -95,7 +96,7 @@ def raster_triangles(tri, lo, out):
                     d2 = _seg_dist2(qx, qy, qz, ax, ay, az, bx, by, bz)
                     d2 = min(d2, _seg_dist2(qx, qy, qz, bx, by, bz, cx, cy, cz))
                     d2 = min(d2, _seg_dist2(qx, qy, qz, cx, cy, cz, ax, ay, az))
-                    if d2 <= h * h:
+                    if d2 <= dmax * dmax:
                         out[i, j, k] = True
 
 

@@ -14,7 +14,7 @@ Rules (lattice units, node ``k`` at ``k``; ``EPS`` = 1e-6):
   inside nodes with a face-neighbour (4 in 2D, 6 in 3D) outside the shape. It is
   closed: no face-connected path leads from the interior to the outside
   without crossing it.
-* **Lines**: the nearest node of samples taken every 1/4 along the segment.
+* **Lines**: one node per lattice step along the dominant axis (nearest nodes).
 * **Points**: the nearest node.
 
 Nodes outside the lattice are never drawn.
@@ -114,9 +114,11 @@ def triangle_pieces(lat: Lattice, tris, surface: bool = True, solid: bool = Fals
     itri = np.ascontiguousarray(lat.to_index(tris))
     out = np.zeros(tuple(int(v) for v in hi - lo + 1), dtype=np.bool_)
     if solid:
+        # inside by parity, plus the nodes lying on the surface (within 2 EPS)
         kernels.parity_inside(itri, lo, out)
+        kernels.raster_triangles(itri, lo, out, -2 * EPS, 2 * EPS, 2 * EPS)
     if surface:
-        kernels.raster_triangles(itri, lo, out)
+        kernels.raster_triangles(itri, lo, out, -0.5 + EPS, 0.5 + EPS, 0.5 + EPS)
     return [Piece("mask", lo, mask=out)]
 
 
@@ -157,10 +159,10 @@ def _clip_segment(ia, ib, shape):
 
 
 def segment_pieces(lat: Lattice, segs, chunk: int = 1_000_000):
-    """Nodes of world segments (S,2,3): nearest nodes of samples at most 1/2 apart per axis.
+    """Nodes of world segments (S,2,3): one node per lattice step along the dominant axis.
 
-    Consecutive samples round to the same or a neighbouring node, so the
-    line is 26-connected.
+    Samples are at most 1 apart along every axis and are rounded to the
+    nearest node (a digital, 26-connected line, like Bresenham's).
     """
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 3)
     shape = np.array(lat.shape)
@@ -171,7 +173,7 @@ def segment_pieces(lat: Lattice, segs, chunk: int = 1_000_000):
         if r is None:
             continue
         pa, pb = ia + r[0] * (ib - ia), ia + r[1] * (ib - ia)
-        n = int(np.ceil(np.max(np.abs(pb - pa)) * 2.0)) + 1
+        n = int(np.ceil(np.max(np.abs(pb - pa)) - EPS)) + 1
         for s0 in range(0, n, chunk):
             t = (np.arange(s0, min(s0 + chunk, n), dtype=np.float64) / max(n - 1, 1))[:, None]
             idx = np.floor(pa + t * (pb - pa) + 0.5 + EPS).astype(np.int64)

@@ -34,7 +34,8 @@ def polygon_triangles(pts: np.ndarray) -> list[tuple[int, int, int]]:
     drop = int(np.argmax(np.abs(nrm)))
     keep = [i for i in range(3) if i != drop]
     p2 = pts[:, keep]
-    if nrm[drop] < 0:
+    # the projection is counter-clockwise when the normal points along keep[0] x keep[1]
+    if nrm[drop] * (-1.0 if drop == 1 else 1.0) < 0:
         p2 = p2[:, ::-1]
 
     def cross(o, a, b):

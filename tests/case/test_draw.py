@@ -1,0 +1,550 @@
+"""GenCase drawing (sphdvi.case.draw): counts and positions on small hand-computed lattices."""
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from lxml import etree
+
+from sphdvi.case.draw import run_geometry
+from sphdvi.case.xmldoc import CaseReader
+from sphdvi.errors import CaseError
+
+
+def geometry_xml(body, dp=1.0, pmin=(0, 0, 0), pmax=(10, 10, 10), pointref=None, predef="",
+                 lists=""):
+    ref = "" if pointref is None else '<pointref x="{}" y="{}" z="{}"/>'.format(*pointref)
+    return (f"<geometry>{predef}<definition dp=\"{dp}\">{ref}"
+            '<pointmin x="{}" y="{}" z="{}"/>'.format(*pmin)
+            + '<pointmax x="{}" y="{}" z="{}"/>'.format(*pmax)
+            + f"</definition><commands>{lists}<mainlist>{body}</mainlist></commands></geometry>")
+
+
+def draw(tmp_path, body, outdir=None, max_nodes=200_000_000, **kw):
+    el = etree.fromstring(geometry_xml(body, **kw))
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    return run_geometry(reader, el, casename="case", outdir=outdir, max_nodes=max_nodes)
+
+
+def nodes(d, fluid=None):
+    """Set of integer (x, y, z) node tuples (dp = 1 lattices starting at 0)."""
+    sel = np.ones(len(d.pos), bool) if fluid is None else (d.is_fluid == fluid)
+    return {tuple(int(round(v)) for v in p) for p in d.pos[sel]}
+
+
+def box(point, size=None, endpoint=None, fill="solid", extra=""):
+    s = f'<size x="{size[0]}" y="{size[1]}" z="{size[2]}"/>' if size is not None else \
+        f'<endpoint x="{endpoint[0]}" y="{endpoint[1]}" z="{endpoint[2]}"/>'
+    return (f"<drawbox><boxfill>{fill}</boxfill>"
+            f'<point x="{point[0]}" y="{point[1]}" z="{point[2]}"/>{s}{extra}</drawbox>')
+
+
+def lattice_box(lo, hi):
+    return set(itertools.product(*[range(a, b + 1) for a, b in zip(lo, hi)]))
+
+
+DAMBREAK = """<setdrawmode mode="full" />
+<setmkfluid mk="0" />
+<drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="1" y="2" z="2" /></drawbox>
+<setmkbound mk="0" />
+<drawbox><boxfill>bottom | left | right | front | back</boxfill>
+<point x="0" y="-1" z="0" /><size x="4" y="2" z="3" /></drawbox>"""
+
+
+# ---------------------------------------------------------------- acceptance: 2D dam break
+@pytest.mark.parametrize("dp,nfluid,nbound", [(0.02, 5000, 501), (0.01, 20000, 1001)])
+def test_dambreak_2d_counts(tmp_path, dp, nfluid, nbound):
+    d = draw(tmp_path, DAMBREAK, dp=dp, pmin=(-1, 0, -1), pmax=(4.5, 0, 3.5))
+    assert d.is2d and d.posy2d == 0.0
+    assert (d.count_fluid, d.count_bound) == (nfluid, nbound)
+    assert np.all(d.pos[:, 1] == 0.0)
+    assert d.mk.dtype == np.int32 and set(d.mk.tolist()) == {0}
+    f = np.round(d.pos[d.is_fluid] / dp).astype(int)
+    assert f[:, 0].min() == 1 and f[:, 0].max() == round(1 / dp)
+    assert f[:, 2].min() == 1 and f[:, 2].max() == round(2 / dp)
+    b = np.round(d.pos[~d.is_fluid] / dp).astype(int)
+    assert set(b[:, 0].tolist()) == set(range(0, round(4 / dp) + 1))
+    assert b[:, 2].max() == round(3 / dp)
+    assert len({tuple(p) for p in np.round(d.pos / dp).astype(int).tolist()}) == len(d.pos)
+
+
+def test_dambreak_primitives(tmp_path):
+    d = draw(tmp_path, DAMBREAK, dp=0.02, pmin=(-1, 0, -1), pmax=(4.5, 0, 3.5))
+    assert [p["shape"] for p in d.primitives] == ["box", "box"]
+    assert d.primitives[0]["fluid"] and d.primitives[0]["solid"]
+    assert not d.primitives[1]["fluid"] and not d.primitives[1]["solid"]
+    assert d.primitives[0]["params"]["min"] == [0, -1, 0]
+    assert d.primitives[0]["params"]["max"] == [1, 1, 2]
+
+
+# ---------------------------------------------------------------- boxes
+def test_box_solid_3d(tmp_path):
+    d = draw(tmp_path, '<setmkfluid mk="2"/>' + box((1, 2, 3), (2, 1, 3)))
+    assert nodes(d) == lattice_box((1, 2, 3), (3, 3, 6))
+    assert d.is_fluid.all() and set(d.mk.tolist()) == {2}
+
+
+def test_box_endpoint_and_negative_size(tmp_path):
+    a = draw(tmp_path, '<setmkbound mk="1"/>' + box((1, 1, 1), endpoint=(3, 4, 2)))
+    b = draw(tmp_path, '<setmkbound mk="1"/>' + box((3, 4, 2), (-2, -3, -1)))
+    assert nodes(a) == nodes(b) == lattice_box((1, 1, 1), (3, 4, 2))
+    assert not a.is_fluid.any()
+
+
+def test_box_all_faces(tmp_path):
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((1, 1, 1), (4, 4, 4), fill="all"))
+    assert len(d.pos) == 5 ** 3 - 3 ** 3
+    assert nodes(d) == lattice_box((1, 1, 1), (5, 5, 5)) - lattice_box((2, 2, 2), (4, 4, 4))
+
+
+@pytest.mark.parametrize("face,axis,value", [("bottom", 2, 1), ("top", 2, 5), ("left", 0, 1),
+                                             ("right", 0, 5), ("front", 1, 1), ("back", 1, 5)])
+def test_box_single_face(tmp_path, face, axis, value):
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((1, 1, 1), (4, 4, 4), fill=face))
+    assert len(d.pos) == 25
+    assert np.all(d.pos[:, axis] == value)
+
+
+def test_box_face_combination(tmp_path):
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((1, 1, 1), (4, 4, 4), fill="bottom | left"))
+    assert len(d.pos) == 25 + 25 - 5
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((1, 1, 1), (4, 4, 4), fill="solid | top"))
+    assert len(d.pos) == 125
+
+
+def test_box_off_lattice(tmp_path):
+    # 0.3..2.3: inside nodes 1, 2; faces at the nearest layers 0 and 2, extent 0..2
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0.3, 0.3, 0.3), (2, 2, 2)))
+    assert nodes(d) == lattice_box((1, 1, 1), (2, 2, 2))
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((0.3, 0.3, 0.3), (2, 2, 2), fill="all"))
+    assert nodes(d) == lattice_box((0, 0, 0), (2, 2, 2)) - {(1, 1, 1)}
+
+
+def test_box_thin_plate_face(tmp_path):
+    # a zero-thickness plate off the lattice still gets its nearest layer
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((0, 0, 2.4), (3, 3, 0), fill="bottom"))
+    assert nodes(d) == lattice_box((0, 0, 2), (3, 3, 2))
+
+
+def test_box_drawmode_without_boxfill(tmp_path):
+    body = '<setmkbound mk="0"/><setdrawmode mode="{}"/><drawbox><point x="1" y="1" z="1"/>' \
+           '<size x="4" y="4" z="4"/></drawbox>'
+    assert len(draw(tmp_path, body.format("full")).pos) == 125
+    assert len(draw(tmp_path, body.format("solid")).pos) == 125
+    assert len(draw(tmp_path, body.format("face")).pos) == 98
+    # wire: 8 corners + 12 edges x 3 inner nodes
+    assert len(draw(tmp_path, body.format("wire")).pos) == 8 + 12 * 3
+
+
+def test_box_rotated_by_angles(tmp_path):
+    # 2x1x1 box rotated 90 degrees about z around its point (5,5,5): x in [4,5], y in [5,7]
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((5, 5, 5), (2, 1, 1),
+                                                   extra='<angles x="0" y="0" z="90"/>'))
+    assert nodes(d) == lattice_box((4, 5, 5), (5, 7, 6))
+
+
+def test_box_rotated_faces(tmp_path):
+    # a 45-degree rotated square plate (bottom face only) in 3D
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((5, 5, 3), (2, 2, 1), fill="bottom",
+                                                    extra='<angles x="0" y="0" z="45"/>'))
+    assert len(d.pos) > 0 and np.all(d.pos[:, 2] == 3)
+    solid = draw(tmp_path, '<setmkbound mk="0"/>' + box((5, 5, 3), (2, 2, 0), fill="solid",
+                                                        extra='<angles x="0" y="0" z="45"/>'))
+    # the plate covers the solid (in-plane) nodes of the rotated square
+    assert nodes(solid) <= nodes(d)
+
+
+def test_box_clipped_to_domain(tmp_path):
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((-5, -5, -5), (8, 8, 8)), pmax=(2, 2, 2))
+    assert nodes(d) == lattice_box((0, 0, 0), (2, 2, 2))
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((20, 20, 20), (8, 8, 8)), pmax=(2, 2, 2))
+    assert len(d.pos) == 0
+
+
+def test_overwrite_order_and_void(tmp_path):
+    body = ('<setmkfluid mk="1"/>' + box((0, 0, 0), (4, 4, 4))
+            + '<setmkbound mk="3"/>' + box((0, 0, 0), (4, 4, 0))
+            + '<setmkvoid/>' + box((0, 0, 4), (4, 4, 0)))
+    d = draw(tmp_path, body)
+    assert len(d.pos) == 125 - 25
+    assert nodes(d, fluid=False) == lattice_box((0, 0, 0), (4, 4, 0))
+    assert nodes(d, fluid=True) == lattice_box((0, 0, 1), (4, 4, 3))
+    assert set(d.mk[~d.is_fluid].tolist()) == {3} and set(d.mk[d.is_fluid].tolist()) == {1}
+
+
+def test_order_of_particles_x_fastest(tmp_path):
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, 0, 0), (1, 1, 1)))
+    assert d.pos.tolist() == [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0],
+                              [0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1]]
+
+
+def test_pointref_alignment(tmp_path):
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, 0, 0), (2, 2, 2)), dp=0.5,
+             pmin=(0.25, 0.25, 0.25), pmax=(2, 2, 2), pointref=(0, 0, 0))
+    assert d.origin.tolist() == [0.5, 0.5, 0.5]
+    assert d.pos.min(axis=0).tolist() == [0.5, 0.5, 0.5]
+    assert len(d.pos) == 4 ** 3
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, 0, 0), (2, 2, 2)), dp=0.5,
+             pmin=(0.25, 0.25, 0.25), pmax=(2, 2, 2))
+    assert d.pos.min(axis=0).tolist() == [0.25, 0.25, 0.25]
+    assert len(d.pos) == 4 ** 3 and d.pos.max(axis=0).tolist() == [1.75, 1.75, 1.75]
+
+
+def test_2d_layer_only(tmp_path):
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, -1, 0), (3, 2, 2)),
+             pmin=(0, 0.5, 0), pmax=(5, 0.5, 5))
+    assert d.is2d and d.posy2d == 0.5
+    assert len(d.pos) == 4 * 3 and np.all(d.pos[:, 1] == 0.5)
+    # a box that does not reach the 2D plane draws nothing
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, 1, 0), (3, 2, 2)),
+             pmin=(0, 0.5, 0), pmax=(5, 0.5, 5))
+    assert len(d.pos) == 0
+
+
+def test_floating_point_noise_never_loses_nodes(tmp_path):
+    # 0.1 steps accumulate noise; every node of 0..3 (31 per axis) must be there
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0.3, 0, 0.3), (2.7, 0, 2.7)), dp=0.1,
+             pmin=(0, 0, 0), pmax=(3.0000000001, 0, 3))
+    assert len(d.pos) == 28 * 28
+
+
+# ---------------------------------------------------------------- curved shapes
+def brute(fn, lo=-6, hi=6):
+    return {p for p in itertools.product(range(lo, hi + 1), repeat=3) if fn(*p)}
+
+
+def shell_of(inside, is2d=False):
+    dirs = [(1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, 0, -1)] + ([] if is2d else [(0, 1, 0), (0, -1, 0)])
+    return {p for p in inside if any((p[0] + a, p[1] + b, p[2] + c) not in inside
+                                     for a, b, c in dirs)}
+
+
+SPHERE = '<setdrawmode mode="{mode}"/><setmkbound mk="0"/><drawsphere radius="{r}">' \
+         '<point x="{c}" y="{c}" z="{c}"/></drawsphere>'
+
+
+def test_sphere_solid_and_shell(tmp_path):
+    ball = brute(lambda x, y, z: x * x + y * y + z * z <= 4)
+    assert len(ball) == 33
+    d = draw(tmp_path, SPHERE.format(mode="full", r=2, c=5))
+    assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in ball}
+    d = draw(tmp_path, SPHERE.format(mode="face", r=2, c=5))
+    shell = shell_of(ball)
+    assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in shell}
+    assert len(shell) == 26  # the centre and its 6 neighbours have all neighbours inside
+
+
+def test_sphere_shell_is_closed(tmp_path):
+    d = draw(tmp_path, SPHERE.format(mode="face", r=3.7, c=5))
+    s = nodes(d)
+    inside = brute(lambda x, y, z: (x - 5) ** 2 + (y - 5) ** 2 + (z - 5) ** 2 <= 3.7 ** 2, 0, 10)
+    # flood from the centre through non-shell nodes never escapes the sphere
+    seen, todo = set(), [(5, 5, 5)]
+    while todo:
+        p = todo.pop()
+        if p in seen or p in s or not all(0 <= v <= 10 for v in p):
+            continue
+        seen.add(p)
+        todo += [(p[0] + a, p[1] + b, p[2] + c) for a, b, c in
+                 [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]]
+    assert seen <= inside and seen
+
+
+def test_circle_2d(tmp_path):
+    d = draw(tmp_path, SPHERE.format(mode="full", r=2, c=5), pmin=(0, 5, 0), pmax=(10, 5, 10))
+    assert len(d.pos) == 13
+    d = draw(tmp_path, SPHERE.format(mode="face", r=2, c=5), pmin=(0, 5, 0), pmax=(10, 5, 10))
+    assert len(d.pos) == 8  # the 2D ring: all but the centre and its 4 neighbours
+
+
+def test_sphere_params_after_transform(tmp_path):
+    d = draw(tmp_path, '<move x="1" y="0" z="0"/><scale x="2" y="2" z="2"/>'
+             + SPHERE.format(mode="full", r=1, c=2))
+    p = d.primitives[0]["params"]
+    assert p["center"] == [5, 4, 4] and p["radius"] == 2
+    assert len(d.pos) == 33
+
+
+CYL = '<setdrawmode mode="{mode}"/><setmkbound mk="0"/><drawcylinder radius="1.5" mask="{mask}">' \
+      '<point x="5" y="5" z="2"/><point x="5" y="5" z="6"/></drawcylinder>'
+
+
+@pytest.mark.parametrize("mode,mask,count", [("full", "0", 45), ("solid", "0", 45),
+                                             ("face", "0", 9 + 9 + 3 * 8),
+                                             ("face", "1 | 2", 5 * 8), ("face", "3", 5 * 8),
+                                             ("face", "4", 9 + 9), ("face", "1", 9 + 4 * 8)])
+def test_cylinder(tmp_path, mode, mask, count):
+    d = draw(tmp_path, CYL.format(mode=mode, mask=mask))
+    assert len(d.pos) == count
+    assert d.pos[:, 2].min() >= 2 and d.pos[:, 2].max() <= 6
+
+
+def test_cylinder_mask_hides_first_cover(tmp_path):
+    d = draw(tmp_path, CYL.format(mode="face", mask="1"))
+    layer2 = d.pos[d.pos[:, 2] == 2]
+    assert len(layer2) == 8 and [5, 5, 2] not in layer2.tolist()
+    assert len(d.pos[d.pos[:, 2] == 6]) == 9
+
+
+def test_cylinder_oblique_matches_brute_force(tmp_path):
+    body = ('<setmkfluid mk="0"/><drawcylinder radius="2"><point x="2" y="3" z="1"/>'
+            '<point x="8" y="6" z="7"/></drawcylinder>')
+    d = draw(tmp_path, body)
+    p1, p2 = np.array([2, 3, 1.0]), np.array([8, 6, 7.0])
+    u = (p2 - p1) / np.linalg.norm(p2 - p1)
+
+    def inside(x, y, z):
+        v = np.array([x, y, z]) - p1
+        t = v @ u
+        return -1e-9 <= t <= np.linalg.norm(p2 - p1) + 1e-9 and v @ v - t * t <= 4 + 1e-9
+    assert nodes(d) == brute(inside, 0, 10)
+
+
+def test_ellipsoid_axes_and_foci(tmp_path):
+    body = ('<setmkfluid mk="0"/><drawellipsoid><point x="5" y="5" z="5"/>'
+            '<radius x="3" y="2" z="1"/></drawellipsoid>')
+    d = draw(tmp_path, body)
+    exp = brute(lambda x, y, z: x * x / 9 + y * y / 4 + z * z <= 1)
+    assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in exp}
+    body = ('<setmkfluid mk="0"/><drawellipsoid radius="2"><point x="4" y="5" z="5"/>'
+            '<point x="6" y="5" z="5"/></drawellipsoid>')
+    d = draw(tmp_path, body)
+    exp = brute(lambda x, y, z: np.hypot(np.hypot(x + 1, y), z) + np.hypot(np.hypot(x - 1, y), z)
+                <= 4 + 1e-9)
+    assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in exp}
+    assert d.primitives[0]["params"]["radii"][0] == 2
+
+
+# ---------------------------------------------------------------- polyhedra
+PRISM = ('<setdrawmode mode="{mode}"/><setmkbound mk="0"/><drawprism mask="{mask}">'
+         '<point x="0" y="0" z="0"/><point x="4" y="0" z="0"/><point x="0" y="4" z="0"/>'
+         '<point x="0" y="0" z="2"/><point x="4" y="0" z="2"/><point x="0" y="4" z="2"/>'
+         '</drawprism>')
+
+
+@pytest.mark.parametrize("mode,mask,count", [("solid", "0", 45), ("full", "0", 45),
+                                             ("face", "0", 15 + 15 + 12),
+                                             ("face", "1 | 2", 3 * 12), ("wire", "0", 27)])
+def test_prism(tmp_path, mode, mask, count):
+    d = draw(tmp_path, PRISM.format(mode=mode, mask=mask))
+    assert len(d.pos) == count
+    assert np.all(d.pos[:, 0] + d.pos[:, 1] <= 4)
+
+
+def test_pyramid_tetrahedron(tmp_path):
+    body = ('<setdrawmode mode="solid"/><setmkfluid mk="0"/><drawpyramid>'
+            '<point x="0" y="0" z="3"/><point x="0" y="0" z="0"/><point x="3" y="0" z="0"/>'
+            '<point x="0" y="3" z="0"/></drawpyramid>')
+    d = draw(tmp_path, body)
+    assert nodes(d) == brute(lambda x, y, z: min(x, y, z) >= 0 and x + y + z <= 3, 0, 4)
+    assert len(d.pos) == 20
+    d = draw(tmp_path, body.replace('"solid"', '"face"').replace("<drawpyramid>",
+                                                                  '<drawpyramid mask="1">'))
+    # base hidden: no node of z=0 except those on the three side faces
+    assert nodes(d) == brute(lambda x, y, z: min(x, y, z) >= 0 and x + y + z <= 3
+                             and (x == 0 or y == 0 or x + y + z == 3), 0, 4)
+
+
+# ---------------------------------------------------------------- planar shapes, lines, points
+def test_polygon_2d_nonconvex(tmp_path):
+    body = ('<setmkfluid mk="0"/><drawpolygon>'
+            '<point x="0" y="0" z="0"/><point x="4" y="0" z="0"/><point x="4" y="0" z="2"/>'
+            '<point x="2" y="0" z="2"/><point x="2" y="0" z="4"/><point x="0" y="0" z="4"/>'
+            '</drawpolygon>')
+    d = draw(tmp_path, body, pmin=(-2, 0, -2), pmax=(8, 0, 8))
+    exp = {(x, 0, z) for x in range(5) for z in range(5) if x <= 2 or z <= 2}
+    assert nodes(d) == exp
+
+
+def test_triangle_quadri_strip_fan(tmp_path):
+    q = ('<point x="1" y="1" z="3"/><point x="4" y="1" z="3"/><point x="4" y="4" z="3"/>'
+         '<point x="1" y="4" z="3"/>')
+    d = draw(tmp_path, f'<setmkbound mk="0"/><drawquadri>{q}</drawquadri>')
+    assert nodes(d) == lattice_box((1, 1, 3), (4, 4, 3))
+    d = draw(tmp_path, '<setmkbound mk="0"/><drawtriangle><point x="0" y="0" z="1"/>'
+             '<point x="3" y="0" z="1"/><point x="0" y="3" z="1"/></drawtriangle>')
+    assert nodes(d) == {(x, y, 1) for x in range(4) for y in range(4) if x + y <= 3}
+    strip = ('<point x="0" y="0" z="2"/><point x="0" y="2" z="2"/><point x="2" y="0" z="2"/>'
+             '<point x="2" y="2" z="2"/>')
+    d = draw(tmp_path, f'<setmkbound mk="0"/><drawtrianglesstrip>{strip}</drawtrianglesstrip>')
+    assert nodes(d) == lattice_box((0, 0, 2), (2, 2, 2))
+    fan = ('<point x="1" y="1" z="2"/><point x="0" y="0" z="2"/><point x="2" y="0" z="2"/>'
+           '<point x="2" y="2" z="2"/><point x="0" y="2" z="2"/>')
+    d = draw(tmp_path, f'<setmkbound mk="0"/><drawtrianglesfan>{fan}</drawtrianglesfan>')
+    assert nodes(d) == lattice_box((0, 0, 2), (2, 2, 2)) - {(0, 1, 2)}
+
+
+def cube_triangles(lo=1, hi=5):
+    v = [[x, y, z] for x in (lo, hi) for y in (lo, hi) for z in (lo, hi)]
+    faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    tris = []
+    for a, b, c, e in faces:
+        tris += [(a, b, c), (a, c, e)]
+    return v, tris
+
+
+def test_drawtriangles_closed_cube(tmp_path):
+    v, tris = cube_triangles()
+    pts = "".join(f'<point x="{x}" y="{y}" z="{z}"/>' for x, y, z in v)
+    tri = "".join(f'<triangle x="{a}" y="{b}" z="{c}"/>' for a, b, c in tris)
+    d = draw(tmp_path, f'<setmkbound mk="0"/><drawtriangles><points>{pts}</points>'
+             f'<triangles>{tri}</triangles></drawtriangles>')
+    assert nodes(d) == lattice_box((1, 1, 1), (5, 5, 5)) - lattice_box((2, 2, 2), (4, 4, 4))
+
+
+def test_lines_and_points(tmp_path):
+    d = draw(tmp_path, '<setmkbound mk="0"/><drawline><point x="0" y="1" z="1"/>'
+             '<point x="4" y="1" z="1"/></drawline>')
+    assert nodes(d) == {(x, 1, 1) for x in range(5)}
+    d = draw(tmp_path, '<setmkbound mk="0"/><drawline><point x="0" y="0" z="0"/>'
+             '<point x="4" y="4" z="4"/></drawline>')
+    assert nodes(d) == {(i, i, i) for i in range(5)}
+    d = draw(tmp_path, '<setmkbound mk="0"/><drawlines><point x="0" y="0" z="0"/>'
+             '<point x="2" y="0" z="0"/><point x="2" y="0" z="2"/></drawlines>')
+    assert nodes(d) == {(0, 0, 0), (1, 0, 0), (2, 0, 0), (2, 0, 1), (2, 0, 2)}
+    d = draw(tmp_path, '<setmkbound mk="0"/><setlinebegin x="0" y="0" z="0"/>'
+             '<drawlineto x="0" y="2" z="0"/><drawlineto x="2" y="2" z="0"/>')
+    assert nodes(d) == {(0, 0, 0), (0, 1, 0), (0, 2, 0), (1, 2, 0), (2, 2, 0)}
+    d = draw(tmp_path, '<setmkfluid mk="4"/><drawpoint x="1.4" y="2.6" z="3.5"/>'
+             '<drawpoints><point x="0" y="0" z="0"/><point x="-3" y="0" z="0"/></drawpoints>')
+    assert nodes(d) == {(1, 3, 4), (0, 0, 0)}
+
+
+def test_long_line_clipped(tmp_path):
+    d = draw(tmp_path, '<setmkbound mk="0"/><drawline><point x="-1e12" y="1" z="1"/>'
+             '<point x="1e12" y="1" z="1"/></drawline>')
+    assert nodes(d) == {(x, 1, 1) for x in range(11)}
+
+
+# ---------------------------------------------------------------- transforms
+def test_move_rotate_order(tmp_path):
+    # rotate first (90 deg about z), then move: box [0,2]x[0,1]x[0,1] -> x in [-1,0] -> +5
+    d = draw(tmp_path, '<setmkfluid mk="0"/><move x="5" y="5" z="5"/><rotate ang="90" x="0" '
+             'y="0" z="1"/>' + box((0, 0, 0), (2, 1, 1)))
+    assert nodes(d) == lattice_box((4, 5, 5), (5, 7, 6))
+
+
+def test_rotateline_scale_and_matrix_stack(tmp_path):
+    body = ('<setmkfluid mk="0"/><rotateline ang="180"><point x="5" y="0" z="0"/>'
+            '<point x="5" y="1" z="0"/></rotateline>' + box((1, 1, 0), (1, 1, 1)))
+    d = draw(tmp_path, body, pmin=(-10, -10, -10))
+    # 180 deg about the line x=5, z=0 (along y): x -> 10-x, z -> -z
+    assert nodes(d) == lattice_box((8, 1, -1), (9, 2, 0))
+    body = ('<setmkfluid mk="0"/><matrixsave/><scale x="2" y="1" z="1"/>' + box((1, 1, 1), (1, 0, 0))
+            + '<matrixload/>' + box((0, 5, 0), (0, 0, 0)))
+    d = draw(tmp_path, body)
+    assert nodes(d) == {(2, 1, 1), (3, 1, 1), (4, 1, 1), (0, 5, 0)}
+    body = ('<setmkfluid mk="0"/><move x="3" y="0" z="0"/><matrixreset/>' + box((0, 0, 0), (0, 0, 0)))
+    assert nodes(draw(tmp_path, body)) == {(0, 0, 0)}
+
+
+def test_statesave_stateload(tmp_path):
+    body = ('<setmkfluid mk="1"/><statesave/><setmkbound mk="7"/><move x="2" y="0" z="0"/>'
+            '<stateload/>' + box((0, 0, 0), (0, 0, 0)))
+    d = draw(tmp_path, body)
+    assert nodes(d) == {(0, 0, 0)} and d.is_fluid.all() and d.mk.tolist() == [1]
+    body = '<setmkfluid mk="1"/><mksave/><setmkbound mk="7"/><mkload/>' + box((0, 0, 0), (0, 0, 0))
+    d = draw(tmp_path, body)
+    assert d.is_fluid.all() and d.mk.tolist() == [1]
+
+
+# ---------------------------------------------------------------- fills
+TANK = '<setmkbound mk="0"/>' + box((0, 0, 0), (6, 6, 6), fill="all")
+
+
+def test_fillpoint_void_inside_tank(tmp_path):
+    d = draw(tmp_path, TANK + '<setmkfluid mk="2"/><fillpoint x="3" y="3" z="3">'
+             '<modefill>void</modefill></fillpoint>')
+    assert nodes(d, fluid=True) == lattice_box((1, 1, 1), (5, 5, 5))
+    assert len(d.pos) == 7 ** 3
+    d = draw(tmp_path, TANK + '<setmkfluid mk="2"/><fillvoidpoint x="3" y="3" z="3"/>')
+    assert d.count_fluid == 125
+
+
+def test_fillbox_limits(tmp_path):
+    d = draw(tmp_path, TANK + '<setmkfluid mk="2"/><fillbox x="3" y="3" z="2">'
+             '<modefill>void</modefill><point x="0" y="0" z="0"/><size x="6" y="6" z="3"/>'
+             '</fillbox>')
+    assert nodes(d, fluid=True) == lattice_box((1, 1, 1), (5, 5, 3))
+
+
+def test_fill_modes_fluid_bound_and_filters(tmp_path):
+    pre = TANK + '<setmkfluid mk="2"/><fillvoidpoint x="3" y="3" z="3"/>'
+    # void erases the fluid (modefill fluid), walls stay
+    d = draw(tmp_path, pre + '<setmkvoid/><fillpoint x="3" y="3" z="3"><modefill>fluid</modefill>'
+             '</fillpoint>')
+    assert d.count_fluid == 0 and d.count_bound == 7 ** 3 - 5 ** 3
+    # through fluid and bound: the whole tank becomes mk 9 fluid
+    d = draw(tmp_path, pre + '<setmkfluid mk="9"/><fillpoint x="3" y="3" z="3">'
+             '<modefill>fluid | bound</modefill></fillpoint>')
+    assert d.count_fluid == 7 ** 3 and set(d.mk.tolist()) == {9}
+    # mkfluid filter: only fluid of mk 5 is fillable -> nothing happens
+    d = draw(tmp_path, pre + '<setmkfluid mk="9"/><fillpoint x="3" y="3" z="3" mkfluid="5">'
+             '<modefill>fluid</modefill></fillpoint>')
+    assert set(d.mk[d.is_fluid].tolist()) == {2}
+    # border alone acts as void: seed on a fluid node fills nothing
+    d = draw(tmp_path, pre + '<setmkfluid mk="9"/><fillpoint x="3" y="3" z="3">'
+             '<modefill>border</modefill></fillpoint>')
+    assert set(d.mk[d.is_fluid].tolist()) == {2}
+
+
+def test_fill_leaks_through_open_top(tmp_path):
+    body = ('<setmkbound mk="0"/>' + box((0, 0, 0), (6, 6, 6), fill="bottom | left | right | front | back")
+            + '<setmkfluid mk="0"/><fillbox x="3" y="3" z="3"><modefill>void</modefill>'
+            '<point x="-1" y="-1" z="-1"/><size x="8" y="8" z="8"/></fillbox>')
+    d = draw(tmp_path, body, pmin=(-2, -2, -2), pmax=(8, 8, 8))
+    # the fill escapes over the walls (top z=6) and fills the whole fill box but the walls
+    walls = 7 * 7 + 24 * 6
+    assert d.count_bound == walls
+    assert d.count_fluid == 9 ** 3 - walls
+
+
+def test_fill_2d(tmp_path):
+    body = ('<setmkbound mk="0"/>' + box((0, -1, 0), (6, 2, 6), fill="all")
+            + '<setmkfluid mk="1"/><fillvoidpoint x="2" y="0" z="2"/>')
+    d = draw(tmp_path, body, pmin=(-1, 0, -1), pmax=(8, 0, 8))
+    assert d.count_fluid == 25 and d.count_bound == 24
+
+
+# ---------------------------------------------------------------- variables and lists
+def test_variables_predefinition_and_builtins(tmp_path):
+    predef = '<predefinition><newvarcte L="2"/><newvar H="L+1"/></predefinition>'
+    body = ('<setmkfluid mk="0"/><newvar half="Dp/2" top="PosMax_z-1"/>'
+            '<drawbox><point x="0" y="0" z="#top-H"/><size x="#L" y="0" z="#H"/></drawbox>')
+    d = draw(tmp_path, body, predef=predef)
+    assert nodes(d) == lattice_box((0, 0, 6), (2, 0, 9))
+
+
+def test_runlist_loop_with_counter(tmp_path):
+    lists = '<list name="step"><drawpoint x="#i" y="0" z="0"/><setvar i="i+1"/></list>'
+    body = '<setmkbound mk="0"/><newvar i="0"/><runlist name="step" times="5"/>'
+    d = draw(tmp_path, body, lists=lists)
+    assert nodes(d) == {(i, 0, 0) for i in range(5)}
+
+
+def test_strings_printf_delvar(tmp_path, capsys):
+    body = ('<newvarstr T="ab"/><newvarstr U="[T]_[Dp*100]"/><printf text="U=[U]\\nok"/>'
+            '<printf if="Dp&gt;2" text="never"/><newvar x1="1" x2="2"/><delvar vars="x*"/>'
+            '<printf text="[Data2D]"/>')
+    d = draw(tmp_path, body)
+    assert d.messages == ["U=ab_100\nok", "0"]
+    assert "U=ab_100" in capsys.readouterr().out
+
+
+def test_abort(tmp_path):
+    with pytest.raises(CaseError, match="too small"):
+        draw(tmp_path, '<abort if="Dp&lt;2" text="Dp [Dp] too small"/>')
+    draw(tmp_path, '<abort if="Dp&gt;2" text="no"/>')
+
+
+def test_setactive_drawpoints(tmp_path):
+    d = draw(tmp_path, '<setmkfluid mk="0"/><setactive drawpoints="false"/>' + box((0, 0, 0), (1, 1, 1))
+             + '<setactive drawpoints="true"/>' + box((5, 5, 5), (0, 0, 0)))
+    assert nodes(d) == {(5, 5, 5)}
+
+
+def test_no_effect_commands_accepted(tmp_path):
+    d = draw(tmp_path, '<setdpctes cteline="0.1"/><setshapemode>actual | dp</setshapemode>'
+             '<debugout/><setmkfluid mk="0"/>' + box((0, 0, 0), (0, 0, 0)))
+    assert len(d.pos) == 1
