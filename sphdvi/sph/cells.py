@@ -1,0 +1,181 @@
+"""Counting-sort cell lists (cell size 2h) and reordering of particles by cell.
+
+The cells are numbered with x fastest, so the cells of one stencil row
+(x-1, x, x+1) hold a contiguous range of the sorted particles: the 2D search
+scans 3 ranges (3x3 stencil), the 3D search 9 ranges (27 cells).  In 2D the
+plane is x-z (DualSPHysics convention), y is ignored.
+"""
+import numpy as np
+
+from . import _env  # noqa: F401
+from numba import njit
+
+
+def grid_shape(pmin, pmax, cellsize, is2d):
+    """Number of cells (ncx, ncy, ncz) covering [pmin, pmax]."""
+    n = np.floor((np.asarray(pmax, float) - np.asarray(pmin, float)) / cellsize).astype(np.int64) + 1
+    n = np.maximum(n, 1)
+    if is2d:
+        n[1] = 1
+    return int(n[0]), int(n[1]), int(n[2])
+
+
+@njit(cache=True)
+def bounding_box(pos):
+    """Min and max corner of the particle positions (N, 3)."""
+    lo = np.empty(3)
+    hi = np.empty(3)
+    for k in range(3):
+        lo[k] = pos[0, k]
+        hi[k] = pos[0, k]
+    for i in range(1, pos.shape[0]):
+        for k in range(3):
+            v = pos[i, k]
+            if v < lo[k]:
+                lo[k] = v
+            if v > hi[k]:
+                hi[k] = v
+    return lo, hi
+
+
+@njit(cache=True)
+def counting_sort_cells(pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell, order, cell_start):
+    """Assign each particle to a cell and counting-sort the particles by cell.
+
+    Writes ``cell[i]`` (cell of particle i in the current order),
+    ``order[k]`` (current index of the k-th particle in sorted order) and
+    ``cell_start`` (size ncells+1: particles of cell c are
+    ``order[cell_start[c]:cell_start[c+1]]``).  Positions outside the grid
+    are clamped to the border cells.  Stable: equal cells keep their order.
+    """
+    n = pos.shape[0]
+    ncells = ncx * ncy * ncz
+    for c in range(ncells + 1):
+        cell_start[c] = 0
+    for i in range(n):
+        cx = int((pos[i, 0] - pmin[0]) * inv_cell)
+        cz = int((pos[i, 2] - pmin[2]) * inv_cell)
+        cx = min(max(cx, 0), ncx - 1)
+        cz = min(max(cz, 0), ncz - 1)
+        if is2d:
+            c = cz * ncx + cx
+        else:
+            cy = int((pos[i, 1] - pmin[1]) * inv_cell)
+            cy = min(max(cy, 0), ncy - 1)
+            c = (cz * ncy + cy) * ncx + cx
+        cell[i] = c
+        cell_start[c + 1] += 1
+    for c in range(ncells):
+        cell_start[c + 1] += cell_start[c]
+    # cursor: reuse order positions via a running copy of the starts
+    cursor = cell_start[:ncells].copy()
+    for i in range(n):
+        c = cell[i]
+        order[cursor[c]] = i
+        cursor[c] += 1
+
+
+@njit(cache=True)
+def gather_rows(src, order, dst):
+    """dst[k, :] = src[order[k], :]"""
+    for k in range(order.shape[0]):
+        i = order[k]
+        for m in range(src.shape[1]):
+            dst[k, m] = src[i, m]
+
+
+@njit(cache=True)
+def gather(src, order, dst):
+    """dst[k] = src[order[k]]"""
+    for k in range(order.shape[0]):
+        dst[k] = src[order[k]]
+
+
+def neighbour_pairs_bruteforce(pos, radius, is2d):
+    """All pairs (i < j) closer than ``radius``: reference for the tests."""
+    p = pos[:, [0, 2]] if is2d else pos
+    d2 = ((p[:, None, :] - p[None, :, :]) ** 2).sum(-1)
+    i, j = np.nonzero(np.triu(d2 < radius * radius, 1))
+    return set(zip(i.tolist(), j.tolist()))
+
+
+@njit(cache=True)
+def _pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius):
+    """Pairs (i < j, sorted-order indices) found through the cell stencil."""
+    r2max = radius * radius
+    n = pos.shape[0]
+    out = []
+    for i in range(n):
+        c = cell[i]
+        cx = c % ncx
+        if is2d:
+            cz = c // ncx
+            cy = 0
+        else:
+            cy = (c // ncx) % ncy
+            cz = c // (ncx * ncy)
+        for dz in range(-1, 2):
+            z = cz + dz
+            if z < 0 or z >= ncz:
+                continue
+            for dy in range(-1, 2):
+                y = cy + dy
+                if is2d and dy != 0:
+                    continue
+                if y < 0 or y >= ncy:
+                    continue
+                row = (z * ncy + y) * ncx
+                j0 = cell_start[row + max(cx - 1, 0)]
+                j1 = cell_start[row + min(cx + 1, ncx - 1) + 1]
+                for j in range(j0, j1):
+                    if j <= i:
+                        continue
+                    d2 = 0.0
+                    for k in range(3):
+                        if is2d and k == 1:
+                            continue
+                        d = pos[i, k] - pos[j, k]
+                        d2 += d * d
+                    if d2 < r2max:
+                        out.append((i, j))
+    return out
+
+
+class CellList:
+    """Cell list of cell size 2h over a box, with reusable work arrays."""
+
+    def __init__(self, h, is2d):
+        self.cellsize = 2.0 * h
+        self.is2d = bool(is2d)
+        self.cell = np.empty(0, np.int64)
+        self.order = np.empty(0, np.int64)
+        self.cell_start = np.empty(1, np.int64)
+        self.shape = (1, 1, 1)
+        self.pmin = np.zeros(3)
+
+    def build(self, pos, pmin=None, pmax=None):
+        """Sort ``pos`` into cells; returns ``order`` (sorted -> current index).
+
+        The grid covers [pmin, pmax] (default: the bounding box of ``pos``).
+        """
+        n = pos.shape[0]
+        if pmin is None or pmax is None:
+            lo, hi = bounding_box(pos)
+            pmin = lo if pmin is None else pmin
+            pmax = hi if pmax is None else pmax
+        self.pmin = np.asarray(pmin, float)
+        self.shape = grid_shape(self.pmin, pmax, self.cellsize, self.is2d)
+        ncells = self.shape[0] * self.shape[1] * self.shape[2]
+        if self.cell.shape[0] != n:
+            self.cell = np.empty(n, np.int64)
+            self.order = np.empty(n, np.int64)
+        if self.cell_start.shape[0] != ncells + 1:
+            self.cell_start = np.empty(ncells + 1, np.int64)
+        counting_sort_cells(pos, self.pmin, 1.0 / self.cellsize, self.shape[0],
+                            self.shape[1], self.shape[2], self.is2d,
+                            self.cell, self.order, self.cell_start)
+        return self.order
+
+    def sorted_cells(self):
+        """Cell of each particle in sorted order."""
+        return self.cell[self.order]

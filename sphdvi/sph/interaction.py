@@ -1,0 +1,589 @@
+r"""Fused particle interaction in gather form (DualSPHysics formulation).
+
+For each particle ``a`` (one loop iteration per particle, no atomics) the
+kernel sums over its neighbours ``b`` found through the cell list:
+
+* momentum (Crespo et al. 2015 eq. 4; Domínguez et al. 2022 eq. 8)
+  dv_a/dt = -sum_b m_b (p_a + p_b)/(rho_a rho_b) grad_a W_ab + viscous + g,
+  with the cubic-spline tensile correction (Monaghan 2000) when Kernel=1;
+* viscosity: ``ViscoTreatment`` 1, artificial (Monaghan 1992)
+  Pi_ab = -Visco c0 mu_ab / rho_ab for v_ab.r_ab < 0,
+  mu_ab = h v_ab.r_ab / (r_ab^2 + eta^2), eta^2 = 0.01 h^2;
+  3, laminar (Lo & Shao 2002)
+  sum_b m_b 4 nu (r_ab.grad_a W_ab) / ((rho_a+rho_b)(r_ab^2+eta^2)) v_ab;
+  2, laminar + SPS (Dalrymple & Rogers 2006), sum_b m_b (tau_a + tau_b).grad W
+  with tau/rho^2 from :func:`sps_tau` (lagged by one evaluation, as DualSPHysics);
+  ``ViscoBoundFactor`` multiplies Visco for fluid-boundary pairs;
+* continuity (Domínguez et al. 2022 eq. 6)
+  drho_a/dt = rho_a sum_b (m_b/rho_b) v_ab . grad_a W_ab + D_a,
+* density diffusion D_a (``DensityDT``): 1 Molteni & Colagrossi (2009),
+  2 Fourtakas et al. (2019) with the hydrostatic correction, on fluid
+  particles with no boundary neighbour, 3 the same on all fluid particles
+  over fluid-fluid pairs;
+* the viscous time-step term max_b h v_ab.r_ab/(r_ab^2+eta^2);
+* shifting sums (Lind et al. 2012): grad C_a = sum_b m_b/rho_b grad_a W_ab and
+  the free-surface detector div r_a = -sum_b m_b/rho_b r_ab.grad_a W_ab.
+
+Boundary particles (DBC; ptype 0 fixed, 1 moving) get continuity only, from
+their fluid and floating neighbours.  Floating particles (ptype 2) interact
+with fluid only; their ``ace`` excludes gravity (the body solver adds it).
+
+Feature flags are ``numba.literally`` arguments (compile-time constants):
+kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3.  The 2D (x-z plane) and 3D
+paths are separate functions.
+"""
+import math
+
+from . import _env  # noqa: F401
+import numpy as np
+from numba import njit, prange, literally
+
+from .kernels import kernel_fac, kernel_w
+
+
+@njit(cache=True)
+def _hydrostatic_drho(x, rhop0, inv_gamma):
+    """rho0 ((1+x)^(1/gamma) - 1): hydrostatic density difference (Fourtakas).
+
+    Binomial series for |x| < 0.01 (relative error < 1e-10), pow otherwise.
+    """
+    if abs(x) < 0.01:
+        a = inv_gamma
+        c1 = a
+        c2 = c1 * (a - 1.0) * 0.5
+        c3 = c2 * (a - 2.0) / 3.0
+        c4 = c3 * (a - 3.0) * 0.25
+        c5 = c4 * (a - 4.0) * 0.2
+        return rhop0 * x * (c1 + x * (c2 + x * (c3 + x * (c4 + x * c5))))
+    return rhop0 * ((1.0 + x) ** inv_gamma - 1.0)
+
+
+@njit(cache=True)
+def _tensile(p, rho):
+    """Monaghan (2000) tensile-correction coefficient R_a/(W/W(dp))^4."""
+    return p / (rho * rho) * (0.01 if p > 0.0 else -0.2)
+
+
+# --------------------------------------------------------------------------
+# Packing of the neighbour data
+# --------------------------------------------------------------------------
+# 2D packed row: x, z, vx, vz, rho, p, m, 1/rho   (one 64-byte line)
+# 3D packed row: x, y, z, vx, vy, vz, rho, p, m, 1/rho
+@njit(cache=True)
+def tait_pressure(rho, b, rhop0, gamma):
+    """Tait equation of state p = B ((rho/rho0)^gamma - 1) (Batchelor 1967)."""
+    x = rho / rhop0
+    if gamma == 7.0:
+        x2 = x * x
+        x3 = x2 * x
+        return b * (x3 * x3 * x - 1.0)
+    return b * (x ** gamma - 1.0)
+
+
+@njit(cache=True)
+def _pack_row(i, is2d, pos, vel, rhop, mass, cst, nb):
+    rho = rhop[i]
+    p = tait_pressure(rho, cst[16], cst[10], cst[17])
+    if is2d:
+        nb[i, 0] = pos[i, 0]
+        nb[i, 1] = pos[i, 2]
+        nb[i, 2] = vel[i, 0]
+        nb[i, 3] = vel[i, 2]
+        nb[i, 4] = rho
+        nb[i, 5] = p
+        nb[i, 6] = mass[i]
+        nb[i, 7] = 1.0 / rho
+    else:
+        for k in range(3):
+            nb[i, k] = pos[i, k]
+            nb[i, 3 + k] = vel[i, k]
+        nb[i, 6] = rho
+        nb[i, 7] = p
+        nb[i, 8] = mass[i]
+        nb[i, 9] = 1.0 / rho
+
+
+@njit(cache=True)
+def pack_serial(is2d, pos, vel, rhop, mass, cst, nb):
+    """Fill the packed neighbour array, computing the pressure from Tait's EOS."""
+    for i in range(pos.shape[0]):
+        _pack_row(i, is2d, pos, vel, rhop, mass, cst, nb)
+
+
+@njit(cache=True, parallel=True)
+def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
+    """Threaded :func:`pack_serial`."""
+    for i in prange(pos.shape[0]):
+        _pack_row(i, is2d, pos, vel, rhop, mass, cst, nb)
+
+
+# --------------------------------------------------------------------------
+# 2D (x-z plane)
+# --------------------------------------------------------------------------
+@njit(cache=True)
+def _particle_rates_2d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+                       ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
+                       gradvel):
+    kern = literally(kern)
+    visco = literally(visco)
+    ddt = literally(ddt)
+    shift = literally(shift)
+    h = cst[0]
+    inv_h = 1.0 / h
+    r2max = cst[1]
+    eta2 = cst[2]
+    alpha = cst[3]
+    alpha_h2 = cst[4]
+    cs0h = cst[5] * h
+    vis_f = cst[6]
+    vis_b = cst[7]
+    ddt_gz = cst[9]
+    rhop0 = cst[10]
+    inv_gamma = cst[11]
+    od_wdp = cst[15]
+
+    xi = nb[i, 0]
+    zi = nb[i, 1]
+    vxi = nb[i, 2]
+    vzi = nb[i, 3]
+    rhoi = nb[i, 4]
+    pi = nb[i, 5]
+    iri = nb[i, 7]
+    pti = ptype[i]
+    c = cell[i]
+    cx = c % ncx
+    cz = c // ncx
+    xlo = max(cx - 1, 0)
+    xhi = min(cx + 1, ncx - 1)
+    zlo = max(cz - 1, 0)
+    zhi = min(cz + 1, ncz - 1)
+
+    if pti < 2:
+        # DBC boundary particle: continuity with fluid/floating neighbours.
+        arp = 0.0
+        vmax = 0.0
+        for z in range(zlo, zhi + 1):
+            row = z * ncx
+            for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
+                if ptype[j] < 2:
+                    continue
+                dx = xi - nb[j, 0]
+                dz = zi - nb[j, 1]
+                r2 = dx * dx + dz * dz
+                if r2 >= r2max or r2 < 1e-18:
+                    continue
+                fac = kernel_fac(kern, math.sqrt(r2) * inv_h, alpha_h2)
+                dot = (vxi - nb[j, 2]) * dx + (vzi - nb[j, 3]) * dz
+                arp += nb[j, 6] * fac * dot * nb[j, 7]
+                vmax = max(vmax, dot / (r2 + eta2))
+        ace[i, 0] = 0.0
+        ace[i, 1] = 0.0
+        ace[i, 2] = 0.0
+        ar[i] = rhoi * arp
+        viscdt[i] = vmax
+        return
+
+    acex = 0.0
+    acez = 0.0
+    arp = 0.0
+    vmax = 0.0
+    deltap = 0.0
+    ddt_off = False
+    shx = 0.0
+    shz = 0.0
+    shdet = 0.0
+    sh_off = False
+    gxx = 0.0
+    gxz = 0.0
+    gzz = 0.0
+    tens_i = 0.0
+    if kern == 1:
+        tens_i = _tensile(pi, rhoi)
+    txx_i = 0.0
+    txz_i = 0.0
+    tzz_i = 0.0
+    if visco == 2:
+        txx_i = tau[i, 0]
+        txz_i = tau[i, 2]
+        tzz_i = tau[i, 5]
+    for z in range(zlo, zhi + 1):
+        row = z * ncx
+        for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
+            dx = xi - nb[j, 0]
+            dz = zi - nb[j, 1]
+            r2 = dx * dx + dz * dz
+            if r2 >= r2max or r2 < 1e-18:
+                continue
+            ptj = ptype[j]
+            if pti == 2 and ptj != 3:
+                continue  # floating particles see fluid only
+            boundj = ptj < 2
+            q = math.sqrt(r2) * inv_h
+            fac = kernel_fac(kern, q, alpha_h2)
+            rhoj = nb[j, 4]
+            pj = nb[j, 5]
+            mfac = nb[j, 6] * fac
+            irj = nb[j, 7]
+            dvx = vxi - nb[j, 2]
+            dvz = vzi - nb[j, 3]
+            dot = dvx * dx + dvz * dz
+            ir2e = 1.0 / (r2 + eta2)
+            dot_rr2 = dot * ir2e
+            vmax = max(vmax, dot_rr2)
+            # continuity: rho_a m_b/rho_b v_ab.gradW (rho_a applied at the end)
+            arp += mfac * dot * irj
+            # symmetric pressure term
+            coef = -(pi + pj) * iri * irj
+            if kern == 1:
+                wr = kernel_w(1, q, alpha) * od_wdp
+                wr = wr * wr
+                coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
+            vis = vis_b if boundj else vis_f
+            if visco == 1:
+                # Monaghan artificial viscosity, active for approaching pairs
+                coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
+            else:
+                # Lo & Shao laminar viscosity
+                vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
+                acex += vtemp * dvx
+                acez += vtemp * dvz
+                if visco == 2 and not boundj:
+                    mj = nb[j, 6]
+                    sxx = txx_i + tau[j, 0]
+                    sxz = txz_i + tau[j, 2]
+                    szz = tzz_i + tau[j, 5]
+                    acex += mj * fac * (sxx * dx + sxz * dz)
+                    acez += mj * fac * (sxz * dx + szz * dz)
+                    volj = -mfac * irj
+                    gxx += dvx * volj * dx
+                    gxz += dvx * volj * dz + dvz * volj * dx
+                    gzz += dvz * volj * dz
+            acex += coef * mfac * dx
+            acez += coef * mfac * dz
+            # density diffusion
+            if ddt == 1:
+                if ptj != 3:
+                    ddt_off = True
+                else:
+                    deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
+            elif ddt == 2 or ddt == 3:
+                if boundj:
+                    if ddt == 2:
+                        ddt_off = True
+                elif ptj == 3:
+                    drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
+                    deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
+            # shifting
+            if shift > 0:
+                if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
+                    sh_off = True
+                mr = mfac * irj
+                shx += mr * dx
+                shz += mr * dz
+                shdet -= mr * r2
+    arp *= rhoi
+    if pti == 3:
+        ace[i, 0] = acex + cst[12]
+        ace[i, 1] = cst[13]
+        ace[i, 2] = acez + cst[14]
+        if ddt != 0 and not ddt_off:
+            arp += cst[8] * deltap
+    else:
+        ace[i, 0] = acex
+        ace[i, 1] = 0.0
+        ace[i, 2] = acez
+    ar[i] = arp
+    viscdt[i] = vmax
+    if shift > 0:
+        if sh_off or pti != 3:
+            shiftpos[i, 0] = 0.0
+            shiftpos[i, 2] = 0.0
+        else:
+            shiftpos[i, 0] = shx
+            shiftpos[i, 2] = shz
+        shiftpos[i, 1] = 0.0
+        shiftdet[i] = shdet
+    if visco == 2:
+        gradvel[i, 0] = gxx
+        gradvel[i, 2] = gxz
+        gradvel[i, 5] = gzz
+
+
+@njit(cache=True)
+def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
+    """Serial driver of the 2D interaction (use below ~10k particles)."""
+    kern = literally(kern)
+    visco = literally(visco)
+    ddt = literally(ddt)
+    shift = literally(shift)
+    for i in range(nb.shape[0]):
+        _particle_rates_2d(i, kern, visco, ddt, shift, nb, ptype, cell,
+                           cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
+                           shiftpos, shiftdet, gradvel)
+
+
+@njit(cache=True, parallel=True)
+def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
+    """Threaded driver of the 2D interaction (prange over particles)."""
+    kern = literally(kern)
+    visco = literally(visco)
+    ddt = literally(ddt)
+    shift = literally(shift)
+    for i in prange(nb.shape[0]):
+        _particle_rates_2d(i, kern, visco, ddt, shift, nb, ptype, cell,
+                           cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
+                           shiftpos, shiftdet, gradvel)
+
+
+# --------------------------------------------------------------------------
+# 3D
+# --------------------------------------------------------------------------
+@njit(cache=True)
+def _particle_rates_3d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+                       ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
+                       gradvel):
+    kern = literally(kern)
+    visco = literally(visco)
+    ddt = literally(ddt)
+    shift = literally(shift)
+    h = cst[0]
+    inv_h = 1.0 / h
+    r2max = cst[1]
+    eta2 = cst[2]
+    alpha = cst[3]
+    alpha_h2 = cst[4]
+    cs0h = cst[5] * h
+    vis_f = cst[6]
+    vis_b = cst[7]
+    ddt_gz = cst[9]
+    rhop0 = cst[10]
+    inv_gamma = cst[11]
+    od_wdp = cst[15]
+
+    xi = nb[i, 0]
+    yi = nb[i, 1]
+    zi = nb[i, 2]
+    vxi = nb[i, 3]
+    vyi = nb[i, 4]
+    vzi = nb[i, 5]
+    rhoi = nb[i, 6]
+    pi = nb[i, 7]
+    iri = nb[i, 9]
+    pti = ptype[i]
+    c = cell[i]
+    cx = c % ncx
+    cy = (c // ncx) % ncy
+    cz = c // (ncx * ncy)
+    xlo = max(cx - 1, 0)
+    xhi = min(cx + 1, ncx - 1)
+    ylo = max(cy - 1, 0)
+    yhi = min(cy + 1, ncy - 1)
+    zlo = max(cz - 1, 0)
+    zhi = min(cz + 1, ncz - 1)
+
+    if pti < 2:
+        arp = 0.0
+        vmax = 0.0
+        for z in range(zlo, zhi + 1):
+            for y in range(ylo, yhi + 1):
+                row = (z * ncy + y) * ncx
+                for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
+                    if ptype[j] < 2:
+                        continue
+                    dx = xi - nb[j, 0]
+                    dy = yi - nb[j, 1]
+                    dz = zi - nb[j, 2]
+                    r2 = dx * dx + dy * dy + dz * dz
+                    if r2 >= r2max or r2 < 1e-18:
+                        continue
+                    fac = kernel_fac(kern, math.sqrt(r2) * inv_h, alpha_h2)
+                    dot = ((vxi - nb[j, 3]) * dx + (vyi - nb[j, 4]) * dy
+                           + (vzi - nb[j, 5]) * dz)
+                    arp += nb[j, 8] * fac * dot * nb[j, 9]
+                    vmax = max(vmax, dot / (r2 + eta2))
+        ace[i, 0] = 0.0
+        ace[i, 1] = 0.0
+        ace[i, 2] = 0.0
+        ar[i] = rhoi * arp
+        viscdt[i] = vmax
+        return
+
+    acex = 0.0
+    acey = 0.0
+    acez = 0.0
+    arp = 0.0
+    vmax = 0.0
+    deltap = 0.0
+    ddt_off = False
+    shx = 0.0
+    shy = 0.0
+    shz = 0.0
+    shdet = 0.0
+    sh_off = False
+    gxx = 0.0
+    gxy = 0.0
+    gxz = 0.0
+    gyy = 0.0
+    gyz = 0.0
+    gzz = 0.0
+    tens_i = 0.0
+    if kern == 1:
+        tens_i = _tensile(pi, rhoi)
+    t0 = 0.0
+    t1 = 0.0
+    t2 = 0.0
+    t3 = 0.0
+    t4 = 0.0
+    t5 = 0.0
+    if visco == 2:
+        t0 = tau[i, 0]
+        t1 = tau[i, 1]
+        t2 = tau[i, 2]
+        t3 = tau[i, 3]
+        t4 = tau[i, 4]
+        t5 = tau[i, 5]
+    for z in range(zlo, zhi + 1):
+        for y in range(ylo, yhi + 1):
+            row = (z * ncy + y) * ncx
+            for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
+                dx = xi - nb[j, 0]
+                dy = yi - nb[j, 1]
+                dz = zi - nb[j, 2]
+                r2 = dx * dx + dy * dy + dz * dz
+                if r2 >= r2max or r2 < 1e-18:
+                    continue
+                ptj = ptype[j]
+                if pti == 2 and ptj != 3:
+                    continue
+                boundj = ptj < 2
+                q = math.sqrt(r2) * inv_h
+                fac = kernel_fac(kern, q, alpha_h2)
+                rhoj = nb[j, 6]
+                pj = nb[j, 7]
+                mfac = nb[j, 8] * fac
+                irj = nb[j, 9]
+                dvx = vxi - nb[j, 3]
+                dvy = vyi - nb[j, 4]
+                dvz = vzi - nb[j, 5]
+                dot = dvx * dx + dvy * dy + dvz * dz
+                ir2e = 1.0 / (r2 + eta2)
+                dot_rr2 = dot * ir2e
+                vmax = max(vmax, dot_rr2)
+                arp += mfac * dot * irj
+                coef = -(pi + pj) * iri * irj
+                if kern == 1:
+                    wr = kernel_w(1, q, alpha) * od_wdp
+                    wr = wr * wr
+                    coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
+                vis = vis_b if boundj else vis_f
+                if visco == 1:
+                    coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
+                else:
+                    vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
+                    acex += vtemp * dvx
+                    acey += vtemp * dvy
+                    acez += vtemp * dvz
+                    if visco == 2 and not boundj:
+                        mj = nb[j, 8]
+                        sxx = t0 + tau[j, 0]
+                        sxy = t1 + tau[j, 1]
+                        sxz = t2 + tau[j, 2]
+                        syy = t3 + tau[j, 3]
+                        syz = t4 + tau[j, 4]
+                        szz = t5 + tau[j, 5]
+                        acex += mj * fac * (sxx * dx + sxy * dy + sxz * dz)
+                        acey += mj * fac * (sxy * dx + syy * dy + syz * dz)
+                        acez += mj * fac * (sxz * dx + syz * dy + szz * dz)
+                        volj = -mfac * irj
+                        ax = dvx * volj
+                        ay = dvy * volj
+                        az = dvz * volj
+                        gxx += ax * dx
+                        gxy += ax * dy + ay * dx
+                        gxz += ax * dz + az * dx
+                        gyy += ay * dy
+                        gyz += ay * dz + az * dy
+                        gzz += az * dz
+                acex += coef * mfac * dx
+                acey += coef * mfac * dy
+                acez += coef * mfac * dz
+                if ddt == 1:
+                    if ptj != 3:
+                        ddt_off = True
+                    else:
+                        deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
+                elif ddt == 2 or ddt == 3:
+                    if boundj:
+                        if ddt == 2:
+                            ddt_off = True
+                    elif ptj == 3:
+                        drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
+                        deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
+                if shift > 0:
+                    if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
+                        sh_off = True
+                    mr = mfac * irj
+                    shx += mr * dx
+                    shy += mr * dy
+                    shz += mr * dz
+                    shdet -= mr * r2
+    arp *= rhoi
+    if pti == 3:
+        ace[i, 0] = acex + cst[12]
+        ace[i, 1] = acey + cst[13]
+        ace[i, 2] = acez + cst[14]
+        if ddt != 0 and not ddt_off:
+            arp += cst[8] * deltap
+    else:
+        ace[i, 0] = acex
+        ace[i, 1] = acey
+        ace[i, 2] = acez
+    ar[i] = arp
+    viscdt[i] = vmax
+    if shift > 0:
+        if sh_off or pti != 3:
+            shiftpos[i, 0] = 0.0
+            shiftpos[i, 1] = 0.0
+            shiftpos[i, 2] = 0.0
+        else:
+            shiftpos[i, 0] = shx
+            shiftpos[i, 1] = shy
+            shiftpos[i, 2] = shz
+        shiftdet[i] = shdet
+    if visco == 2:
+        gradvel[i, 0] = gxx
+        gradvel[i, 1] = gxy
+        gradvel[i, 2] = gxz
+        gradvel[i, 3] = gyy
+        gradvel[i, 4] = gyz
+        gradvel[i, 5] = gzz
+
+
+@njit(cache=True)
+def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, ncy,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
+    """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows)."""
+    kern = literally(kern)
+    visco = literally(visco)
+    ddt = literally(ddt)
+    shift = literally(shift)
+    for i in range(nb.shape[0]):
+        _particle_rates_3d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+                           ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos,
+                           shiftdet, gradvel)
+
+
+@njit(cache=True, parallel=True)
+def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, ncy,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
+    """Threaded driver of the 3D interaction."""
+    kern = literally(kern)
+    visco = literally(visco)
+    ddt = literally(ddt)
+    shift = literally(shift)
+    for i in prange(nb.shape[0]):
+        _particle_rates_3d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+                           ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos,
+                           shiftdet, gradvel)

@@ -1,0 +1,390 @@
+"""The SPH solver: advances a :class:`FluidState` one time step at a time.
+
+Physics sees arrays only: no files, no CLI.  Built from two plain dicts:
+
+``constants`` (names as GenCase resolves them, ``sphdvi.case`` Constants.to_dict()):
+  dp, h, b, cs0, rhop0, gamma, gravity (3 floats), is2d, cflnumber,
+  massfluid / mass_fluid, massbound / mass_bound (used only by helpers that
+  build states; the state carries the per-particle mass).
+
+``params`` (DualSPHysics ``<execution><parameters>`` names, case-format.md
+§2.8; missing keys take the DualSPHysics defaults in :data:`DEFAULT_PARAMS`,
+unknown keys are ignored):
+  StepAlgorithm, VerletSteps, Kernel, ViscoTreatment, Visco,
+  ViscoBoundFactor, DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
+  CoefDtMin, DtIni, DtMin, DtFixed, RhopOutMin, RhopOutMax, Boundary and the
+  periodic keys (only their absence is supported for now).
+"""
+import math
+import warnings
+
+from . import _env  # noqa: F401
+import numba
+import numpy as np
+
+from . import cells as _cells
+from . import integrators as _int
+from . import interaction as _ia
+from . import sps as _sps
+from . import timestep as _ts
+from .exclusion import REASON_NAMES
+from .kernels import kernel_alpha, kernel_w
+from .specialise import specialised
+from .state import FLUID, FluidState
+
+DEFAULT_PARAMS = {
+    "StepAlgorithm": 1, "VerletSteps": 40, "Kernel": 2, "ViscoTreatment": 1,
+    "Visco": 0.01, "ViscoBoundFactor": 1.0, "DensityDT": 0, "DensityDTvalue": 0.1,
+    "Shifting": 0, "ShiftCoef": -2.0, "ShiftTFS": 0.0, "CoefDtMin": 0.05,
+    "DtIni": 0.0, "DtMin": 0.0, "DtFixed": 0.0, "RhopOutMin": 700.0,
+    "RhopOutMax": 1300.0, "Boundary": 1,
+}
+PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ",
+                 "ZPeriodicIncX", "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
+PARALLEL_THRESHOLD = 10000
+
+
+def resolve_params(params):
+    """DualSPHysics defaults updated with ``params`` (unknown keys kept as given)."""
+    p = dict(DEFAULT_PARAMS)
+    if params:
+        p.update({k: v for k, v in params.items() if v is not None})
+    return p
+
+
+class SPHSolver:
+    """Weakly-compressible SPH (DualSPHysics formulation) on a FluidState.
+
+    Parameters
+    ----------
+    state : FluidState
+        The particles; modified in place (arrays may be swapped, see FluidState).
+    constants, params : dict
+        See the module docstring.
+    domain : (pmin, pmax) or None
+        Simulation box: fluid particles leaving it are excluded and the cell
+        grid covers it.  None: the grid follows the particle bounding box and
+        no particle is excluded for its position.
+    motion_hook : callable(solver, t, dt) or None
+        Called at the end of every step (time already advanced).  It must
+        set ``state.pos`` and ``state.vel`` of the moving (ptype 1) and
+        floating (ptype 2) particles.  Without a hook those particles move
+        with their current velocity, r += v dt.
+    parallel_threshold : int
+        Below this many particles the serial kernels run (no thread launch).
+
+    After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
+    accelerations, density rates and pressures of the last interaction, in
+    the current particle order (``state.idp`` identifies the particles).
+    For floating particles ``ace`` is the fluid force per unit mass, without
+    gravity.
+    """
+
+    def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
+                 parallel_threshold=PARALLEL_THRESHOLD):
+        if not isinstance(state, FluidState):
+            raise TypeError("state must be a FluidState")
+        self.state = state
+        self.constants = dict(constants)
+        self.params = resolve_params(params)
+        self.motion_hook = motion_hook
+        self.parallel_threshold = int(parallel_threshold)
+        self.time = 0.0
+        self.nstep = 0
+        self.n_dtmin = 0          # steps where dt was raised to DtMin (DtModif)
+        self.n_excluded = {name: 0 for name in REASON_NAMES.values()}
+        self.excluded = []        # list of dicts: time, idp, pos, vel, rhop, reason
+        self.last_dt = 0.0
+        self._setup_constants()
+        self._domain = None
+        if domain is not None:
+            self._domain = (np.asarray(domain[0], float), np.asarray(domain[1], float))
+        self.cells = _cells.CellList(self.h, self.is2d)
+        self._verlet_count = 0
+        self._entry = {}
+        self._alloc()
+        self.dt_pre = self.dtini
+
+    # ------------------------------------------------------------------ set-up
+    def _setup_constants(self):
+        c = self.constants
+        p = self.params
+        self.is2d = bool(c["is2d"])
+        self.h = h = float(c["h"])
+        self.dp = float(c["dp"])
+        self.cs0 = float(c["cs0"])
+        self.rhop0 = float(c["rhop0"])
+        self.gamma = float(c["gamma"])
+        self.b = float(c.get("b") or self.cs0 ** 2 * self.rhop0 / self.gamma)
+        self.gravity = np.asarray(c["gravity"], float).reshape(3)
+        self.cfl = float(c.get("cflnumber", 0.2))
+        if int(p["Boundary"]) != 1:
+            raise NotImplementedError("Boundary=2 (mDBC) is not implemented yet; use Boundary=1 (DBC)")
+        for k in PERIODIC_KEYS:
+            if p.get(k):
+                raise NotImplementedError("periodic boundaries (%s) are not implemented yet" % k)
+        self.kernel = int(p["Kernel"])
+        self.visco_kind = int(p["ViscoTreatment"])
+        self.ddt = int(p["DensityDT"])
+        self.shift = int(p["Shifting"])
+        if self.kernel not in (1, 2):
+            raise ValueError("Kernel must be 1 or 2")
+        if self.visco_kind not in (1, 2, 3):
+            raise ValueError("ViscoTreatment must be 1, 2 or 3")
+        if self.ddt not in (0, 1, 2, 3):
+            raise ValueError("DensityDT must be 0..3")
+        if self.shift == 4:
+            warnings.warn("Shifting=4 (advanced) is not implemented; using 3 (full)")
+            self.shift = 3
+        if self.shift not in (0, 1, 2, 3):
+            raise ValueError("Shifting must be 0..4")
+        self.step_algorithm = int(p["StepAlgorithm"])
+        if self.step_algorithm not in (1, 2):
+            raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
+        self.verlet_steps = int(p["VerletSteps"])
+        alpha = kernel_alpha(self.kernel, h, self.is2d)
+        cst = np.zeros(18)
+        cst[0] = h
+        cst[1] = 4.0 * h * h
+        cst[2] = (0.1 * h) ** 2
+        cst[3] = alpha
+        cst[4] = alpha / (h * h)
+        cst[5] = self.cs0
+        cst[6] = float(p["Visco"])
+        cst[7] = float(p["Visco"]) * float(p["ViscoBoundFactor"])
+        cst[8] = float(p["DensityDTvalue"]) * 2.0 * h * self.cs0
+        cst[9] = self.rhop0 * self.gravity[2] / self.b
+        cst[10] = self.rhop0
+        cst[11] = 1.0 / self.gamma
+        cst[12:15] = self.gravity
+        cst[15] = 1.0 / kernel_w(1, self.dp / h, kernel_alpha(1, h, self.is2d)) if self.kernel == 1 else 0.0
+        cst[16] = self.b
+        cst[17] = self.gamma
+        self.cst = cst
+        self.dtmin = float(p["DtMin"]) or float(p["CoefDtMin"]) * h / self.cs0
+        self.dtini = float(p["DtIni"]) or h / self.cs0
+        self.dtfixed = float(p["DtFixed"] or 0.0)
+        self.sps_smag = (0.12 * self.dp) ** 2
+        self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
+        self.shift_tfs = float(p["ShiftTFS"])
+        self.ip = np.zeros(14)
+        self.ip[1] = self.rhop0
+        self.ip[2] = float(p["RhopOutMin"])
+        self.ip[3] = float(p["RhopOutMax"])
+        self.ip[4] = float(p["ShiftCoef"]) * h
+        self.ip[5] = self.shift_tfs
+
+    def _aux_names(self):
+        names = []
+        if self.step_algorithm == 1:
+            names += ["vel_m1", "rhop_m1"]
+        else:
+            names += ["pos_pre", "vel_pre", "rhop_pre"]
+        if self.visco_kind == 2:
+            names += ["tau"]
+        return names
+
+    def _alloc(self):
+        """(Re)allocate the per-particle work arrays for the current N."""
+        s = self.state
+        n = s.n
+        if not hasattr(self, "vel_m1"):
+            self.vel_m1 = s.vel.copy()
+            self.rhop_m1 = s.rhop.copy()
+            self.pos_pre = s.pos.copy()
+            self.vel_pre = s.vel.copy()
+            self.rhop_pre = s.rhop.copy()
+            self.tau = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
+        self.nb = np.zeros((n, 8 if self.is2d else 10))
+        self.ace = np.zeros((n, 3))
+        self.ar = np.zeros(n)
+        self.viscdt = np.zeros(n)
+        self.out = np.zeros(n, np.int8)
+        self.cell_sorted = np.zeros(n, np.int64)
+        if self.shift:
+            self.shiftpos = np.zeros((n, 3))
+            self.shiftdet = np.zeros(n)
+        else:
+            self.shiftpos = np.zeros((1, 3))
+            self.shiftdet = np.zeros(1)
+        self.gradvel = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
+        self._bufs = {}
+
+    # ------------------------------------------------------------------ kernels
+    def _use_parallel(self):
+        return self.state.n >= self.parallel_threshold and numba.get_num_threads() > 1
+
+    def _kernels(self, parallel):
+        """Entry points of the compiled kernels for this run's flags."""
+        if parallel in self._entry:
+            return self._entry[parallel]
+        sfx = "parallel" if parallel else "serial"
+        rates = getattr(_ia, ("rates_2d_" if self.is2d else "rates_3d_") + sfx)
+        k = {
+            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3)),
+            "pack": getattr(_ia, "pack_" + sfx),
+            "sps": getattr(_sps, "sps_tau_" + sfx),
+        }
+        if self.step_algorithm == 1:
+            k["verlet"] = specialised(getattr(_int, "verlet_" + sfx), self._verlet_args(False), (0,))
+        else:
+            k["sym_pre"] = getattr(_int, "symplectic_pre_" + sfx)
+            k["sym_corr"] = specialised(getattr(_int, "symplectic_corr_" + sfx),
+                                        self._corr_args(), (0,))
+        self._entry[parallel] = k
+        return k
+
+    def _rates_args(self):
+        ncx, ncy, ncz = self.cells.shape
+        s = self.state
+        geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
+        return ((self.kernel, self.visco_kind, self.ddt, self.shift, self.nb, s.ptype,
+                 self.cell_sorted, self.cells.cell_start) + geo
+                + (self.cst, self.tau, self.ace, self.ar, self.viscdt, self.shiftpos,
+                   self.shiftdet, self.gradvel))
+
+    def _verlet_args(self, euler):
+        s = self.state
+        return (self.shift, bool(euler), s.pos, s.vel, s.rhop, self.vel_m1, self.rhop_m1,
+                self.ace, self.ar, s.ptype, self.shiftpos, self.shiftdet, self.ip, self.out)
+
+    def _corr_args(self):
+        s = self.state
+        return (self.shift, s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
+                self.ace, self.ar, s.ptype, self.shiftpos, self.shiftdet, self.ip, self.out)
+
+    # ------------------------------------------------------------------ steps
+    def _reorder(self):
+        """Counting-sort the particles by cell and permute every per-particle array."""
+        s = self.state
+        if self._domain is not None:
+            order = self.cells.build(s.pos, self._domain[0], self._domain[1])
+        else:
+            order = self.cells.build(s.pos)
+        _cells.gather(self.cells.cell, order, self.cell_sorted)
+        for holder, names in ((s, FluidState.FIELDS), (self, self._aux_names())):
+            for name in names:
+                a = getattr(holder, name)
+                if a.shape[0] != order.shape[0]:
+                    continue
+                buf = self._bufs.get(name)
+                if buf is None or buf.shape != a.shape:
+                    buf = np.empty_like(a)
+                if a.ndim == 2:
+                    _cells.gather_rows(a, order, buf)
+                else:
+                    _cells.gather(a, order, buf)
+                setattr(holder, name, buf)
+                self._bufs[name] = a
+
+    def compute_rates(self):
+        """Reorder, then evaluate accelerations, density rates and dt terms."""
+        self._reorder()
+        k = self._kernels(self._use_parallel())
+        s = self.state
+        k["pack"](self.is2d, s.pos, s.vel, s.rhop, s.mass, self.cst, self.nb)
+        k["rates"](*self._rates_args())
+        if self.visco_kind == 2:
+            k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
+
+    def _variable_dt(self):
+        if self.dtfixed > 0.0:
+            return self.dtfixed
+        a2, v2, cv = _ts.dt_terms(self.ace, self.state.vel, self.viscdt, self.state.ptype)
+        dt = _ts.variable_dt(a2, v2, cv, self.h, self.cs0, self.cfl)
+        if dt < self.dtmin:
+            dt = self.dtmin
+            self.n_dtmin += 1
+        return dt
+
+    def _set_ip(self, dt):
+        ip = self.ip
+        ip[0] = dt
+        if self._domain is not None:
+            ip[6] = 1.0
+            ip[7:10] = self._domain[0]
+            ip[10:13] = self._domain[1]
+        ip[13] = 0.0 if self.motion_hook is not None else 1.0
+
+    def step(self):
+        """Advance one time step; returns dt."""
+        if self.step_algorithm == 1:
+            dt = self._step_verlet()
+        else:
+            dt = self._step_symplectic()
+        self.time += dt
+        self.nstep += 1
+        self.last_dt = dt
+        if self.motion_hook is not None:
+            self.motion_hook(self, self.time, dt)
+        return dt
+
+    def _step_verlet(self):
+        self.compute_rates()
+        dt = self._variable_dt()
+        self._set_ip(dt)
+        euler = self._verlet_count >= self.verlet_steps
+        self._verlet_count = 0 if euler else self._verlet_count + 1
+        k = self._kernels(self._use_parallel())
+        nout = k["verlet"](*self._verlet_args(euler))
+        if nout:
+            self._exclude()
+        return dt
+
+    def _step_symplectic(self):
+        dt = self.dtfixed if self.dtfixed > 0.0 else self.dt_pre
+        self._set_ip(dt)
+        s = self.state
+        self.compute_rates()
+        k = self._kernels(self._use_parallel())
+        k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
+                     self.ace, self.ar, s.ptype, self.ip)
+        self.compute_rates()
+        k = self._kernels(self._use_parallel())
+        nout = k["sym_corr"](*self._corr_args())
+        self.dt_pre = self._variable_dt()
+        if nout:
+            self._exclude()
+        return dt
+
+    def run(self, tmax, max_steps=None):
+        """Step until ``time >= tmax`` (or ``max_steps``); returns the number of steps."""
+        n = 0
+        while self.time < tmax and (max_steps is None or n < max_steps):
+            self.step()
+            n += 1
+        return n
+
+    # ------------------------------------------------------------------ exclusion
+    def _exclude(self):
+        """Remove the flagged fluid particles from the state and work arrays."""
+        s = self.state
+        codes = self.out.copy()
+        bad = codes != 0
+        for code, name in REASON_NAMES.items():
+            self.n_excluded[name] += int(np.count_nonzero(codes == code))
+        self.excluded.append({
+            "time": self.time, "idp": s.idp[bad].copy(), "pos": s.pos[bad].copy(),
+            "vel": s.vel[bad].copy(), "rhop": s.rhop[bad].copy(),
+            "reason": [REASON_NAMES[int(c)] for c in codes[bad]]})
+        keep = ~bad
+        s.select(keep)
+        for name in self._aux_names():
+            a = getattr(self, name)
+            if a.shape[0] == keep.shape[0]:
+                setattr(self, name, np.ascontiguousarray(a[keep]))
+        self._alloc()
+
+    # ------------------------------------------------------------------ outputs
+    @property
+    def press(self):
+        """Pressure from Tait's EOS for the current densities."""
+        return self.b * ((self.state.rhop / self.rhop0) ** self.gamma - 1.0)
+
+    @property
+    def n_fluid(self):
+        return int(np.count_nonzero(self.state.ptype == FLUID))
+
+    def particle_forces(self):
+        """m_a a_a for every particle (for floating bodies: fluid force, no gravity)."""
+        return self.state.mass[:, None] * self.ace
