@@ -95,5 +95,66 @@ def gencase(case_xml, outdir, max_nodes, quiet):
         click.echo("Files: " + ", ".join(files))
 
 
+@main.command(context_settings=CONTEXT)
+@click.argument("source", type=click.Path())
+@click.option("-o", "--out", "outdir", type=click.Path(file_okay=False), default=None,
+              help="Output folder (default: SOURCE when it is a gencase output, else ./<casename>_out).")
+@click.option("--tmax", type=float, default=None, help="Simulated time [s] (overrides TimeMax).")
+@click.option("--tout", type=float, default=None, help="Output interval [s] (overrides TimeOut).")
+@click.option("--threads", type=click.IntRange(min=1), default=None,
+              help="Threads (default: SLURM_CPUS_PER_TASK or the CPU affinity).")
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
+              help="Override any <parameters> key, e.g. --set Visco=0.05 (repeatable).")
+@click.option("--resume", is_flag=True, help="Continue an interrupted run from its last output.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress output.")
+@report_errors
+def run(source, outdir, tmax, tout, threads, sets, resume, quiet):
+    """Run a case: SOURCE is a case XML (gencase runs first) or a gencase output folder.
+
+    \b
+    Outputs in OUT: particles.vtkhdf (one temporal VTKHDF file), run.json,
+    run.log, run.csv, restart.h5; body-only cases write bodies.csv and links.csv.
+    Exit codes: 0 completed, 1 failed or interrupted, 2 bad input, 3 diverged.
+    """
+    from .errors import InputError
+    from .simulation import find_case_file, run as run_case
+    if os.path.isfile(source) and source.lower().endswith(".xml"):
+        from .case.gencase import build_case, write_outputs
+        from .case.reader import case_name_from_path
+        outdir = outdir or f"{case_name_from_path(source)}_out"
+        if resume:
+            case_h5 = find_case_file(outdir)
+        else:
+            result = build_case(source, outdir)
+            print_warnings(result.warnings)
+            case_h5 = write_outputs(result, outdir)[0]
+    elif os.path.isdir(source):
+        case_h5 = find_case_file(source)
+        outdir = outdir or source
+    else:
+        raise InputError(f"{source}: not a case XML file or a gencase output folder")
+    result = run_case(case_h5, outdir, tmax=tmax, tout=tout, threads=threads, sets=sets, resume=resume,
+                      quiet=quiet)
+    if result.status != "completed":
+        click.echo(f"{result.status}: {result.message}", err=True)
+    elif not quiet:
+        click.echo(f"completed: t = {result.physical_time:.6g} s, {result.steps} steps, "
+                   f"{result.runtime_s:.2f} s of time stepping -> {outdir}", err=True)
+    sys.exit(result.exit_code)
+
+
+@main.command(context_settings=CONTEXT)
+@click.argument("outdir", type=click.Path(exists=True, file_okay=False))
+@click.option("--format", "fmt", type=click.Choice(["vtp"]), default="vtp", show_default=True,
+              help="Output format.")
+@click.option("--dir", "subdir", default="vtp", show_default=True, help="Sub-folder of OUTDIR to write to.")
+@report_errors
+def export(outdir, fmt, subdir):
+    """Export particles.vtkhdf as Part_XXXX.vtp files and a .pvd for older ParaView."""
+    from .io.export import export_vtp
+    files = export_vtp(outdir, subdir)
+    click.echo(f"wrote {len(files) - 1} .vtp files and {files[-1]}")
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()

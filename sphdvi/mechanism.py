@@ -1,0 +1,163 @@
+"""From a gencase output to the multibody engine: bodies, shapes, materials and links.
+
+DualSPHysics's ``<special><chrono>`` section names the bodies (``bodyfixed``,
+``bodyfloating``, ``bodymoving``) by mkbound; masses, centres and inertias come
+from ``<floatings>`` (resolved by gencase from the particles). With
+``<collision activate="true">`` a body with a ``modelfile`` collides through a
+sphere cloud built from its own boundary particles (what DualSPHysics builds
+from ``modelfile="AutoActual"``): spheres of radius dp/2 at the particle
+centres, so two bodies touch where their particle layers are one dp apart,
+with a collision envelope of ``distancedp``·dp.
+
+Links map one to one: ``link_hinge`` → hinge, ``link_spheric`` → spherical,
+``link_pointline`` → point-line (``rotvector``/``rotvector2`` lock rotations),
+``link_linearspring`` → spring-damper, ``link_coulombdamping`` → Coulomb damper,
+``link_pulley`` → pulley. Stiffness and damping tables become time tables.
+In 2D cases bodies move in the x–z plane (y translation and x, z rotations locked).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import CaseError
+
+TYPE_FLOATING, TYPE_MOVING, TYPE_FLUID = 2, 1, 3
+
+
+def _table(v):
+    """A stiffness/damping value: number, {"times","values"} or {"file"} → number or [[t, v], ...]."""
+    if v is None or isinstance(v, (int, float)):
+        return v
+    if "file" in v:
+        data = np.genfromtxt(v["file"], delimiter=";", comments="#", invalid_raise=False)
+        data = data[~np.isnan(data).any(axis=1)]
+        return data[:, :2].tolist()
+    return [[t, x] for t, x in zip(v["times"], v["values"])]
+
+
+def _material_for(mkbound, case_json, body_property=None):
+    mats = case_json.get("materials", {})
+    name = body_property
+    if name is None:
+        for link in case_json.get("material_links", []):
+            if mkbound in link.get("mkbound", []):
+                name = link["property"].split("+")[-1].strip()
+    if name is None or name not in mats:
+        return None, None
+    m = mats[name]
+    spec = {"name": name}
+    if m.get("kfric") is not None:
+        spec["friction"] = m["kfric"]
+    if m.get("restitution") is not None:
+        spec["restitution"] = m["restitution"]
+    if m.get("young") is not None:
+        spec["young"] = m["young"]
+    if m.get("poisson") is not None:
+        spec["poisson"] = m["poisson"]
+    return name, spec
+
+
+def mechanism_from_case(data: dict, motions=None) -> dict:
+    """Build the inputs of :func:`sphdvi.dvi.run_bodies` from a case file read by
+    :func:`sphdvi.io.casefile.read_case_h5`.
+
+    Returns ``{"bodies", "links", "materials", "system", "mkbounds"}`` where
+    ``mkbounds[i]`` is the mkbound of body i.
+    """
+    js = data["json"]
+    chrono = js.get("chrono") or {}
+    consts = data["constants"]
+    p = data["particles"]
+    dp, is2d = float(consts["dp"]), bool(consts["is2d"])
+    label = p["mk"].astype(np.int64) - int(js["mkconfig"]["fluidcount"]) - 1
+    bound = p["type"] != TYPE_FLUID
+    floating = {int(b["mkbound"]): b for b in js.get("bodies_extra", [])}
+    collision = chrono.get("collision", {"activate": False, "distancedp": 0.5, "contactmethod": 0})
+    entries = chrono.get("bodies") or [{"kind": "floating", "id": f"floating{mk}", "mkbound": mk,
+                                        "modelfile": None} for mk in sorted(floating)]
+    materials, bodies, mkbounds = {}, [], []
+    for entry in entries:
+        mkb = int(entry["mkbound"])
+        sel = bound & (label == mkb)
+        pts = p["pos"][sel]
+        if pts.shape[0] == 0:
+            raise CaseError(f"body '{entry['id']}' (mkbound {mkb}) has no particles")
+        kind = entry["kind"]
+        body = {"name": entry["id"], "kind": "fixed" if kind == "fixed" else kind}
+        fb = floating.get(mkb)
+        if kind == "floating":
+            if fb is None:
+                raise CaseError(f"bodyfloating '{entry['id']}' (mkbound {mkb}) is not in <floatings>")
+            body.update(mass=fb["mass"], inertia=np.asarray(fb["inertia"]), pos=fb["center"],
+                        vel=fb["linearvelini"], omega=fb["angularvelini"],
+                        translation_dof=list(fb["translation_dof"]), rotation_dof=list(fb["rotation_dof"]))
+            if is2d:
+                body["translation_dof"][1] = 0
+                body["rotation_dof"][0] = body["rotation_dof"][2] = 0
+        else:
+            centre = pts.mean(axis=0)
+            body.update(mass=float(entry.get("massbody") or 1.0), inertia=(1.0, 1.0, 1.0), pos=centre.tolist())
+            if kind == "moving" and motions is not None and mkb in motions.mkbounds:
+                body["motion"] = _motion_callable(motions, mkb, centre)
+        shapes = []
+        if collision.get("activate") and entry.get("modelfile"):
+            name, spec = _material_for(mkb, js, fb.get("property") if fb else None)
+            if spec is not None and name not in materials:
+                materials[name] = spec
+            centre = np.asarray(body["pos"], float)
+            shapes.append({"shape": "cloud", "points": pts - centre, "radius": 0.5 * dp, "material": name})
+        body["shapes"] = shapes
+        bodies.append(body)
+        mkbounds.append(mkb)
+    links = [_link(ln, bodies) for ln in chrono.get("links", [])]
+    g = consts["gravity"]
+    system = {"gravity": tuple(g), "contactmethod": "smc" if collision.get("contactmethod") == 1 else "nsc",
+              "envelope": float(collision.get("distancedp", 0.5)) * dp}
+    solver = chrono.get("solver") or {}
+    if solver.get("type"):
+        system["solver"] = solver["type"].lower()
+    return {"bodies": bodies, "links": links, "materials": list(materials.values()), "system": system,
+            "mkbounds": mkbounds}
+
+
+def _motion_callable(motions, mkb, centre):
+    def motion(t):
+        rig = motions.transform(mkb, t)
+        x = rig.R @ centre + rig.d
+        return rig.V + np.cross(rig.W, x - rig.c), rig.W
+    return motion
+
+
+def _link(ln: dict, bodies: list) -> dict:
+    kind = ln["type"]
+    b1, b2 = ln["idbody1"], ln.get("idbody2")
+    name = ln.get("name") or f"Link_{b1}_{b2 if b2 else 'ground'}"
+    out = {"body1": b1, "body2": b2, "name": name}
+    if kind == "hinge":
+        out.update(kind="hinge", point=ln["rotpoint"], axis=ln["rotvector"])
+    elif kind == "spheric":
+        out.update(kind="spherical", point=ln["rotpoint"])
+    elif kind == "pointline":
+        out.update(kind="pointline", point=ln["rotpoint"], axis=ln["slidingvector"])
+        if ln.get("rotvector") and np.linalg.norm(ln["rotvector"]) > 0:
+            out["rot_axis"] = ln["rotvector"]
+        if ln.get("rotvector2") and np.linalg.norm(ln["rotvector2"]) > 0:
+            out["rot_axis2"] = ln["rotvector2"]
+    elif kind == "linearspring":
+        out.update(kind="spring", point1=ln["point_fb1"], point2=ln["point_fb2"],
+                   stiffness=_table(ln["stiffness"]), damping=_table(ln.get("damping", 0.0)) or 0.0,
+                   rest_length=ln["rest_length"])
+        return out
+    elif kind == "coulombdamping":
+        out.update(kind="coulombdamper", point1=ln["point_fb1"], point2=ln["point_fb2"], force=ln["damping"])
+        return out
+    elif kind == "pulley":
+        out.update(kind="pulley", axis=ln["rotvector"], radius=ln["radius"], radius2=ln["radius2"])
+        return out
+    else:
+        raise CaseError(f"link type {kind} is not supported")
+    if ln.get("stiffness") is not None:
+        out["stiffness"] = _table(ln["stiffness"])
+    if ln.get("damping") is not None:
+        out["damping"] = _table(ln["damping"])
+    return out

@@ -1,0 +1,596 @@
+"""The simulation loop of ``sphdvi run``: time stepping, outputs, stability checks, resume.
+
+Model (the SPH solver, imposed motions, floating bodies) ≠ simulation (this
+loop: output schedule, divergence checks, checkpoints, logs) ≠ writers
+(``sphdvi.io``). Outputs in OUT:
+
+* ``particles.vtkhdf``: temporal VTKHDF PolyData, one step per TimeOut (live particles);
+* ``run.json``: provenance and status, written at the start and at the end;
+* ``run.log`` / ``run.csv``: one line per output time (like Run.out and RunPARTs.csv);
+* ``restart.h5``: the complete solver state at the last output, written atomically;
+  ``--resume`` continues from it (on 1 thread the result is bitwise that of an
+  uninterrupted run).
+
+A run that goes unstable (NaN or inf, dt held at DtMin, too many particles
+excluded) stops with status ``diverged`` (exit code 3) and a message naming the
+time, step, particle id, position and cause; what was written before stays.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import sys
+import time as _time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._version import __version__
+from .errors import DivergenceError, InputError
+from .io.atomic import atomic_path, write_text_atomic
+
+POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
+                "Press": (np.float32, 1), "Type": (np.uint8, 1), "Mk": (np.int32, 1)}
+RUN_CSV_HEADER = "part,time,steps,particles,excluded,dtmin,dtmax,walltime"
+DTMIN_STUCK_STEPS = 200
+DEFAULT_MAX_EXCLUDED_FRACTION = 0.5
+
+
+@dataclass
+class RunResult:
+    status: str
+    message: str
+    exit_code: int
+    steps: int
+    physical_time: float
+    runtime_s: float
+
+
+def default_threads() -> int:
+    """SLURM_CPUS_PER_TASK, else the CPU affinity of this process."""
+    env = os.environ.get("SLURM_CPUS_PER_TASK")
+    if env and env.isdigit() and int(env) > 0:
+        return int(env)
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover
+        return os.cpu_count() or 1
+
+
+# ---------------------------------------------------------------------------------
+# parameters from the case file and the command line
+# ---------------------------------------------------------------------------------
+def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
+    """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError."""
+    from .case.parameters import PARAMETERS, closest_key, coerce
+    out = dict(params)
+    for item in sets or ():
+        if "=" not in item:
+            raise InputError(f"--set {item!r}: expected KEY=VALUE")
+        key, value = (s.strip() for s in item.split("=", 1))
+        if key not in PARAMETERS:
+            hint = closest_key(key)
+            raise InputError(f"--set: unknown parameter '{key}'" + (f"; did you mean '{hint}'?" if hint else ""))
+        try:
+            out[key] = coerce(key, value)
+        except ValueError as exc:
+            raise InputError(f"--set {key}: {exc}") from None
+    if tmax is not None:
+        out["TimeMax"] = coerce("TimeMax", tmax)
+    if tout is not None:
+        out["TimeOut"] = coerce("TimeOut", tout)
+    if not out["TimeOut"] > 0:
+        raise InputError("TimeOut must be positive")
+    return out
+
+
+# ---------------------------------------------------------------------------------
+# run.json, run.log, run.csv
+# ---------------------------------------------------------------------------------
+class RunFiles:
+    """The small text outputs of a run, all written atomically."""
+
+    def __init__(self, outdir: str):
+        self.outdir = outdir
+        self.json_path = os.path.join(outdir, "run.json")
+        self.log_path = os.path.join(outdir, "run.log")
+        self.csv_path = os.path.join(outdir, "run.csv")
+        self.meta: dict = {}
+        self.log_lines: list[str] = []
+        self.csv_rows: list[str] = []
+
+    def write_json(self, **updates) -> None:
+        self.meta.update(updates)
+        write_text_atomic(self.json_path, json.dumps(self.meta, indent=2, default=_jsonable) + "\n")
+
+    def log(self, line: str) -> None:
+        self.log_lines.append(line)
+        write_text_atomic(self.log_path, "\n".join(self.log_lines) + "\n")
+
+    def csv(self, row: str) -> None:
+        self.csv_rows.append(row)
+        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n" + "\n".join(self.csv_rows) + "\n")
+
+    def load_existing(self, nparts: int) -> None:
+        """On resume: keep the log, and the CSV rows of the first ``nparts`` outputs."""
+        if os.path.exists(self.log_path):
+            with open(self.log_path) as fh:
+                self.log_lines = fh.read().splitlines()
+        if os.path.exists(self.csv_path):
+            with open(self.csv_path) as fh:
+                rows = fh.read().splitlines()[1:]
+            self.csv_rows = rows[:nparts]
+        if os.path.exists(self.json_path):
+            with open(self.json_path) as fh:
+                try:
+                    self.meta = json.load(fh)
+                except json.JSONDecodeError:
+                    self.meta = {}
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return str(obj)
+
+
+class Progress:
+    """A progress line on a terminal; a log line every ``interval`` seconds otherwise."""
+
+    def __init__(self, tmax: float, quiet: bool, stream=None, interval: float = 30.0):
+        self.tmax = tmax
+        self.quiet = quiet
+        self.stream = stream or sys.stderr
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.interval = interval
+        self.last = 0.0
+        self.t0 = _time.perf_counter()
+
+    def update(self, t: float, steps: int, n: int, force: bool = False) -> None:
+        if self.quiet:
+            return
+        now = _time.perf_counter()
+        if not force and now - self.last < (0.2 if self.tty else self.interval):
+            return
+        self.last = now
+        frac = min(1.0, t / self.tmax) if self.tmax > 0 else 1.0
+        wall = now - self.t0
+        eta = wall * (1 - frac) / frac if frac > 0 else float("nan")
+        if self.tty:
+            bar = "#" * int(30 * frac)
+            self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t={t:.4f} s  steps={steps}  "
+                              f"np={n}  eta={eta:6.0f} s ")
+            self.stream.flush()
+        else:
+            self.stream.write(f"progress: t={t:.5g} s ({100 * frac:.1f}%) steps={steps} particles={n} "
+                              f"wall={wall:.1f} s eta={eta:.0f} s\n")
+            self.stream.flush()
+
+    def close(self):
+        if self.tty and not self.quiet:
+            self.stream.write("\n")
+
+
+# ---------------------------------------------------------------------------------
+# entry point
+# ---------------------------------------------------------------------------------
+def find_case_file(folder: str) -> str:
+    """The gencase HDF5 file in a run folder."""
+    import h5py
+    if not os.path.isdir(folder):
+        raise InputError(f"{folder}: not a folder or case file")
+    found = []
+    for name in sorted(os.listdir(folder)):
+        if name.endswith(".h5") and name != "restart.h5":
+            path = os.path.join(folder, name)
+            try:
+                with h5py.File(path, "r") as f:
+                    if f.attrs.get("format") == "sphdvi-case":
+                        found.append(path)
+            except OSError:
+                continue
+    if not found:
+        raise InputError(f"{folder}: no gencase output (<casename>.h5) found; run 'sphdvi gencase' first "
+                         "or give the case XML")
+    if len(found) > 1:
+        raise InputError(f"{folder}: several case files ({', '.join(os.path.basename(f) for f in found)})")
+    return found[0]
+
+
+def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(), resume=False,
+        quiet=False) -> RunResult:
+    """Run a gencase output: body-only cases go to the multibody engine, the rest to SPH."""
+    from .io.casefile import read_case_h5
+    t_start = _time.perf_counter()
+    data = read_case_h5(case_h5)
+    params = apply_overrides(data["parameters"], sets, tmax, tout)
+    threads = int(threads) if threads else default_threads()
+    os.makedirs(outdir, exist_ok=True)
+    files = RunFiles(outdir)
+    nfluid = int(np.count_nonzero(data["particles"]["type"] == 3))
+    base_meta = {
+        "version": __version__, "case": data["casename"], "case_file": os.path.abspath(case_h5),
+        "parameters": params, "threads": threads, "particles": int(data["particles"]["type"].size),
+        "fluid_particles": nfluid, "python": sys.version.split()[0], "numpy": np.__version__,
+    }
+    if nfluid == 0:
+        return _run_bodies_only(data, params, outdir, files, base_meta, t_start, quiet)
+    return _run_sph(data, params, outdir, files, base_meta, threads, resume, quiet, t_start)
+
+
+def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet) -> RunResult:
+    from .dvi import run_bodies
+    from .mechanism import mechanism_from_case
+    from .motion import MotionSet
+    js = data["json"]
+    motions = MotionSet(js.get("motions", []), js.get("special", {}).get("wavepaddles", []))
+    mech = mechanism_from_case(data, motions)
+    if not mech["bodies"]:
+        raise InputError("the case has neither fluid nor bodies: nothing to simulate")
+    dt = params["DtFixed"] if params["DtFixed"] > 0 else 1e-3
+    files.write_json(**meta, mode="bodies", status="running", message="", dt=dt, steps=0, physical_time=0.0,
+                     runtime_s=0.0, startup_s=_time.perf_counter() - t_start, bodies=len(mech["bodies"]),
+                     links=len(mech["links"]))
+    t0 = _time.perf_counter()
+    system = run_bodies(mech["bodies"], mech["links"], out_dir=outdir, tmax=params["TimeMax"],
+                        tout=params["TimeOut"], dt=dt, materials=mech["materials"], **mech["system"])
+    runtime = _time.perf_counter() - t0
+    steps = int(round(params["TimeMax"] / dt))
+    finite = np.isfinite(system.pos).all() and np.isfinite(system.vel).all()
+    status, code, msg = ("completed", 0, "") if finite else ("diverged", 3, "body state is not finite")
+    files.write_json(status=status, message=msg, steps=steps, physical_time=float(system.time), runtime_s=runtime)
+    if not quiet:
+        print(f"bodies-only run: {len(mech['bodies'])} bodies, {len(mech['links'])} links, {steps} steps "
+              f"of {dt:g} s in {runtime:.2f} s -> {os.path.join(outdir, 'bodies.csv')}", file=sys.stderr)
+    return RunResult(status, msg, code, steps, float(system.time), runtime)
+
+
+# ---------------------------------------------------------------------------------
+# SPH run
+# ---------------------------------------------------------------------------------
+class SPHRun:
+    """One SPH run: the solver, its motion/body hook, the output schedule and the checks."""
+
+    def __init__(self, data: dict, params: dict, outdir: str):
+        from .motion import MotionSet
+        from .sph.solver import SPHSolver
+        from .sph.state import FluidState
+        self.data = data
+        self.params = params
+        self.outdir = outdir
+        p = data["particles"]
+        c = dict(data["constants"])
+        self.consts = c
+        self.fluidcount = int(data["json"]["mkconfig"]["fluidcount"])
+        state = FluidState(p["pos"], p["vel"], p["rhop"], p["mass"], p["type"], p["idp"], p["mk"],
+                           rhop0=c["rhop0"])
+        js = data["json"]
+        self.motions = MotionSet(js.get("motions", []), js.get("special", {}).get("wavepaddles", []),
+                                 g=float(np.linalg.norm(c["gravity"])))
+        self.pos0 = p["pos"].copy()                 # initial positions, indexed by idp
+        moving = p["type"] == 1
+        self.has_moving = bool(moving.any())
+        self.has_floating = bool((p["type"] == 2).any())
+        domain = (np.asarray(data["domain"]["posmin"], float), np.asarray(data["domain"]["posmax"], float))
+        if c["is2d"]:
+            domain[0][1] -= c["h"]
+            domain[1][1] += c["h"]
+        hook = self._hook if (self.has_moving or self.has_floating) else None
+        self.bodies = None
+        if self.has_floating:
+            self._setup_bodies()
+        self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook)
+        self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
+        self.dtmin_run = 0
+        self.dtmin_seen = 0
+
+    # -- coupling: imposed motions and floating bodies ------------------------------
+    def _setup_bodies(self):
+        """Floating bodies integrated by the multibody engine, driven by the fluid force."""
+        from .dvi.runner import build_system
+        from .mechanism import mechanism_from_case
+        mech = mechanism_from_case(self.data, self.motions)
+        system, _ = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
+        self.bodies = system
+        p = self.data["particles"]
+        label = p["mk"].astype(np.int64) - self.fluidcount - 1
+        self.body_sel = []          # per body: idp of its particles and body-frame offsets
+        for i, mkb in enumerate(mech["mkbounds"]):
+            idp = p["idp"][(p["type"] != 3) & (label == mkb)]
+            R = _quat_matrix(system.quat[i])
+            local = (p["pos"][idp] - system.pos[i]) @ R
+            self.body_sel.append((mkb, idp, local, system.kind[i]))
+        self.idp_body = np.full(p["idp"].size, -1, np.int64)
+        for i, (_, idp, _, _) in enumerate(self.body_sel):
+            self.idp_body[idp] = i
+
+    def _hook(self, solver, t, dt):
+        s = solver.state
+        if self.has_moving:
+            sel = np.flatnonzero(s.ptype == 1)
+            label = s.mk[sel].astype(np.int64) - self.fluidcount - 1
+            for mkb in np.unique(label):
+                rows = sel[label == mkb]
+                rig = self.motions.transform(int(mkb), t)
+                x, v = rig.apply(self.pos0[s.idp[rows]])
+                s.pos[rows] = x
+                s.vel[rows] = v
+        if self.bodies is not None:
+            self._step_bodies(solver, dt)
+
+    def _step_bodies(self, solver, dt):
+        s = solver.state
+        sel = np.flatnonzero(s.ptype == 2)
+        body = self.idp_body[s.idp[sel]]
+        nb = self.bodies.nb
+        f = s.mass[sel, None] * solver.ace[sel]
+        F = np.zeros((nb, 3))
+        T = np.zeros((nb, 3))
+        np.add.at(F, body, f)
+        r = s.pos[sel] - self.bodies.pos[body]
+        np.add.at(T, body, np.cross(r, f))
+        if self.consts["is2d"]:
+            F[:, 1] = 0.0
+            T[:, 0] = T[:, 2] = 0.0
+        ftpause = float(self.params.get("FtPause", 0.0))
+        if solver.time <= ftpause:
+            return
+        self.bodies.step(dt, F, T)
+        pos, quat, vel, omega = self.bodies.pos, self.bodies.quat, self.bodies.vel, self.bodies.omega_world
+        for i, (_, idp, local, _) in enumerate(self.body_sel):
+            rows = sel[body == i]
+            if rows.size == 0:
+                continue
+            R = _quat_matrix(quat[i])
+            loc = local[np.searchsorted(idp, s.idp[rows])]
+            x = pos[i] + loc @ R.T
+            s.pos[rows] = x
+            s.vel[rows] = vel[i] + np.cross(omega[i], x - pos[i])
+
+    # -- checks --------------------------------------------------------------------------
+    def check(self, nexcl_before: int) -> None:
+        """Raise DivergenceError when the run has gone unstable."""
+        sol = self.solver
+        if sol.excluded and sol.n_excluded.get("not finite", 0):
+            ev = sol.excluded[-1]
+            bad = [i for i, r in enumerate(ev["reason"]) if r == "not finite"]
+            if bad:
+                i = bad[0]
+                raise DivergenceError(
+                    f"t={sol.time:.6g} s, step {sol.nstep}: particle {int(ev['idp'][i])} at "
+                    f"{_fmt(ev['pos'][i])} has a non-finite value (NaN or inf); cause: the solution blew up "
+                    f"(try a smaller cflnumber or DtFixed, or more viscosity)")
+        if sol.n_dtmin > self.dtmin_seen:
+            self.dtmin_run += sol.n_dtmin - self.dtmin_seen
+            self.dtmin_seen = sol.n_dtmin
+            if self.dtmin_run >= DTMIN_STUCK_STEPS:
+                i = int(np.argmax(np.einsum("ij,ij->i", sol.ace, sol.ace)))
+                raise DivergenceError(
+                    f"t={sol.time:.6g} s, step {sol.nstep}: dt held at DtMin for {self.dtmin_run} steps; "
+                    f"largest acceleration on particle {int(sol.state.idp[i])} at {_fmt(sol.state.pos[i])} "
+                    f"({math.sqrt(float(sol.ace[i] @ sol.ace[i])):.3g} m/s2)")
+        else:
+            self.dtmin_run = 0
+        excluded = sum(sol.n_excluded.values())
+        limit = self.max_excluded()
+        if excluded > limit:
+            ev = sol.excluded[-1]
+            raise DivergenceError(
+                f"t={sol.time:.6g} s, step {sol.nstep}: {excluded} of {self.n0_fluid} fluid particles excluded "
+                f"(limit {limit}); last: particle {int(ev['idp'][0])} at {_fmt(ev['pos'][0])}, "
+                f"reason {ev['reason'][0]}")
+        if not np.isfinite(sol.last_dt) or sol.last_dt <= 0:
+            raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: time step {sol.last_dt} is not valid")
+        if self.bodies is not None and not (np.isfinite(self.bodies.pos).all() and np.isfinite(self.bodies.vel).all()):
+            raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: a floating body state is not finite")
+
+    def max_excluded(self) -> int:
+        p = self.params
+        frac = DEFAULT_MAX_EXCLUDED_FRACTION
+        if "PartsOutMax" in self.data["json"].get("parameters_set", []) and p.get("PartsOutMax", 1.0) < 1.0:
+            frac = float(p["PartsOutMax"])
+        if p.get("MinFluidStop", 0.0) > 0:
+            frac = min(frac, 1.0 - float(p["MinFluidStop"]))
+        return int(frac * self.n0_fluid)
+
+    # -- snapshots and checkpoints ------------------------------------------------------
+    def snapshot(self) -> tuple[np.ndarray, dict]:
+        s = self.solver.state
+        press = self.solver.press
+        return s.pos, {"Idp": s.idp, "Vel": s.vel, "Rhop": s.rhop, "Press": press, "Type": s.ptype,
+                       "Mk": s.mk}
+
+    SCALARS = ("time", "nstep", "n_dtmin", "_verlet_count", "dt_pre", "last_dt")
+
+    def save_checkpoint(self, path: str, extra: dict) -> None:
+        import h5py
+        sol = self.solver
+        with atomic_path(path) as tmp:
+            with h5py.File(tmp, "w") as f:
+                g = f.create_group("state")
+                for name in sol.state.FIELDS:
+                    g.create_dataset(name, data=getattr(sol.state, name))
+                a = f.create_group("aux")
+                for name in sol._aux_names():
+                    a.create_dataset(name, data=getattr(sol, name))
+                sc = f.create_group("scalars")
+                for name in self.SCALARS:
+                    sc.attrs[name] = getattr(sol, name)
+                sc.attrs["n_excluded"] = json.dumps(sol.n_excluded)
+                sc.attrs["dtmin_run"] = self.dtmin_run
+                sc.attrs["dtmin_seen"] = self.dtmin_seen
+                for k, v in extra.items():
+                    sc.attrs[k] = v
+                if self.bodies is not None:
+                    b = f.create_group("bodies")
+                    for name in ("pos", "quat", "vel", "omega_b"):
+                        b.create_dataset(name, data=getattr(self.bodies, name))
+                    b.attrs["time"] = self.bodies.time
+
+    def load_checkpoint(self, path: str) -> dict:
+        import h5py
+        sol = self.solver
+        with h5py.File(path, "r") as f:
+            for name in sol.state.FIELDS:
+                setattr(sol.state, name, np.ascontiguousarray(f["state"][name][...]))
+            sol._alloc()
+            for name in sol._aux_names():
+                setattr(sol, name, np.ascontiguousarray(f["aux"][name][...]))
+            sc = f["scalars"].attrs
+            for name in self.SCALARS:
+                value = sc[name]
+                setattr(sol, name, value.item() if isinstance(value, np.generic) else value)
+            sol.n_excluded = json.loads(sc["n_excluded"])
+            self.dtmin_run = int(sc["dtmin_run"])
+            self.dtmin_seen = int(sc["dtmin_seen"])
+            extra = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in sc.items()}
+            if self.bodies is not None and "bodies" in f:
+                for name in ("pos", "quat", "vel", "omega_b"):
+                    getattr(self.bodies, name)[...] = f["bodies"][name][...]
+                self.bodies.time = float(f["bodies"].attrs["time"])
+        return extra
+
+
+def _quat_matrix(q):
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def _fmt(v) -> str:
+    return "(" + ", ".join(f"{float(x):.5g}" for x in v) + ")"
+
+
+class _Stop:
+    """SIGTERM/SIGINT turn into a clean stop at the next step boundary."""
+
+    def __init__(self):
+        self.signal = None
+        self._old = {}
+
+    def __enter__(self):
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            try:
+                self._old[sig] = signal.signal(sig, self._handle)
+            except ValueError:  # not in the main thread
+                pass
+        return self
+
+    def _handle(self, signum, frame):
+        self.signal = signum
+
+    def __exit__(self, *exc):
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+
+def _warm_up(sph: "SPHRun") -> float:
+    """Compile (or load from cache) the kernels on a throw-away copy of the solver."""
+    import copy
+    t0 = _time.perf_counter()
+    clone = copy.deepcopy(sph.solver)
+    clone.motion_hook = None
+    clone.step()
+    return _time.perf_counter() - t0
+
+
+def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start) -> RunResult:
+    import numba
+    from .io.vtkhdf import VTKHDFParticleWriter
+    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    sph = SPHRun(data, params, outdir)
+    sol = sph.solver
+    tmax, tout = float(params["TimeMax"]), float(params["TimeOut"])
+    vtk_path = os.path.join(outdir, "particles.vtkhdf")
+    ckpt = os.path.join(outdir, "restart.h5")
+    part = 0
+    wall_prev = 0.0
+    if resume:
+        if not os.path.exists(ckpt):
+            raise InputError(f"--resume: no checkpoint {ckpt} in {outdir}")
+        extra = sph.load_checkpoint(ckpt)
+        part = int(extra["part"])
+        wall_prev = float(extra.get("runtime_s", 0.0))
+        writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS, append=True)
+        writer.truncate_to(part + 1)
+        files.load_existing(part + 1)
+        files.log(f"resumed from part {part} at t={sol.time:.6g} s, step {sol.nstep}")
+    else:
+        writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS)
+    jit_s = _warm_up(sph)
+    startup = _time.perf_counter() - t_start
+    files.write_json(**meta, mode="sph", numba=numba.__version__, threading_layer=_threading_layer(),
+                     status="running", message="", steps=int(sol.nstep), physical_time=float(sol.time),
+                     runtime_s=wall_prev, startup_s=startup, jit_s=jit_s)
+    progress = Progress(tmax, quiet)
+    dt_lo, dt_hi = math.inf, 0.0
+    runtime = wall_prev
+    steps_at_start = int(sol.nstep)
+    t_loop = _time.perf_counter()
+
+    def write_part(k):
+        pos, arrays = sph.snapshot()
+        writer.append(sol.time, pos, arrays)
+        excl = sum(sol.n_excluded.values())
+        wall = runtime + (_time.perf_counter() - t_loop)
+        files.csv(f"{k},{sol.time:.9g},{sol.nstep},{sol.state.n},{excl},"
+                  f"{dt_lo if dt_lo < math.inf else 0:.6g},{dt_hi:.6g},{wall:.3f}")
+        files.log(f"Part {k:04d}  t={sol.time:.6f} s  steps={sol.nstep}  particles={sol.state.n}  "
+                  f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s")
+        sph.save_checkpoint(ckpt, {"part": k, "runtime_s": wall})
+
+    status, code, message = "completed", 0, ""
+    with _Stop() as stop:
+        try:
+            if not resume:
+                write_part(0)
+            next_out = (part + 1) * tout
+            while sol.time < tmax - 1e-12 * max(1.0, tmax):
+                sol.step()
+                dt_lo, dt_hi = min(dt_lo, sol.last_dt), max(dt_hi, sol.last_dt)
+                sph.check(0)
+                if sol.time >= next_out - 1e-12 * max(1.0, tout) or sol.time >= tmax:
+                    part += 1
+                    write_part(part)
+                    dt_lo, dt_hi = math.inf, 0.0
+                    next_out = (part + 1) * tout
+                progress.update(sol.time, sol.nstep, sol.state.n)
+                if stop.signal is not None:
+                    status, code = "interrupted", 1
+                    message = (f"stopped by signal {stop.signal} at t={sol.time:.6g} s; resume with "
+                               f"'sphdvi run {outdir} --resume' from part {part}")
+                    break
+        except DivergenceError as exc:
+            status, code, message = "diverged", 3, str(exc)
+        except BaseException as exc:
+            status, code, message = "failed", 1, f"{type(exc).__name__}: {exc}"
+            runtime += _time.perf_counter() - t_loop
+            files.write_json(status=status, message=message, steps=int(sol.nstep),
+                             physical_time=float(sol.time), runtime_s=runtime)
+            writer.close()
+            raise
+    runtime += _time.perf_counter() - t_loop
+    progress.update(sol.time, sol.nstep, sol.state.n, force=True)
+    progress.close()
+    writer.close()
+    files.log(f"{status}: t={sol.time:.6g} s, {sol.nstep} steps, runtime {runtime:.2f} s"
+              + (f" -- {message}" if message else ""))
+    files.write_json(status=status, message=message, steps=int(sol.nstep), physical_time=float(sol.time),
+                     runtime_s=runtime, excluded=dict(sol.n_excluded), dtmin_steps=int(sol.n_dtmin),
+                     particles_final=int(sol.state.n),
+                     us_per_particle_step=(1e6 * (runtime - wall_prev)
+                                           / max(1, sol.nstep - steps_at_start) / max(1, sol.state.n)))
+    return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)
+
+
+def _threading_layer() -> str:
+    import numba
+    try:
+        return numba.threading_layer()
+    except ValueError:
+        return "not initialised"
