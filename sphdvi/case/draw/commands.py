@@ -155,6 +155,10 @@ class GeometryRunner:
             handler(el)
         except ExpressionError as exc:
             raise self.reader.error(el, str(exc)) from None
+        except (ValueError, ArithmeticError) as exc:
+            # degenerate geometry that slipped through the checks (e.g. 1e308 sizes)
+            raise self.reader.error(el, f"cannot draw this shape: {exc}",
+                                    "finite, reasonably sized geometry") from None
 
     # ------------------------------------------------------------ small readers
     def _points(self, el, tag: str = "point", least: int = 0, exact: int | None = None):
@@ -830,6 +834,11 @@ def _read_definition(reader, geometry_el):
 def run_geometry(reader, geometry_el, *, casename: str, outdir: str | None,
                  max_nodes: int = 200_000_000) -> Drawing:
     """Execute ``<geometry>`` (predefinition, definition, commands) and return the particles."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return _run_geometry(reader, geometry_el, casename, outdir, max_nodes)
+
+
+def _run_geometry(reader, geometry_el, casename, outdir, max_nodes) -> Drawing:
     reader.check_children(geometry_el, {"predefinition", "definition", "commands", "rem"},
                           "child element")
     pre = reader.child(geometry_el, "predefinition")

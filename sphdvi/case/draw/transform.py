@@ -78,7 +78,7 @@ def inverse(m: np.ndarray) -> np.ndarray:
     """Inverse of an affine matrix; ValueError when it is singular."""
     det = float(np.linalg.det(m[:3, :3]))
     if not math.isfinite(det) or abs(det) < 1e-300:
-        raise ValueError("transformation matrix is singular (a scale of 0?)")
+        raise ValueError("transformation is singular or overflows (a scale of 0 or 1e308?)")
     return np.linalg.inv(m)
 
 
