@@ -249,7 +249,7 @@ class System:
         (``points`` = sphere centres, ``radius``).  pos/quat: shape pose in
         the body frame (``local=True``) or in the world frame."""
         t = col.SHAPE_NAMES[shape] if isinstance(shape, str) else int(shape)
-        size = np.zeros(3) + np.asarray(size, float).ravel()[:3] if np.size(size) < 3 else np.asarray(size, float).ravel()[:3]
+        size = np.atleast_1d(np.asarray(size, float)).ravel()[:3]
         dims = np.zeros(3)
         dims[: len(size)] = size
         q = np.asarray(quat, float)
