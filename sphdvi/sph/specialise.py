@@ -31,7 +31,9 @@ def specialised(dispatcher, args, literal_positions):
     The dispatcher is called once with ``args`` to compile (or load) the
     specialisation, which is then looked up among its overloads.
     """
-    dispatcher(*args)
+    # compile on copies: the kernels write into their array arguments, and this
+    # call must not advance the real state (it would, e.g., on a resumed run)
+    dispatcher(*[a.copy() if hasattr(a, "copy") and hasattr(a, "shape") else a for a in args])
     want = {k: args[k] for k in literal_positions}
     found = [cres for sig, cres in dispatcher.overloads.items()
              if _matches(sig, want)]
