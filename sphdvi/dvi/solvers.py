@@ -500,3 +500,148 @@ def solve_ccp(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag,
                            gdiag, gamma, max_iter, tol)
     scatter_impulses(nr, ra, rb, MiJ, gamma, vout)
     return it, res
+
+
+# ------------------------------------------------------- dense / direct path
+@njit(cache=True)
+def assemble_dense(nr, ra, rb, J, MiJ, E):
+    """Dense N = J M⁻¹ Jᵀ + E (only for small row counts: O(nr²))."""
+    N = np.zeros((nr, nr))
+    for i in range(nr):
+        for j in range(i, nr):
+            s = 0.0
+            for si in range(2):
+                bi = ra[i] if si == 0 else rb[i]
+                if bi < 0:
+                    continue
+                for sj in range(2):
+                    bj = ra[j] if sj == 0 else rb[j]
+                    if bj != bi:
+                        continue
+                    for c in range(6):
+                        s += J[i, 6 * si + c] * MiJ[j, 6 * sj + c]
+            N[i, j] = s
+            N[j, i] = s
+        N[i, i] += E[i]
+    return N
+
+
+@njit(cache=True)
+def solve_dense_bb(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
+    """Spectral projected gradient on an explicit (small) N, Jacobi-scaled."""
+    n = r.shape[0]
+    d0 = np.empty(n)
+    for k in range(n):
+        d0[k] = max(N[k, k], 1e-300)
+    i = 0
+    while i < n:
+        if kind[i] == FRIC_N:
+            a = (d0[i] + d0[i + 1] + d0[i + 2]) / 3.0
+            d0[i] = a
+            d0[i + 1] = a
+            d0[i + 2] = a
+            i += 3
+        else:
+            i += 1
+    s = np.sqrt(d0)
+    Ns = N / np.outer(s, s)
+    rs = r / s
+    z = gamma * s
+    project_all(z, kind, mu, lo, hi, s)
+    tmp = np.empty(n)
+    g = Ns @ z + rs
+    f = 0.5 * (z @ (g - rs)) + rs @ z
+    hist = np.full(10, f)
+    best = z.copy()
+    best_res = _natural_residual(z, g, s, kind, mu, lo, hi, tmp)
+    alpha = 1.0
+    it = 0
+    for it in range(1, max_iter + 1):
+        if best_res <= tol:
+            break
+        d = z - alpha * g
+        project_all(d, kind, mu, lo, hi, s)
+        d -= z
+        Nd = Ns @ d
+        gd = g @ d
+        dNd = d @ Nd
+        if gd >= 0.0:
+            if alpha != 1.0:
+                alpha = 1.0
+                continue
+            break
+        fmax = hist.max()
+        lam = 1.0
+        fnew = f + gd + 0.5 * dNd
+        for _bt in range(20):
+            fnew = f + lam * gd + 0.5 * lam * lam * dNd
+            if fnew <= fmax + 1e-4 * lam * gd:
+                break
+            lq = -gd / dNd if dNd > 0.0 else 0.5 * lam
+            lam = min(max(lq, 0.1 * lam), 0.9 * lam)
+        sv = lam * d
+        yv = lam * Nd
+        z += sv
+        g += yv
+        f = fnew
+        hist[it % 10] = f
+        sy = sv @ yv
+        if sy <= 0.0:
+            alpha = 1.0
+        elif it % 2 == 0:
+            alpha = (sv @ sv) / sy
+        else:
+            alpha = sy / (yv @ yv)
+        alpha = min(max(alpha, 1e-13), 1e13)
+        res = _natural_residual(z, g, s, kind, mu, lo, hi, tmp)
+        if res < best_res:
+            best_res = res
+            best[:] = z
+    gamma[:] = best / s
+    return it, best_res
+
+
+def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree, vout,
+                 max_iter, tol):
+    """Direct path for small mechanisms: the bilateral (and compliance) rows are
+    eliminated exactly with a Cholesky factorisation of their Schur block and
+    the remaining contact/boxed rows solve the reduced CCP
+    ``N' = N_cc − N_cb N_bb⁻¹ N_bc`` with a dense spectral projected gradient.
+    Robust to large mass ratios and stiff compliance (dense: nr ≲ 1000)."""
+    from scipy.linalg import cho_factor, cho_solve
+    vout[:, :] = vfree
+    if nr == 0:
+        return 0, 0.0
+    sl = slice(0, nr)
+    ra, rb, J, MiJ, b, E = ra[sl], rb[sl], J[sl], MiJ[sl], b[sl], E[sl]
+    kind, mu, lo, hi, g = kind[sl], mu[sl], lo[sl], hi[sl], gamma[sl]
+    N = assemble_dense(nr, ra, rb, J, MiJ, E)
+    r = np.empty(nr)
+    rows_times_v(nr, ra, rb, J, vfree, r)
+    r += b
+    bil = kind == BILATERAL
+    ib = np.nonzero(bil)[0]
+    ic = np.nonzero(~bil)[0]
+    it, res = 0, 0.0
+    if ib.size:
+        Nbb = N[np.ix_(ib, ib)]
+        reg = 1e-13 * max(np.trace(Nbb) / ib.size, 1e-300)
+        fac = cho_factor(Nbb + reg * np.eye(ib.size))
+    if ic.size == 0:
+        g[ib] = -cho_solve(fac, r[ib])
+    else:
+        Ncc = N[np.ix_(ic, ic)]
+        rc = r[ic].copy()
+        if ib.size:
+            Nbc = N[np.ix_(ib, ic)]
+            X = cho_solve(fac, Nbc)
+            Ncc = Ncc - Nbc.T @ X
+            rc = rc - X.T @ r[ib]
+        gc = g[ic].copy()
+        it, res = solve_dense_bb(Ncc, rc, kind[ic].copy(), mu[ic].copy(), lo[ic].copy(),
+                                 hi[ic].copy(), gc, max_iter, tol)
+        g[ic] = gc
+        if ib.size:
+            g[ib] = -cho_solve(fac, r[ib] + Nbc @ gc)
+    scatter_impulses(nr, ra, rb, MiJ, g, vout)
+    return it, res

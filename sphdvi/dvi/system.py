@@ -19,7 +19,7 @@ from . import rows as rw
 from ._math import (body_rotations, frame_from_axis, integrate_bodies, np_mat_to_quat,
                     np_quat_to_mat)
 from ._kernels import apply_dof_masks, free_velocity, link_point_torques
-from .solvers import SOLVER_NAMES, solve_ccp, prepare_rows
+from .solvers import SOLVER_NAMES, prepare_rows, solve_ccp, solve_direct
 
 FLOATING = 0
 FIXED = 1
@@ -67,7 +67,10 @@ class System:
     Parameters
     ----------
     gravity : 3 floats (world).
-    solver : "psor" | "apgd" | "bb".
+    solver : "psor" | "apgd" | "bb" (iterative, matrix-free) or "direct"
+        (bilateral rows eliminated by a dense Cholesky factorisation, the
+        remaining contact rows by a dense projected gradient; for small,
+        stiff or badly scaled mechanisms).
     max_iter, tol : iteration limit and residual tolerance (m/s, see
         :mod:`sphdvi.dvi.solvers`).
     omega : PSOR relaxation.
@@ -733,10 +736,15 @@ class System:
         prepare_rows(nr, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
                      self.r_MiJ, self.r_g)
         vout = np.empty((nb, 6))
-        it, res = solve_ccp(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
-                            self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind, self.r_mu,
-                            self.r_lo, self.r_hi, self.r_g, g, vfree, vout, self.max_iter,
-                            self.tol, self.omega)
+        if self.solver.lower() == "direct":
+            it, res = solve_direct(nr, nb, self.r_a, self.r_b, self.r_J, self.r_MiJ, self.r_bias,
+                                   self.r_E, self.r_kind, self.r_mu, self.r_lo, self.r_hi,
+                                   self.r_g, g, vfree, vout, self.max_iter, self.tol)
+        else:
+            it, res = solve_ccp(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
+                                self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind,
+                                self.r_mu, self.r_lo, self.r_hi, self.r_g, g, vfree, vout,
+                                self.max_iter, self.tol, self.omega)
         self.last_iterations = int(it)
         self.last_residual = float(res)
         self.n_rows = nr
