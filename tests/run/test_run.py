@@ -1,0 +1,164 @@
+"""sphdvi run: outputs, resume (bitwise on 1 thread), divergence, body-only runs."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from conftest import REPO
+from sphdvi.cli import main
+
+DAMBREAK = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
+
+
+def small_case(tmp_path, dp="0.04", extra_params=""):
+    text = DAMBREAK.read_text().replace('dp="0.01"', f'dp="{dp}"')
+    if extra_params:
+        text = text.replace("<parameters>", "<parameters>" + extra_params)
+    path = tmp_path / "CaseDB_Def.xml"
+    path.write_text(text)
+    return path
+
+
+def invoke(args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def final_state(outdir):
+    with h5py.File(os.path.join(outdir, "restart.h5"), "r") as f:
+        idp = f["state/idp"][...]
+        o = np.argsort(idp)
+        return {k: f["state"][k][...][o] for k in ("pos", "vel", "rhop")}, dict(f["scalars"].attrs)
+
+
+def test_run_outputs(tmp_path):
+    case = small_case(tmp_path)
+    out = tmp_path / "out"
+    r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.005", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "completed" and meta["steps"] > 0 and meta["physical_time"] >= 0.02
+    assert meta["threads"] == 1 and meta["runtime_s"] > 0 and meta["startup_s"] > 0
+    assert meta["parameters"]["TimeMax"] == 0.02
+    rows = (out / "run.csv").read_text().splitlines()
+    assert rows[0] == "part,time,steps,particles,excluded,dtmin,dtmax,walltime" and len(rows) == 1 + 5
+    assert len((out / "run.log").read_text().splitlines()) >= 5
+    from sphdvi.io.vtkhdf import read_step, step_times
+    times = step_times(str(out / "particles.vtkhdf"))
+    assert len(times) == 5 and times[0] == 0.0
+    s = read_step(str(out / "particles.vtkhdf"), -1)
+    assert set(s) >= {"Idp", "Vel", "Rhop", "Press", "Type", "Mk"}
+    assert set(np.unique(s["Type"])) == {0, 3}
+    vtk = pytest.importorskip("vtkmodules.vtkIOHDF")
+    reader = vtk.vtkHDFReader()
+    reader.SetFileName(str(out / "particles.vtkhdf"))
+    reader.UpdateInformation()
+    assert reader.GetNumberOfSteps() == 5
+    r = invoke(["export", out])
+    assert r.exit_code == 0 and (out / "vtp" / "particles.pvd").is_file()
+    assert len(list((out / "vtp").glob("Part_*.vtp"))) == 5
+
+
+def test_set_overrides_and_bad_set(tmp_path):
+    case = small_case(tmp_path)
+    r = invoke(["run", case, "-o", tmp_path / "o", "--tmax", "0.002", "--set", "Visco=0.05",
+                "--set", "StepAlgorithm=2", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    meta = json.loads((tmp_path / "o" / "run.json").read_text())
+    assert meta["parameters"]["Visco"] == 0.05 and meta["parameters"]["StepAlgorithm"] == 2
+    r = invoke(["run", tmp_path / "o", "--set", "Visc=1"])
+    assert r.exit_code == 2 and "did you mean 'Visco'" in r.output
+    r = invoke(["run", tmp_path / "o", "--set", "Kernel=7"])
+    assert r.exit_code == 2
+
+
+@pytest.mark.parametrize("algo", [1, 2])
+def test_resume_is_bitwise(tmp_path, algo):
+    """Stop at an output, resume, and end in the bitwise same state as an uninterrupted run."""
+    case = small_case(tmp_path)
+    common = ["--tout", "0.004", "--threads", "1", "-q", "--set", f"StepAlgorithm={algo}"]
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert invoke(["run", case, "-o", a, "--tmax", "0.012"] + common).exit_code == 0
+    assert invoke(["run", case, "-o", b, "--tmax", "0.008"] + common).exit_code == 0
+    r = invoke(["run", b, "--resume", "--tmax", "0.012"] + common)
+    assert r.exit_code == 0, r.output
+    sa, ka = final_state(a)
+    sb, kb = final_state(b)
+    assert ka["nstep"] == kb["nstep"] and ka["time"] == kb["time"]
+    for k in sa:
+        assert np.array_equal(sa[k], sb[k]), k
+    assert (a / "run.csv").read_text().count("\n") == (b / "run.csv").read_text().count("\n")
+
+
+def test_sigkill_then_resume(tmp_path):
+    """A run killed with SIGKILL resumes from its last output, bitwise equal on 1 thread."""
+    case = small_case(tmp_path)
+    args = ["--tmax", "0.03", "--tout", "0.003", "--threads", "1", "-q"]
+    full = tmp_path / "full"
+    assert invoke(["run", case, "-o", full] + args).exit_code == 0
+    killed = tmp_path / "killed"
+    env = dict(os.environ, NUMBA_NUM_THREADS="1")
+    proc = subprocess.Popen([sys.executable, "-m", "sphdvi", "run", str(case), "-o", str(killed)] + args, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    csv = killed / "run.csv"
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        if csv.exists() and csv.read_text().count("\n") >= 4:
+            break
+        if proc.poll() is not None:
+            break
+        time.sleep(0.05)
+    killed_early = proc.poll() is None
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert killed_early, "the run finished before it could be killed"
+    meta = json.loads((killed / "run.json").read_text())
+    assert meta["status"] == "running"
+    r = invoke(["run", killed, "--resume"] + args)
+    assert r.exit_code == 0, r.output
+    s1, k1 = final_state(full)
+    s2, k2 = final_state(killed)
+    assert k1["nstep"] == k2["nstep"]
+    for k in s1:
+        assert np.array_equal(s1[k], s2[k]), k
+    from sphdvi.io.vtkhdf import step_times
+    assert np.array_equal(step_times(str(full / "particles.vtkhdf")), step_times(str(killed / "particles.vtkhdf")))
+
+
+def test_sigterm_stops_cleanly(tmp_path):
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    proc = subprocess.Popen([sys.executable, "-m", "sphdvi", "run", str(case), "-o", str(out), "--tmax", "5",
+                             "--tout", "0.002", "--threads", "1", "-q"], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and not ((out / "run.csv").exists()
+                                          and (out / "run.csv").read_text().count("\n") >= 3):
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 1 and "Traceback" not in err
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "interrupted" and "--resume" in meta["message"]
+
+
+def test_divergence_exit_3(tmp_path):
+    """A time step far above the CFL limit blows up: exit 3 naming time, step, particle and cause."""
+    case = small_case(tmp_path)
+    out = tmp_path / "o"
+    proc = subprocess.run([sys.executable, "-m", "sphdvi", "run", str(case), "-o", str(out), "--tmax", "0.5",
+                           "--tout", "0.01", "--threads", "1", "-q", "--set", "DtFixed=0.004"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 3, proc.stderr
+    assert "Traceback" not in proc.stderr
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "diverged"
+    assert "t=" in meta["message"] and "step" in meta["message"] and "particle" in meta["message"]
+    from sphdvi.io.vtkhdf import step_times
+    assert len(step_times(str(out / "particles.vtkhdf"))) >= 1
