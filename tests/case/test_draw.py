@@ -548,3 +548,37 @@ def test_no_effect_commands_accepted(tmp_path):
     d = draw(tmp_path, '<setdpctes cteline="0.1"/><setshapemode>actual | dp</setshapemode>'
              '<debugout/><setmkfluid mk="0"/>' + box((0, 0, 0), (0, 0, 0)))
     assert len(d.pos) == 1
+
+
+def test_triangle_raster_matches_its_definition():
+    """The compiled triangle rasteriser marks exactly the nodes its rule describes."""
+    from sphdvi.case.draw import kernels
+    rng = np.random.default_rng(7)
+    g = np.stack(np.meshgrid(*[np.arange(-2, 13)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+    for _ in range(40):
+        tri = rng.uniform(0, 10, (1, 3, 3))
+        out = np.zeros((15, 15, 15), dtype=bool)
+        kernels.raster_triangles(tri, np.array([-2, -2, -2]), out, -0.5 + 1e-6, 0.5 + 1e-6, 0.5 + 1e-6)
+        a, b, c = tri[0]
+        n = np.cross(b - a, c - a)
+        n /= np.linalg.norm(n)
+        w = (g - a) @ n
+        q = g - w[:, None] * n
+        # distance of q to the triangle (inside -> 0), by dense sampling of the closed triangle
+        uv = np.array([(u, v) for u in np.linspace(0, 1, 121) for v in np.linspace(0, 1, 121)
+                       if u + v <= 1])
+        samples = a + uv[:, :1] * (b - a) + uv[:, 1:] * (c - a)
+        band = (w > -0.5 + 1e-6) & (w <= 0.5 + 1e-6)
+        exp = np.zeros(len(g), bool)
+        idx = np.nonzero(band)[0]
+        if idx.size:
+            d = np.sqrt(((q[idx, None, :] - samples[None]) ** 2).sum(-1)).min(axis=1)
+            exp[idx] = d <= 0.5 + 1e-6
+            unsure = np.abs(d - 0.5) < 0.02  # sampling error near the edge tolerance
+        got = out.reshape(-1)
+        if idx.size:
+            keep = np.ones(len(g), bool)
+            keep[idx[unsure]] = False
+            assert np.array_equal(got[keep], exp[keep])
+        else:
+            assert not got.any()

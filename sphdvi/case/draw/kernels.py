@@ -32,6 +32,27 @@ def _seg_dist2(px, py, pz, ax, ay, az, bx, by, bz):
 
 
 @njit(cache=True)
+def _near_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz, nxv, nyv, nzv,
+                   e1x, e1y, e1z, e2x, e2y, e2z, d00, d01, d11, den, wlo, whi, dmax):
+    """Is the node within the band (wlo, whi] of the plane and within dmax of the triangle?"""
+    w = (px - ax) * nxv + (py - ay) * nyv + (pz - az) * nzv
+    if w <= wlo or w > whi:
+        return False
+    qx, qy, qz = px - w * nxv, py - w * nyv, pz - w * nzv
+    vx, vy, vz = qx - ax, qy - ay, qz - az
+    d20 = vx * e1x + vy * e1y + vz * e1z
+    d21 = vx * e2x + vy * e2y + vz * e2z
+    v = (d11 * d20 - d01 * d21) / den
+    u = (d00 * d21 - d01 * d20) / den
+    if v >= 0.0 and u >= 0.0 and u + v <= 1.0:
+        return True
+    d2 = _seg_dist2(qx, qy, qz, ax, ay, az, bx, by, bz)
+    d2 = min(d2, _seg_dist2(qx, qy, qz, bx, by, bz, cx, cy, cz))
+    d2 = min(d2, _seg_dist2(qx, qy, qz, cx, cy, cz, ax, ay, az))
+    return d2 <= dmax * dmax
+
+
+@njit(cache=True)
 def raster_triangles(tri, lo, out, wlo, whi, dmax):
     """Mark the nodes near triangles (T,3,3).
 
@@ -39,65 +60,72 @@ def raster_triangles(tri, lo, out, wlo, whi, dmax):
     in (wlo, whi] and its projection lies within ``dmax`` of the triangle.
     Surfaces use (-1/2, 1/2] and 1/2 (one node layer, never a gap a 6-connected
     path can cross; edges reach the nearest node, like box faces); "on the
-    surface" tests use a band of a few 1e-6.
+    surface" tests use a band of a few 1e-6. Only the nodes of the band are
+    visited: the loop runs over the two axes most parallel to the plane and
+    solves the band for the third.
     """
-    nx, ny, nz = out.shape
-    h = max(dmax, -wlo, whi)
+    shape = out.shape
+    h = dmax + max(-wlo, whi)  # a marked node is within this distance of the triangle
+    p = np.empty(3)
     for t in range(tri.shape[0]):
         ax, ay, az = tri[t, 0, 0], tri[t, 0, 1], tri[t, 0, 2]
         bx, by, bz = tri[t, 1, 0], tri[t, 1, 1], tri[t, 1, 2]
         cx, cy, cz = tri[t, 2, 0], tri[t, 2, 1], tri[t, 2, 2]
         e1x, e1y, e1z = bx - ax, by - ay, bz - az
         e2x, e2y, e2z = cx - ax, cy - ay, cz - az
-        nxv = e1y * e2z - e1z * e2y
-        nyv = e1z * e2x - e1x * e2z
-        nzv = e1x * e2y - e1y * e2x
-        nn = np.sqrt(nxv * nxv + nyv * nyv + nzv * nzv)
+        n = np.array([e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x])
+        nn = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
         if not nn > 1e-12:
             continue
-        nxv /= nn
-        nyv /= nn
-        nzv /= nn
-        i0 = int(np.ceil(min(ax, bx, cx) - h)) - lo[0]
-        i1 = int(np.floor(max(ax, bx, cx) + h)) - lo[0]
-        j0 = int(np.ceil(min(ay, by, cy) - h)) - lo[1]
-        j1 = int(np.floor(max(ay, by, cy) + h)) - lo[1]
-        k0 = int(np.ceil(min(az, bz, cz) - h)) - lo[2]
-        k1 = int(np.floor(max(az, bz, cz) + h)) - lo[2]
-        i0 = max(i0, 0)
-        j0 = max(j0, 0)
-        k0 = max(k0, 0)
-        i1 = min(i1, nx - 1)
-        j1 = min(j1, ny - 1)
-        k1 = min(k1, nz - 1)
-        # barycentric set-up
+        n /= nn
         d00 = e1x * e1x + e1y * e1y + e1z * e1z
         d01 = e1x * e2x + e1y * e2y + e1z * e2z
         d11 = e2x * e2x + e2y * e2y + e2z * e2z
         den = d00 * d11 - d01 * d01
-        for i in range(i0, i1 + 1):
-            px = float(i + lo[0])
-            for j in range(j0, j1 + 1):
-                py = float(j + lo[1])
+        # index ranges of the triangle's box widened by h, in sub-array indices
+        r0 = np.empty(3, dtype=np.int64)
+        r1 = np.empty(3, dtype=np.int64)
+        r0[0] = max(int(np.ceil(min(ax, bx, cx) - h)) - lo[0], 0)
+        r1[0] = min(int(np.floor(max(ax, bx, cx) + h)) - lo[0], shape[0] - 1)
+        r0[1] = max(int(np.ceil(min(ay, by, cy) - h)) - lo[1], 0)
+        r1[1] = min(int(np.floor(max(ay, by, cy) + h)) - lo[1], shape[1] - 1)
+        r0[2] = max(int(np.ceil(min(az, bz, cz) - h)) - lo[2], 0)
+        r1[2] = min(int(np.floor(max(az, bz, cz) + h)) - lo[2], shape[2] - 1)
+        if r0[0] > r1[0] or r0[1] > r1[1] or r0[2] > r1[2]:
+            continue
+        # solve for the axis c where the normal is largest
+        c = 0
+        if abs(n[1]) > abs(n[c]):
+            c = 1
+        if abs(n[2]) > abs(n[c]):
+            c = 2
+        a_ = (c + 1) % 3
+        b_ = (c + 2) % 3
+        A = np.array([ax, ay, az])
+        for i in range(r0[a_], r1[a_] + 1):
+            p[a_] = float(i + lo[a_])
+            for j in range(r0[b_], r1[b_] + 1):
+                p[b_] = float(j + lo[b_])
+                # w = s + n_c * (p_c - A_c) in (wlo, whi]
+                s = (p[a_] - A[a_]) * n[a_] + (p[b_] - A[b_]) * n[b_]
+                t0 = A[c] + (wlo - s) / n[c]
+                t1 = A[c] + (whi - s) / n[c]
+                if t0 > t1:
+                    t0, t1 = t1, t0
+                k0 = max(int(np.floor(t0)) - lo[c], r0[c])
+                k1 = min(int(np.ceil(t1)) - lo[c], r1[c])
                 for k in range(k0, k1 + 1):
-                    pz = float(k + lo[2])
-                    w = (px - ax) * nxv + (py - ay) * nyv + (pz - az) * nzv
-                    if w <= wlo or w > whi:
-                        continue
-                    qx, qy, qz = px - w * nxv, py - w * nyv, pz - w * nzv
-                    vx, vy, vz = qx - ax, qy - ay, qz - az
-                    d20 = vx * e1x + vy * e1y + vz * e1z
-                    d21 = vx * e2x + vy * e2y + vz * e2z
-                    v = (d11 * d20 - d01 * d21) / den
-                    u = (d00 * d21 - d01 * d20) / den
-                    if v >= 0.0 and u >= 0.0 and u + v <= 1.0:
-                        out[i, j, k] = True
-                        continue
-                    d2 = _seg_dist2(qx, qy, qz, ax, ay, az, bx, by, bz)
-                    d2 = min(d2, _seg_dist2(qx, qy, qz, bx, by, bz, cx, cy, cz))
-                    d2 = min(d2, _seg_dist2(qx, qy, qz, cx, cy, cz, ax, ay, az))
-                    if d2 <= dmax * dmax:
-                        out[i, j, k] = True
+                    p[c] = float(k + lo[c])
+                    if _near_triangle(p[0], p[1], p[2], ax, ay, az, bx, by, bz, cx, cy, cz,
+                                      n[0], n[1], n[2], e1x, e1y, e1z, e2x, e2y, e2z,
+                                      d00, d01, d11, den, wlo, whi, dmax):
+                        # (i, j, k) run along axes (c+1, c+2, c)
+                        if c == 0:
+                            out[k, i, j] = True
+                        elif c == 1:
+                            out[j, k, i] = True
+                        else:
+                            out[i, j, k] = True
 
 
 @njit(cache=True)

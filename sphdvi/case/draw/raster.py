@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import kernels
 from . import transform as tf
 from .lattice import EPS, Lattice, ceil_idx, floor_idx, round_idx
 
@@ -104,6 +103,7 @@ def world_range(lat: Lattice, pts, pad: float):
 
 def triangle_pieces(lat: Lattice, tris, surface: bool = True, solid: bool = False):
     """Surface and/or inside (parity) nodes of world triangles (T,3,3)."""
+    from . import kernels  # numba: imported only when a triangle is drawn
     tris = np.asarray(tris, dtype=np.float64).reshape(-1, 3, 3)
     if tris.shape[0] == 0:
         return []
