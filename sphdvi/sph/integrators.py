@@ -25,86 +25,102 @@ set to zero where the free-surface detector div r < ShiftTFS.  It is added to
 the fluid displacement (Verlet step, Symplectic corrector) when ``shift`` is on.
 
 ``ip`` holds the step parameters: [dt, rhop0, RhopOutMin, RhopOutMax,
-ShiftCoef*h, ShiftTFS, use_domain, xmin, ymin, zmin, xmax, ymax, zmax].
+ShiftCoef*h, ShiftTFS, use_domain, xmin, ymin, zmin, xmax, ymax, zmax,
+move] where move = 1 lets moving/floating particles advance with their
+velocity (no motion hook).
 """
 import math
 
 from . import _env  # noqa: F401
 from numba import njit, prange, literally
 
+# particles per work item of the threaded drivers
+CHUNK = 256
+
 
 @njit(cache=True)
-def _check_out(i, pos, rho, ip, out):
-    """Flag code of fluid particle i (0 keep, 1 density, 2 position, 3 not finite)."""
-    if not (math.isfinite(rho) and math.isfinite(pos[i, 0])
-            and math.isfinite(pos[i, 1]) and math.isfinite(pos[i, 2])):
-        out[i] = 3
+def _out_code(x, y, z, rho, rmin, rmax, usedom, x0, y0, z0, x1, y1, z1):
+    """Exclusion code of a fluid particle (0 keep, 1 density, 2 position, 3 not finite)."""
+    if not (math.isfinite(rho) and math.isfinite(x) and math.isfinite(y)
+            and math.isfinite(z)):
+        return 3
+    if rho < rmin or rho > rmax:
         return 1
-    if rho < ip[2] or rho > ip[3]:
-        out[i] = 1
-        return 1
-    if ip[6] != 0.0:
-        for k in range(3):
-            if pos[i, k] < ip[7 + k] or pos[i, k] > ip[10 + k]:
-                out[i] = 2
-                return 1
-    out[i] = 0
+    if usedom:
+        if x < x0 or y < y0 or z < z0 or x > x1 or y > y1 or z > z1:
+            return 2
     return 0
 
 
 @njit(cache=True)
-def _shift_factor(i, vel, shiftdet, ip):
+def _shift_factor(vx, vy, vz, det, coefh, tfs, dt):
     """A h |v| dt, or 0 at the free surface (div r < ShiftTFS)."""
-    if shiftdet[i] < ip[5]:
+    if det < tfs:
         return 0.0
-    vm = math.sqrt(vel[i, 0] ** 2 + vel[i, 1] ** 2 + vel[i, 2] ** 2)
-    return ip[4] * vm * ip[0]
+    return coefh * math.sqrt(vx * vx + vy * vy + vz * vz) * dt
 
 
 @njit(cache=True)
-def _verlet_particle(i, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar,
-                     ptype, shiftpos, shiftdet, ip, out):
+def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar,
+                  ptype, shiftpos, shiftdet, ip, out):
     dt = ip[0]
-    pt = ptype[i]
-    if pt == 3:
-        sf = 0.0
-        if shift > 0:
-            sf = _shift_factor(i, vel, shiftdet, ip)
-        dt205 = 0.5 * dt * dt
-        for k in range(3):
-            v = vel[i, k]
-            a = ace[i, k]
-            dx = v * dt + a * dt205
-            if shift > 0:
-                dx += sf * shiftpos[i, k]
-            pos[i, k] += dx
-            if euler:
-                vn = v + a * dt
-            else:
-                vn = vel_m1[i, k] + 2.0 * dt * a
-            vel_m1[i, k] = v
-            vel[i, k] = vn
+    rhop0 = ip[1]
+    rmin = ip[2]
+    rmax = ip[3]
+    coefh = ip[4]
+    tfs = ip[5]
+    usedom = ip[6] != 0.0
+    x0 = ip[7]
+    y0 = ip[8]
+    z0 = ip[9]
+    x1 = ip[10]
+    y1 = ip[11]
+    z1 = ip[12]
+    move = ip[13] != 0.0
+    dt205 = 0.5 * dt * dt
+    dt2 = dt if euler else 2.0 * dt
+    nout = 0
+    for i in range(i0, i1):
+        pt = ptype[i]
         r = rhop[i]
         if euler:
-            rn = r + dt * ar[i]
+            rn = r + dt2 * ar[i]
         else:
-            rn = rhop_m1[i] + 2.0 * dt * ar[i]
+            rn = rhop_m1[i] + dt2 * ar[i]
         rhop_m1[i] = r
-        rhop[i] = rn
-        return _check_out(i, pos, rn, ip, out)
-    r = rhop[i]
-    if euler:
-        rn = r + dt * ar[i]
-    else:
-        rn = rhop_m1[i] + 2.0 * dt * ar[i]
-    rhop_m1[i] = r
-    rhop[i] = max(rn, ip[1])
-    if pt >= 1:
-        for k in range(3):
-            pos[i, k] += vel[i, k] * dt
-            vel_m1[i, k] = vel[i, k]
-    out[i] = 0
-    return 0
+        if pt == 3:
+            sf = 0.0
+            if shift > 0:
+                sf = _shift_factor(vel[i, 0], vel[i, 1], vel[i, 2], shiftdet[i],
+                                   coefh, tfs, dt)
+            for k in range(3):
+                v = vel[i, k]
+                a = ace[i, k]
+                dx = v * dt + a * dt205
+                if shift > 0:
+                    dx += sf * shiftpos[i, k]
+                pos[i, k] += dx
+                if euler:
+                    vn = v + a * dt
+                else:
+                    vn = vel_m1[i, k] + dt2 * a
+                vel_m1[i, k] = v
+                vel[i, k] = vn
+            rhop[i] = rn
+            code = _out_code(pos[i, 0], pos[i, 1], pos[i, 2], rn, rmin, rmax, usedom,
+                             x0, y0, z0, x1, y1, z1)
+            out[i] = code
+            if code != 0:
+                nout += 1
+        else:
+            rhop[i] = max(rn, rhop0)
+            out[i] = 0
+            if pt >= 1:
+                for k in range(3):
+                    if move:
+                        pos[i, k] += vel[i, k] * dt
+                    vel_m1[i, k] = vel[i, k]
+    return nout
 
 
 @njit(cache=True)
@@ -112,11 +128,8 @@ def verlet_serial(shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar, ptype,
                   shiftpos, shiftdet, ip, out):
     """One Verlet (or Euler, ``euler=True``) step; returns the count of flagged particles."""
     shift = literally(shift)
-    nout = 0
-    for i in range(pos.shape[0]):
-        nout += _verlet_particle(i, shift, euler, pos, vel, rhop, vel_m1, rhop_m1,
-                                 ace, ar, ptype, shiftpos, shiftdet, ip, out)
-    return nout
+    return _verlet_range(0, pos.shape[0], shift, euler, pos, vel, rhop, vel_m1, rhop_m1,
+                         ace, ar, ptype, shiftpos, shiftdet, ip, out)
 
 
 @njit(cache=True, parallel=True)
@@ -124,79 +137,105 @@ def verlet_parallel(shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar, ptyp
                     shiftpos, shiftdet, ip, out):
     """Threaded :func:`verlet_serial`."""
     shift = literally(shift)
+    n = pos.shape[0]
     nout = 0
-    for i in prange(pos.shape[0]):
-        nout += _verlet_particle(i, shift, euler, pos, vel, rhop, vel_m1, rhop_m1,
-                                 ace, ar, ptype, shiftpos, shiftdet, ip, out)
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        nout += _verlet_range(c * CHUNK, min(n, (c + 1) * CHUNK), shift, euler, pos, vel,
+                              rhop, vel_m1, rhop_m1, ace, ar, ptype, shiftpos, shiftdet,
+                              ip, out)
     return nout
 
 
 @njit(cache=True)
-def _sym_pre_particle(i, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
-                      ptype, ip):
+def _sym_pre_range(i0, i1, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
+                   ptype, ip):
     dt05 = 0.5 * ip[0]
-    pt = ptype[i]
-    for k in range(3):
-        pos_pre[i, k] = pos[i, k]
-        vel_pre[i, k] = vel[i, k]
-    rhop_pre[i] = rhop[i]
-    if pt == 3:
-        rhop[i] = rhop_pre[i] + dt05 * ar[i]
+    rhop0 = ip[1]
+    move = ip[13] != 0.0
+    for i in range(i0, i1):
+        pt = ptype[i]
         for k in range(3):
-            pos[i, k] = pos_pre[i, k] + dt05 * vel_pre[i, k]
-            vel[i, k] = vel_pre[i, k] + dt05 * ace[i, k]
-    else:
-        rhop[i] = max(rhop_pre[i] + dt05 * ar[i], ip[1])
-        if pt >= 1:
+            pos_pre[i, k] = pos[i, k]
+            vel_pre[i, k] = vel[i, k]
+        rhop_pre[i] = rhop[i]
+        if pt == 3:
+            rhop[i] = rhop_pre[i] + dt05 * ar[i]
             for k in range(3):
-                pos[i, k] = pos_pre[i, k] + dt05 * vel[i, k]
+                pos[i, k] = pos_pre[i, k] + dt05 * vel_pre[i, k]
+                vel[i, k] = vel_pre[i, k] + dt05 * ace[i, k]
+        else:
+            rhop[i] = max(rhop_pre[i] + dt05 * ar[i], rhop0)
+            if pt >= 1 and move:
+                for k in range(3):
+                    pos[i, k] = pos_pre[i, k] + dt05 * vel[i, k]
 
 
 @njit(cache=True)
 def symplectic_pre_serial(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                           ptype, ip):
     """Symplectic predictor: saves the state at n in ``*_pre`` and advances dt/2."""
-    for i in range(pos.shape[0]):
-        _sym_pre_particle(i, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
-                          ptype, ip)
+    _sym_pre_range(0, pos.shape[0], pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
+                   ptype, ip)
 
 
 @njit(cache=True, parallel=True)
 def symplectic_pre_parallel(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                             ptype, ip):
     """Threaded :func:`symplectic_pre_serial`."""
-    for i in prange(pos.shape[0]):
-        _sym_pre_particle(i, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
-                          ptype, ip)
+    n = pos.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _sym_pre_range(c * CHUNK, min(n, (c + 1) * CHUNK), pos, vel, rhop, pos_pre,
+                       vel_pre, rhop_pre, ace, ar, ptype, ip)
 
 
 @njit(cache=True)
-def _sym_corr_particle(i, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace,
-                       ar, ptype, shiftpos, shiftdet, ip, out):
+def _sym_corr_range(i0, i1, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace,
+                    ar, ptype, shiftpos, shiftdet, ip, out):
     dt = ip[0]
     dt05 = 0.5 * dt
-    pt = ptype[i]
-    eps = -(ar[i] / rhop[i]) * dt
-    rn = rhop_pre[i] * (2.0 - eps) / (2.0 + eps)
-    if pt == 3:
-        sf = 0.0
-        if shift > 0:
-            sf = _shift_factor(i, vel, shiftdet, ip)
-        rhop[i] = rn
-        for k in range(3):
-            vn = vel_pre[i, k] + dt * ace[i, k]
-            dx = (vel_pre[i, k] + vn) * dt05
+    rhop0 = ip[1]
+    rmin = ip[2]
+    rmax = ip[3]
+    coefh = ip[4]
+    tfs = ip[5]
+    usedom = ip[6] != 0.0
+    x0 = ip[7]
+    y0 = ip[8]
+    z0 = ip[9]
+    x1 = ip[10]
+    y1 = ip[11]
+    z1 = ip[12]
+    move = ip[13] != 0.0
+    nout = 0
+    for i in range(i0, i1):
+        pt = ptype[i]
+        eps = -(ar[i] / rhop[i]) * dt
+        rn = rhop_pre[i] * (2.0 - eps) / (2.0 + eps)
+        if pt == 3:
+            sf = 0.0
             if shift > 0:
-                dx += sf * shiftpos[i, k]
-            vel[i, k] = vn
-            pos[i, k] = pos_pre[i, k] + dx
-        return _check_out(i, pos, rn, ip, out)
-    rhop[i] = max(rn, ip[1])
-    if pt >= 1:
-        for k in range(3):
-            pos[i, k] = pos_pre[i, k] + dt * vel[i, k]
-    out[i] = 0
-    return 0
+                sf = _shift_factor(vel[i, 0], vel[i, 1], vel[i, 2], shiftdet[i],
+                                   coefh, tfs, dt)
+            rhop[i] = rn
+            for k in range(3):
+                vn = vel_pre[i, k] + dt * ace[i, k]
+                dx = (vel_pre[i, k] + vn) * dt05
+                if shift > 0:
+                    dx += sf * shiftpos[i, k]
+                vel[i, k] = vn
+                pos[i, k] = pos_pre[i, k] + dx
+            code = _out_code(pos[i, 0], pos[i, 1], pos[i, 2], rn, rmin, rmax, usedom,
+                             x0, y0, z0, x1, y1, z1)
+            out[i] = code
+            if code != 0:
+                nout += 1
+        else:
+            rhop[i] = max(rn, rhop0)
+            out[i] = 0
+            if pt >= 1 and move:
+                for k in range(3):
+                    pos[i, k] = pos_pre[i, k] + dt * vel[i, k]
+    return nout
 
 
 @njit(cache=True)
@@ -204,12 +243,8 @@ def symplectic_corr_serial(shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ac
                            ar, ptype, shiftpos, shiftdet, ip, out):
     """Symplectic corrector; returns the count of flagged particles."""
     shift = literally(shift)
-    nout = 0
-    for i in range(pos.shape[0]):
-        nout += _sym_corr_particle(i, shift, pos, vel, rhop, pos_pre, vel_pre,
-                                   rhop_pre, ace, ar, ptype, shiftpos, shiftdet,
-                                   ip, out)
-    return nout
+    return _sym_corr_range(0, pos.shape[0], shift, pos, vel, rhop, pos_pre, vel_pre,
+                           rhop_pre, ace, ar, ptype, shiftpos, shiftdet, ip, out)
 
 
 @njit(cache=True, parallel=True)
@@ -217,9 +252,10 @@ def symplectic_corr_parallel(shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, 
                              ar, ptype, shiftpos, shiftdet, ip, out):
     """Threaded :func:`symplectic_corr_serial`."""
     shift = literally(shift)
+    n = pos.shape[0]
     nout = 0
-    for i in prange(pos.shape[0]):
-        nout += _sym_corr_particle(i, shift, pos, vel, rhop, pos_pre, vel_pre,
-                                   rhop_pre, ace, ar, ptype, shiftpos, shiftdet,
-                                   ip, out)
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        nout += _sym_corr_range(c * CHUNK, min(n, (c + 1) * CHUNK), shift, pos, vel, rhop,
+                                pos_pre, vel_pre, rhop_pre, ace, ar, ptype, shiftpos,
+                                shiftdet, ip, out)
     return nout

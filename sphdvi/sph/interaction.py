@@ -40,6 +40,9 @@ from numba import njit, prange, literally
 
 from .kernels import kernel_fac, kernel_w
 
+# particles per work item of the threaded drivers
+CHUNK = 128
+
 
 @njit(cache=True)
 def _hydrostatic_drho(x, rhop0, inv_gamma):
@@ -81,47 +84,48 @@ def tait_pressure(rho, b, rhop0, gamma):
 
 
 @njit(cache=True)
-def _pack_row(i, is2d, pos, vel, rhop, mass, cst, nb):
-    rho = rhop[i]
-    p = tait_pressure(rho, cst[16], cst[10], cst[17])
-    if is2d:
-        nb[i, 0] = pos[i, 0]
-        nb[i, 1] = pos[i, 2]
-        nb[i, 2] = vel[i, 0]
-        nb[i, 3] = vel[i, 2]
-        nb[i, 4] = rho
-        nb[i, 5] = p
-        nb[i, 6] = mass[i]
-        nb[i, 7] = 1.0 / rho
-    else:
-        for k in range(3):
-            nb[i, k] = pos[i, k]
-            nb[i, 3 + k] = vel[i, k]
-        nb[i, 6] = rho
-        nb[i, 7] = p
-        nb[i, 8] = mass[i]
-        nb[i, 9] = 1.0 / rho
+def _pack_range(i0, i1, is2d, pos, vel, rhop, mass, cst, nb):
+    for i in range(i0, i1):
+        rho = rhop[i]
+        p = tait_pressure(rho, cst[16], cst[10], cst[17])
+        if is2d:
+            nb[i, 0] = pos[i, 0]
+            nb[i, 1] = pos[i, 2]
+            nb[i, 2] = vel[i, 0]
+            nb[i, 3] = vel[i, 2]
+            nb[i, 4] = rho
+            nb[i, 5] = p
+            nb[i, 6] = mass[i]
+            nb[i, 7] = 1.0 / rho
+        else:
+            for k in range(3):
+                nb[i, k] = pos[i, k]
+                nb[i, 3 + k] = vel[i, k]
+            nb[i, 6] = rho
+            nb[i, 7] = p
+            nb[i, 8] = mass[i]
+            nb[i, 9] = 1.0 / rho
 
 
 @njit(cache=True)
 def pack_serial(is2d, pos, vel, rhop, mass, cst, nb):
     """Fill the packed neighbour array, computing the pressure from Tait's EOS."""
-    for i in range(pos.shape[0]):
-        _pack_row(i, is2d, pos, vel, rhop, mass, cst, nb)
+    _pack_range(0, pos.shape[0], is2d, pos, vel, rhop, mass, cst, nb)
 
 
 @njit(cache=True, parallel=True)
 def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
     """Threaded :func:`pack_serial`."""
-    for i in prange(pos.shape[0]):
-        _pack_row(i, is2d, pos, vel, rhop, mass, cst, nb)
+    n = pos.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _pack_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, pos, vel, rhop, mass, cst, nb)
 
 
 # --------------------------------------------------------------------------
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
 @njit(cache=True)
-def _particle_rates_2d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel):
     kern = literally(kern)
@@ -142,171 +146,172 @@ def _particle_rates_2d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
     inv_gamma = cst[11]
     od_wdp = cst[15]
 
-    xi = nb[i, 0]
-    zi = nb[i, 1]
-    vxi = nb[i, 2]
-    vzi = nb[i, 3]
-    rhoi = nb[i, 4]
-    pi = nb[i, 5]
-    iri = nb[i, 7]
-    pti = ptype[i]
-    c = cell[i]
-    cx = c % ncx
-    cz = c // ncx
-    xlo = max(cx - 1, 0)
-    xhi = min(cx + 1, ncx - 1)
-    zlo = max(cz - 1, 0)
-    zhi = min(cz + 1, ncz - 1)
+    for i in range(i0, i1):
+        xi = nb[i, 0]
+        zi = nb[i, 1]
+        vxi = nb[i, 2]
+        vzi = nb[i, 3]
+        rhoi = nb[i, 4]
+        pi = nb[i, 5]
+        iri = nb[i, 7]
+        pti = ptype[i]
+        c = cell[i]
+        cx = c % ncx
+        cz = c // ncx
+        xlo = max(cx - 1, 0)
+        xhi = min(cx + 1, ncx - 1)
+        zlo = max(cz - 1, 0)
+        zhi = min(cz + 1, ncz - 1)
 
-    if pti < 2:
-        # DBC boundary particle: continuity with fluid/floating neighbours.
+        if pti < 2:
+            # DBC boundary particle: continuity with fluid/floating neighbours.
+            arp = 0.0
+            vmax = 0.0
+            for z in range(zlo, zhi + 1):
+                row = z * ncx
+                for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
+                    if ptype[j] < 2:
+                        continue
+                    dx = xi - nb[j, 0]
+                    dz = zi - nb[j, 1]
+                    r2 = dx * dx + dz * dz
+                    if r2 >= r2max or r2 < 1e-18:
+                        continue
+                    fac = kernel_fac(kern, math.sqrt(r2) * inv_h, alpha_h2)
+                    dot = (vxi - nb[j, 2]) * dx + (vzi - nb[j, 3]) * dz
+                    arp += nb[j, 6] * fac * dot * nb[j, 7]
+                    vmax = max(vmax, dot / (r2 + eta2))
+            ace[i, 0] = 0.0
+            ace[i, 1] = 0.0
+            ace[i, 2] = 0.0
+            ar[i] = rhoi * arp
+            viscdt[i] = vmax
+            continue
+
+        acex = 0.0
+        acez = 0.0
         arp = 0.0
         vmax = 0.0
+        deltap = 0.0
+        ddt_off = False
+        shx = 0.0
+        shz = 0.0
+        shdet = 0.0
+        sh_off = False
+        gxx = 0.0
+        gxz = 0.0
+        gzz = 0.0
+        tens_i = 0.0
+        if kern == 1:
+            tens_i = _tensile(pi, rhoi)
+        txx_i = 0.0
+        txz_i = 0.0
+        tzz_i = 0.0
+        if visco == 2:
+            txx_i = tau[i, 0]
+            txz_i = tau[i, 2]
+            tzz_i = tau[i, 5]
         for z in range(zlo, zhi + 1):
             row = z * ncx
             for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
-                if ptype[j] < 2:
-                    continue
                 dx = xi - nb[j, 0]
                 dz = zi - nb[j, 1]
                 r2 = dx * dx + dz * dz
                 if r2 >= r2max or r2 < 1e-18:
                     continue
-                fac = kernel_fac(kern, math.sqrt(r2) * inv_h, alpha_h2)
-                dot = (vxi - nb[j, 2]) * dx + (vzi - nb[j, 3]) * dz
-                arp += nb[j, 6] * fac * dot * nb[j, 7]
-                vmax = max(vmax, dot / (r2 + eta2))
-        ace[i, 0] = 0.0
-        ace[i, 1] = 0.0
-        ace[i, 2] = 0.0
-        ar[i] = rhoi * arp
-        viscdt[i] = vmax
-        return
-
-    acex = 0.0
-    acez = 0.0
-    arp = 0.0
-    vmax = 0.0
-    deltap = 0.0
-    ddt_off = False
-    shx = 0.0
-    shz = 0.0
-    shdet = 0.0
-    sh_off = False
-    gxx = 0.0
-    gxz = 0.0
-    gzz = 0.0
-    tens_i = 0.0
-    if kern == 1:
-        tens_i = _tensile(pi, rhoi)
-    txx_i = 0.0
-    txz_i = 0.0
-    tzz_i = 0.0
-    if visco == 2:
-        txx_i = tau[i, 0]
-        txz_i = tau[i, 2]
-        tzz_i = tau[i, 5]
-    for z in range(zlo, zhi + 1):
-        row = z * ncx
-        for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
-            dx = xi - nb[j, 0]
-            dz = zi - nb[j, 1]
-            r2 = dx * dx + dz * dz
-            if r2 >= r2max or r2 < 1e-18:
-                continue
-            ptj = ptype[j]
-            if pti == 2 and ptj != 3:
-                continue  # floating particles see fluid only
-            boundj = ptj < 2
-            q = math.sqrt(r2) * inv_h
-            fac = kernel_fac(kern, q, alpha_h2)
-            rhoj = nb[j, 4]
-            pj = nb[j, 5]
-            mfac = nb[j, 6] * fac
-            irj = nb[j, 7]
-            dvx = vxi - nb[j, 2]
-            dvz = vzi - nb[j, 3]
-            dot = dvx * dx + dvz * dz
-            ir2e = 1.0 / (r2 + eta2)
-            dot_rr2 = dot * ir2e
-            vmax = max(vmax, dot_rr2)
-            # continuity: rho_a m_b/rho_b v_ab.gradW (rho_a applied at the end)
-            arp += mfac * dot * irj
-            # symmetric pressure term
-            coef = -(pi + pj) * iri * irj
-            if kern == 1:
-                wr = kernel_w(1, q, alpha) * od_wdp
-                wr = wr * wr
-                coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
-            vis = vis_b if boundj else vis_f
-            if visco == 1:
-                # Monaghan artificial viscosity, active for approaching pairs
-                coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
-            else:
-                # Lo & Shao laminar viscosity
-                vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
-                acex += vtemp * dvx
-                acez += vtemp * dvz
-                if visco == 2 and not boundj:
-                    mj = nb[j, 6]
-                    sxx = txx_i + tau[j, 0]
-                    sxz = txz_i + tau[j, 2]
-                    szz = tzz_i + tau[j, 5]
-                    acex += mj * fac * (sxx * dx + sxz * dz)
-                    acez += mj * fac * (sxz * dx + szz * dz)
-                    volj = -mfac * irj
-                    gxx += dvx * volj * dx
-                    gxz += dvx * volj * dz + dvz * volj * dx
-                    gzz += dvz * volj * dz
-            acex += coef * mfac * dx
-            acez += coef * mfac * dz
-            # density diffusion
-            if ddt == 1:
-                if ptj != 3:
-                    ddt_off = True
+                ptj = ptype[j]
+                if pti == 2 and ptj != 3:
+                    continue  # floating particles see fluid only
+                boundj = ptj < 2
+                q = math.sqrt(r2) * inv_h
+                fac = kernel_fac(kern, q, alpha_h2)
+                rhoj = nb[j, 4]
+                pj = nb[j, 5]
+                mfac = nb[j, 6] * fac
+                irj = nb[j, 7]
+                dvx = vxi - nb[j, 2]
+                dvz = vzi - nb[j, 3]
+                dot = dvx * dx + dvz * dz
+                ir2e = 1.0 / (r2 + eta2)
+                dot_rr2 = dot * ir2e
+                vmax = max(vmax, dot_rr2)
+                # continuity: rho_a m_b/rho_b v_ab.gradW (rho_a applied at the end)
+                arp += mfac * dot * irj
+                # symmetric pressure term
+                coef = -(pi + pj) * iri * irj
+                if kern == 1:
+                    wr = kernel_w(1, q, alpha) * od_wdp
+                    wr = wr * wr
+                    coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
+                vis = vis_b if boundj else vis_f
+                if visco == 1:
+                    # Monaghan artificial viscosity, active for approaching pairs
+                    coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
                 else:
-                    deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
-            elif ddt == 2 or ddt == 3:
-                if boundj:
-                    if ddt == 2:
+                    # Lo & Shao laminar viscosity
+                    vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
+                    acex += vtemp * dvx
+                    acez += vtemp * dvz
+                    if visco == 2 and not boundj:
+                        mj = nb[j, 6]
+                        sxx = txx_i + tau[j, 0]
+                        sxz = txz_i + tau[j, 2]
+                        szz = tzz_i + tau[j, 5]
+                        acex += mj * fac * (sxx * dx + sxz * dz)
+                        acez += mj * fac * (sxz * dx + szz * dz)
+                        volj = -mfac * irj
+                        gxx += dvx * volj * dx
+                        gxz += dvx * volj * dz + dvz * volj * dx
+                        gzz += dvz * volj * dz
+                acex += coef * mfac * dx
+                acez += coef * mfac * dz
+                # density diffusion
+                if ddt == 1:
+                    if ptj != 3:
                         ddt_off = True
-                elif ptj == 3:
-                    drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
-                    deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
-            # shifting
-            if shift > 0:
-                if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
-                    sh_off = True
-                mr = mfac * irj
-                shx += mr * dx
-                shz += mr * dz
-                shdet -= mr * r2
-    arp *= rhoi
-    if pti == 3:
-        ace[i, 0] = acex + cst[12]
-        ace[i, 1] = cst[13]
-        ace[i, 2] = acez + cst[14]
-        if ddt != 0 and not ddt_off:
-            arp += cst[8] * deltap
-    else:
-        ace[i, 0] = acex
-        ace[i, 1] = 0.0
-        ace[i, 2] = acez
-    ar[i] = arp
-    viscdt[i] = vmax
-    if shift > 0:
-        if sh_off or pti != 3:
-            shiftpos[i, 0] = 0.0
-            shiftpos[i, 2] = 0.0
+                    else:
+                        deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
+                elif ddt == 2 or ddt == 3:
+                    if boundj:
+                        if ddt == 2:
+                            ddt_off = True
+                    elif ptj == 3:
+                        drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
+                        deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
+                # shifting
+                if shift > 0:
+                    if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
+                        sh_off = True
+                    mr = mfac * irj
+                    shx += mr * dx
+                    shz += mr * dz
+                    shdet -= mr * r2
+        arp *= rhoi
+        if pti == 3:
+            ace[i, 0] = acex + cst[12]
+            ace[i, 1] = cst[13]
+            ace[i, 2] = acez + cst[14]
+            if ddt != 0 and not ddt_off:
+                arp += cst[8] * deltap
         else:
-            shiftpos[i, 0] = shx
-            shiftpos[i, 2] = shz
-        shiftpos[i, 1] = 0.0
-        shiftdet[i] = shdet
-    if visco == 2:
-        gradvel[i, 0] = gxx
-        gradvel[i, 2] = gxz
-        gradvel[i, 5] = gzz
+            ace[i, 0] = acex
+            ace[i, 1] = 0.0
+            ace[i, 2] = acez
+        ar[i] = arp
+        viscdt[i] = vmax
+        if shift > 0:
+            if sh_off or pti != 3:
+                shiftpos[i, 0] = 0.0
+                shiftpos[i, 2] = 0.0
+            else:
+                shiftpos[i, 0] = shx
+                shiftpos[i, 2] = shz
+            shiftpos[i, 1] = 0.0
+            shiftdet[i] = shdet
+        if visco == 2:
+            gradvel[i, 0] = gxx
+            gradvel[i, 2] = gxz
+            gradvel[i, 5] = gzz
 
 
 @njit(cache=True)
@@ -317,10 +322,9 @@ def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
-    for i in range(nb.shape[0]):
-        _particle_rates_2d(i, kern, visco, ddt, shift, nb, ptype, cell,
-                           cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
-                           shiftpos, shiftdet, gradvel)
+    _rates_range_2d(0, nb.shape[0], kern, visco, ddt, shift, nb, ptype, cell,
+                    cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
+                    shiftpos, shiftdet, gradvel)
 
 
 @njit(cache=True, parallel=True)
@@ -331,17 +335,19 @@ def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
-    for i in prange(nb.shape[0]):
-        _particle_rates_2d(i, kern, visco, ddt, shift, nb, ptype, cell,
-                           cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
-                           shiftpos, shiftdet, gradvel)
+    n = nb.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _rates_range_2d(c * CHUNK, min(n, (c + 1) * CHUNK), kern, visco, ddt, shift,
+                        nb, ptype, cell, cell_start, ncx, ncz, cst, tau, ace, ar,
+                        viscdt,
+                        shiftpos, shiftdet, gradvel)
 
 
 # --------------------------------------------------------------------------
 # 3D
 # --------------------------------------------------------------------------
 @njit(cache=True)
-def _particle_rates_3d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel):
     kern = literally(kern)
@@ -362,203 +368,204 @@ def _particle_rates_3d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
     inv_gamma = cst[11]
     od_wdp = cst[15]
 
-    xi = nb[i, 0]
-    yi = nb[i, 1]
-    zi = nb[i, 2]
-    vxi = nb[i, 3]
-    vyi = nb[i, 4]
-    vzi = nb[i, 5]
-    rhoi = nb[i, 6]
-    pi = nb[i, 7]
-    iri = nb[i, 9]
-    pti = ptype[i]
-    c = cell[i]
-    cx = c % ncx
-    cy = (c // ncx) % ncy
-    cz = c // (ncx * ncy)
-    xlo = max(cx - 1, 0)
-    xhi = min(cx + 1, ncx - 1)
-    ylo = max(cy - 1, 0)
-    yhi = min(cy + 1, ncy - 1)
-    zlo = max(cz - 1, 0)
-    zhi = min(cz + 1, ncz - 1)
+    for i in range(i0, i1):
+        xi = nb[i, 0]
+        yi = nb[i, 1]
+        zi = nb[i, 2]
+        vxi = nb[i, 3]
+        vyi = nb[i, 4]
+        vzi = nb[i, 5]
+        rhoi = nb[i, 6]
+        pi = nb[i, 7]
+        iri = nb[i, 9]
+        pti = ptype[i]
+        c = cell[i]
+        cx = c % ncx
+        cy = (c // ncx) % ncy
+        cz = c // (ncx * ncy)
+        xlo = max(cx - 1, 0)
+        xhi = min(cx + 1, ncx - 1)
+        ylo = max(cy - 1, 0)
+        yhi = min(cy + 1, ncy - 1)
+        zlo = max(cz - 1, 0)
+        zhi = min(cz + 1, ncz - 1)
 
-    if pti < 2:
+        if pti < 2:
+            arp = 0.0
+            vmax = 0.0
+            for z in range(zlo, zhi + 1):
+                for y in range(ylo, yhi + 1):
+                    row = (z * ncy + y) * ncx
+                    for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
+                        if ptype[j] < 2:
+                            continue
+                        dx = xi - nb[j, 0]
+                        dy = yi - nb[j, 1]
+                        dz = zi - nb[j, 2]
+                        r2 = dx * dx + dy * dy + dz * dz
+                        if r2 >= r2max or r2 < 1e-18:
+                            continue
+                        fac = kernel_fac(kern, math.sqrt(r2) * inv_h, alpha_h2)
+                        dot = ((vxi - nb[j, 3]) * dx + (vyi - nb[j, 4]) * dy
+                               + (vzi - nb[j, 5]) * dz)
+                        arp += nb[j, 8] * fac * dot * nb[j, 9]
+                        vmax = max(vmax, dot / (r2 + eta2))
+            ace[i, 0] = 0.0
+            ace[i, 1] = 0.0
+            ace[i, 2] = 0.0
+            ar[i] = rhoi * arp
+            viscdt[i] = vmax
+            continue
+
+        acex = 0.0
+        acey = 0.0
+        acez = 0.0
         arp = 0.0
         vmax = 0.0
+        deltap = 0.0
+        ddt_off = False
+        shx = 0.0
+        shy = 0.0
+        shz = 0.0
+        shdet = 0.0
+        sh_off = False
+        gxx = 0.0
+        gxy = 0.0
+        gxz = 0.0
+        gyy = 0.0
+        gyz = 0.0
+        gzz = 0.0
+        tens_i = 0.0
+        if kern == 1:
+            tens_i = _tensile(pi, rhoi)
+        t0 = 0.0
+        t1 = 0.0
+        t2 = 0.0
+        t3 = 0.0
+        t4 = 0.0
+        t5 = 0.0
+        if visco == 2:
+            t0 = tau[i, 0]
+            t1 = tau[i, 1]
+            t2 = tau[i, 2]
+            t3 = tau[i, 3]
+            t4 = tau[i, 4]
+            t5 = tau[i, 5]
         for z in range(zlo, zhi + 1):
             for y in range(ylo, yhi + 1):
                 row = (z * ncy + y) * ncx
                 for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
-                    if ptype[j] < 2:
-                        continue
                     dx = xi - nb[j, 0]
                     dy = yi - nb[j, 1]
                     dz = zi - nb[j, 2]
                     r2 = dx * dx + dy * dy + dz * dz
                     if r2 >= r2max or r2 < 1e-18:
                         continue
-                    fac = kernel_fac(kern, math.sqrt(r2) * inv_h, alpha_h2)
-                    dot = ((vxi - nb[j, 3]) * dx + (vyi - nb[j, 4]) * dy
-                           + (vzi - nb[j, 5]) * dz)
-                    arp += nb[j, 8] * fac * dot * nb[j, 9]
-                    vmax = max(vmax, dot / (r2 + eta2))
-        ace[i, 0] = 0.0
-        ace[i, 1] = 0.0
-        ace[i, 2] = 0.0
-        ar[i] = rhoi * arp
-        viscdt[i] = vmax
-        return
-
-    acex = 0.0
-    acey = 0.0
-    acez = 0.0
-    arp = 0.0
-    vmax = 0.0
-    deltap = 0.0
-    ddt_off = False
-    shx = 0.0
-    shy = 0.0
-    shz = 0.0
-    shdet = 0.0
-    sh_off = False
-    gxx = 0.0
-    gxy = 0.0
-    gxz = 0.0
-    gyy = 0.0
-    gyz = 0.0
-    gzz = 0.0
-    tens_i = 0.0
-    if kern == 1:
-        tens_i = _tensile(pi, rhoi)
-    t0 = 0.0
-    t1 = 0.0
-    t2 = 0.0
-    t3 = 0.0
-    t4 = 0.0
-    t5 = 0.0
-    if visco == 2:
-        t0 = tau[i, 0]
-        t1 = tau[i, 1]
-        t2 = tau[i, 2]
-        t3 = tau[i, 3]
-        t4 = tau[i, 4]
-        t5 = tau[i, 5]
-    for z in range(zlo, zhi + 1):
-        for y in range(ylo, yhi + 1):
-            row = (z * ncy + y) * ncx
-            for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
-                dx = xi - nb[j, 0]
-                dy = yi - nb[j, 1]
-                dz = zi - nb[j, 2]
-                r2 = dx * dx + dy * dy + dz * dz
-                if r2 >= r2max or r2 < 1e-18:
-                    continue
-                ptj = ptype[j]
-                if pti == 2 and ptj != 3:
-                    continue
-                boundj = ptj < 2
-                q = math.sqrt(r2) * inv_h
-                fac = kernel_fac(kern, q, alpha_h2)
-                rhoj = nb[j, 6]
-                pj = nb[j, 7]
-                mfac = nb[j, 8] * fac
-                irj = nb[j, 9]
-                dvx = vxi - nb[j, 3]
-                dvy = vyi - nb[j, 4]
-                dvz = vzi - nb[j, 5]
-                dot = dvx * dx + dvy * dy + dvz * dz
-                ir2e = 1.0 / (r2 + eta2)
-                dot_rr2 = dot * ir2e
-                vmax = max(vmax, dot_rr2)
-                arp += mfac * dot * irj
-                coef = -(pi + pj) * iri * irj
-                if kern == 1:
-                    wr = kernel_w(1, q, alpha) * od_wdp
-                    wr = wr * wr
-                    coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
-                vis = vis_b if boundj else vis_f
-                if visco == 1:
-                    coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
-                else:
-                    vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
-                    acex += vtemp * dvx
-                    acey += vtemp * dvy
-                    acez += vtemp * dvz
-                    if visco == 2 and not boundj:
-                        mj = nb[j, 8]
-                        sxx = t0 + tau[j, 0]
-                        sxy = t1 + tau[j, 1]
-                        sxz = t2 + tau[j, 2]
-                        syy = t3 + tau[j, 3]
-                        syz = t4 + tau[j, 4]
-                        szz = t5 + tau[j, 5]
-                        acex += mj * fac * (sxx * dx + sxy * dy + sxz * dz)
-                        acey += mj * fac * (sxy * dx + syy * dy + syz * dz)
-                        acez += mj * fac * (sxz * dx + syz * dy + szz * dz)
-                        volj = -mfac * irj
-                        ax = dvx * volj
-                        ay = dvy * volj
-                        az = dvz * volj
-                        gxx += ax * dx
-                        gxy += ax * dy + ay * dx
-                        gxz += ax * dz + az * dx
-                        gyy += ay * dy
-                        gyz += ay * dz + az * dy
-                        gzz += az * dz
-                acex += coef * mfac * dx
-                acey += coef * mfac * dy
-                acez += coef * mfac * dz
-                if ddt == 1:
-                    if ptj != 3:
-                        ddt_off = True
+                    ptj = ptype[j]
+                    if pti == 2 and ptj != 3:
+                        continue
+                    boundj = ptj < 2
+                    q = math.sqrt(r2) * inv_h
+                    fac = kernel_fac(kern, q, alpha_h2)
+                    rhoj = nb[j, 6]
+                    pj = nb[j, 7]
+                    mfac = nb[j, 8] * fac
+                    irj = nb[j, 9]
+                    dvx = vxi - nb[j, 3]
+                    dvy = vyi - nb[j, 4]
+                    dvz = vzi - nb[j, 5]
+                    dot = dvx * dx + dvy * dy + dvz * dz
+                    ir2e = 1.0 / (r2 + eta2)
+                    dot_rr2 = dot * ir2e
+                    vmax = max(vmax, dot_rr2)
+                    arp += mfac * dot * irj
+                    coef = -(pi + pj) * iri * irj
+                    if kern == 1:
+                        wr = kernel_w(1, q, alpha) * od_wdp
+                        wr = wr * wr
+                        coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
+                    vis = vis_b if boundj else vis_f
+                    if visco == 1:
+                        coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
                     else:
-                        deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
-                elif ddt == 2 or ddt == 3:
-                    if boundj:
-                        if ddt == 2:
+                        vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
+                        acex += vtemp * dvx
+                        acey += vtemp * dvy
+                        acez += vtemp * dvz
+                        if visco == 2 and not boundj:
+                            mj = nb[j, 8]
+                            sxx = t0 + tau[j, 0]
+                            sxy = t1 + tau[j, 1]
+                            sxz = t2 + tau[j, 2]
+                            syy = t3 + tau[j, 3]
+                            syz = t4 + tau[j, 4]
+                            szz = t5 + tau[j, 5]
+                            acex += mj * fac * (sxx * dx + sxy * dy + sxz * dz)
+                            acey += mj * fac * (sxy * dx + syy * dy + syz * dz)
+                            acez += mj * fac * (sxz * dx + syz * dy + szz * dz)
+                            volj = -mfac * irj
+                            ax = dvx * volj
+                            ay = dvy * volj
+                            az = dvz * volj
+                            gxx += ax * dx
+                            gxy += ax * dy + ay * dx
+                            gxz += ax * dz + az * dx
+                            gyy += ay * dy
+                            gyz += ay * dz + az * dy
+                            gzz += az * dz
+                    acex += coef * mfac * dx
+                    acey += coef * mfac * dy
+                    acez += coef * mfac * dz
+                    if ddt == 1:
+                        if ptj != 3:
                             ddt_off = True
-                    elif ptj == 3:
-                        drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
-                        deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
-                if shift > 0:
-                    if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
-                        sh_off = True
-                    mr = mfac * irj
-                    shx += mr * dx
-                    shy += mr * dy
-                    shz += mr * dz
-                    shdet -= mr * r2
-    arp *= rhoi
-    if pti == 3:
-        ace[i, 0] = acex + cst[12]
-        ace[i, 1] = acey + cst[13]
-        ace[i, 2] = acez + cst[14]
-        if ddt != 0 and not ddt_off:
-            arp += cst[8] * deltap
-    else:
-        ace[i, 0] = acex
-        ace[i, 1] = acey
-        ace[i, 2] = acez
-    ar[i] = arp
-    viscdt[i] = vmax
-    if shift > 0:
-        if sh_off or pti != 3:
-            shiftpos[i, 0] = 0.0
-            shiftpos[i, 1] = 0.0
-            shiftpos[i, 2] = 0.0
+                        else:
+                            deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
+                    elif ddt == 2 or ddt == 3:
+                        if boundj:
+                            if ddt == 2:
+                                ddt_off = True
+                        elif ptj == 3:
+                            drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
+                            deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
+                    if shift > 0:
+                        if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
+                            sh_off = True
+                        mr = mfac * irj
+                        shx += mr * dx
+                        shy += mr * dy
+                        shz += mr * dz
+                        shdet -= mr * r2
+        arp *= rhoi
+        if pti == 3:
+            ace[i, 0] = acex + cst[12]
+            ace[i, 1] = acey + cst[13]
+            ace[i, 2] = acez + cst[14]
+            if ddt != 0 and not ddt_off:
+                arp += cst[8] * deltap
         else:
-            shiftpos[i, 0] = shx
-            shiftpos[i, 1] = shy
-            shiftpos[i, 2] = shz
-        shiftdet[i] = shdet
-    if visco == 2:
-        gradvel[i, 0] = gxx
-        gradvel[i, 1] = gxy
-        gradvel[i, 2] = gxz
-        gradvel[i, 3] = gyy
-        gradvel[i, 4] = gyz
-        gradvel[i, 5] = gzz
+            ace[i, 0] = acex
+            ace[i, 1] = acey
+            ace[i, 2] = acez
+        ar[i] = arp
+        viscdt[i] = vmax
+        if shift > 0:
+            if sh_off or pti != 3:
+                shiftpos[i, 0] = 0.0
+                shiftpos[i, 1] = 0.0
+                shiftpos[i, 2] = 0.0
+            else:
+                shiftpos[i, 0] = shx
+                shiftpos[i, 1] = shy
+                shiftpos[i, 2] = shz
+            shiftdet[i] = shdet
+        if visco == 2:
+            gradvel[i, 0] = gxx
+            gradvel[i, 1] = gxy
+            gradvel[i, 2] = gxz
+            gradvel[i, 3] = gyy
+            gradvel[i, 4] = gyz
+            gradvel[i, 5] = gzz
 
 
 @njit(cache=True)
@@ -569,10 +576,9 @@ def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, n
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
-    for i in range(nb.shape[0]):
-        _particle_rates_3d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
-                           ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos,
-                           shiftdet, gradvel)
+    _rates_range_3d(0, nb.shape[0], kern, visco, ddt, shift, nb, ptype, cell,
+                    cell_start, ncx, ncy, ncz, cst, tau, ace, ar, viscdt,
+                    shiftpos, shiftdet, gradvel)
 
 
 @njit(cache=True, parallel=True)
@@ -583,7 +589,9 @@ def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
-    for i in prange(nb.shape[0]):
-        _particle_rates_3d(i, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
-                           ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos,
-                           shiftdet, gradvel)
+    n = nb.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _rates_range_3d(c * CHUNK, min(n, (c + 1) * CHUNK), kern, visco, ddt, shift,
+                        nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, tau, ace,
+                        ar, viscdt,
+                        shiftpos, shiftdet, gradvel)

@@ -8,47 +8,50 @@ with the off-diagonal terms holding du_i/dx_j + du_j/dx_i); the result is the
 SPS stress divided by rho^2 (times rho: DualSPHysics stores tau/rho), used
 as sum_b m_b (tau_a + tau_b) . grad_a W_ab in the momentum equation.
 """
+import math
+
 from . import _env  # noqa: F401
 from numba import njit, prange
 
 
 @njit(cache=True)
-def _tau_particle(i, gradvel, rhop, ptype, smag, blin, tau):
-    if ptype[i] != 3:
-        for k in range(6):
-            tau[i, k] = 0.0
-        return
-    gxx = gradvel[i, 0]
-    gxy = gradvel[i, 1]
-    gxz = gradvel[i, 2]
-    gyy = gradvel[i, 3]
-    gyz = gradvel[i, 4]
-    gzz = gradvel[i, 5]
-    pow1 = gxx * gxx + gyy * gyy + gzz * gzz
-    prr = pow1 + pow1 + gxy * gxy + gxz * gxz + gyz * gyz
-    visc_sps = smag * prr ** 0.5
-    div_u = gxx + gyy + gzz
-    sps_k = (2.0 / 3.0) * visc_sps * div_u
-    sumsps = -(sps_k + blin * prr)
-    two = visc_sps + visc_sps
-    one_rho = 1.0 / rhop[i]
-    tau[i, 0] = one_rho * (two * gxx + sumsps)
-    tau[i, 1] = one_rho * (visc_sps * gxy)
-    tau[i, 2] = one_rho * (visc_sps * gxz)
-    tau[i, 3] = one_rho * (two * gyy + sumsps)
-    tau[i, 4] = one_rho * (visc_sps * gyz)
-    tau[i, 5] = one_rho * (two * gzz + sumsps)
+def _tau_range(i0, i1, gradvel, rhop, ptype, smag, blin, tau):
+    for i in range(i0, i1):
+        if ptype[i] != 3:
+            for k in range(6):
+                tau[i, k] = 0.0
+            continue
+        gxx = gradvel[i, 0]
+        gxy = gradvel[i, 1]
+        gxz = gradvel[i, 2]
+        gyy = gradvel[i, 3]
+        gyz = gradvel[i, 4]
+        gzz = gradvel[i, 5]
+        pow1 = gxx * gxx + gyy * gyy + gzz * gzz
+        prr = pow1 + pow1 + gxy * gxy + gxz * gxz + gyz * gyz
+        visc_sps = smag * math.sqrt(prr)
+        div_u = gxx + gyy + gzz
+        sps_k = (2.0 / 3.0) * visc_sps * div_u
+        sumsps = -(sps_k + blin * prr)
+        two = visc_sps + visc_sps
+        one_rho = 1.0 / rhop[i]
+        tau[i, 0] = one_rho * (two * gxx + sumsps)
+        tau[i, 1] = one_rho * (visc_sps * gxy)
+        tau[i, 2] = one_rho * (visc_sps * gxz)
+        tau[i, 3] = one_rho * (two * gyy + sumsps)
+        tau[i, 4] = one_rho * (visc_sps * gyz)
+        tau[i, 5] = one_rho * (two * gzz + sumsps)
 
 
 @njit(cache=True)
 def sps_tau_serial(gradvel, rhop, ptype, smag, blin, tau):
     """SPS stress of every fluid particle; smag = (0.12 dp)^2, blin = 2/3 0.0066 dp^2."""
-    for i in range(rhop.shape[0]):
-        _tau_particle(i, gradvel, rhop, ptype, smag, blin, tau)
+    _tau_range(0, rhop.shape[0], gradvel, rhop, ptype, smag, blin, tau)
 
 
 @njit(cache=True, parallel=True)
 def sps_tau_parallel(gradvel, rhop, ptype, smag, blin, tau):
     """Threaded :func:`sps_tau_serial`."""
-    for i in prange(rhop.shape[0]):
-        _tau_particle(i, gradvel, rhop, ptype, smag, blin, tau)
+    n = rhop.shape[0]
+    for c in prange((n + 255) // 256):
+        _tau_range(c * 256, min(n, (c + 1) * 256), gradvel, rhop, ptype, smag, blin, tau)
