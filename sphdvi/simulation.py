@@ -544,6 +544,7 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
                   f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s")
         sph.save_checkpoint(ckpt, {"part": k, "runtime_s": wall})
 
+    gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
     status, code, message = "completed", 0, ""
     with _Stop() as stop:
         try:
@@ -554,6 +555,8 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
                 sol.step()
                 dt_lo, dt_hi = min(dt_lo, sol.last_dt), max(dt_hi, sol.last_dt)
                 sph.check(0)
+                if gauges is not None:
+                    gauges.after_step(sol)
                 if sol.time >= next_out - 1e-12 * max(1.0, tout) or sol.time >= tmax:
                     part += 1
                     write_part(part)
@@ -575,6 +578,8 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
             writer.close()
             raise
     runtime += _time.perf_counter() - t_loop
+    if gauges is not None:
+        gauges.close()
     progress.update(sol.time, sol.nstep, sol.state.n, force=True)
     progress.close()
     writer.close()
@@ -586,6 +591,15 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
                      us_per_particle_step=(1e6 * (runtime - wall_prev)
                                            / max(1, sol.nstep - steps_at_start) / max(1, sol.state.n)))
     return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)
+
+
+def _make_gauges(data, params, outdir, resume, t):
+    """Run-time gauges of ``<special><gauges>`` (None when the case has none)."""
+    items = (data["json"].get("gauges") or {}).get("items") or []
+    if not items:
+        return None
+    from .measure.gauges import RunGauges
+    return RunGauges(data, params, outdir, resume=resume, time=t)
 
 
 def _threading_layer() -> str:
