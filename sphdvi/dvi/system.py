@@ -427,10 +427,15 @@ class System:
                    Q1=R1.T @ Frot, Q2=R2.T @ Frot, mask=np.array(mask, np.int8),
                    k=stiff, c=damp, rest=restv, mmode=mmode, mtarget=mtarget,
                    name=name or f"{kind}{lid}")
-        self.links.append(rec)
+        self._add_link_record(rec)
         self._mates.append(rec)
         self._packed = False
         return lid
+
+    def _add_link_record(self, rec):
+        self.links.append(rec)
+        self.link_force = np.zeros((len(self.links), 3))
+        self.link_torque = np.zeros((len(self.links), 3))
 
     @staticmethod
     def _per_dof(v):
@@ -454,7 +459,7 @@ class System:
         rec = dict(type="spring", lid=lid, b1=body1, b2=body2, p1=R1.T @ (P1 - x1),
                    p2=R2.T @ (P2 - x2), k=_as_table(stiffness), c=_as_table(damping),
                    l0=l0, f0=float(preload), name=name or f"spring{lid}")
-        self.links.append(rec)
+        self._add_link_record(rec)
         self._springs.append(rec)
         self._packed = False
         return lid
@@ -470,7 +475,7 @@ class System:
         lid = len(self.links)
         rec = dict(type="coulomb", lid=lid, b1=body1, b2=body2, p1=R1.T @ (P1 - x1),
                    p2=R2.T @ (P2 - x2), F=float(force), name=name or f"coulombdamper{lid}")
-        self.links.append(rec)
+        self._add_link_record(rec)
         self._dampers.append(rec)
         self._packed = False
         return lid
@@ -485,7 +490,7 @@ class System:
         lid = len(self.links)
         rec = dict(type="pulley", lid=lid, b1=body1, b2=body2, a1=R1.T @ a1, a2=R2.T @ a2,
                    r1=float(radius), r2=float(radius2), name=name or f"pulley{lid}")
-        self.links.append(rec)
+        self._add_link_record(rec)
         self._pulleys.append(rec)
         self._packed = False
         return lid
