@@ -78,6 +78,48 @@ def test_dambreak_primitives(tmp_path):
     assert d.primitives[0]["params"]["max"] == [1, 1, 2]
 
 
+# ---------------------------------------------------------------- parity with GenCase outputs
+def mk_counts(d):
+    out = {}
+    for f, m in zip(d.is_fluid.tolist(), d.mk.tolist()):
+        key = ("fluid" if f else "bound", m)
+        out[key] = out.get(key, 0) + 1
+    return out
+
+
+def test_gencase_parity_off_lattice_3d(tmp_path):
+    """DualSPHysics examples/others/SaveDt/Case5aSvdt_8k.xml: GenCase wrote
+    bound mk0 3965, bound mk1 281, fluid 3795 (dp 0.0272, off-lattice boxes)."""
+    body = ('<setdrawmode mode="full"/><setmkfluid mk="0"/>'
+            + box((0, 0, 0), (0.4, 0.67, 0.3))
+            + '<setmkbound mk="0"/>'
+            + box((0, 0, 0), (1.6, 0.67, 0.4), fill="bottom | left | right | front | back")
+            + '<setmkvoid/>' + box((0.9, 0.24, 0), (0.12, 0.12, 0.45))
+            + '<setmkbound mk="1"/>'
+            + box((0.9, 0.24, 0), (0.12, 0.12, 0.45), fill="top | left | right | front | back")
+            + '<shapeout file=""/>')
+    d = draw(tmp_path, body, dp=0.0272, pmin=(-0.05, -0.05, -0.05), pmax=(2, 1, 1))
+    assert mk_counts(d) == {("bound", 0): 3965, ("bound", 1): 281, ("fluid", 0): 3795}
+
+
+def test_gencase_parity_rotated_box_case(tmp_path):
+    """DualSPHysics examples/others/RotatedBox/RotatedBox.xml: GenCase wrote bound mk0 12630,
+    mk1 16261, mk2 960 (rotated 40 degrees), mk3 832, fluid 99000. sphdvi matches all but
+    the rotated walls (832: one node layer per planar face; GenCase's rule gives 960)."""
+    body = ('<setshapemode>real | bound</setshapemode><setdrawmode mode="full"/>'
+            '<setmkfluid mk="0"/>' + box((0, 0, 0), (0.25, 0.5, 0.1))
+            + '<setmkbound mk="2"/><rotateline ang="40"><point x="0.45" y="0.145" z="0"/>'
+              '<point x="0.45" y="0.145" z="1"/></rotateline>'
+            + box((0.45, 0.04, 0), (0.05, 0.21, 0.04), fill="all ^ top ^ bottom")
+            + '<matrixreset/><setmkbound mk="3"/>'
+            + box((0.45, 0.25, 0), (0.05, 0.21, 0.04), fill="all ^ top ^ bottom")
+            + '<setmkbound mk="0"/>' + box((0, 0, 0), (0.8, 0.5, 0.15), fill="left | front | back")
+            + '<setmkbound mk="1"/>' + box((0, 0, 0), (0.8, 0.5, 0.15), fill="bottom"))
+    d = draw(tmp_path, body, dp=0.005, pmin=(-0.2, -0.2, -0.2), pmax=(3, 0.7, 0.3))
+    assert mk_counts(d) == {("bound", 0): 12630, ("bound", 1): 16261, ("bound", 2): 832,
+                            ("bound", 3): 832, ("fluid", 0): 99000}
+
+
 # ---------------------------------------------------------------- boxes
 def test_box_solid_3d(tmp_path):
     d = draw(tmp_path, '<setmkfluid mk="2"/>' + box((1, 2, 3), (2, 1, 3)))
@@ -114,9 +156,13 @@ def test_box_face_combination(tmp_path):
 
 
 def test_box_off_lattice(tmp_path):
-    # 0.3..2.3: inside nodes 1, 2; faces at the nearest layers 0 and 2, extent 0..2
+    # 0.3..2.3: GenCase fills from the node nearest the min corner (0) to the one nearest
+    # the max corner (2); faces at the nearest layers 0 and 2, extent 0..2
     d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0.3, 0.3, 0.3), (2, 2, 2)))
-    assert nodes(d) == lattice_box((1, 1, 1), (2, 2, 2))
+    assert nodes(d) == lattice_box((0, 0, 0), (2, 2, 2))
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0.6, 0.5, 0.4), (1.8, 2, 2.2)))
+    # x 0.6..2.4 -> 1..2, y 0.5..2.5 -> 1..3 (halves round up), z 0.4..2.6 -> 0..3
+    assert nodes(d) == lattice_box((1, 1, 0), (2, 3, 3))
     d = draw(tmp_path, '<setmkbound mk="0"/>' + box((0.3, 0.3, 0.3), (2, 2, 2), fill="all"))
     assert nodes(d) == lattice_box((0, 0, 0), (2, 2, 2)) - {(1, 1, 1)}
 
@@ -135,6 +181,22 @@ def test_box_drawmode_without_boxfill(tmp_path):
     assert len(draw(tmp_path, body.format("face")).pos) == 98
     # wire: 8 corners + 12 edges x 3 inner nodes
     assert len(draw(tmp_path, body.format("wire")).pos) == 8 + 12 * 3
+
+
+def test_box_faces_add_and_remove(tmp_path):
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((1, 1, 1), (4, 4, 4), fill="all ^ top ^ bottom"))
+    assert len(d.pos) == 16 * 5
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((1, 1, 1), (4, 4, 4), fill="top | left ^ top"))
+    assert np.all(d.pos[:, 0] == 1) and len(d.pos) == 25
+
+
+def test_box_params_world_frame(tmp_path):
+    d = draw(tmp_path, '<setmkbound mk="0"/><move x="1" y="1" z="1"/><scale x="2" y="1" z="1"/>'
+             '<rotate ang="90" x="0" y="0" z="1"/>' + box((0, 0, 0), (1, 2, 3)))
+    p = d.primitives[0]["params"]
+    assert np.allclose(p["size"], [1, 4, 3]) and p["local_size"] == [1, 2, 3]
+    assert np.allclose(np.abs(p["axes"]), [[0, 1, 0], [1, 0, 0], [0, 0, 1]])
+    assert np.allclose(p["min"], [-3, 1, 1]) and np.allclose(p["max"], [1, 2, 4])
 
 
 def test_box_rotated_by_angles(tmp_path):
@@ -582,3 +644,13 @@ def test_triangle_raster_matches_its_definition():
             assert np.array_equal(got[keep], exp[keep])
         else:
             assert not got.any()
+
+
+def test_box_faces_follow_a_quarter_turn(tmp_path):
+    # after a 90-degree turn about z, local x runs along world +y: the "left" face (local
+    # x min) becomes the world y-min face, "front" (local y min) becomes world x max
+    body = '<setmkbound mk="0"/><rotate ang="90" x="0" y="0" z="1"/>'
+    d = draw(tmp_path, body + box((1, -5, 1), (2, 2, 2), fill="left"), pmin=(-10, -10, -10))
+    assert np.all(d.pos[:, 1] == 1) and len(d.pos) == 9
+    d = draw(tmp_path, body + box((1, -5, 1), (2, 2, 2), fill="front"), pmin=(-10, -10, -10))
+    assert np.all(d.pos[:, 0] == 5) and len(d.pos) == 9

@@ -15,7 +15,7 @@ from ...errors import CaseError
 from ..expressions import ExpressionError
 from . import raster, shapes
 from . import transform as tf
-from .lattice import Canvas, Lattice, ceil_idx, floor_idx, round_idx
+from .lattice import Canvas, Lattice, round_idx
 from .shapeout import FORMATS, write_shapes
 
 MAX_COMMANDS = 1_000_000      # commands executed in all (runlist loops included)
@@ -536,13 +536,21 @@ class GeometryRunner:
         if bf is None:
             solid, surface, wire = self._mode_flags()
             return solid, (list(raster.FACE_AXIS) if surface else []), wire
-        tokens = [t.strip().lower() for t in self.reader.element_text(bf).split("|") if t.strip()]
+        text = self.reader.element_text(bf)
+        # "a | b" adds faces, "all ^ top" removes them (left to right)
+        parts = re.split(r"\s*([|^])\s*", text.strip().lower())
+        tokens, ops = parts[0::2], ["|"] + parts[1::2]
         bad = [t for t in tokens if t not in BOX_TOKENS]
-        if bad or not tokens:
-            raise self.reader.error(bf, f"invalid boxfill '{self.reader.element_text(bf)}'",
-                                    "solid, all, or faces bottom | top | left | right | front | back")
-        faces = list(raster.FACE_AXIS) if "all" in tokens else \
-            [f for f in raster.FACE_AXIS if f in tokens]
+        if bad or not text.strip():
+            raise self.reader.error(bf, f"invalid boxfill '{text}'",
+                                    "solid, all, or faces bottom | top | left | right | front | "
+                                    "back, combined with | (add) or ^ (remove)")
+        chosen: set = set()
+        for op, tok in zip(ops, tokens):
+            names = set(raster.FACE_AXIS) if tok == "all" else {tok}
+            chosen = chosen | names if op == "|" else chosen - names
+        faces = [f for f in raster.FACE_AXIS if f in chosen]
+        tokens = chosen
         return "solid" in tokens, faces, False
 
     def cmd_drawbox(self, el):
@@ -774,8 +782,8 @@ class GeometryRunner:
         corners = self._world(np.array([point, point + size]))
         a = self.lat.to_index(corners.min(axis=0))
         b = self.lat.to_index(corners.max(axis=0))
-        lo = [ceil_idx(v) for v in a]
-        hi = [floor_idx(v) for v in b]
+        lo = [round_idx(v) for v in a]  # the same node range as a solid box
+        hi = [round_idx(v) for v in b]
         if self.lat.is2d:
             lo[1] = hi[1] = 0
         self._fill(el, seed, self._fill_modes(el), lo, hi, "fillbox")
@@ -789,6 +797,8 @@ class GeometryRunner:
         base = os.path.basename(value.replace("\\", "/"))
         if base.lower().endswith("." + fmt):
             base = base[: -len(fmt) - 1]
+        if not value.strip():
+            base = "Shapes"  # GenCase examples use file="" for the default name
         if not base or base in (".", "..") or not re.fullmatch(r"[A-Za-z0-9_.\-]+", base):
             raise self.reader.error(el, f"file={value!r} is not a usable file name",
                                     "a plain name of letters, digits, '_', '-', '.'")

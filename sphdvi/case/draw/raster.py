@@ -3,7 +3,10 @@
 Rules (lattice units, node ``k`` at ``k``; ``EPS`` = 1e-6):
 
 * **Solid** (volume): nodes inside the shape, nodes on the boundary (within
-  EPS) included.
+  EPS) included. Boxes follow GenCase instead (checked against GenCase
+  outputs): every node from the one nearest the min corner to the one nearest
+  the max corner, i.e. the box widened by dp/2 (half-open: (min - dp/2,
+  max + dp/2]); the same in the box's own frame when it is rotated.
 * **Planar surfaces** (box faces, prism/pyramid faces, polygons, triangles,
   mesh files): a node belongs to a triangle when its signed distance to the
   plane is in (-1/2, 1/2] and its projection lies within 1/2 of the triangle.
@@ -27,6 +30,8 @@ from . import transform as tf
 from .lattice import EPS, Lattice, ceil_idx, floor_idx, round_idx
 
 SLAB_NODES = 2_000_000  # nodes evaluated at once by analytic shapes
+SURFACE_HALF = 0.5      # half-width of the node band of a planar surface (lattice units)
+EDGE_REACH = 0.5        # how far beyond its edges a planar face reaches (lattice units)
 
 
 class Piece:
@@ -69,8 +74,9 @@ def aligned_box_pieces(lat: Lattice, wmin, wmax, solid: bool, faces, wire: bool)
     b = lat.to_index(np.asarray(wmax, dtype=np.float64))
     pieces = []
     if solid:
-        lo = [ceil_idx(v) for v in a]
-        hi = [floor_idx(v) for v in b]
+        # GenCase: from the node nearest the min corner to the node nearest the max corner
+        lo = [round_idx(v) for v in a]
+        hi = [round_idx(v) for v in b]
         pieces.append(box_piece(lat, lo, hi))
     ext_lo = [ceil_idx(v - 0.5) for v in a]
     ext_hi = [floor_idx(v + 0.5) for v in b]
@@ -107,18 +113,21 @@ def triangle_pieces(lat: Lattice, tris, surface: bool = True, solid: bool = Fals
     tris = np.asarray(tris, dtype=np.float64).reshape(-1, 3, 3)
     if tris.shape[0] == 0:
         return []
+    itri = np.ascontiguousarray(lat.to_index(tris))
+    if not np.all(np.abs(itri) < 1e15):
+        raise ValueError("triangle coordinates are not finite or lie absurdly far from the domain")
     r = world_range(lat, tris, 0.5 + EPS)
     if r is None:
         return []
     lo, hi = r
-    itri = np.ascontiguousarray(lat.to_index(tris))
     out = np.zeros(tuple(int(v) for v in hi - lo + 1), dtype=np.bool_)
     if solid:
         # inside by parity, plus the nodes lying on the surface (within 2 EPS)
         kernels.parity_inside(itri, lo, out)
         kernels.raster_triangles(itri, lo, out, -2 * EPS, 2 * EPS, 2 * EPS)
     if surface:
-        kernels.raster_triangles(itri, lo, out, -0.5 + EPS, 0.5 + EPS, 0.5 + EPS)
+        kernels.raster_triangles(itri, lo, out, -SURFACE_HALF + EPS, SURFACE_HALF + EPS,
+                                 EDGE_REACH + EPS)
     return [Piece("mask", lo, mask=out)]
 
 

@@ -119,25 +119,29 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
     verts = tf.apply(full, box_corners(size))
     pieces = []
     if tf.is_axis_aligned(full):
-        # map local face names to world faces (a negative scale swaps them)
-        sgn = np.sign(np.diag(full[:3, :3]))
+        # map local face names to world faces (axes may be permuted, a negative scale swaps sides)
+        lin = full[:3, :3]
         world_faces = []
         for f in faces:
             axis, side = raster.FACE_AXIS[f]
-            if sgn[axis] < 0:
+            waxis = int(np.argmax(np.abs(lin[:, axis])))
+            if lin[waxis, axis] < 0:
                 side = 1 - side
             world_faces.append([n for n, (a, s) in raster.FACE_AXIS.items()
-                                if a == axis and s == side][0])
+                                if a == waxis and s == side][0])
         pieces = raster.aligned_box_pieces(lat, verts.min(axis=0), verts.max(axis=0),
                                            solid, world_faces, wire)
     else:
         if solid:
+            # the box widened by dp/2 along its own axes, (min - dp/2, max + dp/2] like GenCase
             tol = local_tol(full, lat.dp)
-            lo, hi = np.zeros(3), np.asarray(size, dtype=np.float64)
+            half = 0.5 * lat.dp / np.maximum(np.linalg.norm(full[:3, :3], axis=0), 1e-300)
+            lo = -half + tol
+            hi = np.asarray(size, dtype=np.float64) + half + tol
 
             def cons(qx, qy, qz):
-                return [(qx >= lo[0] - tol) & (qx <= hi[0] + tol) & (qy >= lo[1] - tol)
-                        & (qy <= hi[1] + tol) & (qz >= lo[2] - tol) & (qz <= hi[2] + tol)]
+                return [(qx > lo[0]) & (qx <= hi[0]) & (qy > lo[1]) & (qy <= hi[1])
+                        & (qz > lo[2]) & (qz <= hi[2])]
             pieces += raster.analytic_pieces(lat, full, lo, hi, cons, solid=True, shell_faces=())
         if faces:
             tris = faces_to_triangles(verts, [BOX_FACES[f] for f in faces])
@@ -145,8 +149,12 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
         if wire:
             segs = [verts[[a, b]] for a, b in face_edges(BOX_FACES.values())]
             pieces += raster.segment_pieces(lat, segs)
+    lin = full[:3, :3]
+    edge_len = np.linalg.norm(lin, axis=0)
     params = {"vertices": verts.tolist(), "center": verts.mean(axis=0).tolist(),
-              "size": [abs(float(v)) for v in size], "matrix": full.tolist(),
+              "size": (edge_len * np.abs(np.asarray(size, dtype=np.float64))).tolist(),
+              "axes": (lin / np.where(edge_len > 0, edge_len, 1.0)).T.tolist(),
+              "local_size": [abs(float(v)) for v in size], "matrix": full.tolist(),
               "axis_aligned": tf.is_axis_aligned(full)}
     if params["axis_aligned"]:
         params["min"] = verts.min(axis=0).tolist()
@@ -201,8 +209,11 @@ def draw_sphere(lat, m, center, radius, *, solid, shell):
 def draw_ellipsoid_axes(lat, m, center, radii, *, solid, shell, frame=None):
     pieces, full, tris = draw_ellipsoid(lat, m, center, radii, solid=solid, shell=shell,
                                         frame=frame)
-    params = {"center": tf.apply(m, center).tolist(), "radii": [float(r) for r in radii],
-              "axes": (full[:3, :3] / np.asarray(radii)).T.tolist(), "matrix": full.tolist()}
+    lin = full[:3, :3]
+    world_radii = np.linalg.norm(lin, axis=0)  # full = m @ T @ frame @ diag(radii)
+    params = {"center": tf.apply(m, center).tolist(), "radii": world_radii.tolist(),
+              "axes": (lin / world_radii).T.tolist(), "local_radii": [float(r) for r in radii],
+              "matrix": full.tolist()}
     return pieces, params, tris
 
 
@@ -255,9 +266,10 @@ def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, 
         tris += [[a0, b0, b1], [a0, b1, a1], [[0, 0, 0], a1, a0], [[L, 0, 0], b0, b1]]
     tris = tf.apply(full, np.array(tris))
     s = tf.uniform_scale(m)
-    params = {"p1": tf.apply(m, p1).tolist(), "p2": tf.apply(m, p2).tolist(),
+    w1, w2 = tf.apply(m, p1), tf.apply(m, p2)
+    params = {"p1": w1.tolist(), "p2": w2.tolist(), "point1": w1.tolist(), "point2": w2.tolist(),
               "radius": float(radius * s) if s is not None else None,
-              "local_radius": float(radius), "length": L * (s if s is not None else float("nan")),
+              "local_radius": float(radius), "length": float(np.linalg.norm(w2 - w1)),
               "matrix": m.tolist()}
     return pieces, params, tris
 

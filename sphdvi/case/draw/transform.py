@@ -69,9 +69,9 @@ def apply(m: np.ndarray, pts) -> np.ndarray:
 
 
 def is_axis_aligned(m: np.ndarray) -> bool:
-    """True if the linear part is diagonal (translation and axis scaling only)."""
-    lin = m[:3, :3]
-    return bool(np.all(lin[~np.eye(3, dtype=bool)] == 0.0))
+    """True if the linear part maps axes onto axes (a scaled, signed permutation)."""
+    nz = m[:3, :3] != 0.0
+    return bool(np.all(nz.sum(axis=0) == 1) and np.all(nz.sum(axis=1) == 1))
 
 
 def inverse(m: np.ndarray) -> np.ndarray:
