@@ -22,7 +22,17 @@ Draw modes (``setdrawmode``)
     edges (polyhedra; curved shapes draw their surface).
     ``drawbox`` with ``<boxfill>`` ignores the mode: ``solid`` = volume,
     ``all`` or any of ``bottom|top|left|right|front|back`` = those faces
-    (left/right = x min/max, front/back = y min/max, bottom/top = z min/max).
+    (left/right = x min/max, front/back = y min/max, bottom/top = z min/max),
+    ``|`` adds and ``^`` removes (``all ^ top``), left to right.
+
+Boxes (GenCase's rule, checked against the particle counts GenCase wrote for
+three DualSPHysics example cases, on and off the lattice)
+    Volume: every node from the one nearest the min corner to the one
+    nearest the max corner (halves round up), i.e. the box widened by dp/2.
+    Face: the node layer nearest the face plane, over the same extent. For a
+    rotated box the volume is the box widened by dp/2 along its own axes and
+    the faces follow the planar-surface rule below (GenCase draws rotated
+    faces somewhat thicker: 960 vs 832 nodes in its RotatedBox example).
     Planar shapes (triangle, quadri, strips, fans, polygon, triangles) are
     surfaces in every mode but ``wire``. Mesh files draw their surface, plus
     the inside (even-odd rule) with ``autofill="true"``.
@@ -58,8 +68,15 @@ Fills (``fillpoint``, ``fillvoidpoint``, ``fillbox``)
 
 ``shapeout``
     Writes the shapes drawn since the last reset as triangles into
-    ``outdir/<casename>_<base name>.<format>`` (vtk, vtp, vtu, stl); the file
-    attribute is reduced to its base name. Nothing is written when outdir is None.
+    ``outdir/<casename>_<base name>.<format>`` (vtk, vtp, vtu, stl; ``file=""``
+    gives ``<casename>_Shapes``); the file attribute is reduced to its base
+    name, so nothing is ever written outside outdir. Nothing is written when
+    outdir is None.
+
+Not supported (CaseError "not supported by sphdvi"): see ``UNSUPPORTED``
+(bathymetry, waves, beaches, extrusions, redraw, clipping, patterns, ...)
+and ``<layers>``; commands that only tune GenCase's own output or sampling
+(``setdpctes``, ``setshapemode``, ``debugout``, ...) are accepted with no effect.
 """
 from .commands import UNSUPPORTED, Drawing, run_geometry
 

@@ -71,10 +71,7 @@ class Lattice:
 
     def to_index(self, p) -> np.ndarray:
         """World coordinates -> continuous lattice coordinates (node k at k)."""
-        q = (np.asarray(p, dtype=np.float64) - self.origin) / self.dp
-        if self.is2d:
-            q[..., 1] = (np.asarray(p, dtype=np.float64)[..., 1] - self.pointmin[1]) / self.dp
-        return q
+        return (np.asarray(p, dtype=np.float64) - self.origin) / self.dp
 
     def node_pos(self, idx) -> np.ndarray:
         """Integer node indices (..., 3) -> world coordinates."""
