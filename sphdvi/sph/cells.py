@@ -20,7 +20,7 @@ def grid_shape(pmin, pmax, cellsize, is2d):
     return int(n[0]), int(n[1]), int(n[2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def bounding_box(pos):
     """Min and max corner of the particle positions (N, 3)."""
     lo = np.empty(3)
@@ -38,7 +38,7 @@ def bounding_box(pos):
     return lo, hi
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def counting_sort_cells(pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell, order, cell_start):
     """Assign each particle to a cell and counting-sort the particles by cell.
 
@@ -75,7 +75,7 @@ def counting_sort_cells(pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell, order, c
         cursor[c] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gather_rows(src, order, dst):
     """dst[k, :] = src[order[k], :]"""
     for k in range(order.shape[0]):
@@ -84,7 +84,7 @@ def gather_rows(src, order, dst):
             dst[k, m] = src[i, m]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gather(src, order, dst):
     """dst[k] = src[order[k]]"""
     for k in range(order.shape[0]):
@@ -99,7 +99,7 @@ def neighbour_pairs_bruteforce(pos, radius, is2d):
     return set(zip(i.tolist(), j.tolist()))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius):
     """Pairs (i < j, sorted-order indices) found through the cell stencil."""
     r2max = radius * radius

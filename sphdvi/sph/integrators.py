@@ -38,7 +38,7 @@ from numba import njit, prange, literally
 CHUNK = 256
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _out_code(x, y, z, rho, rmin, rmax, usedom, x0, y0, z0, x1, y1, z1):
     """Exclusion code of a fluid particle (0 keep, 1 density, 2 position, 3 not finite)."""
     if not (math.isfinite(rho) and math.isfinite(x) and math.isfinite(y)
@@ -52,7 +52,7 @@ def _out_code(x, y, z, rho, rmin, rmax, usedom, x0, y0, z0, x1, y1, z1):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _shift_factor(vx, vy, vz, det, coefh, tfs, dt):
     """A h |v| dt, or 0 at the free surface (div r < ShiftTFS)."""
     if det < tfs:
@@ -60,7 +60,7 @@ def _shift_factor(vx, vy, vz, det, coefh, tfs, dt):
     return coefh * math.sqrt(vx * vx + vy * vy + vz * vz) * dt
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar,
                   ptype, shiftpos, shiftdet, ip, out):
     dt = ip[0]
@@ -123,7 +123,7 @@ def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar
     return nout
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def verlet_serial(shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar, ptype,
                   shiftpos, shiftdet, ip, out):
     """One Verlet (or Euler, ``euler=True``) step; returns the count of flagged particles."""
@@ -132,7 +132,7 @@ def verlet_serial(shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar, ptype,
                          ace, ar, ptype, shiftpos, shiftdet, ip, out)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def verlet_parallel(shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar, ptype,
                     shiftpos, shiftdet, ip, out):
     """Threaded :func:`verlet_serial`."""
@@ -146,7 +146,7 @@ def verlet_parallel(shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar, ptyp
     return nout
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _sym_pre_range(i0, i1, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                    ptype, ip):
     dt05 = 0.5 * ip[0]
@@ -170,7 +170,7 @@ def _sym_pre_range(i0, i1, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                     pos[i, k] = pos_pre[i, k] + dt05 * vel[i, k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def symplectic_pre_serial(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                           ptype, ip):
     """Symplectic predictor: saves the state at n in ``*_pre`` and advances dt/2."""
@@ -178,7 +178,7 @@ def symplectic_pre_serial(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                    ptype, ip)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def symplectic_pre_parallel(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                             ptype, ip):
     """Threaded :func:`symplectic_pre_serial`."""
@@ -188,7 +188,7 @@ def symplectic_pre_parallel(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
                        vel_pre, rhop_pre, ace, ar, ptype, ip)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _sym_corr_range(i0, i1, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace,
                     ar, ptype, shiftpos, shiftdet, ip, out):
     dt = ip[0]
@@ -238,7 +238,7 @@ def _sym_corr_range(i0, i1, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, a
     return nout
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def symplectic_corr_serial(shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace,
                            ar, ptype, shiftpos, shiftdet, ip, out):
     """Symplectic corrector; returns the count of flagged particles."""
@@ -247,7 +247,7 @@ def symplectic_corr_serial(shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ac
                            rhop_pre, ace, ar, ptype, shiftpos, shiftdet, ip, out)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def symplectic_corr_parallel(shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace,
                              ar, ptype, shiftpos, shiftdet, ip, out):
     """Threaded :func:`symplectic_corr_serial`."""

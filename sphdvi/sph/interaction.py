@@ -44,7 +44,7 @@ from .kernels import kernel_fac, kernel_w
 CHUNK = 128
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _hydrostatic_drho(x, rhop0, inv_gamma):
     """rho0 ((1+x)^(1/gamma) - 1): hydrostatic density difference (Fourtakas).
 
@@ -61,7 +61,7 @@ def _hydrostatic_drho(x, rhop0, inv_gamma):
     return rhop0 * ((1.0 + x) ** inv_gamma - 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _tensile(p, rho):
     """Monaghan (2000) tensile-correction coefficient R_a/(W/W(dp))^4."""
     return p / (rho * rho) * (0.01 if p > 0.0 else -0.2)
@@ -72,7 +72,7 @@ def _tensile(p, rho):
 # --------------------------------------------------------------------------
 # 2D packed row: x, z, vx, vz, rho, p, m, 1/rho   (one 64-byte line)
 # 3D packed row: x, y, z, vx, vy, vz, rho, p, m, 1/rho
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def tait_pressure(rho, b, rhop0, gamma):
     """Tait equation of state p = B ((rho/rho0)^gamma - 1) (Batchelor 1967)."""
     x = rho / rhop0
@@ -83,7 +83,7 @@ def tait_pressure(rho, b, rhop0, gamma):
     return b * (x ** gamma - 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _pack_range(i0, i1, is2d, pos, vel, rhop, mass, cst, nb):
     for i in range(i0, i1):
         rho = rhop[i]
@@ -107,13 +107,13 @@ def _pack_range(i0, i1, is2d, pos, vel, rhop, mass, cst, nb):
             nb[i, 9] = 1.0 / rho
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def pack_serial(is2d, pos, vel, rhop, mass, cst, nb):
     """Fill the packed neighbour array, computing the pressure from Tait's EOS."""
     _pack_range(0, pos.shape[0], is2d, pos, vel, rhop, mass, cst, nb)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
     """Threaded :func:`pack_serial`."""
     n = pos.shape[0]
@@ -124,7 +124,7 @@ def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
 # --------------------------------------------------------------------------
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel):
@@ -314,7 +314,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
             gradvel[i, 5] = gzz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
                     ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Serial driver of the 2D interaction (use below ~10k particles)."""
@@ -327,7 +327,7 @@ def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
                     shiftpos, shiftdet, gradvel)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
                       ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Threaded driver of the 2D interaction (prange over particles)."""
@@ -346,7 +346,7 @@ def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
 # --------------------------------------------------------------------------
 # 3D
 # --------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel):
@@ -568,7 +568,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
             gradvel[i, 5] = gzz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, ncy,
                     ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows)."""
@@ -581,7 +581,7 @@ def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, n
                     shiftpos, shiftdet, gradvel)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, ncy,
                       ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Threaded driver of the 3D interaction."""

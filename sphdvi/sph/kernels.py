@@ -27,7 +27,7 @@ def kernel_alpha(kind, h, is2d):
     raise ValueError("Kernel must be 1 (cubic) or 2 (Wendland), got %r" % (kind,))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def kernel_w(kind, q, alpha):
     """Kernel value W(q) (q = r/h); zero for q >= 2."""
     if q >= 2.0:
@@ -42,7 +42,7 @@ def kernel_w(kind, q, alpha):
     return alpha * t2 * t2 * (2.0 * q + 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def kernel_fac(kind, q, alpha_h2):
     """(dW/dr)/r for 0 < q < 2, with ``alpha_h2 = alpha/h^2``."""
     if kind == 1:

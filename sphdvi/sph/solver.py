@@ -43,6 +43,10 @@ PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIn
                  "ZPeriodicIncX", "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
 PARALLEL_THRESHOLD = 10000
 
+# Compiled entry points shared by all solvers, keyed by the feature flags
+# (kept off the instances so that solvers can be deep-copied and pickled).
+_ENTRY_CACHE = {}
+
 
 def resolve_params(params):
     """DualSPHysics defaults updated with ``params`` (unknown keys kept as given)."""
@@ -101,7 +105,6 @@ class SPHSolver:
             self._domain = (np.asarray(domain[0], float), np.asarray(domain[1], float))
         self.cells = _cells.CellList(self.h, self.is2d)
         self._verlet_count = 0
-        self._entry = {}
         self._alloc()
         self.dt_pre = self.dtini
 
@@ -216,8 +219,10 @@ class SPHSolver:
 
     def _kernels(self, parallel):
         """Entry points of the compiled kernels for this run's flags."""
-        if parallel in self._entry:
-            return self._entry[parallel]
+        key = (self.is2d, self.kernel, self.visco_kind, self.ddt, self.shift,
+               self.step_algorithm, bool(parallel))
+        if key in _ENTRY_CACHE:
+            return _ENTRY_CACHE[key]
         sfx = "parallel" if parallel else "serial"
         rates = getattr(_ia, ("rates_2d_" if self.is2d else "rates_3d_") + sfx)
         k = {
@@ -231,7 +236,7 @@ class SPHSolver:
             k["sym_pre"] = getattr(_int, "symplectic_pre_" + sfx)
             k["sym_corr"] = specialised(getattr(_int, "symplectic_corr_" + sfx),
                                         self._corr_args(), (0,))
-        self._entry[parallel] = k
+        _ENTRY_CACHE[key] = k
         return k
 
     def _rates_args(self):

@@ -14,7 +14,7 @@ from . import _env  # noqa: F401
 from numba import njit, prange
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _tau_range(i0, i1, gradvel, rhop, ptype, smag, blin, tau):
     for i in range(i0, i1):
         if ptype[i] != 3:
@@ -43,13 +43,13 @@ def _tau_range(i0, i1, gradvel, rhop, ptype, smag, blin, tau):
         tau[i, 5] = one_rho * (two * gzz + sumsps)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sps_tau_serial(gradvel, rhop, ptype, smag, blin, tau):
     """SPS stress of every fluid particle; smag = (0.12 dp)^2, blin = 2/3 0.0066 dp^2."""
     _tau_range(0, rhop.shape[0], gradvel, rhop, ptype, smag, blin, tau)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def sps_tau_parallel(gradvel, rhop, ptype, smag, blin, tau):
     """Threaded :func:`sps_tau_serial`."""
     n = rhop.shape[0]

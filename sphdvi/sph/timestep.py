@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dt_terms(ace, vel, viscdt, ptype):
     """(max |a|^2 over fluid, max |v|^2 over fluid, max viscdt over all)."""
     amax = 0.0
