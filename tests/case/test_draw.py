@@ -654,3 +654,26 @@ def test_box_faces_follow_a_quarter_turn(tmp_path):
     assert np.all(d.pos[:, 1] == 1) and len(d.pos) == 9
     d = draw(tmp_path, body + box((1, -5, 1), (2, 2, 2), fill="front"), pmin=(-10, -10, -10))
     assert np.all(d.pos[:, 0] == 5) and len(d.pos) == 9
+
+
+def test_curved_modes_solid_and_wire(tmp_path):
+    full = draw(tmp_path, SPHERE.format(mode="full", r=2.5, c=5))
+    solid = draw(tmp_path, SPHERE.format(mode="solid", r=2.5, c=5))
+    face = draw(tmp_path, SPHERE.format(mode="face", r=2.5, c=5))
+    wire = draw(tmp_path, SPHERE.format(mode="wire", r=2.5, c=5))
+    assert nodes(full) == nodes(solid)
+    assert nodes(face) == nodes(wire) and nodes(face) < nodes(full)
+
+
+def test_void_sphere_carves_a_box(tmp_path):
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, 0, 0), (10, 10, 10))
+             + '<setmkvoid/>' + SPHERE.format(mode="full", r=2, c=5).replace('<setmkbound mk="0"/>', ""))
+    assert len(d.pos) == 11 ** 3 - 33
+    assert (5, 5, 5) not in nodes(d)
+
+
+def test_printf_in_predefinition_and_list_calls(tmp_path):
+    predef = '<predefinition><newvar n="3"/><printf text="n=[n]"/></predefinition>'
+    lists = '<list name="inner"><setvar n="n+1"/></list><list name="outer"><runlist name="inner" times="2"/></list>'
+    d = draw(tmp_path, '<runlist name="outer" times="3"/><printf text="[n]"/>', predef=predef, lists=lists)
+    assert d.messages == ["n=3", "9"]

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import CaseError
 from ..expressions import ExpressionError
 from . import raster, shapes
 from . import transform as tf
