@@ -71,9 +71,10 @@ def main():
               help="Output folder (default: ./<casename>_out).")
 @click.option("--max-nodes", type=click.IntRange(min=1), default=200_000_000, show_default=True,
               help="Refuse drawing domains with more lattice nodes than this.")
+@click.option("--dp", type=float, default=None, help="Override the particle spacing of <definition dp>.")
 @click.option("-q", "--quiet", is_flag=True, help="Print only warnings and errors.")
 @report_errors
-def gencase(case_xml, outdir, max_nodes, quiet):
+def gencase(case_xml, outdir, max_nodes, dp, quiet):
     """Turn a DualSPHysics case file into particles, like GenCase.
 
     Writes OUT/<casename>.h5 (particles, constants, parameters, bodies, links,
@@ -87,7 +88,7 @@ def gencase(case_xml, outdir, max_nodes, quiet):
         raise CaseError("case file not found", file=case_xml, expected="an existing XML case file")
     if outdir is None:
         outdir = f"{case_name_from_path(case_xml)}_out"
-    result = build_case(case_xml, outdir, max_nodes=max_nodes)
+    result = build_case(case_xml, outdir, max_nodes=max_nodes, dp=dp)
     files = write_outputs(result, outdir)
     print_warnings(result.warnings)
     if not quiet:
@@ -106,9 +107,10 @@ def gencase(case_xml, outdir, max_nodes, quiet):
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
               help="Override any <parameters> key, e.g. --set Visco=0.05 (repeatable).")
 @click.option("--resume", is_flag=True, help="Continue an interrupted run from its last output.")
+@click.option("--dp", type=float, default=None, help="With a case XML: override <definition dp>.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress output.")
 @report_errors
-def run(source, outdir, tmax, tout, threads, sets, resume, quiet):
+def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
     """Run a case: SOURCE is a case XML (gencase runs first) or a gencase output folder.
 
     \b
@@ -125,7 +127,7 @@ def run(source, outdir, tmax, tout, threads, sets, resume, quiet):
         if resume:
             case_h5 = find_case_file(outdir)
         else:
-            result = build_case(source, outdir)
+            result = build_case(source, outdir, dp=dp)
             print_warnings(result.warnings)
             case_h5 = write_outputs(result, outdir)[0]
     elif os.path.isdir(source):

@@ -49,10 +49,18 @@ def define_builtin_variables(reader, cdef, casename: str) -> None:
 
 
 def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT_MAX_NODES,
-               warnings: Warnings | None = None) -> GenCaseResult:
-    """Read, draw and assemble a case (nothing is written)."""
+               warnings: Warnings | None = None, dp: float | None = None) -> GenCaseResult:
+    """Read, draw and assemble a case (nothing is written).
+
+    ``dp`` overrides ``<definition dp>`` (GenCase's ``-dp:`` option), for convergence studies.
+    """
     warnings = warnings if warnings is not None else Warnings()
     root, reader, text = open_case(path, warnings)
+    if dp is not None:
+        definition = root.find("casedef/geometry/definition")
+        if not (dp > 0 and math.isfinite(dp)):
+            raise CaseError(f"--dp {dp} is not a positive number", file=path)
+        definition.set("dp", repr(float(dp)))
     if outdir is not None:
         os.makedirs(outdir, exist_ok=True)
     casename = case_name_from_path(path)

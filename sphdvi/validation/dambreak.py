@@ -1,0 +1,45 @@
+"""S3: the 2D dam-break surge front against Martin & Moyce (1952), Table 2.
+
+Column a wide and 2a high released on a dry bed; T = t √(2g/a), Z = x_front / a,
+x measured from the left wall. The numerical front is the largest x of the fluid
+particles at each output time, interpolated to the experimental T values.
+"""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+
+def load_martin_moyce(reference_dir: str) -> np.ndarray:
+    """(T, Z) pairs of M&M Table 2."""
+    path = os.path.join(reference_dir, "dambreak2d_front_martin_moyce_1952", "mm1952_table2_front.csv")
+    return np.loadtxt(path, delimiter=",", comments="#", skiprows=3)
+
+
+def front_history(outdir: str, x0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(times, front x − x0) from a run's particles.vtkhdf."""
+    from ..io.vtkhdf import read_step, step_times
+    path = os.path.join(outdir, "particles.vtkhdf")
+    times = step_times(path)
+    front = np.empty(times.size)
+    for k in range(times.size):
+        s = read_step(path, k)
+        front[k] = s["points"][s["Type"] == 3, 0].max() - x0
+    return times, front
+
+
+def front_errors(times, front, ref, a: float = 1.0, g: float = 9.81, trange=(1.0, 3.0)):
+    """Relative errors (Z_sph − Z_exp)/Z_exp at the experimental T in ``trange``, and the
+    relative error of the front speed dZ/dT fitted over T ∈ [1.9, 3.0]."""
+    T = np.asarray(times) * math.sqrt(2 * g / a)
+    Z = np.asarray(front) / a
+    sel = (ref[:, 0] >= trange[0]) & (ref[:, 0] <= trange[1])
+    z_sph = np.interp(ref[sel, 0], T, Z)
+    rel = (z_sph - ref[sel, 1]) / ref[sel, 1]
+    late_ref = (ref[:, 0] >= 1.9) & (ref[:, 0] <= 3.0)
+    late = (T >= 1.9) & (T <= 3.0)
+    speed_exp = np.polyfit(ref[late_ref, 0], ref[late_ref, 1], 1)[0]
+    speed_sph = np.polyfit(T[late], Z[late], 1)[0]
+    return ref[sel, 0], rel, (speed_sph - speed_exp) / speed_exp
