@@ -33,6 +33,7 @@ import numpy as np
 from numba import njit
 
 from ._math import cross
+from ._vec import col, mat_t_vec, mat_vec, row3, v_add, v_cross, v_dot, v_scale, v_sub
 
 SPHERE = 0
 BOX = 1
@@ -188,18 +189,15 @@ def broad_phase(lo, hi, sh_body, sh_type, body_active, pairs):
 # ---------------------------------------------------------- signed distances
 @njit(cache=True)
 def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes):
-    """Signed distance and outward unit gradient of shape s at local point q."""
-    g = np.zeros(3)
+    """Signed distance and outward unit gradient (tuple) of shape s at the
+    local point q (tuple)."""
     if t == SPHERE:
         n = math.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2)
         if n < 1e-14:
-            g[2] = 1.0
-        else:
-            g[:] = q / n
-        return n - dims[0], g
+            return -dims[0], (0.0, 0.0, 1.0)
+        return n - dims[0], (q[0] / n, q[1] / n, q[2] / n)
     if t == PLANE:
-        g[2] = 1.0
-        return q[2], g
+        return q[2], (0.0, 0.0, 1.0)
     if t == BOX:
         d0 = abs(q[0]) - dims[0]
         d1 = abs(q[1]) - dims[1]
@@ -209,29 +207,20 @@ def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, plane
             e1 = max(d1, 0.0)
             e2 = max(d2, 0.0)
             n = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            g[0] = math.copysign(e0, q[0]) / n
-            g[1] = math.copysign(e1, q[1]) / n
-            g[2] = math.copysign(e2, q[2]) / n
-            return n, g
+            return n, (math.copysign(e0, q[0]) / n, math.copysign(e1, q[1]) / n,
+                       math.copysign(e2, q[2]) / n)
         if d0 >= d1 and d0 >= d2:
-            g[0] = math.copysign(1.0, q[0])
-            return d0, g
+            return d0, (math.copysign(1.0, q[0]), 0.0, 0.0)
         if d1 >= d2:
-            g[1] = math.copysign(1.0, q[1])
-            return d1, g
-        g[2] = math.copysign(1.0, q[2])
-        return d2, g
+            return d1, (0.0, math.copysign(1.0, q[1]), 0.0)
+        return d2, (0.0, 0.0, math.copysign(1.0, q[2]))
     if t == CAPSULE:
         zc = min(max(q[2], -dims[1]), dims[1])
         v0, v1, v2 = q[0], q[1], q[2] - zc
         n = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
         if n < 1e-14:
-            g[0] = 1.0
-        else:
-            g[0] = v0 / n
-            g[1] = v1 / n
-            g[2] = v2 / n
-        return n - dims[0], g
+            return -dims[0], (1.0, 0.0, 0.0)
+        return n - dims[0], (v0 / n, v1 / n, v2 / n)
     if t == CYLINDER:
         rho = math.sqrt(q[0] ** 2 + q[1] ** 2)
         if rho < 1e-14:
@@ -245,28 +234,22 @@ def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, plane
             er = max(dr, 0.0)
             ez = max(dz, 0.0)
             n = math.sqrt(er * er + ez * ez)
-            g[0] = er * rx / n
-            g[1] = er * ry / n
-            g[2] = ez * sz / n
-            return n, g
+            return n, (er * rx / n, er * ry / n, ez * sz / n)
         if dr > dz:
-            g[0] = rx
-            g[1] = ry
-            return dr, g
-        g[2] = sz
-        return dz, g
+            return dr, (rx, ry, 0.0)
+        return dz, (0.0, 0.0, sz)
     if t == HULL:
         best = -1e300
+        g = (0.0, 0.0, 1.0)
         for p in range(pl_off[s], pl_off[s] + pl_cnt[s]):
             d = planes[p, 0] * q[0] + planes[p, 1] * q[1] + planes[p, 2] * q[2] + planes[p, 3]
             if d > best:
                 best = d
-                g[0] = planes[p, 0]
-                g[1] = planes[p, 1]
-                g[2] = planes[p, 2]
+                g = (planes[p, 0], planes[p, 1], planes[p, 2])
         return best, g
     # CLOUD: union of spheres
     best = 1e300
+    g = (0.0, 0.0, 1.0)
     for p in range(samp_off[s], samp_off[s] + samp_cnt[s]):
         v0 = q[0] - samp_pts[p, 0]
         v1 = q[1] - samp_pts[p, 1]
@@ -276,13 +259,9 @@ def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, plane
             best = d2
             n = math.sqrt(d2)
             if n < 1e-14:
-                g[0] = 0.0
-                g[1] = 0.0
-                g[2] = 1.0
+                g = (0.0, 0.0, 1.0)
             else:
-                g[0] = v0 / n
-                g[1] = v1 / n
-                g[2] = v2 / n
+                g = (v0 / n, v1 / n, v2 / n)
     return math.sqrt(best) - dims[0], g
 
 
@@ -344,142 +323,166 @@ def _segment_of(t, dims, c, R):
 
 
 @njit(cache=True)
+def _emit_t(nc, cap, ba, bb, sa, sb, pt, n, gap, key, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """_emit for tuple vectors."""
+    if nc < cap:
+        c_a[nc] = ba
+        c_b[nc] = bb
+        c_sa[nc] = sa
+        c_sb[nc] = sb
+        for k in range(3):
+            c_pt[nc, k] = pt[k]
+            c_n[nc, k] = n[k]
+        c_gap[nc] = gap
+        c_key[nc] = key
+    return nc + 1
+
+
+@njit(cache=True)
+def _sat_sep(L, T, RA, hA, RB, hB):
+    """Separation of two boxes along the unit axis L (negative = overlap)."""
+    ra = 0.0
+    rb = 0.0
+    for k in range(3):
+        ra += hA[k] * abs(RA[0, k] * L[0] + RA[1, k] * L[1] + RA[2, k] * L[2])
+        rb += hB[k] * abs(RB[0, k] * L[0] + RB[1, k] * L[1] + RB[2, k] * L[2])
+    return abs(v_dot(T, L)) - ra - rb
+
+
+@njit(cache=True)
 def _box_box(sa, sb, ba, bb, cA, RA, hA, cB, RB, hB, env, keybase, nc, cap,
-             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep):
     """Box–box: separating-axis test over 15 axes, then clipping of the incident
     face against the reference face (≤ 4 points kept) or one edge–edge point."""
-    T = cB - cA
+    T = v_sub(cB, cA)
     best_face = -1e300
     face_ax = -1
+    for ax in range(6):
+        L = col(RA, ax) if ax < 3 else col(RB, ax - 3)
+        sep = _sat_sep(L, T, RA, hA, RB, hB)
+        if sep > env:
+            return nc
+        if sep > best_face:
+            best_face = sep
+            face_ax = ax
     best_edge = -1e300
     edge_i = -1
     edge_j = -1
-    edge_L = np.zeros(3)
-    for ax in range(6):
-        if ax < 3:
-            L = RA[:, ax]
-        else:
-            L = RB[:, ax - 3]
-        ra = 0.0
-        rbx = 0.0
-        for k in range(3):
-            ra += hA[k] * abs(RA[:, k] @ L)
-            rbx += hB[k] * abs(RB[:, k] @ L)
-        s = abs(T @ L) - ra - rbx
-        if s > env:
-            return nc
-        if s > best_face:
-            best_face = s
-            face_ax = ax
+    edge_L = (0.0, 0.0, 0.0)
     for i in range(3):
         for j in range(3):
-            L = cross(RA[:, i], RB[:, j])
-            ln = math.sqrt(L @ L)
+            L = v_cross(col(RA, i), col(RB, j))
+            ln = math.sqrt(v_dot(L, L))
             if ln < 1e-6:
                 continue
-            L = L / ln
-            ra = 0.0
-            rbx = 0.0
-            for k in range(3):
-                ra += hA[k] * abs(RA[:, k] @ L)
-                rbx += hB[k] * abs(RB[:, k] @ L)
-            s = abs(T @ L) - ra - rbx
-            if s > env:
+            L = v_scale(L, 1.0 / ln)
+            sep = _sat_sep(L, T, RA, hA, RB, hB)
+            if sep > env:
                 return nc
-            if s > best_edge:
-                best_edge = s
+            if sep > best_edge:
+                best_edge = sep
                 edge_i = i
                 edge_j = j
-                edge_L[:] = L
-    scale = min(hA.min(), hB.min())
+                edge_L = L
+    scale = min(min(hA[0], hA[1]), min(hA[2], min(hB[0], min(hB[1], hB[2]))))
     if edge_i >= 0 and best_edge > best_face + 0.05 * abs(best_face) + 1e-3 * scale:
-        L = edge_L.copy()
-        if T @ L < 0.0:
-            L = -L
-        pa = cA.copy()
-        pb = cB.copy()
+        L = edge_L
+        if v_dot(T, L) < 0.0:
+            L = v_scale(L, -1.0)
+        pa = cA
+        pb = cB
         for k in range(3):
+            ak = col(RA, k)
+            bk = col(RB, k)
             if k != edge_i:
-                pa += hA[k] * math.copysign(1.0, RA[:, k] @ L) * RA[:, k]
+                pa = v_add(pa, v_scale(ak, hA[k] * math.copysign(1.0, v_dot(ak, L))))
             if k != edge_j:
-                pb -= hB[k] * math.copysign(1.0, RB[:, k] @ L) * RB[:, k]
-        ea = RA[:, edge_i] * hA[edge_i]
-        eb = RB[:, edge_j] * hB[edge_j]
-        x1, x2 = closest_segments(pa - ea, pa + ea, pb - eb, pb + eb)
-        pt = 0.5 * (x1 + x2)
-        return _emit(nc, cap, ba, bb, sa, sb, pt, L, best_edge, keybase + 50,
-                     c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-    # face contact: reference box r, incident box i, nref points from r to i
+                pb = v_sub(pb, v_scale(bk, hB[k] * math.copysign(1.0, v_dot(bk, L))))
+        ea = v_scale(col(RA, edge_i), hA[edge_i])
+        eb = v_scale(col(RB, edge_j), hB[edge_j])
+        x1, x2 = _closest_segments_t(v_sub(pa, ea), v_add(pa, ea), v_sub(pb, eb), v_add(pb, eb))
+        pt = v_scale(v_add(x1, x2), 0.5)
+        return _emit_t(nc, cap, ba, bb, sa, sb, pt, L, best_edge, keybase + 50,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    # face contact: reference box r, incident box i; nref points from r to i
     if face_ax < 3:
-        cr, Rr, hr, ci, Ri, hi_ = cA, RA, hA, cB, RB, hB
         fi = face_ax
-        nref = RA[:, fi] * math.copysign(1.0, T @ RA[:, fi])
-        nab = nref.copy()
+        cr = cA
+        Rr = RA
+        hr = hA
+        ci = cB
+        Ri = RB
+        hi_ = hB
+        nref = v_scale(col(RA, fi), math.copysign(1.0, v_dot(T, col(RA, fi))))
+        nab = nref
     else:
-        cr, Rr, hr, ci, Ri, hi_ = cB, RB, hB, cA, RA, hA
         fi = face_ax - 3
-        nref = RB[:, fi] * (-math.copysign(1.0, T @ RB[:, fi]))
-        nab = -nref
-    # incident face: most anti-parallel face of the incident box
+        cr = cB
+        Rr = RB
+        hr = hB
+        ci = cA
+        Ri = RA
+        hi_ = hA
+        nref = v_scale(col(RB, fi), -math.copysign(1.0, v_dot(T, col(RB, fi))))
+        nab = v_scale(nref, -1.0)
     jbest = 0
     dbest = -1.0
     for j in range(3):
-        dj = abs(Ri[:, j] @ nref)
+        dj = abs(v_dot(col(Ri, j), nref))
         if dj > dbest:
             dbest = dj
             jbest = j
-    ninc = -Ri[:, jbest] * math.copysign(1.0, Ri[:, jbest] @ nref)
-    fc = ci + ninc * hi_[jbest]
+    cj = col(Ri, jbest)
+    ninc = v_scale(cj, -math.copysign(1.0, v_dot(cj, nref)))
+    fc = v_add(ci, v_scale(ninc, hi_[jbest]))
     u = (jbest + 1) % 3
     v = (jbest + 2) % 3
-    U = Ri[:, u] * hi_[u]
-    V = Ri[:, v] * hi_[v]
-    poly = np.empty((16, 3))
+    U = v_scale(col(Ri, u), hi_[u])
+    V = v_scale(col(Ri, v), hi_[v])
+    for k in range(3):
+        poly[0, k] = fc[k] + U[k] + V[k]
+        poly[1, k] = fc[k] - U[k] + V[k]
+        poly[2, k] = fc[k] - U[k] - V[k]
+        poly[3, k] = fc[k] + U[k] - V[k]
     npoly = 4
-    poly[0] = fc + U + V
-    poly[1] = fc - U + V
-    poly[2] = fc - U - V
-    poly[3] = fc + U - V
-    tmp = np.empty((16, 3))
     for side in range(4):
         k = (fi + 1 + side // 2) % 3
         sgn = 1.0 if side % 2 == 0 else -1.0
-        pn = Rr[:, k] * sgn
-        off = pn @ cr + hr[k]
+        pn = v_scale(col(Rr, k), sgn)
+        off = v_dot(pn, cr) + hr[k]
         nt = 0
         for q in range(npoly):
-            P = poly[q]
-            Q = poly[(q + 1) % npoly]
-            dp = P @ pn - off
-            dq = Q @ pn - off
+            q2 = (q + 1) % npoly
+            dp = poly[q, 0] * pn[0] + poly[q, 1] * pn[1] + poly[q, 2] * pn[2] - off
+            dq = poly[q2, 0] * pn[0] + poly[q2, 1] * pn[1] + poly[q2, 2] * pn[2] - off
             if dp <= 0.0:
-                tmp[nt] = P
+                for c in range(3):
+                    tmp[nt, c] = poly[q, c]
                 nt += 1
             if (dp <= 0.0) != (dq <= 0.0):
-                tmp[nt] = P + (Q - P) * (dp / (dp - dq))
+                f = dp / (dp - dq)
+                for c in range(3):
+                    tmp[nt, c] = poly[q, c] + (poly[q2, c] - poly[q, c]) * f
                 nt += 1
         npoly = nt
         for q in range(nt):
-            poly[q] = tmp[q]
+            for c in range(3):
+                poly[q, c] = tmp[q, c]
         if npoly == 0:
             return nc
     # keep points below the envelope, at most 4 (deepest first, then spread)
-    depth = np.empty(npoly)
-    keep = np.zeros(npoly, np.bool_)
-    nk = 0
-    for q in range(npoly):
-        depth[q] = nref @ (poly[q] - cr) - hr[fi]
     cand = 0
-    for q in range(npoly):
-        if depth[q] < env:
-            cand += 1
-    if cand == 0:
-        return nc
-    # deepest
     first = -1
     for q in range(npoly):
-        if depth[q] < env and (first < 0 or depth[q] < depth[first]):
-            first = q
+        depth[q] = (nref[0] * (poly[q, 0] - cr[0]) + nref[1] * (poly[q, 1] - cr[1])
+                    + nref[2] * (poly[q, 2] - cr[2]) - hr[fi])
+        keep[q] = False
+        if depth[q] < env:
+            cand += 1
+            if first < 0 or depth[q] < depth[first]:
+                first = q
+    if cand == 0:
+        return nc
     keep[first] = True
     nk = 1
     while nk < min(4, cand):
@@ -491,8 +494,8 @@ def _box_box(sa, sb, ba, bb, cA, RA, hA, cB, RB, hB, env, keybase, nc, cap,
             dmin = 1e300
             for p in range(npoly):
                 if keep[p]:
-                    dv = poly[q] - poly[p]
-                    dd = dv @ dv
+                    dd = ((poly[q, 0] - poly[p, 0]) ** 2 + (poly[q, 1] - poly[p, 1]) ** 2
+                          + (poly[q, 2] - poly[p, 2]) ** 2)
                     if dd < dmin:
                         dmin = dd
             if dmin > fd:
@@ -504,10 +507,44 @@ def _box_box(sa, sb, ba, bb, cA, RA, hA, cB, RB, hB, env, keybase, nc, cap,
         nk += 1
     for q in range(npoly):
         if keep[q]:
-            pt = poly[q] - 0.5 * depth[q] * nref
-            nc = _emit(nc, cap, ba, bb, sa, sb, pt, nab, depth[q], keybase + q,
-                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            dq = 0.5 * depth[q]
+            pt = (poly[q, 0] - dq * nref[0], poly[q, 1] - dq * nref[1], poly[q, 2] - dq * nref[2])
+            nc = _emit_t(nc, cap, ba, bb, sa, sb, pt, nab, depth[q], keybase + q,
+                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
     return nc
+
+
+@njit(cache=True)
+def _closest_segments_t(p1, q1, p2, q2):
+    """Closest points between segments [p1,q1] and [p2,q2] (tuples)."""
+    d1 = v_sub(q1, p1)
+    d2 = v_sub(q2, p2)
+    r = v_sub(p1, p2)
+    a = v_dot(d1, d1)
+    e = v_dot(d2, d2)
+    f = v_dot(d2, r)
+    if a <= 1e-20 and e <= 1e-20:
+        return p1, p2
+    if a <= 1e-20:
+        s = 0.0
+        t = min(max(f / e, 0.0), 1.0)
+    else:
+        c = v_dot(d1, r)
+        if e <= 1e-20:
+            t = 0.0
+            s = min(max(-c / a, 0.0), 1.0)
+        else:
+            bq = v_dot(d1, d2)
+            den = a * e - bq * bq
+            s = min(max((bq * f - c * e) / den, 0.0), 1.0) if den > 1e-20 else 0.0
+            t = (bq * s + f) / e
+            if t < 0.0:
+                t = 0.0
+                s = min(max(-c / a, 0.0), 1.0)
+            elif t > 1.0:
+                t = 1.0
+                s = min(max((bq - c) / a, 0.0), 1.0)
+    return v_add(p1, v_scale(d1, s)), v_add(p2, v_scale(d2, t))
 
 
 @njit(cache=True)
@@ -518,14 +555,15 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
     """Samples of shape sp (radius ρ) against the SDF of shape so.  The contact
     normal is −∇φ_so (from sp to so); ``swap`` reverses the pair order so that
     the normal is always from the pair's first shape to its second."""
-    cP = w_pos[sp]
+    cP = row3(w_pos, sp)
     RP = w_R[sp]
-    cO = w_pos[so]
+    cO = row3(w_pos, so)
     RO = w_R[so]
     rho = samp_rad[sp]
     to = sh_type[so]
+    dims = sh_dims[so]
     for p in range(samp_off[sp], samp_off[sp] + samp_cnt[sp]):
-        x = cP + RP @ samp_pts[p]
+        x = v_add(cP, mat_vec(RP, row3(samp_pts, p)))
         # AABB cull against the other shape
         out = False
         for k in range(3):
@@ -534,21 +572,21 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
                 break
         if out:
             continue
-        ql = RO.T @ (x - cO)
-        phi, gl = sdf_local(to, sh_dims[so], ql, so, samp_off, samp_cnt, samp_pts,
+        ql = mat_t_vec(RO, v_sub(x, cO))
+        phi, gl = sdf_local(to, dims, ql, so, samp_off, samp_cnt, samp_pts,
                             pl_off, pl_cnt, planes)
         gap = phi - rho
         if gap >= env:
             continue
-        gw = RO @ gl
-        pt = x - 0.5 * (rho + phi) * gw
+        gw = mat_vec(RO, gl)
+        pt = v_sub(x, v_scale(gw, 0.5 * (rho + phi)))
         key = keybase + (p - samp_off[sp]) * 2 + (1 if swap else 0)
         if swap:
-            nc = _emit(nc, cap, bo, bp, so, sp, pt, gw, gap, key,
-                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            nc = _emit_t(nc, cap, bo, bp, so, sp, pt, gw, gap, key,
+                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
         else:
-            nc = _emit(nc, cap, bp, bo, sp, so, pt, -gw, gap, key,
-                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            nc = _emit_t(nc, cap, bp, bo, sp, so, pt, v_scale(gw, -1.0), gap, key,
+                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
     return nc
 
 
@@ -566,6 +604,10 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
     cap = c_a.shape[0]
     nc = 0
     ns = sh_type.shape[0]
+    poly = np.empty((16, 3))
+    tmp = np.empty((16, 3))
+    depth = np.empty(16)
+    keep = np.zeros(16, np.bool_)
     for q in range(npair):
         s1 = pairs[q, 0]
         s2 = pairs[q, 1]
@@ -595,9 +637,9 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                            c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
             continue
         if t1 == BOX and t2 == BOX:
-            nc = _box_box(s1, s2, b1, b2, w_pos[s1], w_R[s1], sh_dims[s1], w_pos[s2],
+            nc = _box_box(s1, s2, b1, b2, row3(w_pos, s1), w_R[s1], sh_dims[s1], row3(w_pos, s2),
                           w_R[s2], sh_dims[s2], env, keybase, nc, cap,
-                          c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+                          c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep)
             continue
         pl1 = _point_like(t1)
         pl2 = _point_like(t2)

@@ -11,6 +11,7 @@ import numpy as np
 from numba import njit
 
 from ._math import cross, mat_to_rotvec
+from ._vec import mat_t_vec, mat_vec, row3, v_cross, v_dot, v_scale, v_sub
 from .solvers import BILATERAL, BOXED, FRIC_N, FRIC_T, UNILATERAL
 
 LINK_CONTACT = -1
@@ -284,6 +285,34 @@ def tangent_basis(n):
 
 
 @njit(cache=True)
+def _tangents_t(n):
+    if abs(n[0]) < 0.6:
+        a = (1.0, 0.0, 0.0)
+    else:
+        a = (0.0, 1.0, 0.0)
+    u = v_sub(a, v_scale(n, v_dot(a, n)))
+    u = v_scale(u, 1.0 / math.sqrt(v_dot(u, u)))
+    return u, v_cross(n, u)
+
+
+@njit(cache=True)
+def _put_side(J, k, o, lin, angw, R, world):
+    """Write one body block of row k (angular part to the body frame)."""
+    J[k, o] = lin[0]
+    J[k, o + 1] = lin[1]
+    J[k, o + 2] = lin[2]
+    if world:
+        J[k, o + 3] = angw[0]
+        J[k, o + 4] = angw[1]
+        J[k, o + 5] = angw[2]
+    else:
+        ab = mat_t_vec(R, angw)
+        J[k, o + 3] = ab[0]
+        J[k, o + 4] = ab[1]
+        J[k, o + 5] = ab[2]
+
+
+@njit(cache=True)
 def build_contact_rows(nr, h, vrec, min_bounce, pos, Rb, vel6, nc, c_a, c_b, c_pt,
                        c_n, c_gap, c_mu, c_e, c_row,
                        ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
@@ -293,16 +322,25 @@ def build_contact_rows(nr, h, vrec, min_bounce, pos, Rb, vel6, nc, c_a, c_b, c_p
     approach speed exceeds the minimum bounce speed and the gap closes within
     the step.  μ > 0 gives a FRIC_N/FRIC_T/FRIC_T triplet, μ = 0 a single
     UNILATERAL row.  ``vel6`` = pre-step velocities (linear world, ω body)."""
+    I3 = np.eye(3)
     for ci in range(nc):
         a = c_a[ci]
         bb = c_b[ci]
-        xa, Ra = _body_frame(a, pos, Rb)
-        xb, Rbb = _body_frame(bb, pos, Rb)
-        P = c_pt[ci]
-        n = c_n[ci].copy()
-        u, w = tangent_basis(n)
-        raa = P - xa
-        rbb = P - xb
+        P = row3(c_pt, ci)
+        n = row3(c_n, ci)
+        u, w = _tangents_t(n)
+        if a >= 0:
+            raa = v_sub(P, row3(pos, a))
+            Ra = Rb[a]
+        else:
+            raa = P
+            Ra = I3
+        if bb >= 0:
+            rbb = v_sub(P, row3(pos, bb))
+            Rbb = Rb[bb]
+        else:
+            rbb = P
+            Rbb = I3
         c_row[ci] = nr
         nrow = 3 if c_mu[ci] > 0.0 else 1
         for r in range(nrow):
@@ -312,10 +350,19 @@ def build_contact_rows(nr, h, vrec, min_bounce, pos, Rb, vel6, nc, c_a, c_b, c_p
                 e = u
             else:
                 e = w
-            _clear_row(nr + r, b, E, kind, lo, hi, mu, rlink, Cpos)
-            _write_row(nr + r, a, bb, -e, -cross(raa, e), e, cross(rbb, e), Ra, Rbb, ra, rb, J)
-            rlink[nr + r] = -1
-            kind[nr + r] = FRIC_T
+            k = nr + r
+            ra[k] = a
+            rb[k] = bb
+            _put_side(J, k, 0, v_scale(e, -1.0), v_scale(v_cross(raa, e), -1.0), Ra, a < 0)
+            _put_side(J, k, 6, e, v_cross(rbb, e), Rbb, bb < 0)
+            b[k] = 0.0
+            E[k] = 0.0
+            kind[k] = FRIC_T
+            lo[k] = -1e300
+            hi[k] = 1e300
+            mu[k] = 0.0
+            rlink[k] = -1
+            Cpos[k] = 0.0
         # pre-step normal velocity
         vn = 0.0
         if a >= 0:
@@ -343,9 +390,9 @@ def build_contact_rows(nr, h, vrec, min_bounce, pos, Rb, vel6, nc, c_a, c_b, c_p
 @njit(cache=True)
 def accumulate_row_forces(nr, ra, rb, J, gamma, inv_h, Rb, rlink, nlinks,
                           c_force, c_torque, l_force, l_torque_c, nb, b_force, b_torque):
-    """Forces γ/h of the last step: per body contact force/torque (world, about
-    the centre) and per link the force/torque on body 1 (torque about body 1's
-    centre; converted to the link point by the caller)."""
+    """Forces γ/h of the last step: per body all-row and contact force/torque
+    (world, about the centre) and per link the force/torque on body 1 (torque
+    about body 1's centre; converted to the link point by the caller)."""
     c_force[:, :] = 0.0
     c_torque[:, :] = 0.0
     l_force[:, :] = 0.0
@@ -358,23 +405,19 @@ def accumulate_row_forces(nr, ra, rb, J, gamma, inv_h, Rb, rlink, nlinks,
         for side in range(2):
             body = ra[k] if side == 0 else rb[k]
             o = 6 * side
-            f = np.empty(3)
-            tb = np.empty(3)
-            for c in range(3):
-                f[c] = J[k, o + c] * g
-                tb[c] = J[k, o + 3 + c] * g
+            f = (J[k, o] * g, J[k, o + 1] * g, J[k, o + 2] * g)
+            tb = (J[k, o + 3] * g, J[k, o + 4] * g, J[k, o + 5] * g)
             if body >= 0:
-                tw = Rb[body] @ tb
-            else:
-                tw = tb
-            if body >= 0:
+                tw = mat_vec(Rb[body], tb)
                 for c in range(3):
                     b_force[body, c] += f[c]
                     b_torque[body, c] += tw[c]
-            if lk == -1 and body >= 0:
-                for c in range(3):
-                    c_force[body, c] += f[c]
-                    c_torque[body, c] += tw[c]
+                if lk == -1:
+                    for c in range(3):
+                        c_force[body, c] += f[c]
+                        c_torque[body, c] += tw[c]
+            else:
+                tw = tb
             if lk >= 0 and side == 0:
                 for c in range(3):
                     l_force[lk, c] += f[c]
