@@ -677,3 +677,33 @@ def test_printf_in_predefinition_and_list_calls(tmp_path):
     lists = '<list name="inner"><setvar n="n+1"/></list><list name="outer"><runlist name="inner" times="2"/></list>'
     d = draw(tmp_path, '<runlist name="outer" times="3"/><printf text="[n]"/>', predef=predef, lists=lists)
     assert d.messages == ["n=3", "9"]
+
+
+def test_box_layers(tmp_path):
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="bottom",
+                                                   extra='<layers vdp="0,1*,2"/>'))
+    assert len(d.pos) == 25 + 49 + 81
+    assert sorted(set(d.pos[:, 2].tolist())) == [1, 2, 3]
+    assert [p["params"]["layer"] for p in d.primitives] == [0, 1, 2]
+    # a tank with 3-layer walls keeps its fluid inside
+    body = ('<setmkfluid mk="0"/>' + box((3, 3, 3), (4, 4, 4))
+            + '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="all",
+                                           extra='<layers vdp="0,1,2"/>'))
+    d = draw(tmp_path, body)
+    assert d.count_fluid == 27 and d.count_bound == 9 ** 3 - 27
+    # an inward layer that shrinks the box away is skipped with a warning
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (2, 2, 2), fill="all",
+                                                   extra='<layers vdp="0,-2"/>'))
+    assert len(d.pos) == 26
+
+
+def test_sphere_and_cylinder_layers(tmp_path):
+    one = draw(tmp_path, SPHERE.format(mode="face", r=2, c=5))
+    two = draw(tmp_path, SPHERE.format(mode="face", r=2, c=5).replace(
+        "</drawsphere>", '<layers vdp="0,1"/></drawsphere>'))
+    big = draw(tmp_path, SPHERE.format(mode="face", r=3, c=5))
+    assert nodes(two) == nodes(one) | nodes(big)
+    d = draw(tmp_path, CYL.format(mode="face", mask="0").replace(
+        "</drawcylinder>", '<layers vdp="1"/></drawcylinder>'))
+    # radius 2.5, covers at z=1 and z=7: 21 nodes per cover, 12 side nodes per layer
+    assert len(d.pos) == 21 + 21 + 5 * 12

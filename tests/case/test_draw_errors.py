@@ -33,9 +33,14 @@ def test_unsupported_commands(tmp_path, tag):
     assert e.value.element == tag
 
 
-def test_layers_unsupported(tmp_path):
+def test_layers_errors(tmp_path):
     with pytest.raises(CaseError, match="not supported"):
-        draw(tmp_path, '<setmkbound mk="0"/>' + box((0, 0, 0), (1, 1, 1), extra='<layers vdp="1"/>'))
+        draw(tmp_path, '<setmkbound mk="0"/><drawellipsoid><point x="5"/><radius x="1" y="1" z="1"/>'
+                       '<layers vdp="1"/></drawellipsoid>')
+    with pytest.raises(CaseError, match="vdp"):
+        draw(tmp_path, '<setmkbound mk="0"/>' + box((0, 0, 0), (1, 1, 1), extra='<layers vdp="1,x"/>'))
+    with pytest.raises(CaseError, match="missing attribute 'vdp'"):
+        draw(tmp_path, '<setmkbound mk="0"/>' + box((0, 0, 0), (1, 1, 1), extra='<layers/>'))
 
 
 @pytest.mark.parametrize("dp,pmax,match", [

@@ -73,9 +73,14 @@ Fills (``fillpoint``, ``fillvoidpoint``, ``fillbox``)
     name, so nothing is ever written outside outdir. Nothing is written when
     outdir is None.
 
+Layers (``<layers vdp="0,1,-0.5*">`` in drawbox, drawsphere, drawcylinder)
+    The shape is drawn once per offset, widened by offset*dp on every side
+    (box), on the radius (sphere), on the radius and at both covers
+    (cylinder); negative offsets shrink it. A trailing ``*`` is ignored.
+
 Not supported (CaseError "not supported by sphdvi"): see ``UNSUPPORTED``
 (bathymetry, waves, beaches, extrusions, redraw, clipping, patterns, ...)
-and ``<layers>``; commands that only tune GenCase's own output or sampling
+and ``<layers>`` of ellipsoids; commands that only tune GenCase's own output or sampling
 (``setdpctes``, ``setshapemode``, ``debugout``, ...) are accepted with no effect.
 """
 from .commands import UNSUPPORTED, Drawing, run_geometry

@@ -552,22 +552,49 @@ class GeometryRunner:
         tokens = chosen
         return "solid" in tokens, faces, False
 
+    def _layers(self, el) -> list[float]:
+        """Offsets (in dp, outward positive) of ``<layers vdp="0,1,-0.5*">``; [0] without it.
+
+        A trailing ``*`` (GenCase: also save that layer's shape) is accepted and ignored.
+        """
+        lay = self.reader.child(el, "layers")
+        if lay is None:
+            return [0.0]
+        text = self.reader.text_attr(lay, "vdp")
+        out = []
+        for tok in text.split(","):
+            tok = tok.strip().rstrip("*").strip()
+            try:
+                v = self.vars.number(tok[1:] if tok.startswith("#") else tok)
+            except ExpressionError:
+                raise self.reader.error(lay, f"vdp={text!r} is not valid",
+                                        "numbers separated by commas, e.g. vdp=\"0,1,2\"") from None
+            if abs(v) > 1e6:
+                raise self.reader.error(lay, f"layer offset {v:g} dp", "at most 1e6 dp")
+            out.append(v)
+        if not out or len(out) > 1000:
+            raise self.reader.error(lay, f"{len(out)} layers", "1 to 1000 layers")
+        return out
+
     def cmd_drawbox(self, el):
         self._need_pen(el)
         self._check(el, {"boxfill", "point", "size", "endpoint", "angles", "layers"})
-        if self.reader.child(el, "layers") is not None:
-            raise self.reader.error(self.reader.child(el, "layers"),
-                                    "<layers> of <drawbox> is not supported by sphdvi",
-                                    "one box per layer")
         point, size = self._box_extent(el)
         ang_el = self.reader.child(el, "angles")
         angles = self.reader.vec3(ang_el) if ang_el is not None else None
         solid, faces, wire = self._box_fill(el)
-        pieces, params, tris = shapes.draw_box(self.lat, self.state.matrix, point, size, angles,
-                                               solid=solid, faces=faces, wire=wire)
-        params["faces"] = faces
-        n = self._paint(el, pieces)
-        self._record(el, "box", params, tris, solid, n)
+        for layer in self._layers(el):
+            grow = layer * self.lat.dp
+            if np.any(size + 2 * grow < 0):
+                self.reader.warn(el, f"layer {layer:g} shrinks the box to nothing; skipped")
+                continue
+            pieces, params, tris = shapes.draw_box(self.lat, self.state.matrix, point, size,
+                                                   angles, solid=solid, faces=faces, wire=wire,
+                                                   grow=grow)
+            params["faces"] = faces
+            params["layer"] = layer
+            n = self._paint(el, pieces)
+            self._record(el, "box", params, tris, solid, n)
 
     # ------------------------------------------------------------ curved shapes
     def _curved_flags(self):
@@ -584,14 +611,19 @@ class GeometryRunner:
     def cmd_drawsphere(self, el):
         self._need_pen(el)
         self._check(el, {"point", "layers"})
-        self._layers_unsupported(el)
-        r = self.reader.num(el, "radius", positive=True)
+        r0 = self.reader.num(el, "radius", positive=True)
         c = self._points(el, exact=1)[0]
         solid, shell = self._curved_flags()
-        pieces, params, tris = shapes.draw_sphere(self.lat, self.state.matrix, c, r,
-                                                  solid=solid, shell=shell)
-        n = self._paint(el, pieces)
-        self._record(el, "sphere", params, tris, solid, n)
+        for layer in self._layers(el):
+            r = r0 + layer * self.lat.dp
+            if not r > 0:
+                self.reader.warn(el, f"layer {layer:g} gives radius {r:g}; skipped")
+                continue
+            pieces, params, tris = shapes.draw_sphere(self.lat, self.state.matrix, c, r,
+                                                      solid=solid, shell=shell)
+            params["layer"] = layer
+            n = self._paint(el, pieces)
+            self._record(el, "sphere", params, tris, solid, n)
 
     def cmd_drawellipsoid(self, el):
         self._need_pen(el)
@@ -624,19 +656,29 @@ class GeometryRunner:
     def cmd_drawcylinder(self, el):
         self._need_pen(el)
         self._check(el, {"point", "layers"})
-        self._layers_unsupported(el)
-        r = self.reader.num(el, "radius", positive=True)
+        r0 = self.reader.num(el, "radius", positive=True)
         p = self._points(el, exact=2)
         mask = self._mask(el)
         solid, shell = self._curved_flags()
-        try:
-            pieces, params, tris = shapes.draw_cylinder(self.lat, self.state.matrix, p[0], p[1], r,
-                                                        solid=solid, shell=shell, mask=mask)
-        except ValueError as exc:
-            raise self.reader.error(el, str(exc), "two distinct axis points") from None
-        params["mask"] = mask
-        n = self._paint(el, pieces)
-        self._record(el, "cylinder", params, tris, solid, n)
+        length = float(np.linalg.norm(p[1] - p[0]))
+        if not length > 0:
+            raise self.reader.error(el, "the two points of the cylinder axis coincide",
+                                    "two distinct axis points")
+        u = (p[1] - p[0]) / length
+        for layer in self._layers(el):
+            grow = layer * self.lat.dp
+            r = r0 + grow
+            if not r > 0 or not length + 2 * grow > 0:
+                self.reader.warn(el, f"layer {layer:g} shrinks the cylinder to nothing; skipped")
+                continue
+            # a layer widens the radius and moves both covers outwards by the same offset
+            pieces, params, tris = shapes.draw_cylinder(
+                self.lat, self.state.matrix, p[0] - grow * u, p[1] + grow * u, r,
+                solid=solid, shell=shell, mask=mask)
+            params["mask"] = mask
+            params["layer"] = layer
+            n = self._paint(el, pieces)
+            self._record(el, "cylinder", params, tris, solid, n)
 
     # ------------------------------------------------------------ polyhedra
     def _draw_polyhedron(self, el, verts, faces, shape):

@@ -111,11 +111,16 @@ def box_corners(size) -> np.ndarray:
     return np.array([[x, y, z] for x in (0.0, sx) for y in (0.0, sy) for z in (0.0, sz)])
 
 
-def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: bool):
-    """A box with a corner at ``point`` and edges ``size`` (rotated by ``angles`` about ``point``)."""
+def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: bool,
+             grow: float = 0.0):
+    """A box with a corner at ``point`` and edges ``size`` (rotated by ``angles`` about
+    ``point``), widened by ``grow`` on every side (``<layers>``)."""
     full = m @ tf.translation(point)
     if angles is not None and np.any(angles != 0):
         full = full @ tf.rotation_xyz(angles)
+    if grow:
+        full = full @ tf.translation([-grow] * 3)
+        size = np.asarray(size, dtype=np.float64) + 2.0 * grow
     verts = tf.apply(full, box_corners(size))
     pieces = []
     if tf.is_axis_aligned(full):
