@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import transform as tf
-from .lattice import EPS, Lattice, ceil_idx, floor_idx, round_idx
+from .lattice import EPS, Lattice, round_idx
 
 SLAB_NODES = 2_000_000  # nodes evaluated at once by analytic shapes
 SURFACE_HALF = 0.5      # half-width of the node band of a planar surface (lattice units)
@@ -78,8 +78,9 @@ def aligned_box_pieces(lat: Lattice, wmin, wmax, solid: bool, faces, wire: bool)
         lo = [round_idx(v) for v in a]
         hi = [round_idx(v) for v in b]
         pieces.append(box_piece(lat, lo, hi))
-    ext_lo = [ceil_idx(v - 0.5) for v in a]
-    ext_hi = [floor_idx(v + 0.5) for v in b]
+    # faces span the same node range as the volume (nearest nodes, halves rounded up)
+    ext_lo = [round_idx(v) for v in a]
+    ext_hi = [round_idx(v) for v in b]
     for face in faces:
         axis, side = FACE_AXIS[face]
         layer = round_idx(b[axis] if side else a[axis])
