@@ -48,6 +48,12 @@ CHUNK = 128
 def _hydrostatic_drho(x, rhop0, inv_gamma):
     """rho0 ((1+x)^(1/gamma) - 1): hydrostatic density difference (Fourtakas).
 
+    Called with x = rho0 |g| (z_a - z_b) / B (= -DDTgz dz), this is
+    rho^H_b - rho^H_a, so that (rho_b - rho_a) - rho^H_ba vanishes in a
+    hydrostatic column.  (Written literally with DualSPHysics's DDTgz dz,
+    DDTgz = rho0 g_z / B < 0, the correction would double the hydrostatic
+    difference instead; tests/sph/test_interaction.py checks the cancellation.)
+
     Binomial series for |x| < 0.01 (relative error < 1e-10), pow otherwise.
     """
     if abs(x) < 0.01:
@@ -276,7 +282,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                         if ddt == 2:
                             ddt_off = True
                     elif ptj == 3:
-                        drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
+                        drh = _hydrostatic_drho(-ddt_gz * dz, rhop0, inv_gamma)
                         deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
                 # shifting
                 if shift > 0:
@@ -526,7 +532,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                             if ddt == 2:
                                 ddt_off = True
                         elif ptj == 3:
-                            drh = _hydrostatic_drho(ddt_gz * dz, rhop0, inv_gamma)
+                            drh = _hydrostatic_drho(-ddt_gz * dz, rhop0, inv_gamma)
                             deltap -= ((rhoj - rhoi) - drh) * ir2e * r2 * mfac * irj
                     if shift > 0:
                         if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
