@@ -20,6 +20,7 @@ from .shapeout import FORMATS, write_shapes
 MAX_COMMANDS = 1_000_000      # commands executed in all (runlist loops included)
 MAX_LIST_DEPTH = 64
 MAX_POINTS = 1_000_000        # points or triangles written inline in one command
+MAX_SHAPE_TRIANGLES = 5_000_000  # triangles kept for <shapeout>
 DRAW_MODES = {"full", "face", "solid", "wire"}
 BOX_TOKENS = {"solid", "all", "bottom", "top", "left", "right", "front", "back"}
 FILL_TOKENS = {"void", "border", "fluid", "bound"}
@@ -81,6 +82,14 @@ class DrawState:
                          self.draw_shapes)
 
 
+def _point_summary(pts: np.ndarray, keep: int = 100) -> dict:
+    """Parameters of a point set: the points themselves when few, else count and bounds."""
+    if len(pts) <= keep:
+        return {"points": pts.tolist()}
+    return {"count": int(len(pts)), "min": pts.min(axis=0).tolist(),
+            "max": pts.max(axis=0).tolist()}
+
+
 def _attr_items(el):
     """User attributes of a variable command (name, value), skipping comments and _private ones."""
     return [(k, v) for k, v in el.attrib.items()
@@ -108,6 +117,8 @@ class GeometryRunner:
         self.line_begin = None
         self.primitives: list = []
         self.shapes: list = []
+        self.keep_shapes = True      # False when the document has no <shapeout>
+        self.shape_triangles = 0
         self.shape_files: list = []
         self.messages: list = []
         self.handlers = self._handler_table()
@@ -201,9 +212,15 @@ class GeometryRunner:
                 "mk": int(s.mk) if s.kind in ("fluid", "bound") else -1, "solid": bool(solid),
                 "mode": s.mode, "nodes": nodes, "line": el.sourceline, "params": params}
         self.primitives.append(prim)
-        if s.draw_shapes and tris is not None:
-            self.shapes.append({"triangles": np.asarray(tris), "mk": prim["mk"],
-                                "fluid": prim["fluid"]})
+        if s.draw_shapes and tris is not None and self.keep_shapes:
+            tris = np.asarray(tris)
+            if self.shape_triangles + len(tris) > MAX_SHAPE_TRIANGLES:
+                self.reader.warn(el, f"more than {MAX_SHAPE_TRIANGLES} shape triangles: this and "
+                                     "later shapes are left out of <shapeout> files")
+                self.keep_shapes = False
+                return
+            self.shape_triangles += len(tris)
+            self.shapes.append({"triangles": tris, "mk": prim["mk"], "fluid": prim["fluid"]})
 
     def _mask(self, el) -> int:
         """The ``mask`` attribute: integers combined with ``|`` (bitwise OR)."""
@@ -411,20 +428,20 @@ class GeometryRunner:
         self._need_pen(el)
         p = self._world(self.reader.vec3(el)[None, :])
         n = self._paint(el, raster.point_pieces(self.lat, p))
-        self._record(el, "point", {"points": p.tolist()}, None, False, n)
+        self._record(el, "point", {"point": p[0].tolist()}, None, False, n)
 
     def cmd_drawpoints(self, el):
         self._need_pen(el)
         self._check(el, {"point"})
         p = self._world(self._points(el, least=1))
         n = self._paint(el, raster.point_pieces(self.lat, p))
-        self._record(el, "points", {"points": p.tolist()}, None, False, n)
+        self._record(el, "points", _point_summary(p), None, False, n)
 
     def _draw_polyline(self, el, pts, shape):
         w = self._world(pts)
         segs = np.stack([w[:-1], w[1:]], axis=1)
         n = self._paint(el, raster.segment_pieces(self.lat, segs))
-        self._record(el, shape, {"points": w.tolist()}, None, False, n)
+        self._record(el, shape, _point_summary(w), None, False, n)
         self.line_begin = pts[-1]
 
     def cmd_drawline(self, el):
@@ -491,6 +508,9 @@ class GeometryRunner:
         self._need_pen(el)
         self._check(el, {"point"})
         p = self._points(el, least=3)
+        if len(p) > 256:
+            raise self.reader.error(el, f"{len(p)} polygon points", "at most 256 (use "
+                                    "<drawtriangles> for big surfaces)")
         tris = shapes.faces_to_triangles(p, [tuple(range(len(p)))])
         if len(tris) == 0:
             raise self.reader.error(el, "the polygon has no area", "at least 3 non-collinear points")
@@ -853,6 +873,7 @@ class GeometryRunner:
             self.shape_files.append(path)
         if reset:
             self.shapes = []
+            self.shape_triangles = 0
 
 
 VARIABLE_COMMANDS = {"newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",
@@ -894,6 +915,7 @@ def _run_geometry(reader, geometry_el, casename, outdir, max_nodes) -> Drawing:
                           "child element")
     pre = reader.child(geometry_el, "predefinition")
     runner = GeometryRunner(reader, None, casename, outdir)
+    runner.keep_shapes = any(True for _ in geometry_el.iter("shapeout"))
     if pre is not None:
         runner.run_commands(pre, only_variables=True)
     d, dp, pmin, pmax, pref = _read_definition(reader, geometry_el)
