@@ -56,7 +56,7 @@ def _clear_row(k, b, E, kind, lo, hi, mu, rlink, Cpos):
     hi[k] = 1e300
     mu[k] = 0.0
     rlink[k] = 0
-    Cpos[k] = 0.0
+    Cpos[k] = np.nan  # position error is defined only on rigid rows
 
 
 @njit(cache=True)
@@ -362,7 +362,7 @@ def build_contact_rows(nr, h, vrec, min_bounce, pos, Rb, vel6, nc, c_a, c_b, c_p
             hi[k] = 1e300
             mu[k] = 0.0
             rlink[k] = -1
-            Cpos[k] = 0.0
+            Cpos[k] = np.nan
         # pre-step normal velocity
         vn = 0.0
         if a >= 0:

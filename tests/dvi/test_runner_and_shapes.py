@@ -1,0 +1,95 @@
+"""CSV runner and extra shape pairs."""
+import math
+
+import numpy as np
+import pytest
+
+from sphdvi.dvi import BODIES_HEADER, LINKS_HEADER, System, run_bodies
+
+G = 9.81
+
+
+def test_run_bodies_writes_csv(tmp_path):
+    bodies = [
+        dict(name="ground", kind="fixed", shapes=[dict(shape="plane", point=(0, 0, 0), normal=(0, 0, 1))]),
+        dict(name="ball", mass=2.0, inertia=(0.008,) * 3, pos=(0, 0, 1.0), vel=(1.0, 0, 0),
+             shapes=[dict(shape="sphere", size=0.1, material="rubber")]),
+        dict(name="flap", mass=1.0, inertia=(0.01, 0.01, 0.01), pos=(3, 0, 0.5)),
+    ]
+    links = [dict(kind="hinge", body1="flap", body2=None, point=(3, 0, 1.0), axis=(0, 1, 0),
+                  stiffness=10.0, damping=0.1)]
+    mats = [dict(name="rubber", friction=0.4, restitution=0.0)]
+    s = run_bodies(bodies, links, out_dir=str(tmp_path), tmax=0.2, tout=0.05, dt=1e-3,
+                   materials=mats, gravity=(0, 0, -G), solver="bb", max_iter=100)
+    lines = (tmp_path / "bodies.csv").read_text().splitlines()
+    assert lines[0] == BODIES_HEADER
+    assert lines[0] == ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
+                        "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz")
+    assert len(lines) == 1 + 3 * 5  # t = 0, 0.05, ..., 0.2
+    data = np.genfromtxt(tmp_path / "bodies.csv", delimiter=",", names=True, dtype=None,
+                         encoding=None)
+    ball = data[data["body"] == "ball"]
+    np.testing.assert_allclose(ball["time"], [0, 0.05, 0.1, 0.15, 0.2], atol=1e-12)
+    t = ball["time"][-1]
+    assert ball["x"][-1] == pytest.approx(t, abs=1e-12)
+    assert ball["z"][-1] == pytest.approx(1 - 0.5 * G * t * t, abs=G * 1e-3 * t)
+    # total force on the free-flying ball = its weight; no contact
+    assert ball["fz"][-1] == pytest.approx(-2 * G, rel=1e-12)
+    assert ball["cfz"][-1] == 0.0
+    llines = (tmp_path / "links.csv").read_text().splitlines()
+    assert llines[0] == LINKS_HEADER
+    assert len(llines) == 1 + 5
+    assert not list(tmp_path.glob("*.tmp"))
+    # the flap hangs below the hinge: reaction on body 1 balances gravity + inertia
+    ld = np.genfromtxt(tmp_path / "links.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    assert ld["fz"][-1] > 0
+
+
+def _drop(shape_a, shape_b, steps=1500):
+    s = System(gravity=(0, 0, -G), solver="bb", max_iter=100, tol=1e-10, envelope=0.01)
+    base = s.add_body(1.0, (1, 1, 1), kind="fixed", pos=(0, 0, 0))
+    shape_a(s, base)
+    b = s.add_body(1.0, (0.01, 0.01, 0.01), pos=(0.01, 0.0, 0.5))
+    shape_b(s, b)
+    for _ in range(steps):
+        s.step(1e-3)
+    return s, b
+
+
+@pytest.mark.parametrize("pair,height", [
+    ("sphere_on_box", 0.1 + 0.1),
+    ("sphere_on_sphere_cloud", None),
+    ("capsule_on_capsule", 0.1 + 0.1),
+    ("box_on_sphere_is_unstable_but_finite", None),
+    ("cylinder_on_box", 0.1 + 0.15),
+    ("hull_on_box", 0.1 + 0.1),
+    ("sphere_on_capsule", 0.1 + 0.1),
+])
+def test_shape_pairs(pair, height):
+    cube = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float) * 0.1
+    rot_x = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0, 0)
+    rot_y = (math.cos(math.pi / 4), 0, math.sin(math.pi / 4), 0)
+    table = {
+        "sphere_on_box": (lambda s, b: s.add_box(b, (0.5, 0.5, 0.1)), lambda s, b: s.add_sphere(b, 0.1)),
+        "sphere_on_sphere_cloud": (
+            lambda s, b: s.add_cloud(b, np.array([[x, y, 0.0] for x in np.linspace(-0.3, 0.3, 13)
+                                                  for y in np.linspace(-0.3, 0.3, 13)]), 0.05),
+            lambda s, b: s.add_sphere(b, 0.1)),
+        "capsule_on_capsule": (lambda s, b: s.add_capsule(b, 0.1, 0.3, quat=rot_y),
+                               lambda s, b: s.add_capsule(b, 0.1, 0.3, quat=rot_x)),
+        "box_on_sphere_is_unstable_but_finite": (lambda s, b: s.add_sphere(b, 0.1),
+                                                  lambda s, b: s.add_box(b, (0.1, 0.1, 0.1))),
+        "cylinder_on_box": (lambda s, b: s.add_box(b, (0.5, 0.5, 0.1)), lambda s, b: s.add_cylinder(b, 0.1, 0.15)),
+        "hull_on_box": (lambda s, b: s.add_box(b, (0.5, 0.5, 0.1)), lambda s, b: s.add_hull(b, cube)),
+        "sphere_on_capsule": (lambda s, b: s.add_capsule(b, 0.1, 0.3, quat=rot_y), lambda s, b: s.add_sphere(b, 0.1)),
+    }
+    fa, fb = table[pair]
+    s, b = _drop(fa, fb)
+    assert np.all(np.isfinite(s.pos))
+    if pair == "sphere_on_sphere_cloud":
+        # sphere resting in the pocket of four cloud spheres: above 0.05 + 0.1
+        assert 0.1 < s.pos[b, 2] < 0.16
+        assert abs(s.contact_force[b, 2] / G - 1) < 1e-2
+    elif height is not None:
+        assert abs(s.pos[b, 2] - height) < 2e-3, s.pos[b]
+        assert abs(s.contact_force[b, 2] / G - 1) < 1e-2
