@@ -149,14 +149,28 @@ def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
 @click.option("--format", "fmt", type=click.Choice(["vtp"]), default="vtp", show_default=True,
               help="Output format.")
-@click.option("--dir", "subdir", default="vtp", show_default=True, help="Sub-folder of OUTDIR to write to.")
+@click.option("--dir", "subdir", default=None, help="Sub-folder of OUTDIR to write to (default vtp, or iso).")
+@click.option("--isosurface", is_flag=True,
+              help="Write the free surface (kernel-sum isosurface) of every output time instead: "
+                   "Iso_XXXX.vtp + isosurface.pvd (needs vtk).")
+@click.option("--iso-spacing", type=float, default=None, help="Isosurface grid spacing (default dp/2).")
+@click.option("--iso-threshold", type=float, default=None,
+              help="Kernel-sum level of the surface (default 0.5 in 3D, 0.4 in 2D).")
 @report_errors
-def export(outdir, fmt, subdir):
+def export(outdir, fmt, subdir, isosurface, iso_spacing, iso_threshold):
     """Export particles.vtkhdf as Part_XXXX.vtp files and a .pvd for older ParaView."""
+    if isosurface:
+        from .measure.isosurface import export_isosurface
+        files = export_isosurface(outdir, subdir or "iso", spacing=iso_spacing, threshold=iso_threshold)
+        click.echo(f"wrote {len(files) - 1} isosurface .vtp files and {files[-1]}")
+        return
     from .io.export import export_vtp
-    files = export_vtp(outdir, subdir)
+    files = export_vtp(outdir, subdir or "vtp")
     click.echo(f"wrote {len(files) - 1} .vtp files and {files[-1]}")
 
+
+from .measure.cli import measure as _measure  # noqa: E402
+main.add_command(_measure)
 
 if __name__ == "__main__":  # pragma: no cover
     main()

@@ -1,14 +1,363 @@
-"""Run-time gauges of ``<special><gauges>`` (placeholder until the measurement module lands)."""
+"""Run-time gauges of ``<special><gauges>`` (DualSPHysics ``JDsGaugeItem``), case-format.md §2.12.
+
+Types and outputs (``;``-separated, first column ``time [s]``, in OUT):
+
+* ``velocity`` -> ``GaugesVel_<name>.csv``: ``time;velx;vely;velz;posx;posy;posz``,
+  Shepard kernel interpolation at ``point`` (empty when the kernel sum < 0.5);
+* ``swl`` -> ``GaugesSWL_<name>.csv``: ``time;swlx;swly;swlz;pos0x..pos2z``, free
+  surface along ``point0`` -> ``point2`` sampled every ``pointdp`` (``value`` [m] or
+  ``coefdp``, default 0.5 dp) where the kernel sum drops below ``masslimit``
+  (``coef``, default 0.5 in 3D / 0.4 in 2D; ``value`` [kg] is divided by massfluid);
+* ``maxz`` -> ``GaugesMaxZ_<name>.csv``: ``time;zmax;posx;posy;posz``, the highest
+  fluid particle within ``distlimit`` (``value`` [m], ``coefdp`` or ``coefh``,
+  default 1.5 dp) horizontally of ``point0`` and up to ``height`` above it;
+* ``force`` -> ``GaugesForce_<name>.csv``: ``time;force;forcex;forcey;forcez``, the
+  fluid force on the particles of ``<target mkbound>`` (per metre in 2D);
+* ``mesh`` -> ``GaugesMesh_<name>.csv``: nodes ``point + i dp e1 + j dp e2 + k dp e3``
+  (e = unit ``vec1..3``, ``size1..3`` lengths, spacing dp), ``outputdata`` among
+  ``vel,veldir,rhop,zsurf`` (veldir: velocity along ``dirdat``; zsurf: free surface
+  along ``vec3`` over ``size3`` for each (i, j) column), ``kclimit`` (default 0.5,
+  ``NONE`` disables).
+
+Each gauge is computed at ``t = 0`` and then at the first step reaching each
+multiple of ``computedt`` (default TimeOut; 0 = every step) inside
+``computetime start end``; rows are kept every ``outputdt`` inside
+``outputtime``; ``output value="false"`` writes no file.  The files are
+rewritten atomically at every TimeOut and at the end.  The interpolation,
+surface and force code is that of ``sphdvi measure`` (:mod:`.core`).
+"""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from ..io.atomic import write_text_atomic
+from . import core
+
+EPS_REL = 1e-12
+
+
+def _num(d, key, default=None):
+    """A number from a raw attribute dict (``{"value": "0.1"}``) or a plain value."""
+    v = d.get(key, default) if isinstance(d, dict) else d
+    if v is None or (isinstance(v, str) and v.strip().lower() in ("", "none")):
+        return default
+    return float(v)
+
+
+class Schedule:
+    """Times k*dt (dt = 0: every call) inside [start, end]."""
+
+    def __init__(self, dt, start=0.0, end=math.inf):
+        self.dt = float(dt)
+        self.start = float(start)
+        self.end = float(end)
+        self.k = 0
+
+    def eps(self):
+        return EPS_REL * max(1.0, self.dt)
+
+    def due(self, t):
+        e = self.eps()
+        if t < self.start - e or t > self.end + e:
+            return False
+        if self.dt <= 0:
+            return True
+        if t >= self.k * self.dt - e:
+            self.k = max(self.k + 1, int(math.floor(t / self.dt + 1e-9)) + 1)
+            return True
+        return False
+
+    def skip_to(self, t):
+        """After a resume at time t: the next due time is the first multiple after t."""
+        if self.dt > 0:
+            self.k = int(math.floor(t / self.dt + 1e-9)) + 1
+
+
+class StateView:
+    """One particle state (solver order or case order) and its lazily built fluid grid."""
+
+    def __init__(self, time, pos, vel, rhop, mass, press, ptype, mk, spec):
+        self.time = float(time)
+        self.pos, self.vel, self.rhop, self.mass = pos, vel, rhop, mass
+        self.press, self.ptype, self.mk = press, ptype, mk
+        self.spec = spec
+        self._grid = None
+
+    @property
+    def grid(self) -> core.ParticleGrid:
+        if self._grid is None:
+            self._grid = core.fluid_grid(self.pos, self.vel, self.rhop, self.mass, self.press, self.ptype,
+                                         self.spec)
+        return self._grid
+
+
+# ---------------------------------------------------------------------------------
+# gauge kinds
+# ---------------------------------------------------------------------------------
+class Gauge:
+    prefix = ""
+    header: tuple = ()
+
+    def __init__(self, item, spec, data):
+        self.name = item["name"]
+        self.item = item
+        self.spec = spec
+
+    def compute(self, view: StateView) -> list:
+        raise NotImplementedError
+
+    def filename(self):
+        return f"Gauges{self.prefix}_{self.name}.csv"
+
+
+class VelocityGauge(Gauge):
+    prefix = "Vel"
+    header = ("velx [m/s]", "vely [m/s]", "velz [m/s]", "posx [m]", "posy [m]", "posz [m]")
+
+    def __init__(self, item, spec, data):
+        super().__init__(item, spec, data)
+        self.point = np.asarray(item["point"], float).reshape(1, 3)
+
+    def compute(self, view):
+        vel, _ = core.interpolate(view.grid, self.point, ("vel",))
+        return list(vel[0]) + list(self.point[0])
+
+
+class SwlGauge(Gauge):
+    prefix = "SWL"
+    header = ("swlx [m]", "swly [m]", "swlz [m]", "pos0x [m]", "pos0y [m]", "pos0z [m]",
+              "pos2x [m]", "pos2y [m]", "pos2z [m]")
+
+    def __init__(self, item, spec, data):
+        super().__init__(item, spec, data)
+        self.p0 = np.asarray(item["point0"], float).reshape(1, 3)
+        self.p2 = np.asarray(item["point2"], float).reshape(1, 3)
+        pdp = item.get("pointdp") or {}
+        self.step = _num(pdp, "value") or (_num(pdp, "coefdp", 0.5) * spec.dp)
+        ml = item.get("masslimit") or {}
+        if _num(ml, "value") is not None and spec.massfluid > 0:
+            self.limit = _num(ml, "value") / spec.massfluid
+        else:
+            self.limit = _num(ml, "coef", spec.surface_threshold)
+
+    def compute(self, view):
+        s = core.surface_along_lines(view.grid, self.p0, self.p2, self.step, self.limit)
+        return list(s[0]) + list(self.p0[0]) + list(self.p2[0])
+
+
+class MaxZGauge(Gauge):
+    prefix = "MaxZ"
+    header = ("zmax [m]", "posx [m]", "posy [m]", "posz [m]")
+
+    def __init__(self, item, spec, data):
+        super().__init__(item, spec, data)
+        self.p0 = np.asarray(item["point0"], float).reshape(1, 3)
+        self.height = float(item.get("height", math.inf))
+        dl = item.get("distlimit") or {}
+        self.radius = (_num(dl, "value") or (_num(dl, "coefh") or 0.0) * spec.h
+                       or _num(dl, "coefdp", 1.5) * spec.dp)
+
+    def compute(self, view):
+        from . import _kernels as K
+        fl = view.ptype == core.FLUID
+        out = np.empty(1)
+        idx = np.empty(1, np.int64)
+        K.column_max_z(self.p0, np.array([self.p0[0, 2] + self.height]),
+                       np.ascontiguousarray(view.pos[fl], dtype=np.float64), self.radius, self.spec.is2d, out, idx)
+        return [out[0], self.p0[0, 0], self.p0[0, 1], out[0]]
+
+
+class ForceGauge(Gauge):
+    prefix = "Force"
+
+    def __init__(self, item, spec, data):
+        super().__init__(item, spec, data)
+        tgt = item.get("target") or {}
+        self.mkbound = int(float(tgt.get("mkbound")))
+        fluidcount = int((data["json"].get("mkconfig") or {}).get("fluidcount", 0))
+        self.mk = self.mkbound + fluidcount + 1
+        u = "N/m" if spec.is2d else "N"
+        self.header = (f"force [{u}]", f"forcex [{u}]", f"forcey [{u}]", f"forcez [{u}]")
+
+    def compute(self, view):
+        sel = np.flatnonzero((view.mk == self.mk) & (view.ptype != core.FLUID))
+        f = core.fluid_forces(view.grid, view.pos[sel], view.vel[sel], view.rhop[sel], view.press[sel],
+                              view.mass[sel], self.spec)
+        total, _ = core.force_and_moment(view.pos[sel], f)
+        return [float(np.sqrt(total @ total))] + list(total)
+
+
+class MeshGauge(Gauge):
+    prefix = "Mesh"
+
+    def __init__(self, item, spec, data):
+        super().__init__(item, spec, data)
+        self.origin = np.asarray(item.get("point", [0, 0, 0]), float)
+        dp = spec.dp
+        axes, counts = [], []
+        for k in (1, 2, 3):
+            v = np.asarray(item.get(f"vec{k}", [1.0 * (k == 1), 1.0 * (k == 2), 1.0 * (k == 3)]), float)
+            nv = np.linalg.norm(v)
+            axes.append(v / nv if nv > 0 else np.zeros(3))
+            size = float(item.get(f"size{k}", 0.0) or 0.0)
+            counts.append(int(math.floor(size / dp + 1e-9)) + 1 if nv > 0 else 1)
+        self.axes, self.counts = axes, counts
+        ii, jj, kk = np.meshgrid(*(np.arange(c) for c in counts), indexing="ij")
+        self.nodes = (self.origin + dp * (ii[..., None] * axes[0] + jj[..., None] * axes[1]
+                                          + kk[..., None] * axes[2])).reshape(-1, 3)
+        self.nodes = np.ascontiguousarray(self.nodes)
+        outd = (item.get("outputdata") or {}).get("value") or "vel,rhop"
+        self.outputs = [s.strip().lower() for s in outd.split(",") if s.strip()]
+        bad = [s for s in self.outputs if s not in ("vel", "veldir", "rhop", "zsurf")]
+        if bad:
+            raise ValueError(f"mesh gauge '{self.name}': unknown outputdata {bad}; expected vel, veldir, rhop, zsurf")
+        kc = (item.get("kclimit") or {}).get("value")
+        self.kclimit = None if (kc is not None and str(kc).strip().upper() == "NONE") else _num(
+            item.get("kclimit") or {}, "value", core.DEFAULT_KCLIMIT)
+        self.dirdat = np.asarray(item.get("dirdat", [0, 0, 0]), float)
+        ml = item.get("masslimit") or {}
+        self.limit = _num(ml, "coef", spec.surface_threshold)
+        base = self.origin + dp * (np.arange(counts[0])[:, None, None] * axes[0]
+                                   + np.arange(counts[1])[None, :, None] * axes[1])
+        self.col0 = base.reshape(-1, 3)
+        self.col1 = self.col0 + float(item.get("size3", 0.0) or 0.0) * axes[2]
+        cols = []
+        n = self.nodes.shape[0]
+        for o in self.outputs:
+            if o == "vel":
+                cols += [f"{c}_{i} [m/s]" for i in range(n) for c in ("velx", "vely", "velz")]
+            elif o == "veldir":
+                cols += [f"veldir_{i} [m/s]" for i in range(n)]
+            elif o == "rhop":
+                cols += [f"rhop_{i} [kg/m^3]" for i in range(n)]
+            else:
+                cols += [f"zsurf_{i} [m]" for i in range(self.col0.shape[0])]
+        self.header = tuple(cols)
+
+    def compute(self, view):
+        vals, _ = core.interpolate(view.grid, self.nodes, ("vel", "rhop"), kclimit=self.kclimit)
+        row = []
+        for o in self.outputs:
+            if o == "vel":
+                row += list(vals[:, :3].reshape(-1))
+            elif o == "veldir":
+                d = self.dirdat / (np.linalg.norm(self.dirdat) or 1.0)
+                row += list(vals[:, :3] @ d)
+            elif o == "rhop":
+                row += list(vals[:, 3])
+            else:
+                s = core.surface_along_lines(view.grid, self.col0, self.col1, 0.25 * self.spec.dp, self.limit)
+                row += list(s @ self.axes[2])
+        return row
+
+
+GAUGE_TYPES = {"velocity": VelocityGauge, "swl": SwlGauge, "maxz": MaxZGauge, "force": ForceGauge,
+               "mesh": MeshGauge}
+
+
+# ---------------------------------------------------------------------------------
+# the run-time driver
+# ---------------------------------------------------------------------------------
+class _Slot:
+    """A gauge with its schedules and rows."""
+
+    def __init__(self, gauge, compute, output, write, path):
+        self.gauge, self.compute, self.output, self.write, self.path = gauge, compute, output, write, path
+        self.rows: list = []
+        self.dirty = False
+
+    def text(self):
+        head = "time [s];" + ";".join(self.gauge.header)
+        lines = [head] + [";".join(_fmt(v) for v in r) for r in self.rows]
+        return "\n".join(lines) + "\n"
+
+
+def _fmt(v) -> str:
+    v = float(v)
+    return "" if not math.isfinite(v) else f"{v:.9g}"
+
+
+def _read_rows(path, tmax):
+    rows = []
+    if not os.path.exists(path):
+        return rows
+    with open(path, encoding="utf-8") as fh:
+        for line in fh.read().splitlines()[1:]:
+            if not line.strip():
+                continue
+            vals = [float(v) if v.strip() else math.nan for v in line.split(";")]
+            if vals[0] <= tmax:
+                rows.append(vals)
+    return rows
 
 
 class RunGauges:
-    """Computes the case's gauges during a run at their ``computedt``."""
+    """Computes the case's gauges during a run at their ``computedt`` (see the module doc)."""
 
     def __init__(self, data, params, outdir, resume=False, time=0.0):
-        self.items = data["json"]["gauges"]["items"]
+        self.spec = core.KernelSpec.from_case(data, params)
+        self.outdir = outdir
+        gauges = data["json"].get("gauges") or {}
+        default = gauges.get("default") or {}
+        self.tout = float(params.get("TimeOut") or 0.0) or 0.01
+        self.slots = []
+        for raw in gauges.get("items") or []:
+            item = {**default, **raw}
+            gauge = GAUGE_TYPES[item["type"]](item, self.spec, data)
+            cdt = item.get("computedt")
+            ct = item.get("computetime") or {}
+            compute = Schedule(self.tout if cdt is None else float(cdt), _num(ct, "start", 0.0),
+                               _num(ct, "end", math.inf))
+            ot = item.get("outputtime") or {}
+            odt = item.get("outputdt")
+            output = Schedule(compute.dt if odt is None else float(odt), _num(ot, "start", 0.0),
+                              _num(ot, "end", math.inf))
+            write = item.get("output", True) is not False
+            self.slots.append(_Slot(gauge, compute, output, write, os.path.join(outdir, gauge.filename())))
+        self.next_flush = 1
+        if resume:
+            for s in self.slots:
+                s.rows = _read_rows(s.path, time + EPS_REL * max(1.0, time))
+                s.compute.skip_to(time)
+                s.output.skip_to(time)
+            self.next_flush = int(math.floor(time / self.tout + 1e-9)) + 1
+        else:
+            p = data["particles"]
+            view = StateView(0.0, p["pos"], p["vel"], p["rhop"], p["mass"], self.spec.tait_pressure(p["rhop"]),
+                             p["type"], p["mk"], self.spec)
+            self._measure(view)
+            self.flush()
+
+    def _measure(self, view):
+        for s in self.slots:
+            if s.compute.due(view.time):
+                row = s.gauge.compute(view)
+                if s.output.due(view.time):
+                    s.rows.append([view.time] + [float(v) for v in row])
+                    s.dirty = True
 
     def after_step(self, solver):
         """Called after every time step with the SPH solver."""
+        t = float(solver.time)
+        if not any(s.compute.dt <= 0 or t >= s.compute.k * s.compute.dt - s.compute.eps() for s in self.slots):
+            return
+        st = solver.state
+        view = StateView(t, st.pos, st.vel, st.rhop, st.mass, solver.press, st.ptype, st.mk, self.spec)
+        self._measure(view)
+        if t >= self.next_flush * self.tout - EPS_REL * max(1.0, self.tout):
+            self.flush()
+            self.next_flush = int(math.floor(t / self.tout + 1e-9)) + 1
+
+    def flush(self):
+        """Rewrite the CSV files that have new rows (atomically)."""
+        for s in self.slots:
+            if s.write and (s.dirty or not os.path.exists(s.path)):
+                write_text_atomic(s.path, s.text())
+                s.dirty = False
 
     def close(self):
         """Flush the CSV files."""
+        self.flush()

@@ -1,0 +1,214 @@
+"""``sphdvi measure``: gauges, elevation, forces and body motion from a run folder.
+
+Only click is imported at module level: numpy, h5py and numba are imported
+inside the commands, so ``sphdvi --help`` stays fast.
+"""
+from __future__ import annotations
+
+import functools
+import os
+import sys
+
+import click
+
+CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+
+
+def _report_errors(fn):
+    """sphdvi's own errors -> 'error: ...' on stderr and their exit code (no traceback)."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        from ..errors import SphdviError
+        try:
+            return fn(*args, **kwargs)
+        except click.ClickException:
+            raise
+        except SphdviError as exc:
+            click.echo(f"error: {exc}", err=True)
+            sys.exit(exc.exit_code)
+        except OSError as exc:
+            click.echo(f"error: {exc.strerror or exc}: {exc.filename or ''}", err=True)
+            sys.exit(1)
+        except Exception as exc:
+            if os.environ.get("SPHDVI_DEBUG"):
+                raise
+            click.echo(f"internal error: {type(exc).__name__}: {exc} "
+                       "(set SPHDVI_DEBUG=1 to see the traceback, and please report it)", err=True)
+            sys.exit(1)
+    return wrapper
+
+
+def _output_options(fn):
+    fn = click.option("--plot", "plot", type=click.Path(dir_okay=False), default=None,
+                      help="Also draw the series into this PNG file (needs matplotlib).")(fn)
+    fn = click.option("--sep", type=click.Choice([",", ";"]), default=",", show_default=True,
+                      help="Separator; ';' writes the DualSPHysics layout (PosX/PosY/PosZ rows, Part column).")(fn)
+    fn = click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
+                      help="Write the table to this file (default: stdout).")(fn)
+    fn = click.option("--every", type=click.IntRange(min=1), default=1, show_default=True,
+                      help="Use every N-th output time.")(fn)
+    fn = click.option("--last", type=click.IntRange(min=0), default=None, help="Last output index.")(fn)
+    fn = click.option("--first", type=click.IntRange(min=0), default=0, show_default=True,
+                      help="First output index.")(fn)
+    return fn
+
+
+def _emit(table, csv_path, sep, plot):
+    from .tables import plot_table, write_table
+    write_table(table, csv_path, sep=sep)
+    if plot:
+        plot_table(table, plot)
+    if csv_path:
+        click.echo(f"wrote {csv_path} ({table.time.shape[0]} times, {len(table.names)} columns)"
+                   + (f" and {plot}" if plot else ""), err=True)
+
+
+def _points_option(value, param_hint, ncoord=3):
+    from .post import parse_points
+    try:
+        return parse_points(value, ncoord=ncoord)
+    except (ValueError, OSError) as exc:
+        raise click.BadParameter(str(exc), param_hint=param_hint) from None
+
+
+def _vector(text, n, param_hint):
+    try:
+        vals = [float(v) for v in str(text).replace(";", ",").split(",") if v.strip()]
+    except ValueError:
+        vals = []
+    if len(vals) != n:
+        raise click.BadParameter(f"'{text}': expected {n} comma-separated numbers", param_hint=param_hint)
+    return vals
+
+
+def _run(outdir):
+    from .post import RunOutput
+    return RunOutput(outdir)
+
+
+@click.group(context_settings=CONTEXT)
+def measure():
+    """Measure a run: kernel-interpolated gauges, free-surface elevation, forces, bodies.
+
+    \b
+    Examples:
+      sphdvi measure points OUT --points "0.5,0,0.1;1,0,0.1" --vars vel,press
+      sphdvi measure elevation OUT --at "0.2;1.0" --csv elevation.csv --plot elevation.png
+      sphdvi measure forces OUT --mk 11 --point 2,0,0.2
+      sphdvi measure bodies OUT --csv bodies.csv
+    """
+
+
+@measure.command(context_settings=CONTEXT)
+@click.argument("outdir", type=click.Path(exists=True, file_okay=False))
+@click.option("--points", "points", required=True, metavar='FILE|"x,y,z;..."',
+              help="Points: 'x,y,z;x,y,z' (2D: 'x,z' allowed) or a file with one point a line "
+                   "(MeasureTool POINTS/POINTSLIST files too).")
+@click.option("--vars", "variables", default="vel,rhop,press", show_default=True,
+              help="Comma-separated: vel, rhop, press, mass, vol.")
+@click.option("--kclimit", type=float, default=0.5, show_default=True,
+              help="Kernel-sum threshold below which a point has no value (empty field).")
+@click.option("--correction", type=click.Choice(["shepard", "linear"]), default="shepard", show_default=True,
+              help="shepard: normalised by the kernel sum (MeasureTool); linear: first-order "
+                   "MLS correction, exact for linear fields.")
+@_output_options
+@_report_errors
+def points(outdir, points, variables, kclimit, correction, first, last, every, csv_path, sep, plot):
+    """Kernel-interpolated fluid values at points, at every output time.
+
+    Points closer than 1.5h to a boundary (DBC) particle are named in a warning:
+    DBC keeps the fluid about 1.5h away from walls, so values there are unreliable.
+    """
+    pts = _points_option(points, "'--points'")
+    from .post import UNITS, measure_points
+    names = [v.strip().lower() for v in variables.split(",") if v.strip()]
+    bad = [v for v in names if v not in UNITS]
+    if bad or not names:
+        raise click.BadParameter(f"unknown variable(s) {', '.join(bad) or '(none)'}; expected some of "
+                                 f"{', '.join(UNITS)}", param_hint="'--vars'")
+    run = _run(outdir)
+    table, near = measure_points(run, pts, names, kclimit=kclimit, order=1 if correction == "linear" else 0,
+                                 first=first, last=last, every=every)
+    for i, d, t in near:
+        p = pts[i]
+        click.echo(f"warning: point {i} ({p[0]:g}, {p[1]:g}, {p[2]:g}) is {d:.3g} m from a boundary particle "
+                   f"(< 1.5h = {1.5 * run.spec.h:.3g} m) at t={t:g} s: values near DBC walls are unreliable",
+                   err=True)
+    _emit(table, csv_path, sep, plot)
+
+
+@measure.command(context_settings=CONTEXT)
+@click.argument("outdir", type=click.Path(exists=True, file_okay=False))
+@click.option("--at", "at", required=True, metavar='"x[,y];..."',
+              help="Horizontal positions: 'x;x' (2D) or 'x,y;x,y' (3D), or a file.")
+@click.option("--threshold", type=float, default=None,
+              help="Kernel-sum threshold of the surface (default 0.5 in 3D, 0.4 in 2D).")
+@click.option("--dz", type=float, default=None, help="Sampling step along the vertical (default dp/4).")
+@_output_options
+@_report_errors
+def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot):
+    """Free-surface elevation and water depth along verticals (MeasureTool -elevation).
+
+    Elevation: where the kernel sum sum_b m_b/rho_b W first drops below the
+    threshold going up. Depth: elevation minus the bottom (the top boundary
+    particle below the surface, plus dp/2).
+    """
+    xy = _points_option(at, "'--at'", ncoord=2)
+    if dz is not None and not dz > 0:
+        raise click.BadParameter("must be positive", param_hint="'--dz'")
+    from .post import measure_elevation
+    run = _run(outdir)
+    _emit(measure_elevation(run, xy, threshold=threshold, dz=dz, first=first, last=last, every=every),
+          csv_path, sep, plot)
+
+
+@measure.command(context_settings=CONTEXT)
+@click.argument("outdir", type=click.Path(exists=True, file_okay=False))
+@click.option("--mk", "mk", default=None, metavar="N[,M]", help="Global mk of the particles (mkbound+fluidcount+1).")
+@click.option("--mkbound", "mkbound", default=None, metavar="N[,M]", help="Or their mkbound.")
+@click.option("--point", "point", default=None, metavar="x,y,z",
+              help="Moment about this point (default: the centre of the selected particles).")
+@click.option("--axis", "axis", default=None, metavar="x1,y1,z1,x2,y2,z2",
+              help="Moment about the axis through two points (projected on it).")
+@click.option("--no-visco", is_flag=True, help="Pressure term only (no viscous force).")
+@_output_options
+@_report_errors
+def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_path, sep, plot):
+    """Fluid force and moment on boundary or floating particles (ComputeForces).
+
+    The SPH force of the fluid on the selected particles, recomputed from each
+    snapshot with the momentum equation (pressure, tensile correction for the
+    cubic kernel, viscosity). Columns time,fx,fy,fz,mx,my,mz; per metre of width in 2D.
+    """
+    from .post import measure_forces, parse_mk_list
+    if (mk is None) == (mkbound is None):
+        raise click.UsageError("give exactly one of --mk or --mkbound")
+    try:
+        mks = parse_mk_list(mk if mk is not None else mkbound)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), param_hint="'--mk'" if mk is not None else "'--mkbound'") from None
+    centre = _vector(point, 3, "'--point'") if point else None
+    ax = None
+    if axis:
+        v = _vector(axis, 6, "'--axis'")
+        ax = (v[:3], v[3:])
+    run = _run(outdir)
+    table = measure_forces(run, mks, mkbound=mkbound is not None, point=centre, axis=ax,
+                           viscosity=not no_visco, first=first, last=last, every=every)
+    _emit(table, csv_path, sep, plot)
+
+
+@measure.command(context_settings=CONTEXT)
+@click.argument("outdir", type=click.Path(exists=True, file_okay=False))
+@_output_options
+@_report_errors
+def bodies(outdir, first, last, every, csv_path, sep, plot):
+    """Body motion and loads per body (FloatingInfo), and link forces.
+
+    From bodies.csv/links.csv when the run wrote them (body-only runs), else
+    derived from the floating particles of each snapshot: centre, surge/sway/
+    heave, roll/pitch/yaw [deg], linear and angular velocity, fluid force and
+    torque about the centre, contact force and torque (empty when not recorded).
+    """
+    from .post import measure_bodies
+    _emit(measure_bodies(outdir, first=first, last=last, every=every), csv_path, sep, plot)

@@ -1,0 +1,558 @@
+"""Post-processing of a run folder (``sphdvi measure``): points, elevation, forces, bodies.
+
+Each function reads OUT/particles.vtkhdf step by step (only the arrays it
+needs, the file kept open) and the gencase file OUT/<casename>.h5 (kernel,
+h, dp, masses by Idp, parameters), and returns a :class:`~.tables.Table`.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from . import core
+from .tables import Table
+
+UNITS = {"vel": "m/s", "rhop": "kg/m^3", "press": "Pa", "mass": "kg", "vol": "m^3"}
+VARS = ("vel", "rhop", "press")
+
+
+# ---------------------------------------------------------------------------------
+# reading a run folder
+# ---------------------------------------------------------------------------------
+@dataclass
+class Snapshot:
+    """One output time of particles.vtkhdf (arrays in file order)."""
+
+    part: int
+    time: float
+    pos: np.ndarray
+    vel: np.ndarray | None
+    rhop: np.ndarray | None
+    press: np.ndarray | None
+    ptype: np.ndarray
+    idp: np.ndarray
+    mk: np.ndarray | None
+    mass: np.ndarray
+
+
+class RunOutput:
+    """A run folder: the case file, its kernel spec and the particle snapshots."""
+
+    def __init__(self, outdir: str):
+        from ..io.casefile import read_case_h5
+        from ..simulation import find_case_file
+        if not os.path.isdir(outdir):
+            raise InputError(f"{outdir}: not a folder")
+        self.outdir = outdir
+        self.case_file = find_case_file(outdir)
+        self.data = read_case_h5(self.case_file)
+        self.params = dict(self.data["parameters"])
+        run_json = os.path.join(outdir, "run.json")
+        if os.path.exists(run_json):
+            try:
+                with open(run_json) as fh:
+                    self.params.update(json.load(fh).get("parameters") or {})
+            except (json.JSONDecodeError, OSError):
+                pass
+        self.spec = core.KernelSpec.from_case(self.data, self.params)
+        p = self.data["particles"]
+        idp = np.asarray(p["idp"], np.int64)
+        self.mass_by_idp = np.zeros(int(idp.max(initial=-1)) + 1)
+        self.mass_by_idp[idp] = p["mass"]
+        self.fluidcount = int((self.data["json"].get("mkconfig") or {}).get("fluidcount", 0))
+        self.vtk_path = os.path.join(outdir, "particles.vtkhdf")
+
+    @property
+    def has_particles(self) -> bool:
+        return os.path.exists(self.vtk_path)
+
+    def times(self) -> np.ndarray:
+        from ..io.vtkhdf import step_times
+        self._require_particles()
+        return step_times(self.vtk_path)
+
+    def _require_particles(self):
+        if not self.has_particles:
+            raise InputError(f"{self.vtk_path} not found: run 'sphdvi run {self.outdir}' first")
+
+    def snapshots(self, arrays=("Vel", "Rhop", "Press", "Mk"), first=0, last=None, every=1):
+        """Yield :class:`Snapshot` objects for steps first..last (inclusive)."""
+        import h5py
+        self._require_particles()
+        with h5py.File(self.vtk_path, "r") as f:
+            root = f["VTKHDF"]
+            steps = root["Steps"]
+            nsteps = int(steps.attrs["NSteps"])
+            values = steps["Values"][:nsteps]
+            offs = steps["PointOffsets"][:nsteps]
+            counts = root["NumberOfPoints"][:nsteps]
+            pd = root["PointData"]
+            last = nsteps - 1 if last is None else min(int(last), nsteps - 1)
+            for k in range(int(first), last + 1, max(1, int(every))):
+                o, n = int(offs[k]), int(counts[k])
+
+                def read(name):
+                    if name not in pd:
+                        return None
+                    d = steps["PointDataOffsets"][name][k]
+                    return pd[name][int(d):int(d) + n]
+
+                idp = read("Idp").astype(np.int64)
+                yield Snapshot(
+                    part=k, time=float(values[k]), pos=root["Points"][o:o + n],
+                    vel=read("Vel") if "Vel" in arrays else None,
+                    rhop=read("Rhop") if "Rhop" in arrays else None,
+                    press=read("Press") if "Press" in arrays else None,
+                    ptype=read("Type"), idp=idp, mk=read("Mk") if "Mk" in arrays else None,
+                    mass=self.mass_by_idp[idp])
+
+    def fluid_grid(self, snap: Snapshot) -> core.ParticleGrid:
+        press = snap.press if snap.press is not None else self.spec.tait_pressure(snap.rhop)
+        return core.fluid_grid(snap.pos, snap.vel, snap.rhop, snap.mass, press, snap.ptype, self.spec)
+
+    def domain_z(self):
+        d = self.data.get("domain") or {}
+        lo, hi = d.get("posmin"), d.get("posmax")
+        return (float(lo[2]), float(hi[2])) if lo is not None and hi is not None else (None, None)
+
+
+# ---------------------------------------------------------------------------------
+# parsing of point lists
+# ---------------------------------------------------------------------------------
+def parse_points(text: str, is2d: bool | None = None, ncoord: int = 3) -> np.ndarray:
+    """Points from ``"x,y,z;x,y,z"`` or a file (one point a line, separators , ; or
+    spaces, ``#`` comments; MeasureTool ``POINTS`` / ``POINTSLIST`` files too).
+
+    ``ncoord=2`` accepts ``x[,y]`` per point (elevation). Raises ValueError.
+    """
+    if os.path.isfile(text):
+        with open(text, encoding="utf-8") as fh:
+            return _points_from_lines(fh.read().splitlines(), ncoord, source=text)
+    items = [s for s in text.replace("\n", ";").split(";") if s.strip()]
+    if not items:
+        raise ValueError("no points given")
+    return _points_from_lines(items, ncoord, source=None)
+
+
+def _numbers(line: str):
+    return [float(v) for v in line.replace(",", " ").replace(";", " ").replace(":", " ").split()]
+
+
+def _points_from_lines(lines, ncoord, source):
+    pts = []
+    mode = None
+    plist = []
+    for no, raw in enumerate(lines, 1):
+        line = raw.split("#", 1)[0].strip()
+        if not line or line.startswith("//"):
+            continue
+        word = line.split()[0].upper()
+        if word in ("POINTS", "POINTSLIST", "POINTSENDLIST"):
+            mode = word
+            continue
+        where = f"{source}:{no}: " if source else ""
+        try:
+            vals = _numbers(line)
+        except ValueError:
+            raise ValueError(f"{where}'{raw.strip()}' is not a list of numbers") from None
+        if mode == "POINTSLIST":
+            if len(vals) != 3:
+                raise ValueError(f"{where}'{raw.strip()}': expected 3 numbers in a POINTSLIST")
+            plist.append(vals)
+            if len(plist) == 3:
+                pts.extend(_pointslist(plist))
+                plist = []
+            continue
+        if ncoord == 2:
+            if len(vals) not in (1, 2, 3):
+                raise ValueError(f"{where}'{raw.strip()}': expected x or x,y")
+            pts.append([vals[0], vals[1] if len(vals) > 1 else 0.0, 0.0])
+        else:
+            if len(vals) == 2:                  # 2D shorthand x,z
+                vals = [vals[0], 0.0, vals[1]]
+            if len(vals) != 3:
+                raise ValueError(f"{where}'{raw.strip()}': expected 3 coordinates x,y,z")
+            pts.append(vals)
+    if not pts:
+        raise ValueError("no points given")
+    arr = np.asarray(pts, np.float64)
+    if not np.isfinite(arr).all():
+        raise ValueError("point coordinates must be finite")
+    return arr
+
+
+def _pointslist(rows):
+    """MeasureTool POINTSLIST: three rows 'begin x y z', 'step dx dy dz', 'count nx ny nz'."""
+    begin, step, count = (np.asarray(r, float) for r in rows)
+    n = np.maximum(count.astype(int), 1)
+    grid = np.stack(np.meshgrid(*(np.arange(k) for k in n), indexing="ij"), -1).reshape(-1, 3)
+    return (begin + grid * step).tolist()
+
+
+# ---------------------------------------------------------------------------------
+# measure points
+# ---------------------------------------------------------------------------------
+def _component_names(var: str, is2d: bool):
+    if var == "vel":
+        return ["velx", "vely", "velz"]
+    return [var]
+
+
+def measure_points(run: RunOutput, points, variables=VARS, kclimit=core.DEFAULT_KCLIMIT, order=0,
+                   wall_factor=1.5, first=0, last=None, every=1):
+    """Kernel interpolation of ``variables`` at ``points`` at every output time.
+
+    Returns (table, near_wall) where ``near_wall`` lists (point index, min
+    distance, first time) of points closer than ``wall_factor`` h to a
+    boundary particle at some output time.
+    """
+    points = core.as_points(points)
+    variables = list(variables)
+    for v in variables:
+        if v not in UNITS:
+            raise InputError(f"unknown variable '{v}'; expected some of {', '.join(UNITS)}")
+    spec = run.spec
+    names, units, positions = [], [], []
+    for v in variables:
+        for i in range(points.shape[0]):
+            for comp in _component_names(v, spec.is2d):
+                names.append(f"{comp}_{i}")
+                units.append(UNITS[v])
+                positions.append(points[i])
+    times, parts, rows = [], [], []
+    near: dict = {}
+    rwall = wall_factor * spec.h
+    for snap in run.snapshots(first=first, last=last, every=every):
+        grid = run.fluid_grid(snap)
+        vals, _ = core.interpolate(grid, points, variables, order=order, kclimit=kclimit)
+        # column order: variable, point, component
+        row, col = [], 0
+        for v in variables:
+            ncomp = 3 if v == "vel" else 1
+            row.append(vals[:, col:col + ncomp].reshape(-1))
+            col += ncomp
+        rows.append(np.concatenate(row) if row else np.zeros(0))
+        times.append(snap.time)
+        parts.append(snap.part)
+        bound = snap.pos[snap.ptype != core.FLUID]
+        if wall_factor > 0 and bound.shape[0]:
+            d = core.nearest_particle_distance(points, bound, spec, min(rwall, 2.0 * spec.h))
+            for i in np.flatnonzero(d < rwall):
+                if int(i) not in near:
+                    near[int(i)] = (float(d[i]), snap.time)
+                else:
+                    near[int(i)] = (min(near[int(i)][0], float(d[i])), near[int(i)][1])
+    table = Table(np.asarray(times), names, units, np.asarray(rows).reshape(len(rows), len(names)),
+                  np.asarray(parts, np.int64), np.asarray(positions).reshape(-1, 3), title="points")
+    near_wall = [(i, d, t) for i, (d, t) in sorted(near.items())]
+    return table, near_wall
+
+
+# ---------------------------------------------------------------------------------
+# measure elevation
+# ---------------------------------------------------------------------------------
+def elevation_step(grid: core.ParticleGrid, bound_pos, xy, zlo, zhi, spec, threshold, dz):
+    """Free-surface elevation and water depth at the (x, y) positions of one snapshot.
+
+    Elevation: first drop of the kernel sum below ``threshold`` going up the
+    vertical from ``zlo`` (MeasureTool -elevation).  Bottom: the top of the
+    boundary below the surface (highest boundary particle within dp
+    horizontally) plus dp/2, its half spacing (the wall face).
+    """
+    from . import _kernels as K
+    xy = np.asarray(xy, np.float64).reshape(-1, 3)
+    p0 = xy.copy()
+    p1 = xy.copy()
+    p0[:, 2] = zlo
+    p1[:, 2] = zhi
+    surf = core.surface_along_lines(grid, p0, p1, dz, threshold)[:, 2]
+    bottom = np.full(xy.shape[0], np.nan)
+    if bound_pos.shape[0]:
+        zlim = np.where(np.isfinite(surf), surf, zhi)
+        K.column_top_below(xy, np.ascontiguousarray(zlim, dtype=np.float64),
+                           np.ascontiguousarray(bound_pos, dtype=np.float64), 0.5 * spec.dp * 1.0001 + 1e-12,
+                           spec.is2d, bottom)
+        if np.isnan(bottom).any():     # no column exactly below: widen to dp
+            wide = np.empty_like(bottom)
+            K.column_top_below(xy, np.ascontiguousarray(zlim, dtype=np.float64),
+                               np.ascontiguousarray(bound_pos, dtype=np.float64), spec.dp * 1.0001,
+                               spec.is2d, wide)
+            bottom = np.where(np.isnan(bottom), wide, bottom)
+        bottom = bottom + 0.5 * spec.dp
+    return surf, bottom
+
+
+def measure_elevation(run: RunOutput, xy, threshold=None, dz=None, first=0, last=None, every=1):
+    """Free-surface elevation and water depth at each (x, y) at every output time."""
+    spec = run.spec
+    xy = np.asarray(xy, np.float64).reshape(-1, 3).copy()
+    if spec.is2d:
+        xy[:, 1] = float(run.data["constants"].get("posy2d") or 0.0)
+    threshold = spec.surface_threshold if threshold is None else float(threshold)
+    dz = 0.25 * spec.dp if dz is None else float(dz)
+    names, units, positions = [], [], []
+    for i in range(xy.shape[0]):
+        names += [f"elevation_{i}", f"depth_{i}"]
+        units += ["m", "m"]
+        positions += [xy[i], xy[i]]
+    times, parts, rows = [], [], []
+    for snap in run.snapshots(arrays=("Rhop",), first=first, last=last, every=every):
+        fl = snap.ptype == core.FLUID
+        grid = core.ParticleGrid(snap.pos[fl], spec, {"vol": snap.mass[fl] / snap.rhop[fl]})
+        bound = snap.pos[~fl]
+        if grid.n:
+            zlo = min(float(snap.pos[:, 2].min()), float(grid.pos[:, 2].min())) - 2 * spec.h
+            zhi = float(grid.pos[:, 2].max()) + 2 * spec.h
+        else:
+            zlo, zhi = 0.0, 1.0
+        surf, bottom = elevation_step(grid, bound, xy, zlo, zhi, spec, threshold, dz)
+        rows.append(np.column_stack([surf, surf - bottom]).reshape(-1))
+        times.append(snap.time)
+        parts.append(snap.part)
+    return Table(np.asarray(times), names, units, np.asarray(rows).reshape(len(rows), len(names)),
+                 np.asarray(parts, np.int64), np.asarray(positions).reshape(-1, 3), title="elevation")
+
+
+# ---------------------------------------------------------------------------------
+# measure forces
+# ---------------------------------------------------------------------------------
+def parse_mk_list(text: str):
+    """``"11,12"`` or ``"11-14"`` -> [11, 12, ...]; raises ValueError."""
+    out = []
+    for part in str(text).replace(";", ",").split(","):
+        part = part.strip()
+        if not part:
+            continue
+        if "-" in part[1:]:
+            a, b = part.split("-", 1)
+            lo, hi = int(a), int(b)
+            if hi < lo:
+                raise ValueError(f"empty mk range '{part}'")
+            out.extend(range(lo, hi + 1))
+        else:
+            out.append(int(part))
+    if not out:
+        raise ValueError("no mk given")
+    return out
+
+
+def force_units(is2d):
+    return ("N/m", "N*m/m") if is2d else ("N", "N*m")
+
+
+def target_mask(snap: Snapshot, mks, fluidcount=0, mkbound=False):
+    """Non-fluid particles whose mk (global, or mkbound when ``mkbound``) is in ``mks``."""
+    mk = snap.mk.astype(np.int64)
+    if mkbound:
+        mk = mk - fluidcount - 1
+    return np.isin(mk, np.asarray(mks, np.int64)) & (snap.ptype != core.FLUID)
+
+
+def step_force(run: RunOutput, snap: Snapshot, sel, grid=None, centre=None, axis=None, viscosity=True):
+    """Total fluid force and moment on the particles ``sel`` of one snapshot."""
+    spec = run.spec
+    grid = grid or run.fluid_grid(snap)
+    press = snap.press if snap.press is not None else spec.tait_pressure(snap.rhop)
+    f = core.fluid_forces(grid, snap.pos[sel], snap.vel[sel], snap.rhop[sel], press[sel], snap.mass[sel],
+                          spec, viscosity=viscosity)
+    return core.force_and_moment(snap.pos[sel], f, centre=centre, axis=axis)
+
+
+def measure_forces(run: RunOutput, mks, mkbound=False, point=None, axis=None, viscosity=True,
+                   first=0, last=None, every=1):
+    """Fluid force and moment on the particles of ``mks`` (ComputeForces).
+
+    Moment about ``point`` (default: the mean position of the selected
+    particles at each time); with ``axis`` = (p1, p2) the moment about the
+    axis through p1 and p2, as a vector along it."""
+    ax = None
+    if axis is not None:
+        p1, p2 = np.asarray(axis[0], float), np.asarray(axis[1], float)
+        if np.linalg.norm(p2 - p1) == 0:
+            raise InputError("--axis: the two points are equal")
+        point, ax = p1, p2 - p1
+    fu, mu = force_units(run.spec.is2d)
+    names = ["fx", "fy", "fz", "mx", "my", "mz"]
+    units = [fu] * 3 + [mu] * 3
+    times, parts, rows = [], [], []
+    found = False
+    for snap in run.snapshots(first=first, last=last, every=every):
+        sel = np.flatnonzero(target_mask(snap, mks, run.fluidcount, mkbound))
+        found = found or sel.size > 0
+        f, m = step_force(run, snap, sel, centre=point, axis=ax, viscosity=viscosity)
+        rows.append(np.concatenate([f, m]))
+        times.append(snap.time)
+        parts.append(snap.part)
+    if not found:
+        kind = "mkbound" if mkbound else "mk"
+        raise InputError(f"no boundary or floating particles with {kind} {','.join(map(str, mks))} in "
+                         f"{run.vtk_path}")
+    return Table(np.asarray(times), names, units, np.asarray(rows).reshape(len(rows), 6),
+                 np.asarray(parts, np.int64), title="forces")
+
+
+# ---------------------------------------------------------------------------------
+# measure bodies
+# ---------------------------------------------------------------------------------
+BODY_COLUMNS = (("cx", "m"), ("cy", "m"), ("cz", "m"), ("surge", "m"), ("sway", "m"), ("heave", "m"),
+                ("roll", "deg"), ("pitch", "deg"), ("yaw", "deg"), ("vx", "m/s"), ("vy", "m/s"),
+                ("vz", "m/s"), ("wx", "rad/s"), ("wy", "rad/s"), ("wz", "rad/s"),
+                ("ffx", "F"), ("ffy", "F"), ("ffz", "F"), ("ftx", "M"), ("fty", "M"), ("ftz", "M"),
+                ("cfx", "F"), ("cfy", "F"), ("cfz", "F"), ("ctx", "M"), ("cty", "M"), ("ctz", "M"))
+LINK_COLUMNS = (("fx", "F"), ("fy", "F"), ("fz", "F"), ("tx", "M"), ("ty", "M"), ("tz", "M"))
+
+
+def rotation_to_euler_deg(R):
+    """Roll, pitch, yaw [deg] of R = Rz(yaw) Ry(pitch) Rx(roll) (the convention of bodies.csv)."""
+    roll = math.atan2(R[2, 1], R[2, 2])
+    pitch = math.asin(max(-1.0, min(1.0, -R[2, 0])))
+    yaw = math.atan2(R[1, 0], R[0, 0])
+    return np.degrees([roll, pitch, yaw])
+
+
+def rigid_fit(ref, cur, is2d=False):
+    """Rotation R and translation t minimising |R ref + t - cur| (Kabsch 1976, SVD);
+    in 2D the rotation is about y only."""
+    mr, mc = ref.mean(axis=0), cur.mean(axis=0)
+    a, b = ref - mr, cur - mc
+    if is2d:
+        # rotation about y in the x-z plane: angle from the 2D cross/dot sums
+        s = np.sum(a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2])
+        c = np.sum(a[:, 0] * b[:, 0] + a[:, 2] * b[:, 2])
+        th = math.atan2(s, c)
+        R = np.array([[math.cos(th), 0.0, math.sin(th)], [0.0, 1.0, 0.0], [-math.sin(th), 0.0, math.cos(th)]])
+    else:
+        u, _, vt = np.linalg.svd(a.T @ b)
+        d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+        R = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return R, mc - R @ mr
+
+
+def rigid_velocity(pos, vel, centre, is2d=False):
+    """Linear velocity of ``centre`` and angular velocity w of a rigid set of particles
+    (least squares of v_i = V + w x (x_i - c))."""
+    m = pos.mean(axis=0)
+    r = pos - m
+    vm = vel.mean(axis=0)
+    L = np.cross(r, vel - vm).sum(axis=0)
+    inertia = (r * r).sum() * np.eye(3) - r.T @ r
+    if is2d:
+        w = np.array([0.0, L[1] / inertia[1, 1] if inertia[1, 1] > 0 else 0.0, 0.0])
+    else:
+        w = np.linalg.lstsq(inertia, L, rcond=None)[0]
+    return vm + np.cross(w, np.asarray(centre) - m), w
+
+
+def _body_table_columns(names, is2d, links=()):
+    fu, mu = force_units(is2d)
+    unit = {"F": fu, "M": mu}
+    cols, units = [], []
+    for nm in names:
+        for c, u in BODY_COLUMNS:
+            cols.append(f"{nm}_{c}")
+            units.append(unit.get(u, u))
+    for ln in links:
+        for c, u in LINK_COLUMNS:
+            cols.append(f"{ln}_{c}")
+            units.append(unit.get(u, u))
+    return cols, units
+
+
+def bodies_from_csv(outdir: str, is2d: bool) -> Table:
+    """The body table from bodies.csv / links.csv of a body-only run (no fluid:
+    the fluid force is zero)."""
+    import csv
+    with open(os.path.join(outdir, "bodies.csv"), newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    links = []
+    lpath = os.path.join(outdir, "links.csv")
+    if os.path.exists(lpath):
+        with open(lpath, newline="") as fh:
+            links = list(csv.DictReader(fh))
+    names = list(dict.fromkeys(r["body"] for r in rows))
+    lnames = list(dict.fromkeys(r["link"] for r in links))
+    times = sorted({float(r["time"]) for r in rows})
+    tindex = {t: i for i, t in enumerate(times)}
+    cols, units = _body_table_columns(names, is2d, lnames)
+    data = np.full((len(times), len(cols)), np.nan)
+    first = {}
+    nb = len(BODY_COLUMNS)
+    for r in rows:
+        i = tindex[float(r["time"])]
+        b = names.index(r["body"])
+        c = np.array([float(r[k]) for k in ("x", "y", "z")])
+        first.setdefault(r["body"], c)
+        vals = np.concatenate([c, c - first[r["body"]], [float(r[k]) for k in ("roll", "pitch", "yaw")],
+                               [float(r[k]) for k in ("vx", "vy", "vz", "wx", "wy", "wz")], np.zeros(6),
+                               [float(r[k]) for k in ("cfx", "cfy", "cfz", "ctx", "cty", "ctz")]])
+        data[i, b * nb:(b + 1) * nb] = vals
+    base = len(names) * nb
+    for r in links:
+        t = float(r["time"])
+        if t not in tindex:
+            continue
+        l = lnames.index(r["link"])
+        data[tindex[t], base + 6 * l: base + 6 * (l + 1)] = [float(r[k]) for k in
+                                                              ("fx", "fy", "fz", "tx", "ty", "tz")]
+    return Table(np.asarray(times), cols, units, data, title="bodies")
+
+
+def bodies_from_snapshots(run: RunOutput, first=0, last=None, every=1) -> Table:
+    """Body motion of the floating bodies from the particle snapshots (rigid fit of
+    each body's particles to their initial positions), and the fluid force and
+    torque about the centre recomputed from the fluid (contact forces: not
+    recorded in SPH runs, left empty)."""
+    data = run.data
+    bodies = data.get("bodies") or {}
+    if "mk" not in bodies or len(bodies["mk"]) == 0:
+        raise InputError(f"{run.outdir}: the case has no floating bodies and no bodies.csv")
+    is2d = run.spec.is2d
+    mks = [int(v) for v in bodies["mk"]]
+    names = [f"mkbound{int(v)}" for v in bodies["mkbound"]]
+    centre0 = np.asarray(bodies["center"], float).reshape(-1, 3)
+    p = data["particles"]
+    ref = {}
+    for b, mk in enumerate(mks):
+        sel = np.flatnonzero((p["mk"] == mk) & (p["type"] != core.FLUID))
+        o = np.argsort(p["idp"][sel])
+        ref[b] = (p["idp"][sel][o], p["pos"][sel][o])
+    cols, units = _body_table_columns(names, is2d)
+    nb = len(BODY_COLUMNS)
+    times, parts, rows = [], [], []
+    for snap in run.snapshots(first=first, last=last, every=every):
+        grid = run.fluid_grid(snap)
+        row = np.full(len(cols), np.nan)
+        for b, mk in enumerate(mks):
+            sel = np.flatnonzero((snap.mk == mk) & (snap.ptype != core.FLUID))
+            if sel.size == 0:
+                continue
+            sel = sel[np.argsort(snap.idp[sel])]
+            ridp, rpos = ref[b]
+            keep = np.isin(ridp, snap.idp[sel])
+            R, t = rigid_fit(rpos[keep], snap.pos[sel], is2d)
+            c = R @ centre0[b] + t
+            v, w = rigid_velocity(snap.pos[sel], snap.vel[sel].astype(float), c, is2d)
+            f, m = step_force(run, snap, sel, grid=grid, centre=c)
+            row[b * nb:(b + 1) * nb] = np.concatenate([c, c - centre0[b], rotation_to_euler_deg(R), v, w, f, m,
+                                                       np.full(6, np.nan)])
+        rows.append(row)
+        times.append(snap.time)
+        parts.append(snap.part)
+    return Table(np.asarray(times), cols, units, np.asarray(rows).reshape(len(rows), len(cols)),
+                 np.asarray(parts, np.int64), title="bodies")
+
+
+def measure_bodies(outdir: str, first=0, last=None, every=1) -> Table:
+    """Per body: centre, surge/sway/heave, roll/pitch/yaw, velocities, fluid force and
+    torque, contact force and torque, and link forces (FloatingInfo)."""
+    from ..io.casefile import read_case_h5
+    from ..simulation import find_case_file
+    if os.path.exists(os.path.join(outdir, "bodies.csv")):
+        is2d = bool(read_case_h5(find_case_file(outdir))["constants"]["is2d"])
+        return bodies_from_csv(outdir, is2d)
+    return bodies_from_snapshots(RunOutput(outdir), first=first, last=last, every=every)
