@@ -24,6 +24,9 @@ Draw modes (``setdrawmode``)
     ``all`` or any of ``bottom|top|left|right|front|back`` = those faces
     (left/right = x min/max, front/back = y min/max, bottom/top = z min/max),
     ``|`` adds and ``^`` removes (``all ^ top``), left to right.
+    Planar shapes (triangle, quadri, strips, fans, polygon, triangles) are
+    surfaces in every mode but ``wire``. Mesh files draw their surface, plus
+    the inside (even-odd rule) with ``autofill="true"``.
 
 Boxes (GenCase's rule, checked against the particle counts GenCase wrote for
 three DualSPHysics example cases, on and off the lattice)
@@ -33,9 +36,6 @@ three DualSPHysics example cases, on and off the lattice)
     rotated box the volume is the box widened by dp/2 along its own axes and
     the faces follow the planar-surface rule below (GenCase draws rotated
     faces somewhat thicker: 960 vs 832 nodes in its RotatedBox example).
-    Planar shapes (triangle, quadri, strips, fans, polygon, triangles) are
-    surfaces in every mode but ``wire``. Mesh files draw their surface, plus
-    the inside (even-odd rule) with ``autofill="true"``.
 
 Surfaces (see :mod:`.raster`)
     Planar faces: nodes whose distance to the plane is in (-dp/2, dp/2] and
@@ -62,7 +62,7 @@ Fills (``fillpoint``, ``fillvoidpoint``, ``fillbox``)
     nodes whose kind is listed in ``<modefill>`` (void, fluid, bound; the
     ``mkfluid``/``mkbound`` attributes restrict fluid/bound nodes to that mk;
     ``border`` alone means void, GenCase users see no difference), limited to
-    the lattice or to the nodes inside the ``fillbox`` box. Every reached node
+    the lattice or to the ``fillbox`` box (the node range of a solid box). Every reached node
     gets the current pen. A seed outside, or on a node of another kind, fills
     nothing (warning).
 
