@@ -1,0 +1,162 @@
+"""sphdvi measure on analytic snapshots: hydrostatic tank (elevation, forces), CLI, CSV."""
+import os
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from _tank import hydrostatic_tank, write_run
+from sphdvi.cli import main
+from sphdvi.measure.post import RunOutput, measure_elevation, measure_forces, measure_points
+from sphdvi.measure.tables import Table, read_table, table_text, write_table
+
+DEPTH = 0.4
+
+
+@pytest.fixture(scope="module")
+def tank2d(tmp_path_factory):
+    tank = hydrostatic_tank(1.0, DEPTH, 0.02, True, layers=3)
+    return tank, write_run(str(tmp_path_factory.mktemp("t2d")), tank, times=(0.0, 0.1))
+
+
+@pytest.fixture(scope="module")
+def tank3d(tmp_path_factory):
+    tank = hydrostatic_tank(0.6, DEPTH, 0.04, False, width=0.4, layers=3)
+    return tank, write_run(str(tmp_path_factory.mktemp("t3d")), tank)
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+@pytest.mark.parametrize("which", ["tank2d", "tank3d"])
+def test_elevation_equals_depth(which, request):
+    """Still tank: elevation and depth equal the water depth within dp/2
+    (measured: 2D +0.0036 m with dp 0.02, 3D -0.0008 m with dp 0.04)."""
+    tank, out = request.getfixturevalue(which)
+    dp = tank["constants"]["dp"]
+    xy = [[0.3, 0.2, 0.0], [0.11, 0.13, 0.0]]
+    t = measure_elevation(RunOutput(out), xy)
+    assert t.names == ["elevation_0", "depth_0", "elevation_1", "depth_1"]
+    assert np.all(np.abs(t.data - DEPTH) < dp / 2), t.data
+
+
+@pytest.mark.parametrize("which", ["tank2d", "tank3d"])
+def test_force_on_bottom_equals_weight(which, request):
+    """Force of the fluid on the bottom of a hydrostatic tank = weight of the water
+    within 1 % (measured: 2D Wendland h=sqrt(2)dp: 0.78 % low; 3D h=sqrt(3)dp: 0.25 % low)."""
+    tank, out = request.getfixturevalue(which)
+    run = RunOutput(out)
+    t = measure_forces(run, [0], mkbound=True)
+    assert t.names == ["fx", "fy", "fz", "mx", "my", "mz"]
+    fz = t.column("fz")
+    assert np.all(np.abs(-fz / tank["weight"] - 1.0) < 0.01), fz / tank["weight"]
+    assert np.all(np.abs(t.data[:, :2]) < 1e-9 * tank["weight"])
+    # the whole tank (bottom + walls, by global mk) carries the weight too
+    t_all = measure_forces(run, [2, 3])
+    assert np.all(np.abs(-t_all.column("fz") / tank["weight"] - 1.0) < 0.01)
+    # moment of a symmetric load about the tank centre line is ~0; about x=0 it is F * L/2
+    L = 1.0 if tank["constants"]["is2d"] else 0.6
+    t0 = measure_forces(run, [0], mkbound=True, point=[L / 2, 0.2, 0.0])
+    assert abs(t0.column("my")[0]) < 1e-9 * tank["weight"]
+    ta = measure_forces(run, [0], mkbound=True, axis=([0, 0, 0], [0, 1, 0]))
+    np.testing.assert_allclose(ta.column("my")[0], -L / 2 * t0.column("fz")[0], rtol=2e-3)
+    assert ta.column("mx")[0] == 0 and ta.column("mz")[0] == 0
+
+
+def test_points_values_and_wall_flag(tank2d):
+    tank, out = tank2d
+    c = tank["constants"]
+    run = RunOutput(out)
+    pts = np.array([[0.5, 0.0, 0.2], [0.01, 0.0, 0.2], [0.5, 0.0, 0.8]])
+    t, near = measure_points(run, pts, ["press", "rhop", "vel"])
+    assert t.time.tolist() == [0.0, 0.1] and t.part.tolist() == [0, 1]
+    p_expected = c["rhop0"] * 9.81 * (DEPTH - 0.2)
+    assert abs(t.column("press_0")[0] / p_expected - 1) < 0.01
+    assert np.isnan(t.column("press_2")).all() and np.isnan(t.column("velx_2")).all()
+    assert [i for i, _, _ in near] == [1]
+    r = invoke("measure", "points", out, "--points", "0.5,0,0.2;0.01,0,0.2", "--vars", "press")
+    assert r.exit_code == 0, r.output
+    assert "point 1 (0.01, 0, 0.2)" in r.stderr and "1.5h" in r.stderr
+
+
+def test_cli_outputs_and_exit_codes(tank2d, tmp_path):
+    tank, out = tank2d
+    r = invoke("measure", "points", out, "--points", "0.5,0,0.1")
+    assert r.exit_code == 0, r.output
+    lines = r.stdout.splitlines()
+    assert lines[0].startswith("time [s],velx_0 [m/s],vely_0 [m/s],velz_0 [m/s],rhop_0 [kg/m^3],press_0 [Pa]")
+    assert len(lines) == 3
+    pts = tmp_path / "pts.txt"
+    pts.write_text("POINTS\n0.5 0 0.1\n# comment\n0.6 0 0.1\n")
+    r = invoke("measure", "points", out, "--points", pts, "--vars", "press", "--csv", tmp_path / "p.csv", "--sep", ";")
+    assert r.exit_code == 0, r.output
+    text = (tmp_path / "p.csv").read_text().splitlines()
+    assert text[0] == " ;PosX [m]:;0.5;0.6" and text[3] == "Part;Time [s];press_0 [Pa];press_1 [Pa]"
+    # bad input: exit 2, clear message, no traceback
+    for bad in ("1,2,3,4", "a,b,c", ";", str(tmp_path / "missing.txt")):
+        r = invoke("measure", "points", out, "--points", bad)
+        assert r.exit_code == 2, (bad, r.output)
+        assert "Invalid value for '--points'" in r.output and "Traceback" not in r.output
+    r = invoke("measure", "points", out, "--points", "0,0,0", "--vars", "vel,foo")
+    assert r.exit_code == 2 and "foo" in r.output
+    r = invoke("measure", "forces", out, "--mk", "77")
+    assert r.exit_code == 2 and "no boundary or floating particles with mk 77" in r.output
+    r = invoke("measure", "forces", out)
+    assert r.exit_code == 2
+    r = invoke("measure", "forces", out, "--mk", "2", "--axis", "1,2")
+    assert r.exit_code == 2 and "--axis" in r.output
+    r = invoke("measure", "elevation", str(tmp_path), "--at", "0.5")
+    assert r.exit_code == 2 and "no gencase output" in r.output
+    r = invoke("measure", "forces", out, "--mkbound", "0", "--csv", tmp_path / "f.csv")
+    assert r.exit_code == 0, r.output
+    t = read_table(str(tmp_path / "f.csv"))
+    assert t.names == ["fx", "fy", "fz", "mx", "my", "mz"] and t.units[:3] == ["N/m"] * 3
+
+
+def test_csv_round_trip(tmp_path):
+    rng = np.random.default_rng(3)
+    data = rng.normal(size=(4, 3)) * 1e3
+    data[1, 2] = np.nan
+    t = Table(np.array([0.0, 0.01, 0.02, 0.03]), ["velx_0", "press_0", "press_1"], ["m/s", "Pa", "Pa"], data,
+              np.arange(4), np.array([[0.1, 0, 0.2], [0.1, 0, 0.2], [0.3, 0, 0.4]]))
+    for sep in (",", ";"):
+        path = tmp_path / f"t{sep == ';'}.csv"
+        write_table(t, str(path), sep=sep)
+        back = read_table(str(path))
+        assert back.names == t.names and back.units == t.units
+        np.testing.assert_array_equal(back.time, t.time)
+        np.testing.assert_allclose(back.data, t.data, rtol=5e-9, equal_nan=True)   # 9 digits
+        assert np.isnan(back.data[1, 2])
+        assert table_text(back, sep) == path.read_text()          # text round trip is exact
+        if sep == ";":
+            np.testing.assert_array_equal(back.positions, t.positions)
+            np.testing.assert_array_equal(back.part, t.part)
+
+
+def test_plot(tank2d, tmp_path):
+    pytest.importorskip("matplotlib")
+    tank, out = tank2d
+    r = invoke("measure", "elevation", out, "--at", "0.3;0.6", "--plot", tmp_path / "e.png", "--csv",
+               tmp_path / "e.csv")
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "e.png").stat().st_size > 1000
+
+
+def test_isosurface_export(tank3d):
+    pytest.importorskip("vtkmodules")
+    tank, out = tank3d
+    r = invoke("export", out, "--isosurface")
+    assert r.exit_code == 0, r.output
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+    rd = vtkXMLPolyDataReader()
+    rd.SetFileName(os.path.join(out, "iso", "Iso_0000.vtp"))
+    rd.Update()
+    poly = rd.GetOutput()
+    assert poly.GetNumberOfPolys() > 100
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    p = vtk_to_numpy(poly.GetPoints().GetData())
+    mid = (np.abs(p[:, 0] - 0.3) < 0.1) & (np.abs(p[:, 1] - 0.2) < 0.1) & (p[:, 2] > DEPTH / 2)
+    assert mid.sum() > 10           # the free surface, away from the sheet along the walls
+    assert np.abs(p[mid, 2] - DEPTH).max() < tank["constants"]["dp"] / 2
+    assert os.path.exists(os.path.join(out, "iso", "isosurface.pvd"))
