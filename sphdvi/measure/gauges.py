@@ -271,7 +271,7 @@ class _Slot:
 
     def text(self):
         head = "time [s];" + ";".join(self.gauge.header)
-        lines = [head] + [";".join(_fmt(v) for v in r) for r in self.rows]
+        lines = [head] + [";".join([f"{r[0]:.15g}"] + [_fmt(v) for v in r[1:]]) for r in self.rows]
         return "\n".join(lines) + "\n"
 
 

@@ -58,7 +58,7 @@ def table_text(t: Table, sep: str = ",") -> str:
     buf.write(sep.join(head) + "\n")
     part = t.part if t.part is not None else np.arange(t.time.shape[0])
     for i in range(t.time.shape[0]):
-        cells = ([str(int(part[i]))] if dsph else []) + [_fmt(float(t.time[i]))]
+        cells = ([str(int(part[i]))] if dsph else []) + [f"{float(t.time[i]):.15g}"]
         cells += [_fmt(float(v)) for v in t.data[i]]
         buf.write(sep.join(cells) + "\n")
     return buf.getvalue()
