@@ -188,9 +188,12 @@ def broad_phase(lo, hi, sh_body, sh_type, body_active, pairs):
 
 # ---------------------------------------------------------- signed distances
 @njit(cache=True)
-def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes):
+def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes,
+              cg_meta, cg_start, reach):
     """Signed distance and outward unit gradient (tuple) of shape s at the
-    local point q (tuple)."""
+    local point q (tuple).  For a sphere cloud only centres closer than
+    ``reach`` are searched (body-frame cell grid); beyond, ``reach − r`` is
+    returned."""
     if t == SPHERE:
         n = math.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2)
         if n < 1e-14:
@@ -247,21 +250,33 @@ def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, plane
                 best = d
                 g = (planes[p, 0], planes[p, 1], planes[p, 2])
         return best, g
-    # CLOUD: union of spheres
-    best = 1e300
+    # CLOUD: union of spheres, searched in the body-frame cell grid
+    ox, oy, oz, cs = cg_meta[s, 0], cg_meta[s, 1], cg_meta[s, 2], cg_meta[s, 3]
+    nx, ny, nz = int(cg_meta[s, 4]), int(cg_meta[s, 5]), int(cg_meta[s, 6])
+    base = int(cg_meta[s, 7])
+    kr = int(math.ceil(reach / cs))
+    ix = int(math.floor((q[0] - ox) / cs))
+    iy = int(math.floor((q[1] - oy) / cs))
+    iz = int(math.floor((q[2] - oz) / cs))
+    best = reach * reach
     g = (0.0, 0.0, 1.0)
-    for p in range(samp_off[s], samp_off[s] + samp_cnt[s]):
-        v0 = q[0] - samp_pts[p, 0]
-        v1 = q[1] - samp_pts[p, 1]
-        v2 = q[2] - samp_pts[p, 2]
-        d2 = v0 * v0 + v1 * v1 + v2 * v2
-        if d2 < best:
-            best = d2
-            n = math.sqrt(d2)
-            if n < 1e-14:
-                g = (0.0, 0.0, 1.0)
-            else:
-                g = (v0 / n, v1 / n, v2 / n)
+    off = samp_off[s]
+    for cx in range(max(ix - kr, 0), min(ix + kr, nx - 1) + 1):
+        for cy in range(max(iy - kr, 0), min(iy + kr, ny - 1) + 1):
+            for cz in range(max(iz - kr, 0), min(iz + kr, nz - 1) + 1):
+                cell = base + (cx * ny + cy) * nz + cz
+                for p in range(off + cg_start[cell], off + cg_start[cell + 1]):
+                    v0 = q[0] - samp_pts[p, 0]
+                    v1 = q[1] - samp_pts[p, 1]
+                    v2 = q[2] - samp_pts[p, 2]
+                    d2 = v0 * v0 + v1 * v1 + v2 * v2
+                    if d2 < best:
+                        best = d2
+                        n = math.sqrt(d2)
+                        if n < 1e-14:
+                            g = (0.0, 0.0, 1.0)
+                        else:
+                            g = (v0 / n, v1 / n, v2 / n)
     return math.sqrt(best) - dims[0], g
 
 
@@ -550,7 +565,7 @@ def _closest_segments_t(p1, q1, p2, q2):
 @njit(cache=True)
 def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
                     sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
-                    pl_off, pl_cnt, planes, w_pos, w_R, lo, hi, sh_body,
+                    pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo, hi, sh_body,
                     c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
     """Samples of shape sp (radius ρ) against the SDF of shape so.  The contact
     normal is −∇φ_so (from sp to so); ``swap`` reverses the pair order so that
@@ -562,6 +577,7 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
     rho = samp_rad[sp]
     to = sh_type[so]
     dims = sh_dims[so]
+    reach = rho + dims[0] + max(env, 0.0) + 1e-12
     for p in range(samp_off[sp], samp_off[sp] + samp_cnt[sp]):
         x = v_add(cP, mat_vec(RP, row3(samp_pts, p)))
         # AABB cull against the other shape
@@ -574,7 +590,7 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
             continue
         ql = mat_t_vec(RO, v_sub(x, cO))
         phi, gl = sdf_local(to, dims, ql, so, samp_off, samp_cnt, samp_pts,
-                            pl_off, pl_cnt, planes)
+                            pl_off, pl_cnt, planes, cg_meta, cg_start, reach)
         gap = phi - rho
         if gap >= env:
             continue
@@ -591,14 +607,42 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
 
 
 @njit(cache=True)
+def _cylinder_plane_support(sc, sp, bc, bpl, nc, cap, env, keybase, sh_dims, w_pos, w_R,
+                            c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """Exact deepest rim point of each cap of a cylinder against a plane (the
+    rim samples alone would make a lying cylinder roll like a polygon)."""
+    n = col(w_R[sp], 2)                      # plane normal (world)
+    a = col(w_R[sc], 2)                      # cylinder axis (world)
+    an = v_dot(a, n)
+    if abs(an) > 0.999:
+        return nc
+    rdir = v_sub(v_scale(a, an), n)          # −n projected on the cap plane
+    rdir = v_scale(rdir, 1.0 / math.sqrt(v_dot(rdir, rdir)))
+    c = row3(w_pos, sc)
+    p0 = row3(w_pos, sp)
+    R = sh_dims[sc, 0]
+    H = sh_dims[sc, 1]
+    for side in range(2):
+        sg = 1.0 if side == 0 else -1.0
+        x = v_add(v_add(c, v_scale(a, sg * H)), v_scale(rdir, R))
+        gap = v_dot(v_sub(x, p0), n)
+        if gap < env:
+            pt = v_sub(x, v_scale(n, 0.5 * gap))
+            # pair order: cylinder first, normal from cylinder to plane = −n
+            nc = _emit_t(nc, cap, bc, bpl, sc, sp, pt, v_scale(n, -1.0), gap,
+                         keybase + 1000000 + side, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return nc
+
+
+@njit(cache=True)
 def _point_like(t):
     return t == SPHERE or t == CLOUD
 
 
 @njit(cache=True)
 def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cnt,
-                 samp_pts, samp_rad, pl_off, pl_cnt, planes, w_pos, w_R, lo, hi,
-                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+                 samp_pts, samp_rad, pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R,
+                 lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
     """All contacts of the candidate pairs with gap < env.  Returns the count
     (which may exceed the capacity: the caller then grows and calls again)."""
     cap = c_a.shape[0]
@@ -641,17 +685,22 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                           w_R[s2], sh_dims[s2], env, keybase, nc, cap,
                           c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep)
             continue
+        if t1 == CYLINDER and t2 == PLANE:
+            nc = _cylinder_plane_support(s1, s2, b1, b2, nc, cap, env, keybase, sh_dims, w_pos,
+                                         w_R, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
         pl1 = _point_like(t1)
         pl2 = _point_like(t2)
         if t1 != PLANE and (pl1 or not pl2):
             nc = _samples_vs_sdf(s1, s2, b1, b2, False, nc, cap, env, keybase,
                                  sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
-                                 pl_off, pl_cnt, planes, w_pos, w_R, lo, hi, sh_body,
+                                 pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo,
+                                 hi, sh_body,
                                  c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
         if t2 != PLANE and (pl2 or not pl1) and not (pl1 and pl2):
             nc = _samples_vs_sdf(s2, s1, b2, b1, True, nc, cap, env, keybase,
                                  sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
-                                 pl_off, pl_cnt, planes, w_pos, w_R, lo, hi, sh_body,
+                                 pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo,
+                                 hi, sh_body,
                                  c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
     return nc
 

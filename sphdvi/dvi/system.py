@@ -143,6 +143,8 @@ class System:
         self.pl_off = np.zeros(0, np.int32)
         self.pl_cnt = np.zeros(0, np.int32)
         self.planes = np.zeros((0, 4))
+        self.cg_meta = np.zeros((0, 8))
+        self.cg_start = np.zeros(0, np.int64)
         # links
         self.links = []          # python records, index = link id
         self._mates = []
@@ -303,6 +305,7 @@ class System:
             dims[0] = radius if radius > 0 else dims[0]
             srad = dims[0]
             crad = dims[0]
+            samples, meta, starts = self._cloud_grid(samples, dims[0])
         else:
             raise ValueError(f"unknown shape {shape!r}")
         self.sh_body = np.append(self.sh_body, np.int32(body)).astype(np.int32)
@@ -319,7 +322,28 @@ class System:
         self.pl_off = np.append(self.pl_off, np.int32(self.planes.shape[0])).astype(np.int32)
         self.pl_cnt = np.append(self.pl_cnt, np.int32(planes.shape[0])).astype(np.int32)
         self.planes = np.vstack([self.planes, planes])
+        if t == col.CLOUD:
+            meta[7] = self.cg_start.shape[0]
+            self.cg_start = np.concatenate([self.cg_start, starts])
+        else:
+            meta = np.zeros(8)
+        self.cg_meta = np.vstack([self.cg_meta, meta[None]])
         return self.sh_type.shape[0] - 1
+
+    @staticmethod
+    def _cloud_grid(pts, r):
+        """Body-frame cell grid of a sphere cloud (cell = 2r): points sorted by
+        cell, meta = (origin xyz, cell size, nx, ny, nz, base), cell starts."""
+        cs = max(2.0 * r, 1e-12)
+        org = pts.min(axis=0) - 1e-9
+        ijk = np.floor((pts - org) / cs).astype(np.int64)
+        nxyz = ijk.max(axis=0) + 1
+        cid = (ijk[:, 0] * nxyz[1] + ijk[:, 1]) * nxyz[2] + ijk[:, 2]
+        order = np.argsort(cid, kind="stable")
+        ncell = int(np.prod(nxyz))
+        starts = np.searchsorted(cid[order], np.arange(ncell + 1)).astype(np.int64)
+        meta = np.array([org[0], org[1], org[2], cs, nxyz[0], nxyz[1], nxyz[2], 0.0])
+        return pts[order], meta, starts
 
     @staticmethod
     def _merge_facets(eq):
@@ -665,8 +689,8 @@ class System:
                      key=np.empty(cap, np.int64))
             nc = col.narrow_phase(npair, pairs, self.envelope, self.sh_body, self.sh_type,
                                   self.sh_dims, self.samp_off, self.samp_cnt, self.samp_pts,
-                                  self.samp_rad, self.pl_off, self.pl_cnt, self.planes, w_pos,
-                                  w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
+                                  self.samp_rad, self.pl_off, self.pl_cnt, self.planes,
+                                  self.cg_meta, self.cg_start, w_pos, w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
                                   c["n"], c["gap"], c["key"])
             if nc <= cap:
                 break

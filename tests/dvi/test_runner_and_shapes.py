@@ -93,3 +93,47 @@ def test_shape_pairs(pair, height):
     elif height is not None:
         assert abs(s.pos[b, 2] - height) < 2e-3, s.pos[b]
         assert abs(s.contact_force[b, 2] / G - 1) < 1e-2
+
+
+def test_cylinder_rolls_smoothly_on_plane():
+    """A lying cylinder rolling down a slope: a = (2/3) g sin θ (exact support
+    contacts, not the polygon of rim samples)."""
+    th = math.radians(10)
+    s = System(gravity=(G * math.sin(th), 0, -G * math.cos(th)), solver="bb", max_iter=100,
+               tol=1e-12, envelope=0.01)
+    m = s.add_material("m", friction=0.6)
+    s.add_plane(material=m)
+    r, hl = 0.1, 0.1
+    Iax = 0.5 * r * r
+    Ipe = (3 * r * r + 4 * hl * hl) / 12
+    q = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0, 0)  # axis along world y
+    b = s.add_body(1.0, (Ipe, Ipe, Iax), pos=(0, 0, r), quat=q)
+    s.add_cylinder(b, r, hl, material=m)
+    zs = []
+    for _ in range(1000):
+        s.step(1e-3)
+        zs.append(s.pos[b, 2])
+    a = 2.0 / 3.0 * G * math.sin(th)
+    assert abs(s.pos[b, 0] / (0.5 * a) - 1) < 1e-2
+    assert np.ptp(zs) < 1e-4
+
+
+def test_cloud_on_cloud_stack():
+    """Two particle-cloud cubes (DualSPHysics AutoActual-like): the top one
+    rests on the bottom one at a gap of one particle diameter."""
+    dp = 0.02
+    g1 = np.arange(-0.09, 0.0901, dp)
+    cube = np.array([[x, y, z] for x in g1 for y in g1 for z in g1])
+    s = System(gravity=(0, 0, -G), solver="bb", max_iter=100, tol=1e-10, envelope=0.005)
+    s.add_plane()
+    lo = s.add_body(1.0, (0.01,) * 3, pos=(0, 0, 0.1))
+    s.add_cloud(lo, cube, radius=dp / 2)
+    hi = s.add_body(1.0, (0.01,) * 3, pos=(0.005, 0, 0.32))
+    s.add_cloud(hi, cube, radius=dp / 2)
+    for _ in range(1000):
+        s.step(1e-3)
+    assert abs(s.pos[lo, 2] - 0.1) < 1e-3
+    assert abs(s.pos[hi, 2] - 0.3) < 2e-3
+    assert abs(s.contact_force[hi, 2] / G - 1) < 1e-2
+    Fg = s.contact_force[:, 2].sum()
+    assert abs(Fg / (2 * G) - 1) < 1e-2
