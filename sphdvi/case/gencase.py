@@ -309,14 +309,20 @@ def apply_floating_velocities(particles: dict, bodies: list) -> None:
 
 def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody) -> dict | None:
     """Mass and central inertia of a floating body drawn as exactly one solid primitive."""
-    mine = [p for p in primitives if not p.get("fluid") and p.get("mk") == mkbound]
+    mine = [p for p in primitives if not p.get("fluid") and not p.get("void") and p.get("mk") == mkbound]
     if len(mine) != 1:
         return None
     prim = mine[0]
+    if any(p.get("void") and p.get("line", 0) > prim.get("line", 0) for p in primitives):
+        return None          # something may have been carved out of it
     shape, par = prim.get("shape"), prim.get("params", {})
+    axes = np.eye(3)
     try:
         if shape == "box":
             size = np.abs(np.asarray(par["size"], float))
+            axes = np.asarray(par.get("axes", np.eye(3)), float).T      # columns: the box edges
+            if not np.allclose(axes.T @ axes, np.eye(3), atol=1e-9):
+                return None      # sheared by a non-uniform scale after a rotation
             if is2d:
                 volume = size[0] * size[2]
             else:
@@ -345,8 +351,8 @@ def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody)
     except (KeyError, TypeError, ValueError):
         return None
     mass = density * volume if density is not None else massbody
-    return {"shape": shape, "volume": float(volume), "mass": float(mass),
-            "inertia": np.diag(mass * diag).tolist()}
+    inertia = axes @ np.diag(mass * diag) @ axes.T
+    return {"shape": shape, "volume": float(volume), "mass": float(mass), "inertia": inertia.tolist()}
 
 
 # ---------------------------------------------------------------------------

@@ -232,3 +232,58 @@ def test_shapes_rest_on_plane_and_box(shape):
         assert abs(s.pos[b, 2] - hz) < 2e-3, (shape, b, s.pos[b])
         assert abs(s.contact_force[b, 2] / G - 1) < 1e-2
         assert np.abs(s.vel[b]).max() < 1e-3
+
+
+@pytest.mark.parametrize("gap", [0.0, 0.01])
+def test_newtons_cradle_momentum(gap):
+    """M10: 4 equal balls on a line (no gravity, frictionless, e = 1).
+    Momentum conserved to 1e-8 (relative), kinetic energy never increases;
+    with small gaps the sequential impacts give 'one ball out'."""
+    s = System(gravity=(0, 0, 0), solver="bb", max_iter=500, tol=1e-13, envelope=0.002,
+               min_bounce_speed=1e-3)
+    m = s.add_material("steel", friction=0.0, restitution=1.0)
+    r = 0.05
+    balls = []
+    for i in range(4):
+        x = i * (2 * r + gap) + (0.0 if i else -0.05)
+        b = s.add_body(1.0, (0.001,) * 3, pos=(x, 0, 0), vel=(1.0 if i == 0 else 0.0, 0, 0))
+        s.add_sphere(b, r, material=m)
+        balls.append(b)
+    p0 = s.vel[:, 0].sum()
+    e0 = s.kinetic_energy()
+    for _ in range(300):
+        s.step(1e-3)
+        assert abs(s.vel[:, 0].sum() - p0) < 1e-8 * abs(p0)
+        assert s.kinetic_energy() <= e0 * (1 + 1e-9)
+    if gap > 0:
+        np.testing.assert_allclose(s.vel[:, 0], [0, 0, 0, 1.0], atol=0.01)
+
+
+def test_painleve_rod_stays_finite():
+    """M11: a rod sliding on a plane at 30° with μ = 1.5 (Painlevé region):
+    the velocity-level DVI always has a solution — finite, energy
+    non-increasing, no penetration beyond the recovery tolerance."""
+    s = System(gravity=(0, 0, -G), solver="bb", max_iter=200, tol=1e-12, envelope=0.01)
+    mat = s.add_material("rough", friction=1.5)
+    s.add_plane(material=mat)
+    L = 1.0
+    th = math.radians(30)
+    I = 1.0 * L * L / 12
+    phi = 0.5 * (math.pi / 2 - th)   # body z axis -> (cos θ, 0, sin θ)
+    q = (math.cos(phi), 0, math.sin(phi), 0)
+    zc = 0.5 * L * math.sin(th)      # lower end touching the plane
+    b = s.add_body(1.0, (I, I, 1e-4), pos=(0, 0, zc), quat=q, vel=(-3.0, 0, 0))
+    s.add_capsule(b, 0.0, L / 2, material=mat)
+    e0 = s.kinetic_energy() + s.potential_energy()
+    emax = e0
+    zmin = 1.0
+    for _ in range(1000):
+        s.step(1e-3)
+        assert np.all(np.isfinite(s.pos)) and np.all(np.isfinite(s.vel))
+        e = s.kinetic_energy() + s.potential_energy()
+        emax = max(emax, e)
+        from sphdvi.dvi._math import np_quat_to_mat
+        ax = np_quat_to_mat(s.quat[b])[:, 2]
+        zmin = min(zmin, s.pos[b, 2] - 0.5 * L * abs(ax[2]))
+    assert emax <= e0 + 1e-6
+    assert zmin > -1e-3
