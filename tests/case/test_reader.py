@@ -285,3 +285,23 @@ def test_bad_material_values(tmp_path):
     props = ('<properties><property name="x"><PoissonRatio value="0.7"/></property></properties>')
     with pytest.raises(CaseError, match="PoissonRatio 0.7 out of range"):
         build(tmp_path, casedef_extra=props)
+
+
+def test_analytic_inertia_of_rotated_box(tmp_path):
+    """A 3D box rotated 30° about z: analytic inertia R diag(I) Rᵀ is printed beside the particle one."""
+    commands = """
+        <setmkbound mk="3" />
+        <move x="0.5" y="0.5" z="0.5" />
+        <rotate ang="30" x="0" y="0" z="1" />
+        <drawbox><boxfill>solid</boxfill><point x="-0.2" y="-0.1" z="-0.05" /><size x="0.4" y="0.2" z="0.1" /></drawbox>"""
+    r = build(tmp_path, dp="0.02", pointmin=("-0.5", "-0.5", "-0.5"), pointmax=("1.5", "1.5", "1.5"),
+              commands=commands, casedef_extra='<floatings><floating mkbound="3" rhopbody="500"/></floatings>')
+    (b,) = r.bodies
+    a = b.analytic
+    m = 500 * 0.4 * 0.2 * 0.1
+    assert a["mass"] == pytest.approx(m)
+    c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
+    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    local = np.diag([0.2 ** 2 + 0.1 ** 2, 0.4 ** 2 + 0.1 ** 2, 0.4 ** 2 + 0.2 ** 2]) * m / 12
+    assert np.allclose(a["inertia"], R @ local @ R.T, rtol=1e-9, atol=1e-12)
+    assert b.center == pytest.approx([0.5, 0.5, 0.5], abs=0.011)
