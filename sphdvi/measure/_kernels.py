@@ -71,6 +71,21 @@ def _cell_of(x, y, z, pmin, inv_cs, ncx, ncy, ncz, is2d):
 
 
 @njit(cache=True)
+def bounding_box(pos):
+    """Min and max corners of the positions (N >= 1, 3)."""
+    lo = pos[0].copy()
+    hi = pos[0].copy()
+    for i in range(1, pos.shape[0]):
+        for k in range(3):
+            v = pos[i, k]
+            if v < lo[k]:
+                lo[k] = v
+            elif v > hi[k]:
+                hi[k] = v
+    return lo, hi
+
+
+@njit(cache=True)
 def sort_into_cells(pos, pmin, inv_cs, ncx, ncy, ncz, is2d, order, cell_start):
     """Counting sort of the particles by cell (x fastest, stable).
 

@@ -92,7 +92,7 @@ class ParticleGrid:
         self.cellsize = 2.0 * spec.h
         self.inv_cs = 1.0 / self.cellsize
         if self.n:
-            lo, hi = pos.min(axis=0), pos.max(axis=0)
+            lo, hi = K.bounding_box(pos)
         else:
             lo = hi = np.zeros(3)
         self.pmin = np.ascontiguousarray(lo, dtype=np.float64)
