@@ -552,7 +552,8 @@ def measure_bodies(outdir: str, first=0, last=None, every=1) -> Table:
     torque, contact force and torque, and link forces (FloatingInfo)."""
     from ..io.casefile import read_case_h5
     from ..simulation import find_case_file
-    if os.path.exists(os.path.join(outdir, "bodies.csv")):
-        is2d = bool(read_case_h5(find_case_file(outdir))["constants"]["is2d"])
-        return bodies_from_csv(outdir, is2d)
+    data = read_case_h5(find_case_file(outdir))
+    has_fluid = bool(np.any(data["particles"]["type"] == core.FLUID))
+    if os.path.exists(os.path.join(outdir, "bodies.csv")) and not has_fluid:
+        return bodies_from_csv(outdir, bool(data["constants"]["is2d"]))
     return bodies_from_snapshots(RunOutput(outdir), first=first, last=last, every=every)

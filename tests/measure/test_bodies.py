@@ -1,11 +1,9 @@
 """sphdvi measure bodies: from bodies.csv/links.csv, and from floating-particle snapshots."""
 import csv
 import math
-import os
 from types import SimpleNamespace
 
 import numpy as np
-import pytest
 from click.testing import CliRunner
 
 from _tank import lattice
