@@ -690,13 +690,25 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                                          w_R, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
         pl1 = _point_like(t1)
         pl2 = _point_like(t2)
-        if t1 != PLANE and (pl1 or not pl2):
+        if pl1 and pl2:
+            # two point-like shapes: sample the cloud against the sphere's O(1)
+            # SDF, or the smaller cloud against the other cloud's grid
+            if t1 == SPHERE or (t2 == CLOUD and samp_cnt[s1] > samp_cnt[s2]):
+                dir_a = False
+                dir_b = True
+            else:
+                dir_a = True
+                dir_b = False
+        else:
+            dir_a = t1 != PLANE and (pl1 or not pl2)
+            dir_b = t2 != PLANE and (pl2 or not pl1)
+        if dir_a:
             nc = _samples_vs_sdf(s1, s2, b1, b2, False, nc, cap, env, keybase,
                                  sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
                                  pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo,
                                  hi, sh_body,
                                  c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-        if t2 != PLANE and (pl2 or not pl1) and not (pl1 and pl2):
+        if dir_b:
             nc = _samples_vs_sdf(s2, s1, b2, b1, True, nc, cap, env, keybase,
                                  sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
                                  pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo,

@@ -42,6 +42,11 @@ SOLVER_PSOR = 0
 SOLVER_APGD = 1
 SOLVER_BB = 2
 SOLVER_NAMES = {"psor": SOLVER_PSOR, "apgd": SOLVER_APGD, "bb": SOLVER_BB}
+# accepted spellings (DualSPHysics offers BB and MINRES; MINRES only handles
+# bilateral problems, which the "direct" path solves exactly)
+SOLVER_ALIASES = {"psor": "psor", "pgs": "psor", "sor": "psor", "gs": "psor", "apgd": "apgd",
+                  "apgdref": "apgd", "bb": "bb", "barzilaiborwein": "bb", "spg": "bb",
+                  "direct": "direct", "minres": "direct"}
 
 
 # ------------------------------------------------------------------ projection

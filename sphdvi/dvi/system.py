@@ -19,7 +19,7 @@ from . import rows as rw
 from ._math import (body_rotations, frame_from_axis, integrate_bodies, np_mat_to_quat,
                     np_quat_to_mat)
 from ._kernels import apply_dof_masks, free_velocity, link_point_torques
-from .solvers import SOLVER_NAMES, prepare_rows, solve_ccp, solve_direct
+from .solvers import SOLVER_ALIASES, SOLVER_NAMES, prepare_rows, solve_ccp, solve_direct
 
 FLOATING = 0
 FIXED = 1
@@ -89,7 +89,10 @@ class System:
                  omega=1.0, recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.01,
                  contactmethod="nsc", smc_model="hertz", position_projection=False):
         self.gravity = np.asarray(gravity, dtype=np.float64)
-        self.solver = solver
+        key = str(solver).lower().replace("_", "").replace("-", "")
+        if key not in SOLVER_ALIASES:
+            raise ValueError(f"unknown solver {solver!r}; use psor, apgd, bb or direct")
+        self.solver = SOLVER_ALIASES[key]
         self.max_iter = int(max_iter)
         self.tol = float(tol)
         self.omega = float(omega)
@@ -218,6 +221,7 @@ class System:
         self.imposed = np.vstack([self.imposed, imp[None]])
         self._imposed_fn.append(fn)
         self._motion.append(motion)
+        self._packed = False
         self.names.append(name if name is not None else f"body{self.nb - 1}")
         for a in ("contact_force", "contact_torque", "total_force", "total_torque"):
             setattr(self, a, np.zeros((self.nb, 3)))
@@ -600,6 +604,9 @@ class System:
         self.link_force = np.zeros((len(self.links), 3))
         self.link_torque = np.zeros((len(self.links), 3))
         self._link_P1w = np.zeros((len(self.links), 3))
+        self._link_b1 = np.array([l["b1"] for l in self.links], np.int64)
+        self._imposed_fn_idx = [i for i, f in enumerate(self._imposed_fn) if f is not None]
+        self._motion_idx = [i for i, f in enumerate(self._motion) if f is not None]
         self._packed = True
 
     def _update_time_dependent(self, t_next):
@@ -716,13 +723,12 @@ class System:
         R = body_rotations(self.quat)
         # imposed velocities (rows) and moving bodies (kinematic)
         imp = self.imposed.copy()
-        for i, fn in enumerate(self._imposed_fn):
-            if fn is not None:
-                imp[i] = [np.nan if c is None else c for c in fn(t_next)]
+        for i in self._imposed_fn_idx:
+            imp[i] = [np.nan if c is None else c for c in self._imposed_fn[i](t_next)]
         self._imposed_now = imp
-        for i, mo in enumerate(self._motion):
-            if mo is not None and self.kind[i] == MOVING:
-                v, w = mo(t_next)
+        for i in self._motion_idx:
+            if self.kind[i] == MOVING:
+                v, w = self._motion[i](t_next)
                 self.vel[i] = v
                 self.omega_b[i] = R[i].T @ np.asarray(w, float)
         # applied loads
@@ -891,8 +897,8 @@ class System:
                           (self.d_P1w, self.d_lid), (self.p_P1w, self.p_lid)):
             if lids.shape[0]:
                 P1w[lids] = arr
-        b1 = np.array([l["b1"] for l in self.links], np.int64)
         self.link_force = lf
+        b1 = self._link_b1
         self.link_torque = link_point_torques(lf, ltc, P1w, b1, self.pos)
 
     # ------------------------------------------------------------ accessors
