@@ -85,7 +85,7 @@ class System:
         the O(h²v²/L) drift of the velocity-level stabilisation.
     """
 
-    def __init__(self, gravity=(0.0, 0.0, -9.81), solver="bb", max_iter=100, tol=0.0,
+    def __init__(self, gravity=(0.0, 0.0, -9.81), solver="bb", max_iter=100, tol=1e-10,
                  omega=1.0, recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.01,
                  contactmethod="nsc", smc_model="hertz", position_projection=False):
         self.gravity = np.asarray(gravity, dtype=np.float64)

@@ -148,3 +148,40 @@ def test_imposed_velocity_with_spring_stays_attached():
     assert abs(s.pos[b, 0] - 0.2) < 1e-9
     assert abs(s.pos[b, 2] - 1.0) > 1e-3  # spring acts on the free component
     assert np.linalg.norm(s.link_force[0]) > 0
+
+
+def test_spherical_joint_rotational_stiffness():
+    """Spherical joint with rotational stiffness k on all three axes: small
+    torsional oscillations about x at ω = √(k/I_x), the joint point fixed."""
+    I, k = 0.2, 20.0
+    s = System(gravity=(0, 0, 0), solver="bb", max_iter=50, tol=1e-13)
+    b = s.add_body(1.0, (I, 0.5, 0.5), omega=(0.05, 0, 0))
+    s.add_link("spherical", b, -1, point=(0, 0, 0), stiffness=k)
+    h = 1e-4
+    n = int(1.5 / h)
+    wx = np.empty(n)
+    for i in range(n):
+        s.step(h)
+        wx[i] = s.omega_world[b, 0]
+    t = np.arange(1, n + 1) * h
+    tc = crossing_times(t, wx, -1)
+    assert abs((tc[1] - tc[0]) / (2 * math.pi / math.sqrt(k / I)) - 1) < 2e-3
+    assert np.abs(s.pos[b]).max() < 1e-9
+
+
+def test_hinged_flap_constant_torque():
+    """A flap on a hinge under a constant external torque τ (no gravity):
+    θ(t) = ½ (τ/I_axis) t² exactly for the velocity and O(h) for θ."""
+    s = System(gravity=(0, 0, 0), solver="bb", max_iter=50, tol=1e-13)
+    b = s.add_body(2.0, (0.3, 0.3, 0.3), pos=(0.5, 0, 0))
+    s.add_link("hinge", b, -1, point=(0, 0, 0), axis=(0, 0, 1))
+    Iax = 0.3 + 2.0 * 0.25
+    T = np.zeros((1, 3))
+    T[0, 2] = 0.4
+    h = 1e-3
+    for _ in range(1000):
+        s.step(h, torques=T)
+    w_exact = 0.4 / Iax * 1.0
+    assert abs(s.omega_world[b, 2] - w_exact) < 1e-6 * w_exact + 1e-4
+    th = math.atan2(s.pos[b, 1], s.pos[b, 0])
+    assert abs(th - 0.5 * 0.4 / Iax) < h * w_exact
