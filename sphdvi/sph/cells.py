@@ -8,7 +8,7 @@ plane is x-z (DualSPHysics convention), y is ignored.
 import numpy as np
 
 from . import _env  # noqa: F401
-from numba import njit
+from numba import njit, prange
 
 
 def grid_shape(pmin, pmax, cellsize, is2d):
@@ -39,6 +39,39 @@ def bounding_box(pos):
 
 
 @njit(cache=True, error_model="numpy")
+def _cell_range(i0, i1, pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell):
+    for i in range(i0, i1):
+        cx = int((pos[i, 0] - pmin[0]) * inv_cell)
+        cz = int((pos[i, 2] - pmin[2]) * inv_cell)
+        cx = min(max(cx, 0), ncx - 1)
+        cz = min(max(cz, 0), ncz - 1)
+        if is2d:
+            cell[i] = cz * ncx + cx
+        else:
+            cy = int((pos[i, 1] - pmin[1]) * inv_cell)
+            cy = min(max(cy, 0), ncy - 1)
+            cell[i] = (cz * ncy + cy) * ncx + cx
+
+
+@njit(cache=True, error_model="numpy")
+def _sort_by_cell(cell, order, cell_start):
+    """Stable counting sort of the particles by their cell index."""
+    n = cell.shape[0]
+    ncells = cell_start.shape[0] - 1
+    for c in range(ncells + 1):
+        cell_start[c] = 0
+    for i in range(n):
+        cell_start[cell[i] + 1] += 1
+    for c in range(ncells):
+        cell_start[c + 1] += cell_start[c]
+    cursor = cell_start[:ncells].copy()
+    for i in range(n):
+        c = cell[i]
+        order[cursor[c]] = i
+        cursor[c] += 1
+
+
+@njit(cache=True, error_model="numpy")
 def counting_sort_cells(pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell, order, cell_start):
     """Assign each particle to a cell and counting-sort the particles by cell.
 
@@ -48,31 +81,19 @@ def counting_sort_cells(pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell, order, c
     ``order[cell_start[c]:cell_start[c+1]]``).  Positions outside the grid
     are clamped to the border cells.  Stable: equal cells keep their order.
     """
+    _cell_range(0, pos.shape[0], pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell)
+    _sort_by_cell(cell, order, cell_start)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def counting_sort_cells_parallel(pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell, order,
+                                 cell_start):
+    """:func:`counting_sort_cells` with the cell indices computed by threads."""
     n = pos.shape[0]
-    ncells = ncx * ncy * ncz
-    for c in range(ncells + 1):
-        cell_start[c] = 0
-    for i in range(n):
-        cx = int((pos[i, 0] - pmin[0]) * inv_cell)
-        cz = int((pos[i, 2] - pmin[2]) * inv_cell)
-        cx = min(max(cx, 0), ncx - 1)
-        cz = min(max(cz, 0), ncz - 1)
-        if is2d:
-            c = cz * ncx + cx
-        else:
-            cy = int((pos[i, 1] - pmin[1]) * inv_cell)
-            cy = min(max(cy, 0), ncy - 1)
-            c = (cz * ncy + cy) * ncx + cx
-        cell[i] = c
-        cell_start[c + 1] += 1
-    for c in range(ncells):
-        cell_start[c + 1] += cell_start[c]
-    # cursor: reuse order positions via a running copy of the starts
-    cursor = cell_start[:ncells].copy()
-    for i in range(n):
-        c = cell[i]
-        order[cursor[c]] = i
-        cursor[c] += 1
+    for c in prange((n + 1023) // 1024):
+        _cell_range(c * 1024, min(n, (c + 1) * 1024), pos, pmin, inv_cell, ncx, ncy, ncz,
+                    is2d, cell)
+    _sort_by_cell(cell, order, cell_start)
 
 
 @njit(cache=True, error_model="numpy")
@@ -88,6 +109,22 @@ def gather_rows(src, order, dst):
 def gather(src, order, dst):
     """dst[k] = src[order[k]]"""
     for k in range(order.shape[0]):
+        dst[k] = src[order[k]]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def gather_rows_parallel(src, order, dst):
+    """Threaded :func:`gather_rows`."""
+    for k in prange(order.shape[0]):
+        i = order[k]
+        for m in range(src.shape[1]):
+            dst[k, m] = src[i, m]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def gather_parallel(src, order, dst):
+    """Threaded :func:`gather`."""
+    for k in prange(order.shape[0]):
         dst[k] = src[order[k]]
 
 
@@ -153,7 +190,7 @@ class CellList:
         self.shape = (1, 1, 1)
         self.pmin = np.zeros(3)
 
-    def build(self, pos, pmin=None, pmax=None):
+    def build(self, pos, pmin=None, pmax=None, parallel=False):
         """Sort ``pos`` into cells; returns ``order`` (sorted -> current index).
 
         The grid covers [pmin, pmax] (default: the bounding box of ``pos``).
@@ -171,7 +208,8 @@ class CellList:
             self.order = np.empty(n, np.int64)
         if self.cell_start.shape[0] != ncells + 1:
             self.cell_start = np.empty(ncells + 1, np.int64)
-        counting_sort_cells(pos, self.pmin, 1.0 / self.cellsize, self.shape[0],
+        sort = counting_sort_cells_parallel if parallel else counting_sort_cells
+        sort(pos, self.pmin, 1.0 / self.cellsize, self.shape[0],
                             self.shape[1], self.shape[2], self.is2d,
                             self.cell, self.order, self.cell_start)
         return self.order

@@ -262,11 +262,14 @@ class SPHSolver:
     def _reorder(self):
         """Counting-sort the particles by cell and permute every per-particle array."""
         s = self.state
+        par = self._use_parallel()
         if self._domain is not None:
-            order = self.cells.build(s.pos, self._domain[0], self._domain[1])
+            order = self.cells.build(s.pos, self._domain[0], self._domain[1], parallel=par)
         else:
-            order = self.cells.build(s.pos)
-        _cells.gather(self.cells.cell, order, self.cell_sorted)
+            order = self.cells.build(s.pos, parallel=par)
+        g1 = _cells.gather_parallel if par else _cells.gather
+        g2 = _cells.gather_rows_parallel if par else _cells.gather_rows
+        g1(self.cells.cell, order, self.cell_sorted)
         for holder, names in ((s, FluidState.FIELDS), (self, self._aux_names())):
             for name in names:
                 a = getattr(holder, name)
@@ -276,9 +279,9 @@ class SPHSolver:
                 if buf is None or buf.shape != a.shape:
                     buf = np.empty_like(a)
                 if a.ndim == 2:
-                    _cells.gather_rows(a, order, buf)
+                    g2(a, order, buf)
                 else:
-                    _cells.gather(a, order, buf)
+                    g1(a, order, buf)
                 setattr(holder, name, buf)
                 self._bufs[name] = a
 

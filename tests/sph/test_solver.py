@@ -1,0 +1,147 @@
+"""Solver-level behaviour: threads, exclusion, motion hook, time step, imports."""
+import math
+import subprocess
+import sys
+
+import numba
+import numpy as np
+import pytest
+
+from sphdvi.sph import SPHSolver
+from sphdvi.sph.scenes import tank_2d
+from sphdvi.sph.state import FluidState
+
+from _helpers import constants, jittered_block, random_state
+
+
+def small_tank(dp=0.02):
+    return tank_2d(0.4, 0.4, 0.2, 0.3, dp)
+
+
+def test_import_does_not_load_numba():
+    code = "import sys, sphdvi, sphdvi.sph; from sphdvi.sph import FluidState; " \
+           "assert 'numba' not in sys.modules, 'numba imported'"
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.parametrize("alg", [1, 2])
+def test_parallel_kernels_bitwise_equal_serial(alg):
+    """Gather form: the threaded kernels give bitwise the serial result."""
+    st, c = small_tank()
+    p = {"StepAlgorithm": alg, "DensityDT": 2, "Shifting": 3, "ShiftTFS": 1.5}
+    ser = SPHSolver(st.copy(), c, p, parallel_threshold=10 ** 9)
+    par = SPHSolver(st.copy(), c, p, parallel_threshold=0)
+    old = numba.get_num_threads()
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    try:
+        for _ in range(30):
+            assert ser.step() == par.step()
+    finally:
+        numba.set_num_threads(old)
+    a, b = ser.state.sorted_by_idp(), par.state.sorted_by_idp()
+    assert np.array_equal(a.pos, b.pos) and np.array_equal(a.vel, b.vel)
+    assert np.array_equal(a.rhop, b.rhop)
+
+
+def test_dam_break_runs_and_conserves_particles():
+    st, c = small_tank()
+    sol = SPHSolver(st, c, {"DensityDT": 2, "Visco": 0.02})
+    n0 = st.n
+    sol.run(0.2)
+    assert sol.state.n == n0 and sum(sol.n_excluded.values()) == 0
+    fl = sol.state.ptype == 3
+    # the column has collapsed: the front moved right, particles accelerate
+    assert sol.state.pos[fl, 0].max() > 0.25
+    assert np.isfinite(sol.state.vel).all()
+    # fixed boundaries did not move, their density is >= rho0
+    bd = sol.state.ptype == 0
+    assert sol.state.rhop[bd].min() >= c["rhop0"]
+
+
+def test_exclusion_of_density_and_position():
+    st, c = small_tank()
+    fl = np.flatnonzero(st.ptype == 3)
+    st.rhop[fl[0]] = 1400.0                  # outside RhopOutMax = 1300 after the step
+    st.pos[fl[1]] = [0.2, 0.0, 0.6]          # near the top of the domain
+    st.vel[fl[1]] = [0.0, 0.0, 50.0]         # leaves it in one step
+    ids = st.idp[fl[:2]].copy()
+    dom = (np.array([-0.1, -1.0, -0.1]), np.array([0.5, 1.0, 0.6005]))
+    sol = SPHSolver(st, c, {"RhopOutMax": 1300.0}, domain=dom)
+    sol.step()
+    assert sol.n_excluded["rhop"] == 1 and sol.n_excluded["position"] == 1
+    assert set(sol.excluded[0]["idp"].tolist()) == set(ids.tolist())
+    assert not np.isin(ids, sol.state.idp).any()
+    sol.step()                               # keeps running after compaction
+    assert np.isfinite(sol.state.pos).all()
+
+
+def test_motion_hook_and_free_moving_particles():
+    st, c = small_tank()
+    piston = (st.ptype == 0) & (st.pos[:, 0] == 0.0) & (st.pos[:, 2] > 0)
+    st.ptype[piston] = 1
+    st.vel[piston] = [0.1, 0.0, 0.0]
+    ids = st.idp[piston]
+    x0 = st.pos[piston, 0].copy()
+    sol = SPHSolver(st, c, {})               # no hook: moves with its velocity
+    for _ in range(20):
+        sol.step()
+    s = sol.state
+    m = np.isin(s.idp, ids)
+    assert np.allclose(s.pos[m, 0], x0[0] + 0.1 * sol.time)
+    calls = []
+
+    def hook(solver, t, dt):
+        calls.append((t, dt))
+        mm = solver.state.ptype == 1
+        solver.state.pos[mm, 0] = 0.05 * math.sin(t)
+        solver.state.vel[mm, 0] = 0.05 * math.cos(t)
+
+    st2, _ = small_tank()
+    st2.ptype[piston] = 1
+    sol2 = SPHSolver(st2, c, {}, motion_hook=hook)
+    for _ in range(5):
+        sol2.step()
+    assert len(calls) == 5 and math.isclose(calls[-1][0], sol2.time)
+    mm = sol2.state.ptype == 1
+    assert np.allclose(sol2.state.pos[mm, 0], 0.05 * math.sin(sol2.time))
+
+
+def test_time_step_rules():
+    st, c = small_tank()
+    sol = SPHSolver(st.copy(), c, {"DtFixed": 1e-5})
+    assert sol.step() == 1e-5
+    sol = SPHSolver(st.copy(), c, {"DtMin": 1.0})        # every step raised to DtMin
+    sol.cfl = 1e-9
+    sol.run(1e9, max_steps=3)
+    assert sol.n_dtmin == 3
+    sol = SPHSolver(st.copy(), c, {})
+    dt = sol.step()
+    h, c0 = c["h"], c["cs0"]
+    # at rest the force term dominates: dt = CFL sqrt(h/|g|)... or the sound term
+    assert 0 < dt <= 0.2 * min(math.sqrt(h / 9.81), h / c0) * 1.0001 + 1e-12
+    sol = SPHSolver(st.copy(), c, {"StepAlgorithm": 2, "DtIni": 3e-6})
+    assert sol.step() == 3e-6
+
+
+@pytest.mark.parametrize("visco", [2, 3])
+def test_3d_column_runs(visco):
+    rng = np.random.default_rng(0)
+    dp = 0.02
+    pos = jittered_block(8, dp, False, rng, jitter=0.0) + 2 * dp
+    g = np.arange(-1, 12) * dp
+    X, Y = np.meshgrid(g, g)
+    bd = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel()], 1)
+    ptype = np.r_[np.zeros(len(bd), np.int8), np.full(len(pos), 3, np.int8)]
+    st = FluidState(np.concatenate([bd, pos]), mass=1000 * dp ** 3, ptype=ptype)
+    c = constants(dp, False, g=9.81, cs0=15.0)
+    sol = SPHSolver(st, c, {"ViscoTreatment": visco, "Visco": 1e-3, "DensityDT": 3})
+    sol.run(0.05)
+    assert np.isfinite(sol.state.pos).all() and sol.state.n == st.n
+    if visco == 2:
+        assert np.abs(sol.tau).max() > 0
+
+
+def test_unsupported_options_raise():
+    st, c = small_tank()
+    with pytest.raises(NotImplementedError):
+        SPHSolver(st, c, {"Boundary": 2})

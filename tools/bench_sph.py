@@ -1,0 +1,147 @@
+#!/usr/bin/env python
+"""Speed of the SPH solver on the 2D dam break (and optionally a 3D one).
+
+2D scene (issue 3): 1 m x 2 m water column in a 4 m x 3 m tank, dp = 0.01,
+one layer of boundary particles on the bottom, left and right walls
+(20,000 fluid + 1,001 boundary = 21,001 particles), Wendland, Verlet,
+artificial viscosity 0.02, Fourtakas DDT 0.1, coefh 1.0 (h = 0.01 sqrt 2),
+c0 = 20 sqrt(9.81 * 2).
+
+Prints microseconds per particle-step and interactions (neighbour pairs
+visited by the gather loop, i != j within 2h) per second on 1 and 2 threads.
+
+    NUMBA_NUM_THREADS=2 python tools/bench_sph.py [--steps 300] [--3d] [--flags]
+
+``--flags`` times the same scene with features switched on and off
+(1 thread), to show that an unused feature costs nothing.
+"""
+import argparse
+import math
+import os
+import sys
+import time
+
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+
+import numba  # noqa: E402
+import numpy as np  # noqa: E402
+
+from sphdvi.sph import SPHSolver  # noqa: E402
+from sphdvi.sph import cells as _cells  # noqa: E402
+from sphdvi.sph.scenes import dambreak_2d  # noqa: E402
+from sphdvi.sph.state import FIXED, FLUID, FluidState  # noqa: E402
+
+BENCH_PARAMS = {"StepAlgorithm": 1, "VerletSteps": 40, "Kernel": 2, "ViscoTreatment": 1,
+                "Visco": 0.02, "ViscoBoundFactor": 1.0, "DensityDT": 2, "DensityDTvalue": 0.1}
+
+
+def dambreak_3d(dp=0.02):
+    """3D dam break: 1 x 0.5 x 1 m column in a 3 x 0.5 x 1.5 m open box (one wall layer)."""
+    g = 9.81
+    h = 1.0 * math.sqrt(3) * dp
+    cs0 = 20 * math.sqrt(g * 1.0)
+    ax = lambda a, b: a + dp * np.arange(int(round((b - a) / dp)) + 1)  # noqa: E731
+    X, Y, Z = np.meshgrid(ax(dp, 1.0), ax(dp, 0.5 - dp), ax(dp, 1.0), indexing="ij")
+    fl = np.stack([X.ravel(), Y.ravel(), Z.ravel()], 1)
+    xs, ys, zs = ax(0, 3.0), ax(0, 0.5), ax(0, 1.5)
+    walls = []
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    walls.append(np.stack([X.ravel(), Y.ravel(), 0 * X.ravel()], 1))
+    for x in (0.0, 3.0):
+        Y, Z = np.meshgrid(ys, zs[1:], indexing="ij")
+        walls.append(np.stack([0 * Y.ravel() + x, Y.ravel(), Z.ravel()], 1))
+    for y in (0.0, 0.5):
+        X, Z = np.meshgrid(xs[1:-1], zs[1:], indexing="ij")
+        walls.append(np.stack([X.ravel(), 0 * X.ravel() + y, Z.ravel()], 1))
+    bd = np.concatenate(walls)
+    pos = np.concatenate([bd, fl])
+    ptype = np.r_[np.full(len(bd), FIXED, np.int8), np.full(len(fl), FLUID, np.int8)]
+    rho0 = 1000.0
+    B = cs0 ** 2 * rho0 / 7
+    rho = np.full(len(pos), rho0)
+    depth = np.clip(1.0 + 0.5 * dp - pos[:, 2], 0, None)
+    rho[ptype == FLUID] = (rho0 * (1 + rho0 * g * depth / B) ** (1 / 7))[ptype == FLUID]
+    state = FluidState(pos, rhop=rho, mass=rho0 * dp ** 3, ptype=ptype)
+    c = {"dp": dp, "h": h, "cs0": cs0, "rhop0": rho0, "gamma": 7.0, "b": B,
+         "gravity": [0, 0, -g], "is2d": False, "cflnumber": 0.2}
+    return state, c
+
+
+def count_interactions(state, h, is2d):
+    """Neighbour pairs visited per step: sum over particles of their neighbours
+    (fluid: all; boundary: fluid/floating only), i != j, r < 2h."""
+    cl = _cells.CellList(h, is2d)
+    order = cl.build(state.pos)
+    pos = state.pos[order]
+    pt = state.ptype[order]
+    pairs = np.array(_cells._pairs_from_cells(pos, cl.cell[order], cl.cell_start, *cl.shape,
+                                              is2d, 2 * h), dtype=np.int64).reshape(-1, 2)
+    fi = pt[pairs[:, 0]] >= 2
+    fj = pt[pairs[:, 1]] >= 2
+    # a pair with at least one fluid particle is visited from both sides
+    # (boundary-boundary pairs are skipped)
+    return int(np.count_nonzero(fi | fj) * 2)
+
+
+def time_steps(state, c, params, threads, steps, repeats=3):
+    numba.set_num_threads(threads)
+    sol = SPHSolver(state.copy(), c, params)
+    sol.run(1e9, max_steps=20)             # compile / warm up
+    best = math.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        sol.run(1e9, max_steps=steps)
+        best = min(best, time.perf_counter() - t0)
+    return best / steps, sol
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--steps", type=int, default=300)
+    ap.add_argument("--dp", type=float, default=0.01)
+    ap.add_argument("--3d", dest="three_d", action="store_true", help="also time the 3D dam break")
+    ap.add_argument("--dp3d", type=float, default=0.02)
+    ap.add_argument("--flags", action="store_true", help="time feature variants on 1 thread")
+    ap.add_argument("--threads", type=int, nargs="*", default=None)
+    a = ap.parse_args()
+    maxthr = numba.config.NUMBA_NUM_THREADS
+    threads = a.threads or sorted({1, min(2, maxthr)})
+    print("numba %s, threading layer requested %s, NUMBA_NUM_THREADS=%d, OMP_WAIT_POLICY=%s"
+          % (numba.__version__, numba.config.THREADING_LAYER, maxthr, os.environ.get("OMP_WAIT_POLICY")))
+    scenes = [("2D dam break", *dambreak_2d(a.dp), True)]
+    if a.three_d:
+        scenes.append(("3D dam break", *dambreak_3d(a.dp3d), False))
+    for name, state, c, is2d in scenes:
+        npairs = count_interactions(state, c["h"], is2d)
+        print("\n%s: %d particles (%d fluid), %.1f interactions per particle"
+              % (name, state.n, int((state.ptype == 3).sum()), npairs / state.n))
+        base = None
+        for t in threads:
+            dt_step, sol = time_steps(state, c, BENCH_PARAMS, t, a.steps)
+            us = dt_step / state.n * 1e6
+            base = base or us
+            print("  %d thread(s): %.3f us/particle-step, %.1f M interactions/s, speed-up x%.2f "
+                  "(%d steps, t = %.4f s)" % (t, us, npairs / dt_step / 1e6, base / us, sol.nstep, sol.time))
+    if a.flags:
+        state, c = dambreak_2d(a.dp)
+        print("\nFeature variants, 2D dam break, 1 thread (us/particle-step):")
+        variants = [
+            ("AV, no DDT", {"DensityDT": 0}),
+            ("AV + Fourtakas DDT (benchmark)", {}),
+            ("AV + Molteni DDT", {"DensityDT": 1}),
+            ("laminar (ViscoTreatment 3)", {"ViscoTreatment": 3, "Visco": 1e-6}),
+            ("laminar + SPS (ViscoTreatment 2)", {"ViscoTreatment": 2, "Visco": 1e-6}),
+            ("+ shifting (Shifting 3)", {"Shifting": 3, "ShiftTFS": 1.5}),
+            ("cubic spline", {"Kernel": 1}),
+            ("Symplectic", {"StepAlgorithm": 2}),
+        ]
+        for label, upd in variants:
+            p = dict(BENCH_PARAMS)
+            p.update(upd)
+            dt_step, _ = time_steps(state, c, p, 1, max(50, a.steps // 3), repeats=2)
+            print("  %-36s %.3f" % (label, dt_step / state.n * 1e6))
+
+
+if __name__ == "__main__":
+    main()
