@@ -635,14 +635,115 @@ def _cylinder_plane_support(sc, sp, bc, bpl, nc, cap, env, keybase, sh_dims, w_p
 
 
 @njit(cache=True)
+def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes, edges,
+                  ed_off, ed_cnt, w_pos, w_R, wa, wb):
+    """Separating-axis test of two convex polytopes (box/hull) over the face
+    normals of both and the cross products of their edges.  Returns
+    (separation, edge a, edge b, axis): the edge pair is set (≥ 0) when an
+    edge–edge axis is the axis of least penetration (its supporting edges),
+    the vertex–face contacts cover the face axes.  Edge pairs are skipped
+    for large hulls (> 4096 edge pairs)."""
+    na = samp_cnt[sa]
+    nbv = samp_cnt[sb]
+    Ra = w_R[sa]
+    Rb_ = w_R[sb]
+    ca = row3(w_pos, sa)
+    cb = row3(w_pos, sb)
+    for i in range(na):
+        x = v_add(ca, mat_vec(Ra, row3(samp_pts, samp_off[sa] + i)))
+        wa[i, 0] = x[0]
+        wa[i, 1] = x[1]
+        wa[i, 2] = x[2]
+    for i in range(nbv):
+        x = v_add(cb, mat_vec(Rb_, row3(samp_pts, samp_off[sb] + i)))
+        wb[i, 0] = x[0]
+        wb[i, 1] = x[1]
+        wb[i, 2] = x[2]
+    best_face = -1e300
+    for side in range(2):
+        s = sa if side == 0 else sb
+        R = Ra if side == 0 else Rb_
+        c = ca if side == 0 else cb
+        W = wb if side == 0 else wa
+        nw = nbv if side == 0 else na
+        for p in range(pl_off[s], pl_off[s] + pl_cnt[s]):
+            n = mat_vec(R, (planes[p, 0], planes[p, 1], planes[p, 2]))
+            off = v_dot(n, c) - planes[p, 3]
+            m = 1e300
+            for i in range(nw):
+                d = n[0] * W[i, 0] + n[1] * W[i, 1] + n[2] * W[i, 2] - off
+                if d < m:
+                    m = d
+            if m > best_face:
+                best_face = m
+            if m > env:
+                return m, -1, -1, (0.0, 0.0, 0.0)
+    best_edge = -1e300
+    bea = -1
+    beb = -1
+    bL = (0.0, 0.0, 0.0)
+    nea = ed_cnt[sa]
+    neb = ed_cnt[sb]
+    if nea * neb > 4096:
+        return best_face, -1, -1, bL
+    T = v_sub(cb, ca)
+    scale = 1e300
+    for i in range(na):
+        d = v_sub(row3(wa, i), ca)
+        scale = min(scale, math.sqrt(v_dot(d, d)))
+    tol = 1e-9 * (1.0 + scale)
+    for i in range(nea):
+        a0 = edges[ed_off[sa] + i, 0]
+        a1 = edges[ed_off[sa] + i, 1]
+        da = v_sub(row3(wa, a1), row3(wa, a0))
+        for j in range(neb):
+            b0 = edges[ed_off[sb] + j, 0]
+            b1 = edges[ed_off[sb] + j, 1]
+            db = v_sub(row3(wb, b1), row3(wb, b0))
+            L = v_cross(da, db)
+            ln = math.sqrt(v_dot(L, L))
+            if ln < 1e-9 * math.sqrt(v_dot(da, da) * v_dot(db, db)) + 1e-300:
+                continue
+            L = v_scale(L, 1.0 / ln)
+            if v_dot(L, T) < 0.0:
+                L = v_scale(L, -1.0)
+            maxa = -1e300
+            for k in range(na):
+                d = L[0] * wa[k, 0] + L[1] * wa[k, 1] + L[2] * wa[k, 2]
+                if d > maxa:
+                    maxa = d
+            minb = 1e300
+            for k in range(nbv):
+                d = L[0] * wb[k, 0] + L[1] * wb[k, 1] + L[2] * wb[k, 2]
+                if d < minb:
+                    minb = d
+            sep = minb - maxa
+            if sep > env:
+                return sep, -1, -1, L
+            # only the edges that actually support the axis
+            if (abs(v_dot(L, row3(wa, a0)) - maxa) > tol or abs(v_dot(L, row3(wa, a1)) - maxa) > tol
+                    or abs(v_dot(L, row3(wb, b0)) - minb) > tol
+                    or abs(v_dot(L, row3(wb, b1)) - minb) > tol):
+                continue
+            if sep > best_edge:
+                best_edge = sep
+                bea = i
+                beb = j
+                bL = L
+    if bea >= 0 and best_edge > best_face + 0.05 * abs(best_face) + 1e-6 * (1.0 + scale):
+        return best_edge, bea, beb, bL
+    return max(best_face, best_edge), -1, -1, bL
+
+
+@njit(cache=True)
 def _point_like(t):
     return t == SPHERE or t == CLOUD
 
 
 @njit(cache=True)
 def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cnt,
-                 samp_pts, samp_rad, pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R,
-                 lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+                 samp_pts, samp_rad, pl_off, pl_cnt, planes, cg_meta, cg_start, edges, ed_off,
+                 ed_cnt, w_pos, w_R, lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
     """All contacts of the candidate pairs with gap < env.  Returns the count
     (which may exceed the capacity: the caller then grows and calls again)."""
     cap = c_a.shape[0]
@@ -652,6 +753,12 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
     tmp = np.empty((16, 3))
     depth = np.empty(16)
     keep = np.zeros(16, np.bool_)
+    maxv = 8
+    for s in range(ns):
+        if sh_type[s] == HULL and samp_cnt[s] > maxv:
+            maxv = samp_cnt[s]
+    wa = np.empty((maxv, 3))
+    wb = np.empty((maxv, 3))
     for q in range(npair):
         s1 = pairs[q, 0]
         s2 = pairs[q, 1]
@@ -685,6 +792,22 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                           w_R[s2], sh_dims[s2], env, keybase, nc, cap,
                           c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep)
             continue
+        edge_contact = False
+        if (t1 == BOX or t1 == HULL) and (t2 == BOX or t2 == HULL):
+            sep, ea, eb, L = _polytope_sat(s1, s2, env, samp_off, samp_cnt, samp_pts, pl_off,
+                                           pl_cnt, planes, edges, ed_off, ed_cnt, w_pos, w_R,
+                                           wa, wb)
+            if sep > env:
+                continue  # a separating axis: no contact (also removes SDF lower-bound ghosts)
+            if ea >= 0:
+                pa0 = row3(wa, edges[ed_off[s1] + ea, 0])
+                pa1 = row3(wa, edges[ed_off[s1] + ea, 1])
+                pb0 = row3(wb, edges[ed_off[s2] + eb, 0])
+                pb1 = row3(wb, edges[ed_off[s2] + eb, 1])
+                x1, x2 = _closest_segments_t(pa0, pa1, pb0, pb1)
+                pt = v_scale(v_add(x1, x2), 0.5)
+                nc = _emit_t(nc, cap, b1, b2, s1, s2, pt, L, sep, keybase + 999999,
+                             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
         if t1 == CYLINDER and t2 == PLANE:
             nc = _cylinder_plane_support(s1, s2, b1, b2, nc, cap, env, keybase, sh_dims, w_pos,
                                          w_R, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)

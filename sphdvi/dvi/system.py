@@ -148,6 +148,9 @@ class System:
         self.planes = np.zeros((0, 4))
         self.cg_meta = np.zeros((0, 8))
         self.cg_start = np.zeros(0, np.int64)
+        self.edges = np.zeros((0, 2), np.int32)
+        self.ed_off = np.zeros(0, np.int32)
+        self.ed_cnt = np.zeros(0, np.int32)
         # links
         self.links = []          # python records, index = link id
         self._mates = []
@@ -278,6 +281,7 @@ class System:
         samples = np.zeros((0, 3))
         srad = 0.0
         planes = np.zeros((0, 4))
+        edges = np.zeros((0, 2), np.int64)
         if t == col.SPHERE:
             samples = np.zeros((1, 3))
             srad = dims[0]
@@ -286,6 +290,10 @@ class System:
             s = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float)
             samples = s * dims
             crad = float(dims.min())
+            # vertex index = 4a + 2b + c (a, b, c = coordinate > 0); edges flip one bit
+            edges = np.array([(v, v | bit) for v in range(8) for bit in (1, 2, 4) if not v & bit])
+            planes = np.array([[sg * (k == 0), sg * (k == 1), sg * (k == 2), -dims[k]]
+                               for k in range(3) for sg in (1.0, -1.0)], float)
         elif t == col.CAPSULE:
             samples = np.array([[0, 0, -dims[1]], [0, 0, 0], [0, 0, dims[1]]], float)
             srad = dims[0]
@@ -303,6 +311,7 @@ class System:
             hull = ConvexHull(pts)
             samples = pts[hull.vertices]
             planes = self._merge_facets(hull.equations)
+            edges = self._hull_edges(hull)
             crad = 0.5 * float(np.min(samples.max(0) - samples.min(0)))
         elif t == col.CLOUD:
             samples = np.asarray(points, float).reshape(-1, 3)
@@ -332,7 +341,26 @@ class System:
         else:
             meta = np.zeros(8)
         self.cg_meta = np.vstack([self.cg_meta, meta[None]])
+        self.ed_off = np.append(self.ed_off, np.int32(self.edges.shape[0])).astype(np.int32)
+        self.ed_cnt = np.append(self.ed_cnt, np.int32(edges.shape[0])).astype(np.int32)
+        self.edges = np.vstack([self.edges, np.asarray(edges, np.int32).reshape(-1, 2)])
         return self.sh_type.shape[0] - 1
+
+    @staticmethod
+    def _hull_edges(hull):
+        """Edges of a convex hull (indices into hull.vertices order), without
+        the diagonals of coplanar (merged) facets."""
+        remap = {int(v): i for i, v in enumerate(hull.vertices)}
+        eq = hull.equations
+        out = set()
+        for si, simp in enumerate(hull.simplices):
+            for m in range(3):
+                nb = hull.neighbors[si, m]
+                if 1.0 - float(eq[si, :3] @ eq[nb, :3]) < 1e-9:
+                    continue  # shared by coplanar triangles: not a real edge
+                a, b = (int(simp[k]) for k in range(3) if k != m)
+                out.add((min(remap[a], remap[b]), max(remap[a], remap[b])))
+        return np.array(sorted(out), np.int64).reshape(-1, 2)
 
     @staticmethod
     def _cloud_grid(pts, r):
@@ -697,7 +725,8 @@ class System:
             nc = col.narrow_phase(npair, pairs, self.envelope, self.sh_body, self.sh_type,
                                   self.sh_dims, self.samp_off, self.samp_cnt, self.samp_pts,
                                   self.samp_rad, self.pl_off, self.pl_cnt, self.planes,
-                                  self.cg_meta, self.cg_start, w_pos, w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
+                                  self.cg_meta, self.cg_start, self.edges, self.ed_off,
+                                  self.ed_cnt, w_pos, w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
                                   c["n"], c["gap"], c["key"])
             if nc <= cap:
                 break

@@ -137,3 +137,47 @@ def test_cloud_on_cloud_stack():
     assert abs(s.contact_force[hi, 2] / G - 1) < 1e-2
     Fg = s.contact_force[:, 2].sum()
     assert abs(Fg / (2 * G) - 1) < 1e-2
+
+
+@pytest.mark.parametrize("lower_is_box", [False, True])
+def test_hull_edge_edge_contact(lower_is_box):
+    """Crossed edges: a cube hull with an edge up (along y) under a cube hull
+    with an edge down (along x).  Only an edge–edge contact can hold the upper
+    one: it must not sink (vertex–face contacts alone would let it drop
+    ~h(√2−1))."""
+    h = 0.1
+    cube = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float) * h
+    s = System(gravity=(0, 0, -G), solver="bb", max_iter=100, tol=1e-12, envelope=0.005)
+    qy = (math.cos(math.pi / 8), 0, math.sin(math.pi / 8), 0)   # 45° about y: edge along y up
+    qx = (math.cos(math.pi / 8), math.sin(math.pi / 8), 0, 0)   # 45° about x: edge along x down
+    zlow = 0.5
+    low = s.add_body(1.0, (1, 1, 1), kind="fixed", pos=(0, 0, zlow), quat=qy)
+    if lower_is_box:
+        s.add_box(low, (h, h, h))
+    else:
+        s.add_hull(low, cube)
+    ztop = zlow + 2 * h * math.sqrt(2)
+    up = s.add_body(1.0, (h * h * 2 / 3,) * 3, pos=(0, 0, ztop + 0.002), quat=qx)
+    s.add_hull(up, cube)
+    zmin = 1e9
+    for _ in range(150):
+        s.step(1e-3)
+        zmin = min(zmin, s.pos[up, 2])
+    assert zmin > ztop - 2e-3
+    assert s.n_contacts >= 1
+
+
+def test_hull_hull_stack_rest():
+    h = 0.1
+    cube = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float) * h
+    s = System(gravity=(0, 0, -G), solver="bb", max_iter=100, tol=1e-10, envelope=0.005)
+    s.add_plane()
+    a = s.add_body(1.0, (h * h * 2 / 3,) * 3, pos=(0, 0, h))
+    s.add_hull(a, cube)
+    b = s.add_body(1.0, (h * h * 2 / 3,) * 3, pos=(0.03, 0.02, 3 * h + 0.001))
+    s.add_hull(b, cube)
+    for _ in range(1000):
+        s.step(1e-3)
+    assert abs(s.pos[a, 2] - h) < 1e-3
+    assert abs(s.pos[b, 2] - 3 * h) < 2e-3
+    assert abs(s.contact_force[:, 2].sum() / (2 * G) - 1) < 1e-2
