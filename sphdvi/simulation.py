@@ -201,13 +201,23 @@ def find_case_file(folder: str) -> str:
     return found[0]
 
 
+def special_parameters(data: dict) -> dict:
+    """Parameters with ``<special><shifting>`` applied (it overrides Shifting, ShiftCoef, ShiftTFS)."""
+    params = dict(data["parameters"])
+    shifting = (data["json"].get("special") or {}).get("shifting") or {}
+    for key, name in (("mode", "Shifting"), ("coefficient", "ShiftCoef"), ("fsthreshold", "ShiftTFS")):
+        if key in shifting:
+            params[name] = shifting[key]
+    return params
+
+
 def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(), resume=False,
         quiet=False) -> RunResult:
     """Run a gencase output: body-only cases go to the multibody engine, the rest to SPH."""
     from .io.casefile import read_case_h5
     t_start = _time.perf_counter()
     data = read_case_h5(case_h5)
-    params = apply_overrides(data["parameters"], sets, tmax, tout)
+    params = apply_overrides(special_parameters(data), sets, tmax, tout)
     threads = int(threads) if threads else default_threads()
     os.makedirs(outdir, exist_ok=True)
     files = RunFiles(outdir)
@@ -279,7 +289,8 @@ class SPHRun:
         if c["is2d"]:
             domain[0][1] -= c["h"]
             domain[1][1] += c["h"]
-        hook = self._hook if (self.has_moving or self.has_floating) else None
+        self.damping = damping_zones(js.get("special", {}).get("damping", []))
+        hook = self._hook if (self.has_moving or self.has_floating or self.damping) else None
         self.bodies = None
         if self.has_floating:
             self._setup_bodies()
@@ -321,6 +332,8 @@ class SPHRun:
                 s.vel[rows] = v
         if self.bodies is not None:
             self._step_bodies(solver, dt)
+        for zone in self.damping:
+            zone.apply(s, dt)
 
     def _step_bodies(self, solver, dt):
         s = solver.state
@@ -453,6 +466,37 @@ class SPHRun:
                     getattr(self.bodies, name)[...] = f["bodies"][name][...]
                 self.bodies.time = float(f["bodies"].attrs["time"])
         return extra
+
+
+class DampingZone:
+    """``<special><damping><dampingzone>``: fluid velocities are reduced progressively
+    from ``limitmin`` (no reduction) to ``limitmax`` (full) along the line between them,
+    and fully over ``overlimit`` beyond it: v ← v (1 − min(1, dt·redumax·f²)·factorxyz),
+    f ∈ [0, 1] the normalised distance (DualSPHysics JDamping)."""
+
+    def __init__(self, spec: dict):
+        self.p0 = np.asarray(spec["limitmin"], float)
+        p1 = np.asarray(spec["limitmax"], float)
+        self.length = float(np.linalg.norm(p1 - self.p0))
+        self.dir = (p1 - self.p0) / self.length
+        self.overlimit = float(spec.get("overlimit", 0.0))
+        self.redumax = float(spec.get("redumax", 10.0))
+        self.factor = np.asarray(spec.get("factorxyz", [1.0, 1.0, 1.0]), float)
+
+    def apply(self, state, dt: float) -> None:
+        fluid = np.flatnonzero(state.ptype == 3)
+        d = (state.pos[fluid] - self.p0) @ self.dir
+        inside = (d > 0) & (d < self.length + self.overlimit)
+        if not inside.any():
+            return
+        rows = fluid[inside]
+        f = np.minimum(d[inside] / self.length, 1.0)
+        redu = np.minimum(1.0, dt * self.redumax * f * f)
+        state.vel[rows] *= 1.0 - redu[:, None] * self.factor[None, :]
+
+
+def damping_zones(specs) -> list:
+    return [DampingZone(z) for z in specs or []]
 
 
 def _quat_matrix(q):

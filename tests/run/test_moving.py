@@ -106,3 +106,17 @@ def test_piston_wave_paddle_follows_stroke(tmp_path):
         xs = paddle.stroke_position(t)[0]
         assert np.allclose(x[:, 0] - p0[:, 0], xs, atol=1e-12)
     assert paddle.stroke_position(0.2)[0] == pytest.approx(0.5 * paddle.stroke * math.sin(2 * math.pi * 0.2))
+
+
+def test_damping_zone_reduces_velocity():
+    from sphdvi.simulation import DampingZone
+    from sphdvi.sph.state import FluidState
+    pos = np.array([[0.0, 0, 0], [0.5, 0, 0], [1.0, 0, 0], [1.5, 0, 0], [3.0, 0, 0]])
+    st = FluidState(pos, np.ones((5, 3)), None, 1.0, np.array([3, 3, 3, 3, 0]))
+    zone = DampingZone({"limitmin": [0, 0, 0], "limitmax": [1, 0, 0], "overlimit": 1.0, "redumax": 10.0,
+                        "factorxyz": [1, 1, 0]})
+    zone.apply(st, 0.01)
+    assert st.vel[0] == pytest.approx([1, 1, 1])                  # at limitmin: nothing
+    assert st.vel[1] == pytest.approx([1 - 0.1 * 0.25, 1 - 0.1 * 0.25, 1])
+    assert st.vel[2] == pytest.approx([0.9, 0.9, 1]) and st.vel[3] == pytest.approx([0.9, 0.9, 1])
+    assert st.vel[4] == pytest.approx([1, 1, 1])                  # boundary particle untouched
