@@ -1,42 +1,116 @@
 """sphdvi.dvi — a Chrono-NSC-style rigid multibody engine (no SPH inside).
 
+Importing this sub-package imports numba; ``import sphdvi`` does not.
+
 Quick use::
 
     from sphdvi.dvi import System
-    s = System(gravity=(0, 0, -9.81), solver="psor", max_iter=100)
+    s = System(gravity=(0, 0, -9.81), solver="bb", max_iter=100)
     b = s.add_body(mass=1.0, inertia=(0.1, 0.1, 0.1), pos=(0, 0, 1))
     s.add_box(b, (0.1, 0.1, 0.1))
     s.add_plane((0, 0, 0), (0, 0, 1))
     s.add_link("hinge", b, -1, point=(0, 0, 2), axis=(0, 1, 0))
     for _ in range(1000):
-        s.step(1e-3, forces=None, torques=None)   # (nb,3) world loads per step
+        s.step(1e-3, forces=None, torques=None)   # optional (nb,3) world loads
+
+Method
+------
+One Anitescu–Tasora step per call (Chrono's EULER_IMPLICIT_LINEARIZED): a
+velocity-level cone complementarity problem for the impulses of all joint,
+contact, motor and force-element rows, solved with implicit Schur-complement
+products (N = D M⁻¹ Dᵀ is never formed) and warm started; positions then move
+with the new velocities (x += h v, q ← q ⊗ exp(h ω_body)).  Stabilisation:
+``b = clamp(C/h, ±recovery_speed)`` for joints, ``max(Φ/h, −recovery_speed)``
+for contacts.  Link stiffness/damping, springs (TSDA) and joint stiffness are
+implicit compliance rows ``E = 1/(h(hk + c))`` (stable for k = 1e8 at
+h = 1e-3); Coulomb dampers are boxed rows.
 
 Public API
 ----------
-System(gravity, solver="psor"|"apgd"|"bb", max_iter, tol, omega, recovery_speed=0.6,
-       envelope, min_bounce_speed, contactmethod="nsc"|"smc", smc_model="hertz"|"hooke")
-  .add_body(mass, inertia, pos, quat, vel, omega, kind="floating"|"fixed"|"moving",
-            translation_dof, rotation_dof, motion, imposed_velocity, name, force, torque) -> int
-  .add_material(name, friction, restitution, young, poisson) -> int
-  .add_shape(body, shape, size, pos, quat, material, points, radius, local) -> int
-  .add_sphere/add_box/add_capsule/add_cylinder/add_hull/add_cloud/add_plane
-  .add_link(kind, body1, body2=-1, **kw) -> link id
-  .add_mate / add_spring / add_coulomb_damper / add_pulley
-  .step(dt, forces=None, torques=None) -> (pos, quat, vel, omega_world)
-  .pos, .quat (w,x,y,z), .vel, .omega_world, .omega_b
-  .total_force/.total_torque, .contact_force/.contact_torque   (nb,3), last step
-  .link_force/.link_torque   (nlinks,3): reaction on body 1, world frame,
-                             torque about the link point on body 1
-  .last_iterations, .last_residual, .n_contacts, .constraint_violation()
-run_bodies(bodies, links, out_dir, tmax, tout, dt=1e-3, ...)  -> writes bodies.csv, links.csv
+``System(gravity=(0,0,-9.81), solver="bb", max_iter=100, tol=1e-10, omega=1.0,
+recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.01, contactmethod="nsc",
+smc_model="hertz", position_projection=False)``
 
-Body index -1 means the ground (world).  All quantities SI, world frame unless
-stated.  Contact material pair rule: friction = min(μ1, μ2), restitution =
-min(e1, e2) (Chrono's default composition).
+* solver: "psor" (projected Gauss–Seidel), "apgd" (Nesterov, adaptive step,
+  restart), "bb" (Barzilai–Borwein spectral projected gradient, non-monotone;
+  DualSPHysics's default), "direct" (joint rows eliminated by a dense
+  Cholesky factorisation, contacts by a dense projected gradient; for small,
+  stiff or badly scaled mechanisms; "minres" is an alias).  ``tol`` is a
+  velocity residual (m/s, see :mod:`sphdvi.dvi.solvers`).
+* contactmethod: "nsc" (complementarity: Coulomb cone, Newton restitution
+  above ``min_bounce_speed``) or "smc" (penalty: Hertz or Hooke with Young's
+  modulus, Poisson ratio, restitution); DualSPHysics's 0/1 are accepted.
+* envelope: contacts are created for gaps below it.  Note the convexified CCP
+  lets a sliding contact separate by about h·μ·v_t per step; keep the
+  envelope above that.
+* position_projection: project positions onto the joint constraints after
+  each step (drift-free closed loops).
+
+Bodies, materials, shapes:
+
+* ``add_body(mass, inertia, pos, quat=(1,0,0,0), vel, omega, kind="floating"|"fixed"|"moving",
+  translation_dof=(1,1,1), rotation_dof=(1,1,1), motion=None, imposed_velocity=None,
+  name=None, force=(0,0,0), torque=(0,0,0)) -> int``.  inertia: principal
+  values or a 3x3 tensor about the centre (body frame); velocities world;
+  ``motion(t) -> (v, ω_world)`` for moving bodies; ``imposed_velocity``: 6
+  values (v, ω world) with None/NaN = free, or a callable of t.
+* ``add_material(name, friction=0.3, restitution=0.0, young=1e7, poisson=0.3) -> int``.
+  Pair rule (Chrono's default composition): friction = min(μ1, μ2),
+  restitution = min(e1, e2); SMC: E* = 1/((1−ν1²)/E1 + (1−ν2²)/E2).
+* ``add_shape(body, shape, size, pos, quat, material, points, radius, local=True) -> int``
+  with shape "sphere" (r), "box" (half extents), "capsule" (r, half length,
+  axis z), "cylinder" (r, half length, axis z), "plane", "hull" (convex hull of
+  ``points``), "cloud" (sphere cloud: ``points`` + ``radius``, e.g. a body's
+  particles with r = dp/2).  Shortcuts: ``add_sphere``, ``add_box``,
+  ``add_capsule``, ``add_cylinder``, ``add_hull``, ``add_cloud``,
+  ``add_plane(point, normal, body=-1, material)``.
+
+Links (body index -1 = the ground; points and axes in world coordinates at
+creation):
+
+* ``add_link(kind, body1, body2=-1, **kw) -> link id`` with kind in
+  "fixed", "spherical"/"spheric", "hinge"/"revolute", "slider"/"prismatic",
+  "cylindrical"/"hingedslider", "pointline" (``rot_axis`` = DualSPHysics
+  rotvector, ``rot_axis2`` = rotvector2), "pointplane", "planar", "generic"
+  (``mask`` = 6 flags tx ty tz rx ry rz constrained), "spring"/"linearspring"
+  (TSDA), "coulombdamper", "pulley".
+* ``add_mate(body1, body2, point, axis, mask, stiffness, damping, rest, motor=None|"angle"|"speed",
+  motor_dof, motor_target, ...)``: the free axis of a joint is the z axis of
+  its frame (``axis``).  stiffness/damping/motor_target: constant, table
+  [[t, v], ...] or callable f(t).
+* ``add_spring(body1, body2, point1, point2, stiffness, damping, rest_length, preload)``
+* ``add_coulomb_damper(body1, body2, point1, point2, force)``
+* ``add_pulley(body1, body2, axis, axis2, radius, radius2)``
+
+Stepping and state:
+
+* ``step(dt, forces=None, torques=None) -> (pos, quat, vel, omega_world)``;
+  forces/torques: (nb, 3) world-frame loads for this step (torque about each
+  centre), added to gravity and the persistent loads — the fluid coupling.
+* ``pos`` (nb,3), ``quat`` (nb,4, w x y z), ``vel`` (nb,3), ``omega_world``
+  (nb,3), ``omega_b`` (body frame), ``time``.
+* Last step: ``total_force``/``total_torque`` (all loads incl. gravity,
+  contacts and joint reactions, world, about the centre), ``contact_force``/
+  ``contact_torque`` (contact part), ``link_force``/``link_torque`` (nlinks,3):
+  reaction on body 1 in the world frame, torque about the link point on body
+  1 (for springs/dampers the element force on body 1).
+* ``last_iterations``, ``last_residual``, ``n_contacts``, ``n_rows``,
+  ``constraint_violation()``, ``kinetic_energy()``, ``potential_energy()``,
+  ``set_velocity(body, vel, omega)``, ``set_external_load(body, force, torque)``.
+
+Body-only runs:
+
+* ``run_bodies(bodies, links=(), out_dir=".", tmax, tout, dt=1e-3, materials=(), forces=None,
+  **system_kw) -> System`` writes ``bodies.csv`` (header :data:`BODIES_HEADER`,
+  one row per body per output time, angles in degrees, roll-pitch-yaw with
+  R = Rz(yaw) Ry(pitch) Rx(roll)) and ``links.csv`` (:data:`LINKS_HEADER`),
+  atomically.  ``build_system(bodies, links, materials, **system_kw)`` builds
+  the System from the same plain dicts (see :mod:`sphdvi.dvi.runner`).
 """
+from .runner import BODIES_HEADER, LINKS_HEADER, build_system, run_bodies  # noqa: F401
 from .system import System  # noqa: F401
-from .runner import run_bodies, BODIES_HEADER, LINKS_HEADER  # noqa: F401
 
 MultibodySystem = System
 
-__all__ = ["System", "MultibodySystem", "run_bodies", "BODIES_HEADER", "LINKS_HEADER"]
+__all__ = ["System", "MultibodySystem", "run_bodies", "build_system", "BODIES_HEADER",
+           "LINKS_HEADER"]
