@@ -33,9 +33,9 @@ def scene(is2d, rng, dp=0.02, n=14):
     return FluidState(pos, vel, rho, mass, ptype)
 
 
-@pytest.mark.parametrize("is2d", [True, False])
-@pytest.mark.parametrize("kernel,visco", [(2, 1), (1, 1), (2, 3)])
+@pytest.mark.parametrize("is2d,kernel,visco", [(True, 2, 1), (True, 1, 3), (False, 1, 1), (False, 2, 3)])
 def test_force_equals_solver_ace(is2d, kernel, visco):
+    """Wendland/cubic (tensile correction), artificial/laminar viscosity, 2D and 3D."""
     rng = np.random.default_rng(7)
     state = scene(is2d, rng)
     dp = 0.02
