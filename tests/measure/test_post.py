@@ -166,3 +166,15 @@ def test_isosurface_export(which, request):
     assert np.abs(p[mid, 2] - DEPTH).max() < tank["constants"]["dp"] / 2
     assert os.path.exists(os.path.join(out, "iso", "isosurface.pvd"))
     assert len(os.listdir(os.path.join(out, "iso"))) == len(RunOutput(out).times()) + 1
+
+
+def test_measure_help_imports_nothing_heavy():
+    import subprocess
+    import sys
+    code = ("import sys\nfrom click.testing import CliRunner\nfrom sphdvi.cli import main\n"
+            "for c in ([], ['points'], ['elevation'], ['forces'], ['bodies']):\n"
+            "    r = CliRunner().invoke(main, ['measure'] + c + ['--help'])\n"
+            "    assert r.exit_code == 0 and 'Usage' in r.output, r.output\n"
+            "heavy = [m for m in ('numba', 'h5py', 'numpy', 'matplotlib') if m in sys.modules]\n"
+            "assert not heavy, heavy\n")
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
