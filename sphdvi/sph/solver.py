@@ -76,6 +76,12 @@ class SPHSolver:
         with their current velocity, r += v dt.
     parallel_threshold : int
         Below this many particles the serial kernels run (no thread launch).
+    periodic : iterable of "x", "y", "z" or None
+        Periodic axes.  DualSPHysics switches an axis on when its
+        ``*PeriodicInc*`` key is present in the case (even with value 0), which
+        the caller knows; here an axis is periodic when it is listed, when one
+        of its Inc keys is non-zero, or when XYPeriodic/XZPeriodic/YZPeriodic
+        is 1.  See :mod:`sphdvi.sph.periodic`.
 
     After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
     accelerations, density rates and pressures of the last interaction, in
@@ -85,7 +91,7 @@ class SPHSolver:
     """
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
-                 parallel_threshold=PARALLEL_THRESHOLD):
+                 parallel_threshold=PARALLEL_THRESHOLD, periodic=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.state = state
@@ -102,8 +108,9 @@ class SPHSolver:
         self._setup_constants()
         self._domain = None
         if domain is not None:
-            self._domain = (np.asarray(domain[0], float), np.asarray(domain[1], float))
+            self._domain = (np.array(domain[0], float), np.array(domain[1], float))
         self.cells = _cells.CellList(self.h, self.is2d)
+        self.periodicity = self._setup_periodic(periodic)
         self._verlet_count = 0
         self._alloc()
         self.dt_pre = self.dtini
@@ -123,9 +130,6 @@ class SPHSolver:
         self.cfl = float(c.get("cflnumber", 0.2))
         if int(p["Boundary"]) != 1:
             raise NotImplementedError("Boundary=2 (mDBC) is not implemented yet; use Boundary=1 (DBC)")
-        for k in PERIODIC_KEYS:
-            if p.get(k):
-                raise NotImplementedError("periodic boundaries (%s) are not implemented yet" % k)
         self.kernel = int(p["Kernel"])
         self.visco_kind = int(p["ViscoTreatment"])
         self.ddt = int(p["DensityDT"])
@@ -176,6 +180,29 @@ class SPHSolver:
         self.ip[3] = float(p["RhopOutMax"])
         self.ip[4] = float(p["ShiftCoef"]) * h
         self.ip[5] = self.shift_tfs
+
+    def _setup_periodic(self, periodic):
+        p = self.params
+        axes = set(periodic or ())
+        pairs = {"x": ("XPeriodicIncY", "XPeriodicIncZ"), "y": ("YPeriodicIncX", "YPeriodicIncZ"),
+                 "z": ("ZPeriodicIncX", "ZPeriodicIncY")}
+        for ax, keys in pairs.items():
+            if any(p.get(k) for k in keys):
+                axes.add(ax)
+        for key, both in (("XYPeriodic", "xy"), ("XZPeriodic", "xz"), ("YZPeriodic", "yz")):
+            if p.get(key):
+                axes.update(both)
+        if self.is2d:
+            axes.discard("y")
+        if not axes:
+            return None
+        from .periodic import Periodicity
+        per = Periodicity(axes, self.state.pos, self.dp, p)
+        if self._domain is not None:
+            for k in per.axes:      # no exclusion along a periodic axis
+                self._domain[0][k] = -np.inf
+                self._domain[1][k] = np.inf
+        return per
 
     def _aux_names(self):
         names = []
@@ -287,12 +314,61 @@ class SPHSolver:
 
     def compute_rates(self):
         """Reorder, then evaluate accelerations, density rates and dt terms."""
+        if self.periodicity is not None:
+            self._compute_rates_periodic()
+            return
         self._reorder()
         k = self._kernels(self._use_parallel())
         s = self.state
         k["pack"](self.is2d, s.pos, s.vel, s.rhop, s.mass, self.cst, self.nb)
         k["rates"](*self._rates_args())
         if self.visco_kind == 2:
+            k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
+
+    def _compute_rates_periodic(self):
+        """Rates with ghost copies across the periodic boundaries (no reordering
+        of the real particles; the extended set is sorted by cell instead)."""
+        s = self.state
+        per = self.periodicity
+        per.wrap(s.pos)
+        n = s.n
+        src, disp = per.ghosts(s.pos, 2.0 * self.h)
+        pos_e = np.concatenate([s.pos, s.pos[src] + disp])
+        order = self.cells.build(pos_e, parallel=self._use_parallel())
+        idx = np.concatenate([np.arange(n), src])[order]     # real source of each sorted row
+        pos_e = np.ascontiguousarray(pos_e[order])
+        vel_e = np.ascontiguousarray(s.vel[idx])
+        rhop_e = np.ascontiguousarray(s.rhop[idx])
+        mass_e = np.ascontiguousarray(s.mass[idx])
+        ptype_e = np.ascontiguousarray(s.ptype[idx])
+        ne = pos_e.shape[0]
+        cell_e = np.ascontiguousarray(self.cells.cell[order])
+        nb = np.zeros((ne, self.nb.shape[1]))
+        ace = np.zeros((ne, 3))
+        ar = np.zeros(ne)
+        viscdt = np.zeros(ne)
+        shiftpos = np.zeros((ne, 3)) if self.shift else self.shiftpos
+        shiftdet = np.zeros(ne) if self.shift else self.shiftdet
+        tau = np.ascontiguousarray(self.tau[idx]) if self.visco_kind == 2 else self.tau
+        gradvel = np.zeros((ne, 6)) if self.visco_kind == 2 else self.gradvel
+        par = self._use_parallel()
+        k = self._kernels(par)
+        k["pack"](self.is2d, pos_e, vel_e, rhop_e, mass_e, self.cst, nb)
+        ncx, ncy, ncz = self.cells.shape
+        geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
+        k["rates"](self.kernel, self.visco_kind, self.ddt, self.shift, nb, ptype_e, cell_e,
+                   self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,
+                   shiftdet, gradvel)
+        real = order < n
+        dst = order[real]
+        self.ace[dst] = ace[real]
+        self.ar[dst] = ar[real]
+        self.viscdt[dst] = viscdt[real]
+        if self.shift:
+            self.shiftpos[dst] = shiftpos[real]
+            self.shiftdet[dst] = shiftdet[real]
+        if self.visco_kind == 2:
+            self.gradvel[dst] = gradvel[real]
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
 
     def _variable_dt(self):
@@ -320,6 +396,8 @@ class SPHSolver:
             dt = self._step_verlet()
         else:
             dt = self._step_symplectic()
+        if self.periodicity is not None:
+            self.periodicity.wrap(self.state.pos)
         self.time += dt
         self.nstep += 1
         self.last_dt = dt

@@ -145,3 +145,5 @@ def test_unsupported_options_raise():
     st, c = small_tank()
     with pytest.raises(NotImplementedError):
         SPHSolver(st, c, {"Boundary": 2})
+    with pytest.raises(ValueError):
+        SPHSolver(st, c, {"DensityDT": 5})
