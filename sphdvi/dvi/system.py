@@ -226,8 +226,12 @@ class System:
         self._motion.append(motion)
         self._packed = False
         self.names.append(name if name is not None else f"body{self.nb - 1}")
-        for a in ("contact_force", "contact_torque", "total_force", "total_torque"):
-            setattr(self, a, np.zeros((self.nb, 3)))
+        for a in ("contact_force", "contact_torque"):
+            setattr(self, a, np.vstack([getattr(self, a), np.zeros((1, 3))]))
+        # before the first step the total load is the applied one
+        f0 = np.asarray(force, float) + (float(mass) * self.gravity if dyn else 0.0)
+        self.total_force = np.vstack([self.total_force, f0[None]])
+        self.total_torque = np.vstack([self.total_torque, np.asarray(torque, float)[None]])
         return self.nb - 1
 
     def set_external_load(self, body, force=None, torque=None):
