@@ -294,3 +294,18 @@ def test_painleve_rod_stays_finite():
         zmin = min(zmin, s.pos[b, 2] - 0.5 * L * abs(ax[2]))
     assert emax <= e0 + 1e-6
     assert zmin > -1e-3
+
+
+def test_smc_sliding_stop_distance():
+    """M2 with SMC (Chrono utest_SMC_sliding_gravity criterion < 0.5 %)."""
+    h = 1e-4
+    s = System(gravity=(0, 0, -G), contactmethod=1)  # DualSPHysics contactmethod 1 = SMC
+    m = s.add_material("m", friction=0.5, restitution=0.3, young=2e7, poisson=0.3)
+    s.add_plane(material=m)
+    b = s.add_body(1.0, (1 / 150,) * 3, pos=(0, 0, 0.1), vel=(5.0, 0, 0))
+    s.add_box(b, (0.1, 0.1, 0.1), material=m)
+    for _ in range(int(1.2 / h)):
+        s.step(h)
+    d = 25.0 / (2 * 0.5 * G)
+    assert abs(s.pos[b, 0] / d - 1) < 5e-3
+    assert abs(s.vel[b, 0]) < 1e-6
