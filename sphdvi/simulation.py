@@ -305,8 +305,9 @@ class SPHRun:
         from .dvi.runner import build_system
         from .mechanism import mechanism_from_case
         mech = mechanism_from_case(self.data, self.motions)
-        system, _ = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
+        system, names = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
         self.bodies = system
+        self.body_names = names
         p = self.data["particles"]
         label = p["mk"].astype(np.int64) - self.fluidcount - 1
         self.body_sel = []          # per body: idp of its particles and body-frame offsets
@@ -351,6 +352,7 @@ class SPHRun:
             T[:, 0] = T[:, 2] = 0.0
         ftpause = float(self.params.get("FtPause", 0.0))
         if solver.time <= ftpause:
+            self.bodies.time = solver.time     # frozen bodies (FtPause): the clock still runs
             return
         self.bodies.step(dt, F, T)
         pos, quat, vel, omega = self.bodies.pos, self.bodies.quat, self.bodies.vel, self.bodies.omega_world
@@ -586,9 +588,13 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
                   f"{dt_lo if dt_lo < math.inf else 0:.6g},{dt_hi:.6g},{wall:.3f}")
         files.log(f"Part {k:04d}  t={sol.time:.6f} s  steps={sol.nstep}  particles={sol.state.n}  "
                   f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s")
+        if body_log is not None:
+            body_log.record()
         sph.save_checkpoint(ckpt, {"part": k, "runtime_s": wall})
 
     gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
+    body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None)
+                if sph.bodies is not None else None)
     status, code, message = "completed", 0, ""
     with _Stop() as stop:
         try:
@@ -617,6 +623,8 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
         except BaseException as exc:
             status, code, message = "failed", 1, f"{type(exc).__name__}: {exc}"
             runtime += _time.perf_counter() - t_loop
+            if gauges is not None:
+                gauges.close()
             files.write_json(status=status, message=message, steps=int(sol.nstep),
                              physical_time=float(sol.time), runtime_s=runtime)
             writer.close()
@@ -635,6 +643,32 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
                      us_per_particle_step=(1e6 * (runtime - wall_prev)
                                            / max(1, sol.nstep - steps_at_start) / max(1, sol.state.n)))
     return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)
+
+
+class BodyLog:
+    """``bodies.csv`` and ``links.csv`` of an SPH run with floating bodies (one row per body
+    and per link at every output time), rewritten atomically at each output."""
+
+    def __init__(self, outdir: str, system, names, resume_time: float | None = None):
+        from .dvi.runner import BODIES_HEADER, LINKS_HEADER
+        self.system, self.names = system, names
+        self.paths = (os.path.join(outdir, "bodies.csv"), os.path.join(outdir, "links.csv"))
+        self.headers = (BODIES_HEADER, LINKS_HEADER)
+        self.rows: tuple[list, list] = ([], [])
+        if resume_time is not None:
+            for rows, path in zip(self.rows, self.paths):
+                if os.path.exists(path):
+                    with open(path) as fh:
+                        for line in fh.read().splitlines()[1:]:
+                            if float(line.split(",", 1)[0]) <= resume_time * (1 + 1e-12):
+                                rows.append(line + "\n")
+
+    def record(self) -> None:
+        from .dvi.runner import _body_lines, _link_lines
+        self.rows[0].extend(_body_lines(self.system, self.names))
+        self.rows[1].extend(_link_lines(self.system))
+        for path, header, rows in zip(self.paths, self.headers, self.rows):
+            write_text_atomic(path, header + "\n" + "".join(rows))
 
 
 def _make_gauges(data, params, outdir, resume, t):
