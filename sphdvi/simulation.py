@@ -201,6 +201,20 @@ def find_case_file(folder: str) -> str:
     return found[0]
 
 
+def periodic_axes(data: dict, params: dict) -> list[str]:
+    """Periodic axes: DualSPHysics switches an axis on when one of its ``*PeriodicInc*``
+    keys is written in the case (even with value 0), or with XYPeriodic/XZPeriodic/YZPeriodic = 1."""
+    written = set(data["json"].get("parameters_set", []))
+    axes = set()
+    for axis in "XYZ":
+        if any(k.startswith(f"{axis}PeriodicInc") for k in written):
+            axes.add(axis.lower())
+    for pair in ("XY", "XZ", "YZ"):
+        if int(params.get(f"{pair}Periodic", 0) or 0) == 1:
+            axes.update(pair.lower())
+    return sorted(axes)
+
+
 def special_parameters(data: dict) -> dict:
     """Parameters with ``<special><shifting>`` applied (it overrides Shifting, ShiftCoef, ShiftTFS)."""
     params = dict(data["parameters"])
@@ -294,7 +308,11 @@ class SPHRun:
         self.bodies = None
         if self.has_floating:
             self._setup_bodies()
-        self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook)
+        periodic = periodic_axes(data, params)
+        for k in periodic:
+            i = "xyz".index(k)
+            domain[1][i] += c["dp"]
+        self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None)
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.dtmin_run = 0
         self.dtmin_seen = 0
