@@ -36,10 +36,13 @@ BENCH_PARAMS = {"StepAlgorithm": 1, "VerletSteps": 40, "Kernel": 2, "ViscoTreatm
                 "Visco": 0.02, "ViscoBoundFactor": 1.0, "DensityDT": 2, "DensityDTvalue": 0.1}
 
 
-def dambreak_3d(dp=0.02):
-    """3D dam break: 1 x 0.5 x 1 m column in a 3 x 0.5 x 1.5 m open box (one wall layer)."""
+def dambreak_3d(dp=0.02, coefh=0.866025):
+    """3D dam break: 1 x 0.5 x 1 m column in a 3 x 0.5 x 1.5 m open box (one wall layer).
+
+    coefh 0.866025 (GenCase's default, h = 1.5 dp) unless given.
+    """
     g = 9.81
-    h = 1.0 * math.sqrt(3) * dp
+    h = coefh * math.sqrt(3) * dp
     cs0 = 20 * math.sqrt(g * 1.0)
     ax = lambda a, b: a + dp * np.arange(int(round((b - a) / dp)) + 1)  # noqa: E731
     X, Y, Z = np.meshgrid(ax(dp, 1.0), ax(dp, 0.5 - dp), ax(dp, 1.0), indexing="ij")
@@ -131,6 +134,8 @@ def main():
                 t0 = time.perf_counter()
                 sols[t].run(1e9, max_steps=a.steps)
                 best[t] = min(best[t], (time.perf_counter() - t0) / a.steps)
+        print("  memory: %.0f bytes per particle in per-particle arrays"
+              % (sols[threads[0]].memory_bytes() / state.n))
         base = None
         for t in threads:
             dt_step, sol = best[t], sols[t]

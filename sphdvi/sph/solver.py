@@ -218,12 +218,14 @@ class SPHSolver:
         """(Re)allocate the per-particle work arrays for the current N."""
         s = self.state
         n = s.n
-        if not hasattr(self, "vel_m1"):
-            self.vel_m1 = s.vel.copy()
-            self.rhop_m1 = s.rhop.copy()
-            self.pos_pre = s.pos.copy()
-            self.vel_pre = s.vel.copy()
-            self.rhop_pre = s.rhop.copy()
+        if not hasattr(self, "tau"):
+            if self.step_algorithm == 1:
+                self.vel_m1 = s.vel.copy()
+                self.rhop_m1 = s.rhop.copy()
+            else:
+                self.pos_pre = s.pos.copy()
+                self.vel_pre = s.vel.copy()
+                self.rhop_pre = s.rhop.copy()
             self.tau = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
         self.nb = np.zeros((n, 8 if self.is2d else 10))
         self.ace = np.zeros((n, 3))
@@ -470,6 +472,19 @@ class SPHSolver:
     @property
     def n_fluid(self):
         return int(np.count_nonzero(self.state.ptype == FLUID))
+
+    def memory_bytes(self):
+        """Bytes held in per-particle arrays by the state and the solver."""
+        seen = {}
+        for obj in (self.state, self, self.cells):
+            names = obj.__slots__ if hasattr(obj, "__slots__") else vars(obj)
+            for name in names:
+                a = getattr(obj, name, None)
+                if isinstance(a, np.ndarray):
+                    seen[id(a)] = a.nbytes
+        for a in self._bufs.values():
+            seen[id(a)] = a.nbytes
+        return int(sum(seen.values()))
 
     def particle_forces(self):
         """m_a a_a for every particle (for floating bodies: fluid force, no gravity)."""
