@@ -935,6 +935,17 @@ class System:
         self.link_torque = link_point_torques(lf, ltc, P1w, b1, self.pos)
 
     # ------------------------------------------------------------ accessors
+    def body_index(self, name):
+        """Index of the body called ``name``."""
+        return self.names.index(name)
+
+    def link_index(self, name):
+        """Id of the link called ``name``."""
+        for i, rec in enumerate(self.links):
+            if rec["name"] == name:
+                return i
+        raise KeyError(name)
+
     @property
     def omega_world(self):
         R = body_rotations(self.quat)

@@ -181,3 +181,23 @@ def test_hull_hull_stack_rest():
     assert abs(s.pos[a, 2] - h) < 1e-3
     assert abs(s.pos[b, 2] - 3 * h) < 2e-3
     assert abs(s.contact_force[:, 2].sum() / (2 * G) - 1) < 1e-2
+
+
+def test_add_after_stepping_and_names():
+    s = System(gravity=(0, 0, -G), solver="psor", max_iter=50)
+    s.add_plane()
+    a = s.add_body(1.0, (0.004,) * 3, pos=(0, 0, 0.1), name="a")
+    s.add_sphere(a, 0.1)
+    for _ in range(10):
+        s.step(1e-3)
+    b = s.add_body(1.0, (0.004,) * 3, pos=(1, 0, 0.5), name="b")
+    s.add_sphere(b, 0.1)
+    lid = s.add_link("spring", b, -1, point1=(1, 0, 0.5), point2=(1, 0, 1.5), stiffness=50.0, damping=20.0,
+                     name="rope")
+    for _ in range(2000):
+        s.step(1e-3)
+    assert s.body_index("b") == b and s.link_index("rope") == lid
+    assert abs(s.pos[a, 2] - 0.1) < 1e-4
+    # hanging mass on the spring: static stretch m g / k below the rest length
+    assert abs(s.pos[b, 2] - (0.5 - G / 50.0)) < 1e-4
+    assert s.link_force.shape == (1, 3)
