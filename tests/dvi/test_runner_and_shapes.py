@@ -192,7 +192,7 @@ def test_add_after_stepping_and_names():
         s.step(1e-3)
     b = s.add_body(1.0, (0.004,) * 3, pos=(1, 0, 0.5), name="b")
     s.add_sphere(b, 0.1)
-    lid = s.add_link("spring", b, -1, point1=(1, 0, 0.5), point2=(1, 0, 1.5), stiffness=50.0, damping=20.0,
+    lid = s.add_link("spring", b, -1, point1=(1, 0, 0.5), point2=(1, 0, 1.5), stiffness=50.0, damping=2 * math.sqrt(50.0),
                      name="rope")
     for _ in range(2000):
         s.step(1e-3)
