@@ -16,10 +16,12 @@ kernel sums over its neighbours ``b`` found through the cell list:
   ``ViscoBoundFactor`` multiplies Visco for fluid-boundary pairs;
 * continuity (Domínguez et al. 2022 eq. 6)
   drho_a/dt = rho_a sum_b (m_b/rho_b) v_ab . grad_a W_ab + D_a,
-* density diffusion D_a (``DensityDT``): 1 Molteni & Colagrossi (2009),
-  2 Fourtakas et al. (2019) with the hydrostatic correction, on fluid
-  particles with no boundary neighbour, 3 the same on all fluid particles
-  over fluid-fluid pairs;
+* density diffusion D_a (``DensityDT``), as DualSPHysics applies it:
+  1 Molteni & Colagrossi (2009) over fluid and floating neighbours, on fluid
+  particles with no fixed/moving boundary neighbour; 2 Fourtakas et al.
+  (2019) with the hydrostatic correction, over fluid-fluid pairs, on fluid
+  particles with no fixed/moving boundary neighbour; 3 the same over
+  fluid-fluid pairs on all fluid particles;
 * the viscous time-step term max_b h v_ab.r_ab/(r_ab^2+eta^2);
 * shifting sums (Lind et al. 2012): grad C_a = sum_b m_b/rho_b grad_a W_ab and
   the free-surface detector div r_a = -sum_b m_b/rho_b r_ab.grad_a W_ab.
@@ -273,7 +275,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                 acez += coef * mfac * dz
                 # density diffusion
                 if ddt == 1:
-                    if ptj != 3:
+                    if boundj:
                         ddt_off = True
                     else:
                         deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
@@ -523,7 +525,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                     acey += coef * mfac * dy
                     acez += coef * mfac * dz
                     if ddt == 1:
-                        if ptj != 3:
+                        if boundj:
                             ddt_off = True
                         else:
                             deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac

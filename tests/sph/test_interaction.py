@@ -31,6 +31,7 @@ def reference_rates(s, c, p):
     wdp = kernel_w(1, c["dp"] / h, kernel_alpha(1, h, is2d))
     for a in range(n):
         fluid_a = s.ptype[a] == 3
+        float_a = s.ptype[a] == 2
         dd = 0.0
         ddt_off = False
         for b in range(n):
@@ -43,13 +44,16 @@ def reference_rates(s, c, p):
             if r >= 2 * h:
                 continue
             bound_b = s.ptype[b] < 2
-            if not fluid_a and bound_b:
-                continue
+            float_b = s.ptype[b] == 2
+            if float_a and s.ptype[b] != 3:
+                continue            # floating particles see fluid only
+            if s.ptype[a] < 2 and bound_b:
+                continue            # boundary-boundary pairs are not computed
             gradW = kernel_fac(kind, r / h, alpha / h ** 2) * rab
             vab = s.vel[a] - s.vel[b]
             mb, ra, rb = s.mass[b], s.rhop[a], s.rhop[b]
             ar[a] += ra * mb / rb * (vab @ gradW)
-            if not fluid_a:
+            if s.ptype[a] < 2:
                 continue
             pterm = (press[a] + press[b]) / (ra * rb)
             if kind == 1:
@@ -75,13 +79,13 @@ def reference_rates(s, c, p):
             elif ddt in (2, 3):
                 if bound_b:
                     ddt_off = ddt_off or ddt == 2
-                else:
+                elif not float_b:
                     # hydrostatic density difference rho^H_b - rho^H_a
                     zab = rab[2]
                     drh = rho0 * ((1 + rho0 * abs(g[2]) * zab / B) ** (1 / gam) - 1)
                     psi = -2 * ((rb - ra) - drh) * rab / (r * r + eta2)
                     dd += delta * h * c0 * (psi @ gradW) * mb / rb
-        if fluid_a:
+        if fluid_a:              # floating particles: fluid force only, no gravity
             ace[a] += g
             if p["DensityDT"] and not ddt_off:
                 ar[a] += dd
@@ -105,6 +109,7 @@ def test_rates_match_reference(is2d, kernel, visco, ddt):
         bd = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel() + 0.5 * dp], 1)
     pos = np.concatenate([bd, fl])
     ptype = np.r_[np.zeros(len(bd), np.int8), np.full(len(fl), 3, np.int8)]
+    ptype[len(bd) + len(fl) // 2 + np.arange(3)] = 2      # a few floating particles
     s = random_state(pos, dp, is2d, rng, ptype)
     s.vel[ptype == 0] = 0.0
     c = constants(dp, is2d, g=9.81)
