@@ -75,3 +75,17 @@ def test_moving_body_follows_motion():
         s.step(1e-3)
     assert abs(s.pos[b, 0] - (1 - np.cos(1.0))) < 1e-3
     assert abs(s.pos[b, 2]) < 1e-15
+
+
+def test_euler_angles_convention():
+    """bodies.csv angles: R = Rz(yaw) Ry(pitch) Rx(roll), degrees."""
+    from sphdvi.dvi._math import np_quat_to_mat, quat_to_euler_deg
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        r, p, y = np.radians(quat_to_euler_deg(q)[0])
+        Rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
+        Ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
+        Rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
+        np.testing.assert_allclose(Rz @ Ry @ Rx, np_quat_to_mat(q), atol=1e-10)
