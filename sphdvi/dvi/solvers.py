@@ -132,7 +132,9 @@ def prepare_rows(nr, ra, rb, J, E, kind, invm3, invI, MiJ, gdiag):
             i += 1
     for k in range(nr):
         if gdiag[k] <= 1e-300:
-            gdiag[k] = 1.0  # row touching only fixed bodies with E = 0
+            # row between non-dynamic bodies (fixed/moving or locked DOFs):
+            # it cannot act; a huge diagonal keeps its impulse at zero
+            gdiag[k] = 1e300
     return
 
 

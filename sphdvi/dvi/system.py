@@ -819,6 +819,10 @@ class System:
             self._c_mu = c_mu
         prepare_rows(nr, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
                      self.r_MiJ, self.r_g)
+        dead = self.r_g[:nr] >= 1e300  # rows that cannot act (no dynamic body)
+        if dead.any():
+            self.r_bias[:nr][dead] = 0.0
+            g[:nr][dead] = 0.0
         vout = np.empty((nb, 6))
         if self.solver.lower() == "direct":
             it, res = solve_direct(nr, nb, self.r_a, self.r_b, self.r_J, self.r_MiJ, self.r_bias,

@@ -201,3 +201,19 @@ def test_add_after_stepping_and_names():
     # hanging mass on the spring: static stretch m g / k below the rest length
     assert abs(s.pos[b, 2] - (0.5 - G / 50.0)) < 1e-4
     assert s.link_force.shape == (1, 3)
+
+
+@pytest.mark.parametrize("solver", ["psor", "apgd", "bb", "direct"])
+def test_link_between_fixed_bodies_is_inert(solver):
+    """A joint between two non-dynamic bodies (and a locked-DOF imposed
+    component) must not produce reactions or slow the solver down."""
+    s = System(gravity=(0, 0, -G), solver=solver, max_iter=50)
+    f1 = s.add_body(1.0, (1, 1, 1), kind="fixed", pos=(0, 0, 0))
+    f2 = s.add_body(1.0, (1, 1, 1), kind="fixed", pos=(1, 0, 0.01))
+    lid = s.add_link("hinge", f1, f2, point=(0.5, 0, 0), axis=(0, 1, 0))
+    b = s.add_body(1.0, (0.1,) * 3, pos=(2, 0, 0))
+    s.add_link("hinge", b, -1, point=(2, 0, 1), axis=(0, 1, 0))
+    for _ in range(20):
+        s.step(1e-3)
+    assert np.all(s.link_force[lid] == 0.0)
+    assert np.isfinite(s.last_residual) and s.last_residual < 1e-6
