@@ -603,3 +603,52 @@ def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
                         nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, tau, ace,
                         ar, viscdt,
                         shiftpos, shiftdet, gradvel)
+
+
+# --------------------------------------------------------------------------
+# Fused reorder + pack (one pass, one thread launch per step)
+# --------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def _reorder_pack_range(k0, k1, order, is2d, cst, nb, f2_src, f2_dst, f1_src, f1_dst,
+                        ptype_src, ptype_dst, idp_src, idp_dst, mk_src, mk_dst,
+                        cell_src, cell_dst):
+    for k in range(k0, k1):
+        i = order[k]
+        for a in range(len(f2_src)):
+            src = f2_src[a]
+            dst = f2_dst[a]
+            for m in range(src.shape[1]):
+                dst[k, m] = src[i, m]
+        for a in range(len(f1_src)):
+            f1_dst[a][k] = f1_src[a][i]
+        ptype_dst[k] = ptype_src[i]
+        idp_dst[k] = idp_src[i]
+        mk_dst[k] = mk_src[i]
+        cell_dst[k] = cell_src[i]
+    # pack from the reordered arrays: f2 = (pos, vel, ...), f1 = (rhop, mass, ...)
+    _pack_range(k0, k1, is2d, f2_dst[0], f2_dst[1], f1_dst[0], f1_dst[1], cst, nb)
+
+
+@njit(cache=True, error_model="numpy")
+def reorder_pack_serial(order, is2d, cst, nb, f2_src, f2_dst, f1_src, f1_dst, ptype_src,
+                        ptype_dst, idp_src, idp_dst, mk_src, mk_dst, cell_src, cell_dst):
+    """Permute every per-particle array by ``order`` (dst[k] = src[order[k]]) and
+    fill the packed neighbour array from the result.
+
+    ``f2_*`` are tuples of (N, m) float arrays starting with (pos, vel), ``f1_*``
+    tuples of (N,) float arrays starting with (rhop, mass).
+    """
+    _reorder_pack_range(0, order.shape[0], order, is2d, cst, nb, f2_src, f2_dst, f1_src,
+                        f1_dst, ptype_src, ptype_dst, idp_src, idp_dst, mk_src, mk_dst,
+                        cell_src, cell_dst)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def reorder_pack_parallel(order, is2d, cst, nb, f2_src, f2_dst, f1_src, f1_dst, ptype_src,
+                          ptype_dst, idp_src, idp_dst, mk_src, mk_dst, cell_src, cell_dst):
+    """Threaded :func:`reorder_pack_serial`."""
+    n = order.shape[0]
+    for c in prange((n + 1023) // 1024):
+        _reorder_pack_range(c * 1024, min(n, (c + 1) * 1024), order, is2d, cst, nb, f2_src,
+                            f2_dst, f1_src, f1_dst, ptype_src, ptype_dst, idp_src, idp_dst,
+                            mk_src, mk_dst, cell_src, cell_dst)

@@ -288,41 +288,42 @@ class SPHSolver:
                 self.ace, self.ar, s.ptype, self.shiftpos, self.shiftdet, self.ip, self.out)
 
     # ------------------------------------------------------------------ steps
-    def _reorder(self):
-        """Counting-sort the particles by cell and permute every per-particle array."""
+    def _reorder_and_pack(self):
+        """Counting-sort the particles by cell, permute every per-particle array
+        and fill the packed neighbour array, in one pass (one thread launch)."""
         s = self.state
-        par = self._use_parallel()
         if self._domain is not None:
-            order = self.cells.build(s.pos, self._domain[0], self._domain[1], parallel=par)
+            order = self.cells.build(s.pos, self._domain[0], self._domain[1])
         else:
-            order = self.cells.build(s.pos, parallel=par)
-        g1 = _cells.gather_parallel if par else _cells.gather
-        g2 = _cells.gather_rows_parallel if par else _cells.gather_rows
-        g1(self.cells.cell, order, self.cell_sorted)
-        for holder, names in ((s, FluidState.FIELDS), (self, self._aux_names())):
-            for name in names:
-                a = getattr(holder, name)
-                if a.shape[0] != order.shape[0]:
-                    continue
-                buf = self._bufs.get(name)
-                if buf is None or buf.shape != a.shape:
-                    buf = np.empty_like(a)
-                if a.ndim == 2:
-                    g2(a, order, buf)
-                else:
-                    g1(a, order, buf)
-                setattr(holder, name, buf)
-                self._bufs[name] = a
+            order = self.cells.build(s.pos)
+        n = order.shape[0]
+        aux = [a for a in self._aux_names() if getattr(self, a).shape[0] == n]
+        f2 = ["pos", "vel"] + [a for a in aux if getattr(self, a).ndim == 2]
+        f1 = ["rhop", "mass"] + [a for a in aux if getattr(self, a).ndim == 1]
+        holder = {name: (s if name in FluidState.FIELDS else self) for name in f2 + f1 + ["ptype", "idp", "mk"]}
+        src = {name: getattr(holder[name], name) for name in holder}
+        dst = {}
+        for name, a in src.items():
+            buf = self._bufs.get(name)
+            if buf is None or buf.shape != a.shape:
+                buf = np.empty_like(a)
+            dst[name] = buf
+        fn = _ia.reorder_pack_parallel if self._use_parallel() else _ia.reorder_pack_serial
+        fn(order, self.is2d, self.cst, self.nb, tuple(src[k] for k in f2), tuple(dst[k] for k in f2),
+           tuple(src[k] for k in f1), tuple(dst[k] for k in f1), src["ptype"], dst["ptype"],
+           src["idp"], dst["idp"], src["mk"], dst["mk"], self.cells.cell, self.cell_sorted)
+        for name in src:
+            setattr(holder[name], name, dst[name])
+            self._bufs[name] = src[name]
 
     def compute_rates(self):
         """Reorder, then evaluate accelerations, density rates and dt terms."""
         if self.periodicity is not None:
             self._compute_rates_periodic()
             return
-        self._reorder()
+        self._reorder_and_pack()
         k = self._kernels(self._use_parallel())
         s = self.state
-        k["pack"](self.is2d, s.pos, s.vel, s.rhop, s.mass, self.cst, self.nb)
         k["rates"](*self._rates_args())
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
