@@ -112,7 +112,7 @@ def shape_aabbs(sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad, w_pos,
 
 # ----------------------------------------------------------------- broad phase
 @njit(cache=True)
-def broad_phase(lo, hi, sh_body, sh_type, body_active, pairs):
+def broad_phase(lo, hi, sh_body, sh_type, body_active, pairs, w_pos, w_R, env):
     """Sort-and-sweep along the axis of largest spread of the AABB centres;
     planes are paired with every shape whose AABB reaches below them (tested
     exactly in the narrow phase).  Returns the number of pairs (pairs may be
@@ -172,12 +172,19 @@ def broad_phase(lo, hi, sh_body, sh_type, body_active, pairs):
         if sh_type[s] != PLANE:
             continue
         bs = sh_body[s]
+        n0, n1, n2 = w_R[s, 0, 2], w_R[s, 1, 2], w_R[s, 2, 2]
+        off = n0 * w_pos[s, 0] + n1 * w_pos[s, 1] + n2 * w_pos[s, 2]
         for q in range(nfin):
             t = idx[q]
             bt = sh_body[t]
             if bt == bs:
                 continue
             if not (body_active[bs] if bs >= 0 else False) and not (body_active[bt] if bt >= 0 else False):
+                continue
+            # lowest point of the AABB along the plane normal
+            dmin = (n0 * (hi[t, 0] if n0 < 0.0 else lo[t, 0]) + n1 * (hi[t, 1] if n1 < 0.0 else lo[t, 1])
+                    + n2 * (hi[t, 2] if n2 < 0.0 else lo[t, 2])) - off
+            if dmin > env:
                 continue
             if npair < cap:
                 pairs[npair, 0] = s

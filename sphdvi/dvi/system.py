@@ -716,7 +716,8 @@ class System:
         active = self.kind == FLOATING
         while True:
             pairs = np.empty((self._cap_pairs, 2), np.int64)
-            npair = col.broad_phase(lo, hi, self.sh_body, self.sh_type, active, pairs)
+            npair = col.broad_phase(lo, hi, self.sh_body, self.sh_type, active, pairs, w_pos, w_R,
+                                    self.envelope)
             if npair <= self._cap_pairs:
                 break
             self._cap_pairs = int(npair * 1.5)
