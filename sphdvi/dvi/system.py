@@ -162,6 +162,7 @@ class System:
         self._prev_keys = np.zeros(0, np.int64)
         self._prev_g3 = np.zeros((0, 3))
         self._prev_link_gamma = np.zeros(0)
+        self._prev_h = None
         self._cap_rows = 0
         self._cap_contacts = 256
         self._cap_pairs = 1024
@@ -800,8 +801,10 @@ class System:
         nl_rows = self._build_link_rows(h, R)
         g = self.r_gamma
         g[:] = 0.0
+        # warm start: impulses of the last step, rescaled to this step (γ = h·force)
+        ws = 1.0 if self._prev_h is None else h / self._prev_h
         if self._prev_link_gamma.shape[0] == nl_rows:
-            g[:nl_rows] = self._prev_link_gamma
+            g[:nl_rows] = self._prev_link_gamma * ws
         nr = nl_rows
         if ncr > 0:
             c = self._c
@@ -815,6 +818,8 @@ class System:
                                        c["gap"], c_mu, c_e, c_row, *self._row_args())
             g3 = np.zeros((nc, 3))
             col.match_warm_start(nc, c["key"], self._prev_keys, self._prev_g3, g3)
+            if ws != 1.0:
+                g3 *= ws
             _scatter_warm(g, c_row, c_mu, g3)
             self._c_row = c_row
             self._c_mu = c_mu
@@ -839,6 +844,7 @@ class System:
         self.n_rows = nr
         # warm-start caches
         self._prev_link_gamma = g[:nl_rows].copy()
+        self._prev_h = h
         if ncr > 0:
             keys = self._c["key"][:nc]
             order = np.argsort(keys)

@@ -309,3 +309,17 @@ def test_smc_sliding_stop_distance():
     d = 25.0 / (2 * 0.5 * G)
     assert abs(s.pos[b, 0] / d - 1) < 5e-3
     assert abs(s.vel[b, 0]) < 1e-6
+
+
+def test_variable_time_step_resting_contact():
+    """SPH steps vary every step: the warm start is rescaled (γ = h·force), a
+    resting box keeps its weight balance and does not drift."""
+    s, b = box_on_plane(0.5, (0, 0, -G), solver="psor", iters=20)
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        s.step(1e-3)
+    z0 = s.pos[b, 2]
+    for _ in range(2000):
+        s.step(rng.uniform(1e-5, 1e-4))
+        assert abs(s.contact_force[b, 2] / G - 1) < 1e-3
+    assert abs(s.pos[b, 2] - z0) < 1e-6
