@@ -76,6 +76,22 @@ def tank_2d(tank_w, tank_h, fluid_w, fluid_h, dp, layers=1, hydrostatic=True,
     return state, c
 
 
+def tank_normals_2d(state, tank_w, dp):
+    """mDBC normals of the walls built by :func:`tank_2d` (DualSPHysics
+    convention: vector from the boundary particle to the wall surface, which
+    lies dp/2 inside the first wall layer; corners point to the corner)."""
+    x, z = state.pos[:, 0], state.pos[:, 2]
+    bound = state.ptype < 2
+    sx = np.where(x < 0.5 * tank_w, 0.5 * dp, tank_w - 0.5 * dp)     # wall surfaces
+    sz = 0.5 * dp
+    nx = np.where((x <= 0) | (x >= tank_w), sx - x, 0.0)
+    nz = np.where(z <= 0, sz - z, 0.0)
+    n = np.zeros_like(state.pos)
+    n[:, 0] = np.where(bound, nx, 0.0)
+    n[:, 2] = np.where(bound, nz, 0.0)
+    return n
+
+
 def dambreak_2d(dp=0.01, coefh=1.0):
     """The benchmark dam break: 1 m x 2 m column in a 4 m x 3 m tank.
 

@@ -82,6 +82,11 @@ class SPHSolver:
         the caller knows; here an axis is periodic when it is listed, when one
         of its Inc keys is non-zero, or when XYPeriodic/XZPeriodic/YZPeriodic
         is 1.  See :mod:`sphdvi.sph.periodic`.
+    normals : (N, 3) array or None
+        mDBC (``Boundary=2``): per particle (in the order of ``state``), the
+        vector from a boundary particle to the boundary surface (DualSPHysics
+        convention, ghost node = r + 2 N); zero rows keep DBC.  Required for
+        Boundary=2.  See :mod:`sphdvi.sph.mdbc`.
 
     After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
     accelerations, density rates and pressures of the last interaction, in
@@ -91,7 +96,7 @@ class SPHSolver:
     """
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
-                 parallel_threshold=PARALLEL_THRESHOLD, periodic=None):
+                 parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.state = state
@@ -111,6 +116,12 @@ class SPHSolver:
             self._domain = (np.array(domain[0], float), np.array(domain[1], float))
         self.cells = _cells.CellList(self.h, self.is2d)
         self.periodicity = self._setup_periodic(periodic)
+        if self.boundary == 2:
+            if normals is None:
+                raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
+            if self.periodicity is not None:
+                raise NotImplementedError("mDBC with periodic boundaries is not implemented")
+            self.normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(state.n, 3).copy()
         self._verlet_count = 0
         self._alloc()
         self.dt_pre = self.dtini
@@ -128,8 +139,12 @@ class SPHSolver:
         self.b = float(c.get("b") or self.cs0 ** 2 * self.rhop0 / self.gamma)
         self.gravity = np.asarray(c["gravity"], float).reshape(3)
         self.cfl = float(c.get("cflnumber", 0.2))
-        if int(p["Boundary"]) != 1:
-            raise NotImplementedError("Boundary=2 (mDBC) is not implemented yet; use Boundary=1 (DBC)")
+        self.boundary = int(p["Boundary"])
+        if self.boundary not in (1, 2):
+            raise ValueError("Boundary must be 1 (DBC) or 2 (mDBC)")
+        if self.boundary == 2 and int(p.get("SlipMode", 1) or 1) != 1:
+            raise NotImplementedError("mDBC SlipMode 2/3 (no-slip/free-slip) is not implemented; use SlipMode=1")
+        self.mdbc_ksum = float(p.get("MdbcThreshold") or 0.0)
         self.kernel = int(p["Kernel"])
         self.visco_kind = int(p["ViscoTreatment"])
         self.ddt = int(p["DensityDT"])
@@ -212,6 +227,8 @@ class SPHSolver:
             names += ["pos_pre", "vel_pre", "rhop_pre"]
         if self.visco_kind == 2:
             names += ["tau"]
+        if self.boundary == 2:
+            names += ["normals"]
         return names
 
     def _alloc(self):
@@ -322,8 +339,16 @@ class SPHSolver:
             self._compute_rates_periodic()
             return
         self._reorder_and_pack()
-        k = self._kernels(self._use_parallel())
+        par = self._use_parallel()
+        k = self._kernels(par)
         s = self.state
+        if self.boundary == 2:
+            from . import mdbc
+            fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
+            ncx, ncy, ncz = self.cells.shape
+            fn(self.kernel, self.is2d, self.nb, s.ptype, self.normals, self.cells.cell_start,
+               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
+               self.mdbc_ksum, s.rhop)
         k["rates"](*self._rates_args())
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)

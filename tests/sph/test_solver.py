@@ -143,7 +143,7 @@ def test_3d_column_runs(visco):
 
 def test_unsupported_options_raise():
     st, c = small_tank()
-    with pytest.raises(NotImplementedError):
-        SPHSolver(st, c, {"Boundary": 2})
+    with pytest.raises(ValueError):
+        SPHSolver(st, c, {"Boundary": 2})          # mDBC needs normals
     with pytest.raises(ValueError):
         SPHSolver(st, c, {"DensityDT": 5})

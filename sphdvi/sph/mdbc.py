@@ -1,0 +1,218 @@
+r"""Modified dynamic boundary conditions, mDBC (English et al. 2022).
+
+Each boundary particle b carries a normal vector N_b pointing from the
+particle to the boundary surface (DualSPHysics convention; |N_b| is the
+distance to the surface).  Its ghost node g = r_b + 2 N_b lies inside the
+fluid.  The fluid density and its gradient at g come from the first-order
+consistent kernel interpolation (Liu & Liu 2006)
+
+  [ sum V w        sum V w (r_j-g)^T   ] [rho_g     ]   [ sum m w  ]
+  [ sum V grad w   sum V grad w (r_j-g)^T ] [grad rho_g] = [ sum m grad w ]
+
+over the fluid particles j near g (V = m/rho, w = W(|g - r_j|), grad w its
+gradient with respect to g), and the boundary particle gets
+rho_b = rho_g + (r_b - g) . grad rho_g.  When the matrix is near-singular
+(|det| below ``threshold``, 1e-3) the Shepard value sum m w / sum V w is
+used; with a kernel sum sum V w at g not above ``MdbcThreshold`` (no fluid
+there) the density is left as it is.  As with DBC the result
+is clamped to rho >= rho0.  Slip mode 1 (boundary velocity = its own
+velocity) is the only one implemented.  Particles with N_b = 0 keep plain
+DBC behaviour.
+"""
+import math
+
+from . import _env  # noqa: F401
+import numpy as np
+from numba import njit, prange
+
+from .interaction import tait_pressure
+from .kernels import kernel_fac, kernel_w
+
+
+@njit(cache=True, error_model="numpy")
+def _solve_small(a, b, n):
+    """Solve a[:n,:n] x = b[:n] by Gaussian elimination with partial pivoting
+    (in place); returns the absolute determinant."""
+    det = 1.0
+    for k in range(n):
+        p = k
+        for r in range(k + 1, n):
+            if abs(a[r, k]) > abs(a[p, k]):
+                p = r
+        if a[p, k] == 0.0:
+            return 0.0
+        if p != k:
+            for cc in range(n):
+                t = a[k, cc]
+                a[k, cc] = a[p, cc]
+                a[p, cc] = t
+            t = b[k]
+            b[k] = b[p]
+            b[p] = t
+        det *= a[k, k]
+        for r in range(k + 1, n):
+            f = a[r, k] / a[k, k]
+            for cc in range(k, n):
+                a[r, cc] -= f * a[k, cc]
+            b[r] -= f * b[k]
+    for k in range(n - 1, -1, -1):
+        s = b[k]
+        for cc in range(k + 1, n):
+            s -= a[k, cc] * b[cc]
+        b[k] = s / a[k, k]
+    return abs(det)
+
+
+@njit(cache=True, error_model="numpy")
+def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell,
+                ncx, ncy, ncz, cst, threshold, ksum_min, rhop):
+    h = cst[0]
+    r2max = cst[1]
+    alpha = cst[3]
+    alpha_h2 = cst[4]
+    rhop0 = cst[10]
+    dim = 2 if is2d else 3
+    n = dim + 1
+    a = np.zeros((4, 4))
+    b = np.zeros(4)
+    for i in range(i0, i1):
+        if ptype[i] >= 2:
+            continue
+        nx = normals[i, 0]
+        ny = normals[i, 1]
+        nz = normals[i, 2]
+        if nx == 0.0 and ny == 0.0 and nz == 0.0:
+            continue
+        if is2d:
+            bx = nb[i, 0]
+            by = 0.0
+            bz = nb[i, 1]
+        else:
+            bx = nb[i, 0]
+            by = nb[i, 1]
+            bz = nb[i, 2]
+        gx = bx + 2.0 * nx
+        gy = by + 2.0 * ny
+        gz = bz + 2.0 * nz
+        cx = min(max(int((gx - pmin[0]) * inv_cell), 0), ncx - 1)
+        cy = min(max(int((gy - pmin[1]) * inv_cell), 0), ncy - 1) if not is2d else 0
+        cz = min(max(int((gz - pmin[2]) * inv_cell), 0), ncz - 1)
+        for r in range(4):
+            b[r] = 0.0
+            for cc in range(4):
+                a[r, cc] = 0.0
+        for z in range(max(cz - 1, 0), min(cz + 1, ncz - 1) + 1):
+            for y in range(max(cy - 1, 0), min(cy + 1, ncy - 1) + 1):
+                row = (z * ncy + y) * ncx
+                for j in range(cell_start[row + max(cx - 1, 0)],
+                               cell_start[row + min(cx + 1, ncx - 1) + 1]):
+                    if ptype[j] != 3:
+                        continue
+                    if is2d:
+                        dx = gx - nb[j, 0]
+                        dy = 0.0
+                        dz = gz - nb[j, 1]
+                        mj = nb[j, 6]
+                        vj = mj * nb[j, 7]
+                    else:
+                        dx = gx - nb[j, 0]
+                        dy = gy - nb[j, 1]
+                        dz = gz - nb[j, 2]
+                        mj = nb[j, 8]
+                        vj = mj * nb[j, 9]
+                    r2 = dx * dx + dy * dy + dz * dz
+                    if r2 >= r2max:
+                        continue
+                    q = math.sqrt(r2) / h
+                    w = kernel_w(kern, q, alpha)
+                    fac = kernel_fac(kern, q, alpha_h2) if r2 > 1e-18 else 0.0
+                    # gradient with respect to g, and r_j - g
+                    if is2d:
+                        gw0 = fac * dx
+                        gw1 = fac * dz
+                        d0 = -dx
+                        d1 = -dz
+                        gw2 = 0.0
+                        d2 = 0.0
+                    else:
+                        gw0 = fac * dx
+                        gw1 = fac * dy
+                        gw2 = fac * dz
+                        d0 = -dx
+                        d1 = -dy
+                        d2 = -dz
+                    a[0, 0] += vj * w
+                    a[0, 1] += vj * w * d0
+                    a[0, 2] += vj * w * d1
+                    b[0] += mj * w
+                    a[1, 0] += vj * gw0
+                    a[1, 1] += vj * gw0 * d0
+                    a[1, 2] += vj * gw0 * d1
+                    b[1] += mj * gw0
+                    a[2, 0] += vj * gw1
+                    a[2, 1] += vj * gw1 * d0
+                    a[2, 2] += vj * gw1 * d1
+                    b[2] += mj * gw1
+                    if not is2d:
+                        a[0, 3] += vj * w * d2
+                        a[1, 3] += vj * gw0 * d2
+                        a[2, 3] += vj * gw1 * d2
+                        a[3, 0] += vj * gw2
+                        a[3, 1] += vj * gw2 * d0
+                        a[3, 2] += vj * gw2 * d1
+                        a[3, 3] += vj * gw2 * d2
+                        b[3] += mj * gw2
+        if a[0, 0] <= ksum_min or a[0, 0] <= 0.0:
+            continue
+        shepard = b[0] / a[0, 0]
+        det = _solve_small(a, b, n)
+        if det >= threshold:
+            if is2d:
+                rho = b[0] - 2.0 * (nx * b[1] + nz * b[2])
+            else:
+                rho = b[0] - 2.0 * (nx * b[1] + ny * b[2] + nz * b[3])
+        else:
+            rho = shepard
+        rhop[i] = max(rho, rhop0)
+
+
+@njit(cache=True, error_model="numpy")
+def _refresh_packed(i0, i1, is2d, ptype, rhop, cst, nb):
+    for i in range(i0, i1):
+        if ptype[i] >= 2:
+            continue
+        rho = rhop[i]
+        p = tait_pressure(rho, cst[16], cst[10], cst[17])
+        if is2d:
+            nb[i, 4] = rho
+            nb[i, 5] = p
+            nb[i, 7] = 1.0 / rho
+        else:
+            nb[i, 6] = rho
+            nb[i, 7] = p
+            nb[i, 9] = 1.0 / rho
+
+
+@njit(cache=True, error_model="numpy")
+def mdbc_serial(kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
+                cst, threshold, ksum_min, rhop):
+    """Set the density of every boundary particle with a normal (mDBC) and
+    refresh its packed density and pressure."""
+    n = nb.shape[0]
+    _mdbc_range(0, n, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy,
+                ncz, cst, threshold, ksum_min, rhop)
+    _refresh_packed(0, n, is2d, ptype, rhop, cst, nb)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def mdbc_parallel(kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
+                  cst, threshold, ksum_min, rhop):
+    """Threaded :func:`mdbc_serial`."""
+    n = nb.shape[0]
+    nchunk = (n + 511) // 512
+    for c in prange(nchunk):
+        _mdbc_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, normals,
+                    cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, threshold, ksum_min,
+                    rhop)
+    for c in prange(nchunk):
+        _refresh_packed(c * 512, min(n, (c + 1) * 512), is2d, ptype, rhop, cst, nb)
