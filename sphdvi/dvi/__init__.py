@@ -96,7 +96,9 @@ Stepping and state:
   1 (for springs/dampers the element force on body 1).
 * ``last_iterations``, ``last_residual``, ``n_contacts``, ``n_rows``,
   ``constraint_violation()``, ``kinetic_energy()``, ``potential_energy()``,
-  ``set_velocity(body, vel, omega)``, ``set_external_load(body, force, torque)``.
+  ``set_velocity(body, vel, omega)``, ``set_external_load(body, force, torque)``,
+  ``get_state()``/``set_state(st)`` (predictor–corrector couplings),
+  ``body_index(name)``, ``link_index(name)``.
 
 Body-only runs:
 

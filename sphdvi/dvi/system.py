@@ -945,6 +945,32 @@ class System:
         b1 = self._link_b1
         self.link_torque = link_point_torques(lf, ltc, P1w, b1, self.pos)
 
+    # ------------------------------------------------------------ state
+    def get_state(self):
+        """A copy of the dynamic state (poses, velocities, time, joint angle
+        counters, warm-start caches): for predictor–corrector couplings."""
+        st = dict(pos=self.pos.copy(), quat=self.quat.copy(), vel=self.vel.copy(),
+                  omega_b=self.omega_b.copy(), time=self.time,
+                  prev_keys=self._prev_keys.copy(), prev_g3=self._prev_g3.copy(),
+                  prev_link_gamma=self._prev_link_gamma.copy(), prev_h=self._prev_h)
+        if hasattr(self, "m_angle"):
+            st["m_angle"] = self.m_angle.copy()
+        return st
+
+    def set_state(self, st):
+        """Restore a state returned by :meth:`get_state`."""
+        self.pos[:] = st["pos"]
+        self.quat[:] = st["quat"]
+        self.vel[:] = st["vel"]
+        self.omega_b[:] = st["omega_b"]
+        self.time = st["time"]
+        self._prev_keys = st["prev_keys"].copy()
+        self._prev_g3 = st["prev_g3"].copy()
+        self._prev_link_gamma = st["prev_link_gamma"].copy()
+        self._prev_h = st["prev_h"]
+        if "m_angle" in st and hasattr(self, "m_angle"):
+            self.m_angle[:] = st["m_angle"]
+
     # ------------------------------------------------------------ accessors
     def body_index(self, name):
         """Index of the body called ``name``."""
