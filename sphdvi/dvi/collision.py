@@ -20,12 +20,18 @@ CLOUD      (r, -, -)                                   sphere cloud (particles)
 Generic narrow phase ("samples against signed distance"): every shape has body
 fixed sample points with a radius (sphere centre, capsule axis points, box/hull
 vertices, cylinder rim points, cloud particles) and a signed distance function
-(exact inside; exact or a lower bound outside).  A contact is created for each
-sample of one shape whose distance to the other shape, minus its radius, is
-below the envelope.  Sphere/capsule pairs use closest points between segments
-and box pairs the separating-axis test; both are exact.  Limitation: for two
-polytopes other than box–box (hull–hull, hull–box, cylinder–box…) edge–edge
-contacts are missed (vertex–face only).
+(exact inside; exact or a lower bound outside — the hull's max-of-planes).  A
+contact is created for each sample of one shape whose distance to the other
+shape, minus its radius, is below the envelope.  Exact special cases:
+sphere/capsule pairs (closest points between segments), box–box (separating
+axes + clipping of the incident face, ≤ 4 points), cylinder–plane (exact rim
+support point per cap), and box/hull pairs (separating-axis test over face
+normals and edge cross products: culls separated pairs and adds the edge–edge
+contact when an edge pair is the axis of least penetration; skipped above
+4096 edge pairs).  Sphere clouds are searched through a body-frame cell grid
+(O(1) per query).  Limitations: cylinder–box/hull and cylinder–cylinder rely on
+16 rim samples per cap (no exact rim–edge contact); no rolling/spinning
+friction.
 """
 import math
 
