@@ -10,7 +10,6 @@ One call to :meth:`System.step` performs one Anitescu–Tasora step
 3. one CCP solve (PSOR, APGD or BB) for the impulses γ, warm started;
 4. ``v⁺ = v_free + M⁻¹ Dᵀ γ``, then ``x += h v⁺``, ``q ← q ⊗ exp(h ω⁺_body)``.
 """
-import math
 
 import numpy as np
 
