@@ -460,9 +460,13 @@ class SPHRun:
                     sc.attrs[k] = v
                 if self.bodies is not None:
                     b = f.create_group("bodies")
-                    for name in ("pos", "quat", "vel", "omega_b"):
-                        b.create_dataset(name, data=getattr(self.bodies, name))
-                    b.attrs["time"] = self.bodies.time
+                    scalars = {}
+                    for name, value in self.bodies.get_state().items():
+                        if isinstance(value, np.ndarray):
+                            b.create_dataset(name, data=value)
+                        else:
+                            scalars[name] = value.item() if isinstance(value, np.generic) else value
+                    b.attrs["scalars"] = json.dumps(scalars)   # floats round-trip exactly (repr)
 
     def load_checkpoint(self, path: str) -> dict:
         import h5py
@@ -482,9 +486,10 @@ class SPHRun:
             self.dtmin_seen = int(sc["dtmin_seen"])
             extra = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in sc.items()}
             if self.bodies is not None and "bodies" in f:
-                for name in ("pos", "quat", "vel", "omega_b"):
-                    getattr(self.bodies, name)[...] = f["bodies"][name][...]
-                self.bodies.time = float(f["bodies"].attrs["time"])
+                g = f["bodies"]
+                st = {name: g[name][...] for name in g}
+                st.update(json.loads(g.attrs["scalars"]))
+                self.bodies.set_state(st)
         return extra
 
 
