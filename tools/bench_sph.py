@@ -108,6 +108,8 @@ def main():
     ap.add_argument("--dp3d", type=float, default=0.02)
     ap.add_argument("--flags", action="store_true", help="time feature variants on 1 thread")
     ap.add_argument("--threads", type=int, nargs="*", default=None)
+    ap.add_argument("--cellmode", choices=["2h", "h"], default="2h",
+                    help="cell size of the neighbour search (DualSPHysics full = 2h, half = h)")
     a = ap.parse_args()
     maxthr = numba.config.NUMBA_NUM_THREADS
     threads = a.threads or sorted({1, min(2, maxthr)})
@@ -118,14 +120,14 @@ def main():
         scenes.append(("3D dam break", *dambreak_3d(a.dp3d), False))
     for name, state, c, is2d in scenes:
         npairs = count_interactions(state, c["h"], is2d)
-        print("\n%s: %d particles (%d fluid), %.1f interactions per particle"
-              % (name, state.n, int((state.ptype == 3).sum()), npairs / state.n))
+        print("\n%s: %d particles (%d fluid), %.1f interactions per particle, cell size %s"
+              % (name, state.n, int((state.ptype == 3).sum()), npairs / state.n, a.cellmode))
         # one solver per thread count, timed in interleaved rounds (best of
         # ``--rounds``) so that a busy moment on a shared machine hits both alike
         sols = {}
         for t in threads:
             numba.set_num_threads(t)
-            sols[t] = SPHSolver(state.copy(), c, BENCH_PARAMS)
+            sols[t] = SPHSolver(state.copy(), c, BENCH_PARAMS, cell_mode=a.cellmode)
             sols[t].run(1e9, max_steps=20)         # compile / warm up
         best = {t: math.inf for t in threads}
         for _ in range(a.rounds):

@@ -179,10 +179,16 @@ def _pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius):
 
 
 class CellList:
-    """Cell list of cell size 2h over a box, with reusable work arrays."""
+    """Cell list over a box, with reusable work arrays.
 
-    def __init__(self, h, is2d):
-        self.cellsize = 2.0 * h
+    Cell size 2h (``half=False``, 3x3 / 27-cell stencil) or h (``half=True``,
+    5x5 / 125-cell stencil: fewer candidate pairs, more rows).
+    """
+
+    def __init__(self, h, is2d, half=False):
+        self.half = bool(half)
+        self.stencil = 2 if half else 1
+        self.cellsize = h if half else 2.0 * h
         self.is2d = bool(is2d)
         self.cell = np.empty(0, np.int64)
         self.order = np.empty(0, np.int64)

@@ -17,4 +17,5 @@ GZ = 14
 OD_WDELTAP = 15  # 1/W(dp): tensile correction of the cubic spline
 B = 16         # Tait constant B = c0^2 rhop0 / gamma
 GAMMA = 17
-NCONST = 18
+STENCIL = 18   # cells searched on each side: 1 (cell size 2h) or 2 (cell size h)
+NCONST = 19

@@ -153,6 +153,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
     rhop0 = cst[10]
     inv_gamma = cst[11]
     od_wdp = cst[15]
+    rs = int(cst[18])  # stencil radius in cells: 1 (cells of 2h) or 2 (cells of h)
 
     for i in range(i0, i1):
         xi = nb[i, 0]
@@ -166,10 +167,10 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
         c = cell[i]
         cx = c % ncx
         cz = c // ncx
-        xlo = max(cx - 1, 0)
-        xhi = min(cx + 1, ncx - 1)
-        zlo = max(cz - 1, 0)
-        zhi = min(cz + 1, ncz - 1)
+        xlo = max(cx - rs, 0)
+        xhi = min(cx + rs, ncx - 1)
+        zlo = max(cz - rs, 0)
+        zhi = min(cz + rs, ncz - 1)
 
         if pti < 2:
             # DBC boundary particle: continuity with fluid/floating neighbours.
@@ -375,6 +376,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
     rhop0 = cst[10]
     inv_gamma = cst[11]
     od_wdp = cst[15]
+    rs = int(cst[18])  # stencil radius in cells: 1 (cells of 2h) or 2 (cells of h)
 
     for i in range(i0, i1):
         xi = nb[i, 0]
@@ -391,12 +393,12 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
         cx = c % ncx
         cy = (c // ncx) % ncy
         cz = c // (ncx * ncy)
-        xlo = max(cx - 1, 0)
-        xhi = min(cx + 1, ncx - 1)
-        ylo = max(cy - 1, 0)
-        yhi = min(cy + 1, ncy - 1)
-        zlo = max(cz - 1, 0)
-        zhi = min(cz + 1, ncz - 1)
+        xlo = max(cx - rs, 0)
+        xhi = min(cx + rs, ncx - 1)
+        ylo = max(cy - rs, 0)
+        yhi = min(cy + rs, ncy - 1)
+        zlo = max(cz - rs, 0)
+        zhi = min(cz + rs, ncz - 1)
 
         if pti < 2:
             arp = 0.0

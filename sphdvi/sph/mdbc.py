@@ -101,11 +101,12 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
             b[r] = 0.0
             for cc in range(4):
                 a[r, cc] = 0.0
-        for z in range(max(cz - 1, 0), min(cz + 1, ncz - 1) + 1):
-            for y in range(max(cy - 1, 0), min(cy + 1, ncy - 1) + 1):
+        rs = int(cst[18])
+        for z in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
+            for y in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
                 row = (z * ncy + y) * ncx
-                for j in range(cell_start[row + max(cx - 1, 0)],
-                               cell_start[row + min(cx + 1, ncx - 1) + 1]):
+                for j in range(cell_start[row + max(cx - rs, 0)],
+                               cell_start[row + min(cx + rs, ncx - 1) + 1]):
                     if ptype[j] != 3:
                         continue
                     if is2d:

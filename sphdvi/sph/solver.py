@@ -82,6 +82,9 @@ class SPHSolver:
         the caller knows; here an axis is periodic when it is listed, when one
         of its Inc keys is non-zero, or when XYPeriodic/XZPeriodic/YZPeriodic
         is 1.  See :mod:`sphdvi.sph.periodic`.
+    cell_mode : "2h" or "h"
+        Cell size of the neighbour search (DualSPHysics ``-cellmode``: full = 2h,
+        half = h).
     normals : (N, 3) array or None
         mDBC (``Boundary=2``): per particle (in the order of ``state``), the
         vector from a boundary particle to the boundary surface (DualSPHysics
@@ -96,7 +99,8 @@ class SPHSolver:
     """
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
-                 parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None):
+                 parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None,
+                 cell_mode="2h"):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.state = state
@@ -114,7 +118,8 @@ class SPHSolver:
         self._domain = None
         if domain is not None:
             self._domain = (np.array(domain[0], float), np.array(domain[1], float))
-        self.cells = _cells.CellList(self.h, self.is2d)
+        self.cells = _cells.CellList(self.h, self.is2d, half=cell_mode == "h")
+        self.cst[18] = self.cells.stencil
         self.periodicity = self._setup_periodic(periodic)
         if self.boundary == 2:
             if normals is None:
@@ -165,7 +170,7 @@ class SPHSolver:
             raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
         self.verlet_steps = int(p["VerletSteps"])
         alpha = kernel_alpha(self.kernel, h, self.is2d)
-        cst = np.zeros(18)
+        cst = np.zeros(19)
         cst[0] = h
         cst[1] = 4.0 * h * h
         cst[2] = (0.1 * h) ** 2
@@ -182,6 +187,7 @@ class SPHSolver:
         cst[15] = 1.0 / kernel_w(1, self.dp / h, kernel_alpha(1, h, self.is2d)) if self.kernel == 1 else 0.0
         cst[16] = self.b
         cst[17] = self.gamma
+        cst[18] = 1.0
         self.cst = cst
         self.dtmin = float(p["DtMin"]) or float(p["CoefDtMin"]) * h / self.cs0
         self.dtini = float(p["DtIni"]) or h / self.cs0
