@@ -37,7 +37,6 @@ paths are separate functions.
 import math
 
 from . import _env  # noqa: F401
-import numpy as np
 from numba import njit, prange, literally
 
 from .kernels import kernel_fac, kernel_w

@@ -15,7 +15,6 @@ unknown keys are ignored):
   CoefDtMin, DtIni, DtMin, DtFixed, RhopOutMin, RhopOutMax, Boundary and the
   periodic keys (only their absence is supported for now).
 """
-import math
 import warnings
 
 from . import _env  # noqa: F401
@@ -148,7 +147,8 @@ class SPHSolver:
         if self.boundary not in (1, 2):
             raise ValueError("Boundary must be 1 (DBC) or 2 (mDBC)")
         if self.boundary == 2 and int(p.get("SlipMode", 1) or 1) != 1:
-            raise NotImplementedError("mDBC SlipMode 2/3 (no-slip/free-slip) is not implemented; use SlipMode=1")
+            raise NotImplementedError("mDBC SlipMode 2/3 (no-slip/free-slip) is not implemented; "
+                                      "use SlipMode=1")
         self.mdbc_ksum = float(p.get("MdbcThreshold") or 0.0)
         self.kernel = int(p["Kernel"])
         self.visco_kind = int(p["ViscoTreatment"])
@@ -323,7 +323,8 @@ class SPHSolver:
         aux = [a for a in self._aux_names() if getattr(self, a).shape[0] == n]
         f2 = ["pos", "vel"] + [a for a in aux if getattr(self, a).ndim == 2]
         f1 = ["rhop", "mass"] + [a for a in aux if getattr(self, a).ndim == 1]
-        holder = {name: (s if name in FluidState.FIELDS else self) for name in f2 + f1 + ["ptype", "idp", "mk"]}
+        holder = {name: (s if name in FluidState.FIELDS else self)
+                  for name in f2 + f1 + ["ptype", "idp", "mk"]}
         src = {name: getattr(holder[name], name) for name in holder}
         dst = {}
         for name, a in src.items():

@@ -11,7 +11,6 @@ for the viscous term, as DualSPHysics does.
 import math
 
 from . import _env  # noqa: F401
-import numpy as np
 from numba import njit
 
 

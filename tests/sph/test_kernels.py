@@ -16,7 +16,8 @@ def test_kernel_normalisation(kind, is2d):
     """int W dV = 1 over the support (radial quadrature, 2 pi r dr or 4 pi r^2 dr)."""
     a = kernel_alpha(kind, H, is2d)
     jac = (lambda r: 2 * math.pi * r) if is2d else (lambda r: 4 * math.pi * r * r)
-    total, _ = quad(lambda r: kernel_w(kind, r / H, a) * jac(r), 0.0, 2 * H, points=[H], epsabs=1e-13)
+    total, _ = quad(lambda r: kernel_w(kind, r / H, a) * jac(r), 0.0, 2 * H, points=[H],
+                    epsabs=1e-13)
     assert abs(total - 1.0) < 1e-10
 
 
