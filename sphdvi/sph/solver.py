@@ -311,9 +311,27 @@ class SPHSolver:
                 self.ace, self.ar, s.ptype, self.shiftpos, self.shiftdet, self.ip, self.out)
 
     # ------------------------------------------------------------------ steps
+    _STATE_DTYPES = {"pos": np.float64, "vel": np.float64, "rhop": np.float64, "mass": np.float64,
+                     "ptype": np.int8, "idp": np.int64, "mk": np.int32}
+
+    def _check_state_arrays(self):
+        """Coerce the state arrays to the dtypes and C layout the compiled entry
+        points were specialised for (they do not check their arguments)."""
+        s = self.state
+        n = s.pos.shape[0]
+        for name, dt in self._STATE_DTYPES.items():
+            a = getattr(s, name)
+            if a.dtype != dt or not a.flags.c_contiguous or a.shape[0] != n:
+                if a.shape[0] != n:
+                    raise ValueError("state.%s has %d rows, pos has %d" % (name, a.shape[0], n))
+                setattr(s, name, np.ascontiguousarray(a, dtype=dt))
+        if self.nb.shape[0] != n:
+            self._alloc()
+
     def _reorder_and_pack(self):
         """Counting-sort the particles by cell, permute every per-particle array
         and fill the packed neighbour array, in one pass (one thread launch)."""
+        self._check_state_arrays()
         s = self.state
         if self._domain is not None:
             order = self.cells.build(s.pos, self._domain[0], self._domain[1])
@@ -363,6 +381,7 @@ class SPHSolver:
     def _compute_rates_periodic(self):
         """Rates with ghost copies across the periodic boundaries (no reordering
         of the real particles; the extended set is sorted by cell instead)."""
+        self._check_state_arrays()
         s = self.state
         per = self.periodicity
         per.wrap(s.pos)

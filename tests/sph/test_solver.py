@@ -164,3 +164,20 @@ def test_half_cells_give_the_same_rates(is2d):
     oa, ob = np.argsort(a.state.idp), np.argsort(b.state.idp)
     assert np.allclose(a.ace[oa], b.ace[ob], rtol=1e-12, atol=1e-12 * np.abs(a.ace).max())
     assert np.allclose(a.ar[oa], b.ar[ob], rtol=1e-12, atol=1e-12 * np.abs(a.ar).max())
+
+
+def test_state_arrays_are_coerced_before_the_kernels():
+    """Arrays replaced by the caller with other dtypes or layouts are converted
+    (the compiled entry points do not check their arguments)."""
+    st, c = small_tank()
+    ref = SPHSolver(st.copy(), c, {})
+    sol = SPHSolver(st.copy(), c, {})
+    ref.step()
+    sol.step()
+    sol.state.ptype = sol.state.ptype.astype(np.int64)
+    sol.state.pos = np.asfortranarray(sol.state.pos)
+    sol.state.rhop = sol.state.rhop.astype(np.float64)[::1]
+    ref.step()
+    sol.step()
+    assert np.array_equal(ref.state.pos, sol.state.pos)
+    assert sol.state.ptype.dtype == np.int8
