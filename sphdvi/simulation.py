@@ -312,7 +312,12 @@ class SPHRun:
         for k in periodic:
             i = "xyz".index(k)
             domain[1][i] += c["dp"]
-        self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None)
+        self.normals0 = None
+        if int(params.get("Boundary", 1)) == 2:
+            from .case.normals import boundary_normals
+            self.normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]))
+        self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
+                                normals=self.normals0)
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.dtmin_run = 0
         self.dtmin_seen = 0
@@ -334,6 +339,7 @@ class SPHRun:
             R = _quat_matrix(system.quat[i])
             local = (p["pos"][idp] - system.pos[i]) @ R
             self.body_sel.append((mkb, idp, local, system.kind[i]))
+        self.body_R0 = [_quat_matrix(q) for q in system.quat]
         self.idp_body = np.full(p["idp"].size, -1, np.int64)
         for i, (_, idp, _, _) in enumerate(self.body_sel):
             self.idp_body[idp] = i
@@ -349,6 +355,8 @@ class SPHRun:
                 x, v = rig.apply(self.pos0[s.idp[rows]])
                 s.pos[rows] = x
                 s.vel[rows] = v
+                if self.normals0 is not None:
+                    solver.normals[rows] = self.normals0[s.idp[rows]] @ rig.R.T
         if self.bodies is not None:
             self._step_bodies(solver, dt)
         for zone in self.damping:
@@ -383,6 +391,8 @@ class SPHRun:
             x = pos[i] + loc @ R.T
             s.pos[rows] = x
             s.vel[rows] = vel[i] + np.cross(omega[i], x - pos[i])
+            if self.normals0 is not None:
+                solver.normals[rows] = self.normals0[s.idp[rows]] @ (R @ self.body_R0[i].T).T
 
     # -- checks --------------------------------------------------------------------------
     def check(self, nexcl_before: int) -> None:

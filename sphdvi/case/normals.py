@@ -1,0 +1,151 @@
+"""Boundary normals for mDBC (``Boundary=2``), computed from the particles.
+
+DualSPHysics's GenCase computes a normal per boundary particle from the drawn
+geometry: the vector N from the particle to the boundary surface, which lies
+dp/2 in front of the outer particle layer; the ghost node is r + 2N. Without the
+geometry at hand we derive it from the particle arrangement:
+
+1. the neighbours j of boundary particle i (other boundary particles within 2 dp);
+2. the direction is −(mean of r_j − r_i) when that offset is clear (solid bodies,
+   several wall layers, corners): it points away from the boundary's own mass;
+   otherwise (a single straight layer) it is the normal of the layer (the
+   eigenvector of the smallest eigenvalue of the neighbours' covariance);
+3. the sign is chosen to face the fluid: towards the nearest fluid particle within
+   6 dp, or, with no fluid near, towards the centroid of all fluid particles;
+4. N = n̂ · dp/2.
+
+Particles of a boundary that never meets the fluid get a normal too; it is harmless.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _grid_keys(pos, inv, lo, nx, ny):
+    n = pos.shape[0]
+    keys = np.empty(n, np.int64)
+    for i in range(n):
+        ix = int((pos[i, 0] - lo[0]) * inv)
+        iy = int((pos[i, 1] - lo[1]) * inv)
+        iz = int((pos[i, 2] - lo[2]) * inv)
+        keys[i] = (iz * ny + iy) * nx + ix
+    return keys
+
+
+@njit(cache=True)
+def _normals_kernel(bpos, fpos, dp, is2d, fcentroid):
+    """See the module docstring; brute force over sorted grid cells."""
+    nb = bpos.shape[0]
+    out = np.zeros((nb, 3))
+    cell = 2.05 * dp      # a little over the search radius: rounding never hides a neighbour
+    lo = np.empty(3)
+    hi = np.empty(3)
+    for k in range(3):
+        lo[k] = bpos[:, k].min() - cell
+        hi[k] = bpos[:, k].max() + cell
+        if fpos.shape[0] > 0:
+            lo[k] = min(lo[k], fpos[:, k].min() - cell)
+            hi[k] = max(hi[k], fpos[:, k].max() + cell)
+    inv = 1.0 / cell
+    nx = int((hi[0] - lo[0]) * inv) + 1
+    ny = int((hi[1] - lo[1]) * inv) + 1
+    nz = int((hi[2] - lo[2]) * inv) + 1
+    bkeys = _grid_keys(bpos, inv, lo, nx, ny)
+    border = np.argsort(bkeys)
+    bsorted = bkeys[border]
+    fkeys = _grid_keys(fpos, inv, lo, nx, ny)
+    forder = np.argsort(fkeys)
+    fsorted = fkeys[forder]
+    r2 = (2.0 * dp) ** 2 * 1.0001
+    reach = 3            # fluid search radius about 6 dp = 3 cells
+    for i in range(nb):
+        ix = int((bpos[i, 0] - lo[0]) * inv)
+        iy = int((bpos[i, 1] - lo[1]) * inv)
+        iz = int((bpos[i, 2] - lo[2]) * inv)
+        cnt = 0
+        cx = 0.0
+        cy = 0.0
+        cz = 0.0
+        cov = np.zeros((3, 3))
+        for dz in range(-1, 2):
+            for dy in range(-1, 2):
+                for dx in range(-1, 2):
+                    key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
+                    a = np.searchsorted(bsorted, key)
+                    b = np.searchsorted(bsorted, key + 1)
+                    for q in range(a, b):
+                        j = border[q]
+                        if j == i:
+                            continue
+                        ddx = bpos[j, 0] - bpos[i, 0]
+                        ddy = bpos[j, 1] - bpos[i, 1]
+                        ddz = bpos[j, 2] - bpos[i, 2]
+                        if ddx * ddx + ddy * ddy + ddz * ddz > r2:
+                            continue
+                        cnt += 1
+                        cx += ddx
+                        cy += ddy
+                        cz += ddz
+                        d = (ddx, ddy, ddz)
+                        for u in range(3):
+                            for v in range(3):
+                                cov[u, v] += d[u] * d[v]
+        n = np.zeros(3)
+        if cnt > 0:
+            cx /= cnt
+            cy /= cnt
+            cz /= cnt
+        if cx * cx + cy * cy + cz * cz > (0.25 * dp) ** 2:
+            n[0], n[1], n[2] = -cx, -cy, -cz
+        elif cnt > 0:
+            if is2d:
+                cov[1, :] = 0.0
+                cov[:, 1] = 0.0
+                cov[1, 1] = 1e30
+            w, vecs = np.linalg.eigh(cov)
+            n[:] = vecs[:, 0]
+        else:
+            n[2] = 1.0
+        if is2d:
+            n[1] = 0.0
+        # face the fluid
+        best = 1e300
+        tx = fcentroid[0] - bpos[i, 0]
+        ty = fcentroid[1] - bpos[i, 1]
+        tz = fcentroid[2] - bpos[i, 2]
+        for dz in range(-reach, reach + 1):
+            for dy in range(-reach, reach + 1):
+                for dx in range(-reach, reach + 1):
+                    key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
+                    a = np.searchsorted(fsorted, key)
+                    b = np.searchsorted(fsorted, key + 1)
+                    for q in range(a, b):
+                        j = forder[q]
+                        ddx = fpos[j, 0] - bpos[i, 0]
+                        ddy = fpos[j, 1] - bpos[i, 1]
+                        ddz = fpos[j, 2] - bpos[i, 2]
+                        d2 = ddx * ddx + ddy * ddy + ddz * ddz
+                        if d2 < best:
+                            best = d2
+                            tx, ty, tz = ddx, ddy, ddz
+        if n[0] * tx + n[1] * ty + n[2] * tz < 0.0:
+            n[0], n[1], n[2] = -n[0], -n[1], -n[2]
+        norm = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+        if norm > 0.0:
+            for k in range(3):
+                out[i, k] = 0.5 * dp * n[k] / norm
+    return out
+
+
+def boundary_normals(pos: np.ndarray, ptype: np.ndarray, dp: float, is2d: bool) -> np.ndarray:
+    """(N, 3) mDBC normals: N for boundary particles (types 0–2), zero for fluid."""
+    pos = np.ascontiguousarray(pos, dtype=np.float64)
+    bound = ptype != 3
+    fpos = np.ascontiguousarray(pos[~bound])
+    centroid = fpos.mean(axis=0) if fpos.shape[0] else pos.mean(axis=0)
+    out = np.zeros_like(pos)
+    if bound.any():
+        out[bound] = _normals_kernel(np.ascontiguousarray(pos[bound]), fpos, float(dp), bool(is2d), centroid)
+    return out

@@ -1,0 +1,56 @@
+"""mDBC normals from the particles: wall, floor and corner normals point to the fluid, |N| = dp/2."""
+import numpy as np
+import pytest
+
+from sphdvi.case.normals import boundary_normals
+
+
+def tank(dp=0.05, layers=1, is2d=True):
+    pts, types = [], []
+    for k in range(layers):
+        off = k * dp
+        xs = np.arange(-off, 1.0 + off + dp / 2, dp)
+        zs = np.arange(0, 0.6, dp)
+        pts += [[x, 0, -off] for x in xs] + [[-off, 0, z] for z in zs[1:]] + [[1.0 + off, 0, z] for z in zs[1:]]
+    types += [0] * len(pts)
+    fx, fz = np.meshgrid(np.arange(dp, 1.0 - dp / 2, dp), np.arange(dp, 0.3, dp))
+    fl = np.column_stack([fx.ravel(), 0 * fx.ravel(), fz.ravel()])
+    pos = np.vstack([np.array(pts), fl])
+    ptype = np.array(types + [3] * len(fl))
+    return pos, ptype
+
+
+@pytest.mark.parametrize("layers", [1, 3])
+def test_tank_normals(layers):
+    dp = 0.05
+    pos, ptype = tank(dp, layers)
+    n = boundary_normals(pos, ptype, dp, True)
+    assert np.all(n[ptype == 3] == 0)
+    b = ptype == 0
+
+    def at(x, z):
+        i = np.flatnonzero(b & np.isclose(pos[:, 0], x) & np.isclose(pos[:, 2], z))[0]
+        return n[i]
+
+    assert at(0.5, 0.0) == pytest.approx([0, 0, dp / 2])
+    assert at(0.0, 0.3) == pytest.approx([dp / 2, 0, 0])
+    assert at(1.0, 0.3) == pytest.approx([-dp / 2, 0, 0])
+    c = at(0.0, 0.0)
+    assert c[0] > 0 and c[2] > 0 and np.linalg.norm(c) == pytest.approx(dp / 2)
+    assert np.allclose(np.linalg.norm(n[b], axis=1), dp / 2)
+
+
+def test_solid_body_normals_point_outwards():
+    dp = 0.05
+    g = np.arange(-0.2, 0.2 + dp / 2, dp)
+    X, Z = np.meshgrid(g, g)
+    body = np.column_stack([X.ravel(), 0 * X.ravel(), Z.ravel() + 1.0])
+    fx, fz = np.meshgrid(np.arange(-0.6, 0.6, dp), np.arange(0.5, 1.5, dp))
+    fl = np.column_stack([fx.ravel(), 0 * fx.ravel(), fz.ravel()])
+    keep = np.max(np.abs(fl - [0, 0, 1.0]), axis=1) > 0.2 + dp / 2
+    pos = np.vstack([body, fl[keep]])
+    ptype = np.array([2] * len(body) + [3] * int(keep.sum()))
+    n = boundary_normals(pos, ptype, dp, True)
+    top = np.flatnonzero(np.isclose(pos[:, 2], 1.2) & np.isclose(pos[:, 0], 0.0))[0]
+    side = np.flatnonzero(np.isclose(pos[:, 0], -0.2) & np.isclose(pos[:, 2], 1.0))[0]
+    assert n[top] == pytest.approx([0, 0, dp / 2]) and n[side] == pytest.approx([-dp / 2, 0, 0])
