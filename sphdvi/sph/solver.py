@@ -12,8 +12,12 @@ Physics sees arrays only: no files, no CLI.  Built from two plain dicts:
 unknown keys are ignored):
   StepAlgorithm, VerletSteps, Kernel, ViscoTreatment, Visco,
   ViscoBoundFactor, DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
-  CoefDtMin, DtIni, DtMin, DtFixed, RhopOutMin, RhopOutMax, Boundary and the
-  periodic keys (only their absence is supported for now).
+  CoefDtMin, DtIni, DtMin, DtFixed, RhopOutMin, RhopOutMax, Boundary,
+  SlipMode (1 only), MdbcThreshold and the periodic keys (XPeriodicIncY ...,
+  XYPeriodic ...; see the ``periodic`` argument).
+
+Not implemented: Shifting 4 (advanced; runs as 3 with a warning), mDBC slip
+modes 2/3 and NoPenetration, DtFixedFile, DtAllParticles.
 """
 import warnings
 
