@@ -6,13 +6,16 @@ dp/2 in front of the outer particle layer; the ghost node is r + 2N. Without the
 geometry at hand we derive it from the particle arrangement:
 
 1. the neighbours j of boundary particle i (other boundary particles within 2 dp);
-2. the direction is −(mean of r_j − r_i) when that offset is clear (solid bodies,
-   several wall layers, corners): it points away from the boundary's own mass;
-   otherwise (a single straight layer) it is the normal of the layer (the
-   eigenvector of the smallest eigenvalue of the neighbours' covariance);
+2. where the neighbours form a single layer (the smallest eigenvalue of their covariance
+   is under a tenth of the next one) the direction is the normal of that layer (its
+   eigenvector); otherwise (solid bodies, several wall layers, corners) it is
+   −(mean of r_j − r_i) when that offset is clear, pointing away from the boundary's own
+   mass, and the layer normal when it is not;
 3. the sign is chosen to face the fluid: towards the nearest fluid particle within
    6 dp, or, with no fluid near, towards the centroid of all fluid particles;
-4. N = n̂ · dp/2.
+4. N = n̂ · (k + 1/2) dp, k the number of boundary layers in front of the particle along n̂
+   (found by stepping dp along n̂), so that the ghost node r + 2N lies in the fluid for
+   every layer of a thick wall.
 
 Particles of a boundary that never meets the fluid get a normal too; it is harmless.
 """
@@ -97,17 +100,21 @@ def _normals_kernel(bpos, fpos, dp, is2d, fcentroid):
             cx /= cnt
             cy /= cnt
             cz /= cnt
-        if cx * cx + cy * cy + cz * cz > (0.25 * dp) ** 2:
-            n[0], n[1], n[2] = -cx, -cy, -cz
-        elif cnt > 0:
-            if is2d:
-                cov[1, :] = 0.0
-                cov[:, 1] = 0.0
-                cov[1, 1] = 1e30
-            w, vecs = np.linalg.eigh(cov)
-            n[:] = vecs[:, 0]
+        thin = True
+        if cnt > 0:
+            if is2d:                                # the x-z plane only
+                c2 = np.empty((2, 2))
+                c2[0, 0], c2[0, 1], c2[1, 0], c2[1, 1] = cov[0, 0], cov[0, 2], cov[2, 0], cov[2, 2]
+                w, vecs = np.linalg.eigh(c2)
+                n[0], n[1], n[2] = vecs[0, 0], 0.0, vecs[1, 0]
+            else:
+                w, vecs = np.linalg.eigh(cov)
+                n[:] = vecs[:, 0]                   # normal of the local layer
+            thin = w[0] < 0.1 * w[1]                # a single layer (line in 2D, sheet in 3D)
         else:
             n[2] = 1.0
+        if not thin and cx * cx + cy * cy + cz * cz > (0.25 * dp) ** 2:
+            n[0], n[1], n[2] = -cx, -cy, -cz        # away from the boundary's own mass
         if is2d:
             n[1] = 0.0
         # face the fluid
@@ -135,7 +142,37 @@ def _normals_kernel(bpos, fpos, dp, is2d, fcentroid):
         norm = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
         if norm > 0.0:
             for k in range(3):
-                out[i, k] = 0.5 * dp * n[k] / norm
+                out[i, k] = n[k] / norm
+    # distance to the surface: dp/2 in front of the last boundary layer along the normal
+    tol2 = (0.45 * dp) ** 2
+    for i in range(nb):
+        layers = 0
+        for step in range(1, 9):
+            px = bpos[i, 0] + step * dp * out[i, 0]
+            py = bpos[i, 1] + step * dp * out[i, 1]
+            pz = bpos[i, 2] + step * dp * out[i, 2]
+            ix = int((px - lo[0]) * inv)
+            iy = int((py - lo[1]) * inv)
+            iz = int((pz - lo[2]) * inv)
+            hit = False
+            for dz in range(-1, 2):
+                for dy in range(-1, 2):
+                    for dx in range(-1, 2):
+                        key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
+                        a = np.searchsorted(bsorted, key)
+                        b = np.searchsorted(bsorted, key + 1)
+                        for q in range(a, b):
+                            j = border[q]
+                            ddx = bpos[j, 0] - px
+                            ddy = bpos[j, 1] - py
+                            ddz = bpos[j, 2] - pz
+                            if ddx * ddx + ddy * ddy + ddz * ddz < tol2:
+                                hit = True
+            if not hit:
+                break
+            layers += 1
+        for k in range(3):
+            out[i, k] *= (0.5 + layers) * dp
     return out
 
 

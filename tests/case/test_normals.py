@@ -11,7 +11,8 @@ def tank(dp=0.05, layers=1, is2d=True):
         off = k * dp
         xs = np.arange(-off, 1.0 + off + dp / 2, dp)
         zs = np.arange(0, 0.6, dp)
-        pts += [[x, 0, -off] for x in xs] + [[-off, 0, z] for z in zs[1:]] + [[1.0 + off, 0, z] for z in zs[1:]]
+        zw = np.arange(-off + dp, 0.6, dp)
+        pts += [[x, 0, -off] for x in xs] + [[-off, 0, z] for z in zw] + [[1.0 + off, 0, z] for z in zw]
     types += [0] * len(pts)
     fx, fz = np.meshgrid(np.arange(dp, 1.0 - dp / 2, dp), np.arange(dp, 0.3, dp))
     fl = np.column_stack([fx.ravel(), 0 * fx.ravel(), fz.ravel()])
@@ -37,7 +38,8 @@ def test_tank_normals(layers):
     assert at(1.0, 0.3) == pytest.approx([-dp / 2, 0, 0])
     c = at(0.0, 0.0)
     assert c[0] > 0 and c[2] > 0 and np.linalg.norm(c) == pytest.approx(dp / 2)
-    assert np.allclose(np.linalg.norm(n[b], axis=1), dp / 2)
+    if layers == 1:
+        assert np.allclose(np.linalg.norm(n[b], axis=1), dp / 2)
 
 
 def test_solid_body_normals_point_outwards():
@@ -54,3 +56,13 @@ def test_solid_body_normals_point_outwards():
     top = np.flatnonzero(np.isclose(pos[:, 2], 1.2) & np.isclose(pos[:, 0], 0.0))[0]
     side = np.flatnonzero(np.isclose(pos[:, 0], -0.2) & np.isclose(pos[:, 2], 1.0))[0]
     assert n[top] == pytest.approx([0, 0, dp / 2]) and n[side] == pytest.approx([-dp / 2, 0, 0])
+
+
+def test_thick_wall_distances():
+    """Three wall layers: |N| = 0.5, 1.5, 2.5 dp from the fluid side outwards."""
+    dp = 0.05
+    pos, ptype = tank(dp, layers=3)
+    n = boundary_normals(pos, ptype, dp, True)
+    for k, z in enumerate((0.0, -dp, -2 * dp)):
+        i = np.flatnonzero((ptype == 0) & np.isclose(pos[:, 0], 0.5) & np.isclose(pos[:, 2], z))[0]
+        assert n[i] == pytest.approx([0, 0, (k + 0.5) * dp])
