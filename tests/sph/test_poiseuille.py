@@ -97,3 +97,16 @@ def test_s10_artificial_viscosity_equivalence():
 def test_poiseuille_40_across():
     r = run_poiseuille(40)
     assert abs(r["uc"] - 1) < 0.035
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="TOLERANCES S9: centre-line speed within 1 % at 30-40 across; "
+                                        "measured +3.0 % (30) and +2.7 % (40)")
+def test_s9_tolerance_1_percent():
+    assert abs(run_poiseuille(30)["uc"] - 1) < 0.01
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="TOLERANCES S10: nu_eff = alpha h c0/8 within ~10 %; measured ~0.4x")
+def test_s10_tolerance_10_percent():
+    assert abs(run_poiseuille(20, artificial=True)["uc"] - 1) < 0.1
