@@ -6,45 +6,17 @@ message`` and exit 2 without a traceback; a diverged run exits 3.
 """
 from __future__ import annotations
 
-import functools
 import os
 import sys
 
 import click
 
 from ._version import __version__
+from .cli_errors import report_errors
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
-
-
-def report_errors(fn):
-    """Turn sphdvi's own errors into a message on stderr and their exit code."""
-    @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
-        from .errors import SphdviError
-        try:
-            return fn(*args, **kwargs)
-        except SphdviError as exc:
-            click.echo(f"error: {exc}", err=True)
-            sys.exit(exc.exit_code)
-        except KeyboardInterrupt:
-            click.echo("interrupted", err=True)
-            sys.exit(130)
-        except MemoryError:
-            click.echo("error: out of memory (the case is too large for this machine)", err=True)
-            sys.exit(1)
-        except OSError as exc:
-            click.echo(f"error: {exc.strerror or exc}: {exc.filename or ''}", err=True)
-            sys.exit(1)
-        except Exception as exc:  # an internal error: short message, full trace on demand
-            if os.environ.get("SPHDVI_DEBUG"):
-                raise
-            click.echo(f"internal error: {type(exc).__name__}: {exc} "
-                       "(set SPHDVI_DEBUG=1 to see the traceback, and please report it)", err=True)
-            sys.exit(1)
-    return wrapper
 
 
 def print_warnings(warnings) -> None:

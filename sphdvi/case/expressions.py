@@ -25,22 +25,12 @@ class ExpressionError(ValueError):
 
 
 def _wavelength(gravity, depth, period):
-    """Linear wave length from the dispersion relation ω² = g k tanh(k d)."""
+    """Linear wave length 2π/k, with ω² = g k tanh(k d) (see :func:`sphdvi.motion.wave_number`)."""
+    from ..motion import wave_number
     g = abs(gravity)
     if g <= 0 or depth <= 0 or period <= 0:
         raise ExpressionError("wavelength(gravity, depth, period) needs positive values")
-    omega = 2.0 * math.pi / period
-    k = omega * omega / g  # deep-water start, then Newton iterations
-    k = max(k, omega / math.sqrt(g * depth))
-    for _ in range(100):
-        t = math.tanh(k * depth)
-        f = g * k * t - omega * omega
-        df = g * t + g * k * depth * (1.0 - t * t)
-        dk = f / df
-        k -= dk
-        if abs(dk) < 1e-14 * k:
-            break
-    return 2.0 * math.pi / k
+    return 2.0 * math.pi / wave_number(period, depth, g)
 
 
 def _eval_cond(cond, a, b):

@@ -54,7 +54,7 @@ def _normals_kernel(bpos, fpos, dp, is2d, fcentroid):
     inv = 1.0 / cell
     nx = int((hi[0] - lo[0]) * inv) + 1
     ny = int((hi[1] - lo[1]) * inv) + 1
-    nz = int((hi[2] - lo[2]) * inv) + 1
+
     bkeys = _grid_keys(bpos, inv, lo, nx, ny)
     border = np.argsort(bkeys)
     bsorted = bkeys[border]

@@ -805,7 +805,6 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                           w_R[s2], sh_dims[s2], env, keybase, nc, cap,
                           c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep)
             continue
-        edge_contact = False
         if (t1 == BOX or t1 == HULL) and (t2 == BOX or t2 == HULL):
             sep, ea, eb, L = _polytope_sat(s1, s2, env, samp_off, samp_cnt, samp_pts, pl_off,
                                            pl_cnt, planes, edges, ed_off, ed_cnt, w_pos, w_R,

@@ -18,47 +18,10 @@ import math
 import numpy as np
 from numba import njit
 
-
-def kernel_alpha(kind, h, is2d):
-    """Normalisation alpha_D of the kernel (cubic: 10/(7 pi h^2), 1/(pi h^3);
-    Wendland: 7/(4 pi h^2), 21/(16 pi h^3))."""
-    if kind == 1:
-        return 10.0 / (7.0 * math.pi * h * h) if is2d else 1.0 / (math.pi * h ** 3)
-    if kind == 2:
-        return 7.0 / (4.0 * math.pi * h * h) if is2d else 21.0 / (16.0 * math.pi * h ** 3)
-    raise ValueError(f"Kernel must be 1 (cubic) or 2 (Wendland), got {kind!r}")
+from ..sph.cells import bounding_box  # noqa: F401  (re-exported for the measurement tools)
+from ..sph.kernels import kernel_alpha, kernel_fac, kernel_w  # noqa: F401
 
 
-@njit(cache=True)
-def kernel_w(kind, q, alpha):
-    """Kernel value W(q), zero for q >= 2."""
-    if q >= 2.0:
-        return 0.0
-    if kind == 1:
-        if q < 1.0:
-            return alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q)
-        t = 2.0 - q
-        return alpha * 0.25 * t * t * t
-    t = 1.0 - 0.5 * q
-    t2 = t * t
-    return alpha * t2 * t2 * (2.0 * q + 1.0)
-
-
-@njit(cache=True)
-def kernel_fac(kind, q, alpha_h2):
-    """(dW/dr)/r for 0 < q < 2 (``alpha_h2`` = alpha/h^2): grad_a W_ab = fac r_ab."""
-    if kind == 1:
-        if q < 1.0:
-            return alpha_h2 * (-3.0 + 2.25 * q)
-        t = 2.0 - q
-        return alpha_h2 * (-0.75 * t * t / q)
-    t = 1.0 - 0.5 * q
-    return alpha_h2 * (-5.0) * t * t * t
-
-
-# ---------------------------------------------------------------------------------
-# cell list
-# ---------------------------------------------------------------------------------
 @njit(cache=True)
 def _cell_of(x, y, z, pmin, inv_cs, ncx, ncy, ncz, is2d):
     """Cell coordinates (cx, cy, cz) of a position, not clamped (may lie outside)."""
@@ -68,21 +31,6 @@ def _cell_of(x, y, z, pmin, inv_cs, ncx, ncy, ncz, is2d):
     if not is2d:
         cy = int(math.floor((y - pmin[1]) * inv_cs))
     return cx, cy, cz
-
-
-@njit(cache=True)
-def bounding_box(pos):
-    """Min and max corners of the positions (N >= 1, 3)."""
-    lo = pos[0].copy()
-    hi = pos[0].copy()
-    for i in range(1, pos.shape[0]):
-        for k in range(3):
-            v = pos[i, k]
-            if v < lo[k]:
-                lo[k] = v
-            elif v > hi[k]:
-                hi[k] = v
-    return lo, hi
 
 
 @njit(cache=True)

@@ -5,37 +5,15 @@ inside the commands, so ``sphdvi --help`` stays fast.
 """
 from __future__ import annotations
 
-import functools
-import os
-import sys
 
 import click
+
+from ..cli_errors import report_errors
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
-def _report_errors(fn):
-    """sphdvi's own errors -> 'error: ...' on stderr and their exit code (no traceback)."""
-    @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
-        from ..errors import SphdviError
-        try:
-            return fn(*args, **kwargs)
-        except click.ClickException:
-            raise
-        except SphdviError as exc:
-            click.echo(f"error: {exc}", err=True)
-            sys.exit(exc.exit_code)
-        except OSError as exc:
-            click.echo(f"error: {exc.strerror or exc}: {exc.filename or ''}", err=True)
-            sys.exit(1)
-        except Exception as exc:
-            if os.environ.get("SPHDVI_DEBUG"):
-                raise
-            click.echo(f"internal error: {type(exc).__name__}: {exc} "
-                       "(set SPHDVI_DEBUG=1 to see the traceback, and please report it)", err=True)
-            sys.exit(1)
-    return wrapper
+
 
 
 def _output_options(fn):
@@ -112,7 +90,7 @@ def measure():
               help="shepard: normalised by the kernel sum (MeasureTool); linear: first-order "
                    "MLS correction, exact for linear fields.")
 @_output_options
-@_report_errors
+@report_errors
 def points(outdir, points, variables, kclimit, correction, first, last, every, csv_path, sep, plot):
     """Kernel-interpolated fluid values at points, at every output time.
 
@@ -145,7 +123,7 @@ def points(outdir, points, variables, kclimit, correction, first, last, every, c
               help="Kernel-sum threshold of the surface (default 0.5 in 3D, 0.4 in 2D).")
 @click.option("--dz", type=float, default=None, help="Sampling step along the vertical (default dp/4).")
 @_output_options
-@_report_errors
+@report_errors
 def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot):
     """Free-surface elevation and water depth along verticals (MeasureTool -elevation).
 
@@ -172,7 +150,7 @@ def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot
               help="Moment about the axis through two points (projected on it).")
 @click.option("--no-visco", is_flag=True, help="Pressure term only (no viscous force).")
 @_output_options
-@_report_errors
+@report_errors
 def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_path, sep, plot):
     """Fluid force and moment on boundary or floating particles (ComputeForces).
 
@@ -201,7 +179,7 @@ def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_p
 @measure.command(context_settings=CONTEXT)
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
 @_output_options
-@_report_errors
+@report_errors
 def bodies(outdir, first, last, every, csv_path, sep, plot):
     """Body motion and loads per body (FloatingInfo), and link forces.
 

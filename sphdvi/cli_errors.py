@@ -1,0 +1,40 @@
+"""How every ``sphdvi`` command reports failures: a message on stderr and an exit code, no traceback."""
+from __future__ import annotations
+
+import functools
+import os
+import sys
+
+import click
+
+
+def report_errors(fn):
+    """Turn sphdvi's own errors into ``error: ...`` on stderr and their exit code
+    (2 bad input, 3 diverged, 1 other); click's usage errors pass through; any
+    other exception is an internal error (traceback with SPHDVI_DEBUG=1)."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        from .errors import SphdviError
+        try:
+            return fn(*args, **kwargs)
+        except click.ClickException:
+            raise
+        except SphdviError as exc:
+            click.echo(f"error: {exc}", err=True)
+            sys.exit(exc.exit_code)
+        except KeyboardInterrupt:
+            click.echo("interrupted", err=True)
+            sys.exit(130)
+        except MemoryError:
+            click.echo("error: out of memory (the case is too large for this machine)", err=True)
+            sys.exit(1)
+        except OSError as exc:
+            click.echo(f"error: {exc.strerror or exc}: {exc.filename or ''}", err=True)
+            sys.exit(1)
+        except Exception as exc:  # an internal error: short message, full trace on demand
+            if os.environ.get("SPHDVI_DEBUG"):
+                raise
+            click.echo(f"internal error: {type(exc).__name__}: {exc} "
+                       "(set SPHDVI_DEBUG=1 to see the traceback, and please report it)", err=True)
+            sys.exit(1)
+    return wrapper
