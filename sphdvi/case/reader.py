@@ -863,6 +863,9 @@ def read_wavepaddles(reader, el) -> list:
         for k in ("depth", "waveheight", "waveperiod"):
             if d[k] <= 0:
                 raise reader.error(c, f"<{k}> must be positive", f"{k} > 0")
+        if c.tag == "flap" and d["waveorder"] == 2:
+            raise reader.error(c, "second-order generation is not supported for flaps by sphdvi",
+                               "waveorder 1 for a <flap> (a <piston> supports 2)")
         if c.tag == "flap" and ("flapaxis0" not in d or "flapaxis1" not in d):
             raise reader.error(c, "missing <flapaxis0>/<flapaxis1>", "the two points of the hinge axis")
         d.setdefault("start", 0.0)

@@ -305,3 +305,11 @@ def test_analytic_inertia_of_rotated_box(tmp_path):
     local = np.diag([0.2 ** 2 + 0.1 ** 2, 0.4 ** 2 + 0.1 ** 2, 0.4 ** 2 + 0.2 ** 2]) * m / 12
     assert np.allclose(a["inertia"], R @ local @ R.T, rtol=1e-9, atol=1e-12)
     assert b.center == pytest.approx([0.5, 0.5, 0.5], abs=0.011)
+
+
+def test_second_order_flap_is_refused(tmp_path):
+    special = ('<wavepaddles><flap><mkbound value="0"/><depth value="1"/><waveorder value="2"/>'
+               '<waveheight value="0.1"/><waveperiod value="1"/><flapaxis0 x="0" y="0" z="0"/>'
+               '<flapaxis1 x="0" y="1" z="0"/></flap></wavepaddles>')
+    with pytest.raises(CaseError, match="second-order generation is not supported for flaps"):
+        build(tmp_path, special=special)
