@@ -168,7 +168,7 @@ def test_divergence_exit_3(tmp_path):
 
 def test_resume_bitwise_with_floating_body(tmp_path):
     """SPH + a floating body (multibody engine): a resumed run ends bitwise equal, bodies.csv included."""
-    case = Path(__file__).with_name("CaseFloatingBox2D_Def.xml")
+    case = REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
     common = ["--dp", "0.02", "--tout", "0.01", "--threads", "1", "-q", "--set", "FtPause=0"]
     a, b = tmp_path / "a", tmp_path / "b"
     assert invoke(["run", case, "-o", a, "--tmax", "0.04"] + common).exit_code == 0

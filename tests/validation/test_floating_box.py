@@ -15,7 +15,7 @@ from sphdvi.cli import main
 from sphdvi.io.casefile import read_case_h5
 from sphdvi.io.vtkhdf import read_step, step_times
 
-CASE = Path(__file__).resolve().parents[1] / "run" / "CaseFloatingBox2D_Def.xml"
+CASE = Path(__file__).resolve().parents[2] / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
 
 
 @pytest.mark.slow
