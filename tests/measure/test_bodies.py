@@ -1,6 +1,7 @@
 """sphdvi measure bodies: from bodies.csv/links.csv, and from floating-particle snapshots."""
 import csv
 import math
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -14,55 +15,7 @@ from sphdvi.measure.post import measure_bodies, rotation_to_euler_deg
 from sphdvi.measure.tables import read_table
 from sphdvi.simulation import POINT_ARRAYS
 
-PENDULUM = """<?xml version="1.0" encoding="UTF-8" ?>
-<!-- A 0.2 m cube hinged 1 m above its centre: a compound pendulum (no fluid). -->
-<case>
-    <casedef>
-        <constantsdef>
-            <gravity x="0" y="0" z="-9.81" />
-            <rhop0 value="1000" />
-            <coefh value="1.0" />
-        </constantsdef>
-        <mkconfig boundcount="240" fluidcount="9" />
-        <geometry>
-            <definition dp="0.05">
-                <pointmin x="-2" y="-1" z="-2" />
-                <pointmax x="2" y="1" z="1" />
-            </definition>
-            <commands>
-                <mainlist>
-                    <setmkbound mk="1" />
-                    <drawbox><boxfill>solid</boxfill><point x="-0.1" y="-0.1" z="-1.1" /><size x="0.2" y="0.2" z="0.2" /></drawbox>
-                </mainlist>
-            </commands>
-        </geometry>
-        <floatings>
-            <floating mkbound="1">
-                <massbody value="10" />
-                <linearvelini x="-0.1" y="0" z="0" />
-                <angularvelini x="0" y="0.1" z="0" />
-            </floating>
-        </floatings>
-    </casedef>
-    <execution>
-        <special>
-            <chrono>
-                <bodyfloating id="pend" mkbound="1" />
-                <link_hinge idbody1="pend">
-                    <rotpoint x="0" y="0" z="0" />
-                    <rotvector x="0" y="1" z="0" />
-                </link_hinge>
-            </chrono>
-        </special>
-        <parameters>
-            <parameter key="RigidAlgorithm" value="3" />
-            <parameter key="DtFixed" value="0.001" />
-            <parameter key="TimeMax" value="4.5" />
-            <parameter key="TimeOut" value="0.005" />
-        </parameters>
-    </execution>
-</case>
-"""
+PENDULUM = (Path(__file__).resolve().parents[2] / "cases" / "pendulum" / "CasePendulum_Def.xml").read_text()
 
 
 def invoke(*args):
