@@ -51,6 +51,22 @@ SOLVER_ALIASES = {"psor": "psor", "pgs": "psor", "sor": "psor", "gs": "psor", "a
 
 # ------------------------------------------------------------------ projection
 @njit(cache=True)
+def average_friction_triplets(diag, kind, n):
+    """Replace the three diagonal values of each friction triplet (normal, u, w) by their mean,
+    as Chrono does, so the block-scaled step keeps the cone isotropic (dvi.md §1.3)."""
+    i = 0
+    while i < n:
+        if kind[i] == FRIC_N:
+            avg = (diag[i] + diag[i + 1] + diag[i + 2]) / 3.0
+            diag[i] = avg
+            diag[i + 1] = avg
+            diag[i + 2] = avg
+            i += 3
+        else:
+            i += 1
+
+
+@njit(cache=True)
 def project_cone(gn, gu, gw, mu):
     """Exact Euclidean projection onto the Coulomb cone ‖γ_t‖ ≤ μ γ_n.
 
@@ -120,16 +136,7 @@ def prepare_rows(nr, ra, rb, J, E, kind, invm3, invI, MiJ, gdiag):
             for c in range(6):
                 g += J[k, o + c] * MiJ[k, o + c]
         gdiag[k] = g
-    i = 0
-    while i < nr:
-        if kind[i] == FRIC_N:
-            avg = (gdiag[i] + gdiag[i + 1] + gdiag[i + 2]) / 3.0
-            gdiag[i] = avg
-            gdiag[i + 1] = avg
-            gdiag[i + 2] = avg
-            i += 3
-        else:
-            i += 1
+    average_friction_triplets(gdiag, kind, nr)
     for k in range(nr):
         if gdiag[k] <= 1e-300:
             # row between non-dynamic bodies (fixed/moving or locked DOFs):
@@ -540,16 +547,7 @@ def solve_dense_bb(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
     d0 = np.empty(n)
     for k in range(n):
         d0[k] = max(N[k, k], 1e-300)
-    i = 0
-    while i < n:
-        if kind[i] == FRIC_N:
-            a = (d0[i] + d0[i + 1] + d0[i + 2]) / 3.0
-            d0[i] = a
-            d0[i + 1] = a
-            d0[i + 2] = a
-            i += 3
-        else:
-            i += 1
+    average_friction_triplets(d0, kind, n)
     s = np.sqrt(d0)
     Ns = N / np.outer(s, s)
     rs = r / s
