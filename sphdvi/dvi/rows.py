@@ -17,6 +17,75 @@ from .solvers import BILATERAL, BOXED, FRIC_N, FRIC_T, UNILATERAL
 LINK_CONTACT = -1
 LINK_IMPOSED = -2
 
+
+SPRING_AUTO = 0
+SPRING_IMPLICIT = 1
+SPRING_EXPLICIT = 2
+
+# Explicit (symplectic-Euler) treatment of a spring-damper row is kept where it
+# is stable with a wide margin: ω h ≤ 0.2 and c w h ≤ 0.2 (w = J M⁻¹ Jᵀ); the
+# explicit limits are ω h < 2 and c w h < 2.
+EXPLICIT_OMEGA_H = 0.2
+EXPLICIT_DAMP_H = 0.2
+
+
+@njit(cache=True)
+def _row_mobility(k, ra, rb, J, invm3, invI):
+    """w = J M⁻¹ Jᵀ of row k (DOF-masked inverse mass, body-frame inertia)."""
+    w = 0.0
+    for side in range(2):
+        i = ra[k] if side == 0 else rb[k]
+        if i < 0:
+            continue
+        o = 6 * side
+        for c in range(3):
+            w += J[k, o + c] * J[k, o + c] * invm3[i, c]
+        for c in range(3):
+            s = 0.0
+            for m in range(3):
+                s += invI[i, c, m] * J[k, o + 3 + m]
+            w += J[k, o + 3 + c] * s
+    return w
+
+
+@njit(cache=True)
+def _row_speed(k, ra, rb, J, vel6):
+    """J v of row k at the velocities vel6 (linear world, angular body frame)."""
+    s = 0.0
+    for side in range(2):
+        i = ra[k] if side == 0 else rb[k]
+        if i < 0:
+            continue
+        o = 6 * side
+        for c in range(6):
+            s += J[k, o + c] * vel6[i, c]
+    return s
+
+
+@njit(cache=True)
+def _soft_row(k, h, kk, cc, err, f0, scheme, vel6, invm3, invI, ra, rb, J, b, E, kind, lo, hi):
+    """Spring-damper force ``f = f0 − k·err − c·q̇`` on row k.
+
+    Implicit (backward Euler, unconditionally stable): the compliance row
+    ``E = 1/(h(hk + c))``, ``b = (k·err − f0)/(hk + c)``.  Explicit
+    (symplectic Euler, as Chrono's ChLinkTSDA without Jacobians): the impulse
+    is fixed at ``γ = h f(q_n, q̇_n)`` by a boxed row with ``lo = hi = γ``; it
+    has no numerical damping, so a soft spring keeps its amplitude.  ``auto``
+    takes the explicit form where it is stable with a wide margin."""
+    explicit = scheme == SPRING_EXPLICIT
+    if scheme == SPRING_AUTO:
+        w = _row_mobility(k, ra, rb, J, invm3, invI)
+        explicit = h * h * kk * w <= EXPLICIT_OMEGA_H ** 2 and h * cc * w <= EXPLICIT_DAMP_H
+    if explicit:
+        g = h * (f0 - kk * err - cc * _row_speed(k, ra, rb, J, vel6))
+        kind[k] = BOXED
+        lo[k] = g
+        hi[k] = g
+        return
+    den = h * kk + cc
+    E[k] = 1.0 / (h * den)
+    b[k] = (kk * err - f0) / den
+
 MOTOR_NONE = 0
 MOTOR_POSITION = 1
 MOTOR_SPEED = 2
@@ -68,7 +137,7 @@ def _wrap_angle(a):
 def build_mate_rows(nr, h, vrec, pos, Rb,
                     m_b1, m_b2, m_p1, m_p2, m_T1, m_T2, m_Q1, m_Q2, m_mask,
                     m_k, m_c, m_rest, m_mmode, m_mval, m_mdval, m_angle, m_lid,
-                    m_P1w,
+                    m_P1w, scheme, vel6, invm3, invI,
                     ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
     """Generic mate (Chrono ChLinkMateGeneric semantics, own derivation).
 
@@ -77,8 +146,8 @@ def build_mate_rows(nr, h, vrec, pos, Rb,
     rotation frame, locked with the dot-1 rows ``y1·z2``, ``z1·x2``, ``x1·y2``.
     A constrained DOF gives a stabilised bilateral row ``b = clamp(C/h, ±v_rec)``.
     A free DOF gets a motor row (position or speed) or, with stiffness k and
-    damping c, an implicit compliance row ``E = 1/(h(hk + c))``,
-    ``b = k(q − q0)/(hk + c)`` which is the backward-Euler spring-damper."""
+    damping c, a spring-damper row (:func:`_soft_row`: implicit compliance
+    ``E = 1/(h(hk + c))``, ``b = k(q − q0)/(hk + c)``, or explicit)."""
     nm = m_b1.shape[0]
     for m in range(nm):
         i1 = m_b1[m]
@@ -160,9 +229,8 @@ def build_mate_rows(nr, h, vrec, pos, Rb,
             elif mode == MOTOR_SPEED:
                 b[nr] = -m_mval[m, k]
             else:
-                den = h * kk + cc
-                E[nr] = 1.0 / (h * den)
-                b[nr] = kk * (q - m_rest[m, k]) / den
+                _soft_row(nr, h, kk, cc, q - m_rest[m, k], 0.0, scheme, vel6, invm3, invI,
+                          ra, rb, J, b, E, kind, lo, hi)
             nr += 1
     return nr
 
@@ -186,10 +254,10 @@ def _distance_row(nr, i1, i2, p1, p2, pos, Rb, ra, rb, J):
 
 @njit(cache=True)
 def build_spring_rows(nr, h, pos, Rb, s_b1, s_b2, s_p1, s_p2, s_k, s_c, s_l0, s_f0,
-                      s_lid, s_P1w, s_len,
+                      s_lid, s_P1w, s_len, scheme, vel6, invm3, invI,
                       ra, rb, J, b, E, kind, lo, hi, mu, rlink, Cpos):
-    """Linear spring-damper (TSDA) F = f0 − k(l − l0) − c l̇ along P1−P2, as an
-    implicit compliance row: E = 1/(h(hk + c)), b = (k(l − l0) − f0)/(hk + c)."""
+    """Linear spring-damper (TSDA) F = f0 − k(l − l0) − c l̇ along P1−P2, as a
+    spring-damper row (:func:`_soft_row`, implicit or explicit)."""
     for m in range(s_b1.shape[0]):
         kk = s_k[m]
         cc = s_c[m]
@@ -202,8 +270,8 @@ def build_spring_rows(nr, h, pos, Rb, s_b1, s_b2, s_p1, s_p2, s_k, s_c, s_l0, s_
         if den <= 0.0:
             continue  # pure preload: applied as an explicit force elsewhere
         rlink[nr] = s_lid[m]
-        E[nr] = 1.0 / (h * den)
-        b[nr] = (kk * (l - s_l0[m]) - s_f0[m]) / den
+        _soft_row(nr, h, kk, cc, l - s_l0[m], s_f0[m], scheme, vel6, invm3, invI,
+                  ra, rb, J, b, E, kind, lo, hi)
         nr += 1
     return nr
 

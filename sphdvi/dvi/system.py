@@ -5,7 +5,8 @@ One call to :meth:`System.step` performs one Anitescu–Tasora step
 
 1. free velocity  ``v_free = v + h M⁻¹ (f_ext + m g − ω×Jω)``;
 2. collision detection at the current pose, contact rows, joint rows,
-   compliance rows (springs, joint stiffness/damping), boxed rows
+   spring-damper rows (springs, joint stiffness/damping: implicit compliance
+   rows, or fixed explicit impulses where that is stable), boxed rows
    (Coulomb dampers), motor and imposed-velocity rows;
 3. one CCP solve (PSOR, APGD or BB) for the impulses γ, warm started;
 4. ``v⁺ = v_free + M⁻¹ Dᵀ γ``, then ``x += h v⁺``, ``q ← q ⊗ exp(h ω⁺_body)``.
@@ -41,6 +42,10 @@ _MATE_MASKS = {
     "pointplane": (0, 0, 1, 0, 0, 0),
     "planar": (0, 0, 1, 1, 1, 0),
 }
+
+
+_SPRING_SCHEMES = {"auto": rw.SPRING_AUTO, "implicit": rw.SPRING_IMPLICIT,
+                   "explicit": rw.SPRING_EXPLICIT}
 
 
 def _as_table(v):
@@ -86,7 +91,8 @@ class System:
 
     def __init__(self, gravity=(0.0, 0.0, -9.81), solver="bb", max_iter=100, tol=1e-10,
                  omega=1.0, recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.01,
-                 contactmethod="nsc", smc_model="hertz", position_projection=False):
+                 contactmethod="nsc", smc_model="hertz", position_projection=False,
+                 spring_integration="auto"):
         self.gravity = np.asarray(gravity, dtype=np.float64)
         key = str(solver).lower().replace("_", "").replace("-", "")
         if key not in SOLVER_ALIASES:
@@ -103,6 +109,11 @@ class System:
         self.contactmethod = str(contactmethod)
         self.smc_model = smc_model
         self.position_projection = bool(position_projection)
+        key = str(spring_integration).lower()
+        if key not in _SPRING_SCHEMES:
+            raise ValueError(f"unknown spring_integration {spring_integration!r}; "
+                             "use auto, implicit or explicit")
+        self.spring_integration = key
         self.time = 0.0
         self.last_iterations = 0
         self.last_residual = 0.0
@@ -454,7 +465,8 @@ class System:
         unless ``rot_axis`` (DualSPHysics ``rotvector``: only rotation about it
         allowed) and optionally ``rot_axis2`` (``rotvector2``: a second free
         rotation axis) are given.
-        stiffness/damping: on the free DOFs (implicit compliance rows); a
+        stiffness/damping: on the free DOFs (spring-damper rows, implicit or
+        explicit as ``spring_integration`` says); a
         constant, a table [[t, v], ...] or a callable f(t) for all free DOFs,
         or a dict {dof: value} (dof 0..5 or "tx".."rz"); rest: rest
         coordinate(s) (scalar for all free DOFs, or 6 values).
@@ -524,7 +536,9 @@ class System:
                    damping=0.0, rest_length=None, preload=0.0, name=None):
         """Linear spring-damper (TSDA) between world points point1 (on body1)
         and point2 (on body2): F = f0 − k(l − l0) − c l̇ along the line,
-        positive pushing the bodies apart; treated implicitly (compliance row).
+        positive pushing the bodies apart.  Implicit (compliance row) where
+        it is stiff for the step, explicit where that is stable with margin
+        (``System(spring_integration=...)``: auto, implicit or explicit).
         k and c may be constants, tables [[t, v], ...] or callables."""
         P1 = np.asarray(point1, float)
         P2 = np.asarray(point2, float)
@@ -679,16 +693,27 @@ class System:
         return (self.r_a, self.r_b, self.r_J, self.r_bias, self.r_E, self.r_kind, self.r_lo,
                 self.r_hi, self.r_mu, self.r_link, self.r_C)
 
-    def _build_link_rows(self, h, R):
+    def _build_link_rows(self, h, R, vel6=None, invm3=None, invI=None):
+        """Joint, spring, damper, pulley and imposed-velocity rows.  vel6 and
+        the DOF-masked inverse masses serve the explicit spring-damper rows
+        (:func:`rows._soft_row`); without them every spring is implicit."""
+        scheme = _SPRING_SCHEMES[self.spring_integration]
+        if vel6 is None:
+            nb = self.nb
+            scheme = rw.SPRING_IMPLICIT
+            vel6 = np.zeros((nb, 6))
+            invm3 = np.zeros((nb, 3))
+            invI = np.zeros((nb, 3, 3))
         nr = 0
         nr = rw.build_mate_rows(nr, h, self.recovery_speed, self.pos, R, self.m_b1, self.m_b2,
                                 self.m_p1, self.m_p2, self.m_T1, self.m_T2, self.m_Q1, self.m_Q2,
                                 self.m_mask, self.m_k, self.m_c, self.m_rest, self.m_mmode,
                                 self.m_mval, self.m_mdval, self.m_angle, self.m_lid, self.m_P1w,
-                                *self._row_args())
+                                scheme, vel6, invm3, invI, *self._row_args())
         nr = rw.build_spring_rows(nr, h, self.pos, R, self.s_b1, self.s_b2, self.s_p1, self.s_p2,
                                   self.s_k, self.s_c, self.s_l0, self.s_f0, self.s_lid,
-                                  self.s_P1w, self.s_len, *self._row_args())
+                                  self.s_P1w, self.s_len, scheme, vel6, invm3, invI,
+                                  *self._row_args())
         nr = rw.build_coulomb_rows(nr, h, self.pos, R, self.d_b1, self.d_b2, self.d_p1,
                                    self.d_p2, self.d_F, self.d_lid, self.d_P1w, *self._row_args())
         nr = rw.build_pulley_rows(nr, self.pos, R, self.p_b1, self.p_b2, self.p_a1, self.p_a2,
@@ -797,7 +822,7 @@ class System:
         # rows
         ncr = 0 if smc else nc
         self._ensure_rows(self._max_link_rows() + 3 * ncr)
-        nl_rows = self._build_link_rows(h, R)
+        nl_rows = self._build_link_rows(h, R, vel6, invm3, invI)
         g = self.r_gamma
         g[:] = 0.0
         # warm start: impulses of the last step, rescaled to this step (γ = h·force)

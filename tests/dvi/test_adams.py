@@ -87,18 +87,20 @@ def test_adams_revolute():
 
 
 def test_adams_spherical():
-    """Same motion as the revolute case.  ADAMS's own revolute and spherical
-    velocity series differ by ~1e-3 RMS (integrator error of the reference), so
-    velocities are required to agree to that level; the rest uses Chrono's
-    thresholds."""
+    """Same motion as the revolute case.  Chrono's utest_JOINT_spherical
+    thresholds are Pos 2e-3, Vel 1e-3, Quat 1e-3, Avel 2e-2, Rforce 2e-2: the
+    ADAMS spherical series differs from the ADAMS revolute series of the same
+    motion by ~1e-3 RMS in velocity (integrator error of the reference).  Our
+    spherical pendulum also meets the revolute thresholds against the revolute
+    series."""
     out, viol, e = run("Spherical_Case01", h=5e-4)
     errs = errors("Spherical_Case01", out)
-    ref_spread = {w: rms(load("Spherical_Case01", w)[:, 1:], load("Revolute_Case01", w)[:, 1:])
-                  for w in ("Vel", "Avel")}
-    for what, tol in TOL.items():
-        if what in ref_spread:
-            tol = max(tol, 1.1 * ref_spread[what])
-        assert errs[what] < tol, (what, errs, ref_spread)
+    tol_sph = {"Pos": 2e-3, "Vel": 1e-3, "Quat": 1e-3, "Avel": 2e-2, "Rforce": 2e-2}
+    for what, tol in tol_sph.items():
+        assert errs[what] < tol, (what, errs)
+    errs_rev = errors("Revolute_Case01", out)
+    for what in ("Pos", "Vel", "Rforce"):
+        assert errs_rev[what] < TOL[what], (what, errs_rev)
     assert viol < 1e-5
 
 
@@ -113,24 +115,29 @@ def test_adams_prismatic():
     assert viol < 1e-5
 
 
+# utest_JOINT_transpring (TranSpring_Case01 at Δt = 1e-4 s): Pos 1e-3, Vel 3e-4, Rforce 5e-3
+TOL_TSDA = {"Pos": 1e-3, "Vel": 3e-4, "Quat": 1e-10, "Avel": 1e-10, "Rforce": 5e-3}
+
+
 def test_adams_translational_spring():
-    """TSDA hanging mass.  The shipped .adm lists k = 100, c = 1 with a
-    horizontal geometry, but the ADAMS series is reproduced exactly by a
-    vertical spring with k = 10 N/m, c = 0.5 N s/m (Chrono utest_JOINT_tsda
-    values) at its free length at t = 0; that is what we model.  The implicit
-    (backward-Euler) spring-damper has an O(h) velocity error: at h = 1e-4 the
-    velocity RMS is ~1.3e-3, Pos and Rforce meet Chrono's thresholds."""
+    """TSDA hanging mass at Chrono's step and thresholds.  The shipped .adm
+    lists k = 100, c = 1 with a horizontal geometry, but the ADAMS series is
+    reproduced by a vertical spring with k = 10 N/m, c = 0.5 N s/m (the values
+    of Chrono's utest) at its free length at t = 0; that is what we model.  The
+    soft spring is integrated explicitly (auto scheme), which keeps its
+    amplitude; the implicit row loses ~1e-3 of velocity RMS to numerical
+    damping (measured 1.3e-3)."""
     out, viol, e = run("TranSpring_Case01", h=1e-4)
     errs = errors("TranSpring_Case01", out)
-    tol = dict(TOL, Vel=2e-3)
-    for what in TOL:
-        assert errs[what] < tol[what], (what, errs)
+    for what, tol in TOL_TSDA.items():
+        assert errs[what] < tol, (what, errs)
 
 
 @pytest.mark.slow
 def test_adams_translational_spring_fine():
+    """M9: utest_JOINT_tsda's thresholds at Δt = 1e-5 s, Pos 1e-4, Vel 5e-5."""
     out, viol, e = run("TranSpring_Case01", h=1e-5)
     errs = errors("TranSpring_Case01", out)
-    tol = dict(TOL, Vel=2e-4)
-    for what in TOL:
+    tol = dict(TOL_TSDA, Pos=1e-4, Vel=5e-5)
+    for what in tol:
         assert errs[what] < tol[what], (what, errs)

@@ -1,4 +1,5 @@
-"""M4: springs, dampers, joint stiffness (implicit compliance rows), stiff cases."""
+"""M4: springs, dampers, joint stiffness (implicit compliance rows or explicit
+impulses), stiff cases."""
 import math
 
 import numpy as np
@@ -64,10 +65,13 @@ def test_coulomb_damper_linear_decay():
     assert abs(s.vel[b, 0]) < 1e-8
 
 
-def test_torsional_spring_frequency_and_table():
-    """Hinge with rotational stiffness k (implicit): ω = √(k/I)."""
+@pytest.mark.parametrize("scheme", ["implicit", "explicit", "auto"])
+def test_torsional_spring_frequency_and_table(scheme):
+    """Hinge with rotational stiffness k: ω = √(k/I), implicit or explicit
+    (auto picks explicit here: ω h = 1e-3)."""
     I, k = 0.5, 50.0
-    s = System(gravity=(0, 0, 0), solver="bb", max_iter=50, tol=1e-13)
+    s = System(gravity=(0, 0, 0), solver="bb", max_iter=50, tol=1e-13,
+               spring_integration=scheme)
     b = s.add_body(1.0, (0.1, 0.1, I), omega=(0, 0, 1.0))
     s.add_link("hinge", b, -1, point=(0, 0, 0), axis=(0, 0, 1), stiffness=k)
     h = 1e-4
@@ -81,9 +85,11 @@ def test_torsional_spring_frequency_and_table():
     w = math.sqrt(k / I)
     assert abs((tc[1] - tc[0]) / (2 * math.pi / w) - 1) < 2e-3
     assert abs(th.max() - 1.0 / w) / (1.0 / w) < 1e-2
-    # reaction torque about the axis = −k θ⁺ on body 1 (implicit: end-of-step angle)
+    # reaction torque about the axis on body 1: −k θ at the end of the step
+    # (implicit) or at its start (explicit)
     th_end = th[-1] + h * s.omega_world[b, 2]
-    assert abs(s.link_torque[0][2] + k * th_end) < 1e-6 * k
+    th_force = th_end if scheme == "implicit" else th[-1]
+    assert abs(s.link_torque[0][2] + k * th_force) < 1e-6 * k
     # time-dependent stiffness table: zero stiffness -> free rotation
     s2 = System(gravity=(0, 0, 0), solver="bb", max_iter=50)
     b2 = s2.add_body(1.0, (0.1, 0.1, I), omega=(0, 0, 1.0))
@@ -108,6 +114,32 @@ def test_stiff_hinge_1e8_is_stable():
     assert np.all(np.isfinite(s.pos))
     assert viol < 1e-4
     assert abs(s.pos[b, 2]) < 1e-6  # held horizontal by the stiff spring
+
+
+def test_spring_scheme_auto_is_explicit_when_soft_and_implicit_when_stiff():
+    """A soft spring keeps its amplitude (explicit: no numerical damping); a
+    spring with ω h = 10 stays bounded (implicit) where the explicit form,
+    asked for on purpose, blows up."""
+    def amplitude_after(k, h, steps, scheme):
+        s = System(gravity=(0, 0, 0), solver="bb", max_iter=50, tol=1e-13,
+                   spring_integration=scheme)
+        b = s.add_body(1.0, (0.1, 0.1, 0.1), pos=(1.1, 0, 0))
+        s.add_spring(b, -1, point1=(1.1, 0, 0), point2=(0, 0, 0), stiffness=k, rest_length=1.0)
+        e = []
+        for _ in range(steps):
+            s.step(h)
+            e.append(0.5 * s.vel[b, 0] ** 2 + 0.5 * k * (s.pos[b, 0] - 1.0) ** 2)
+        return math.sqrt(2 * max(e[-steps // 4:]) / k)
+    # soft: ω h = 1e-3 over 10 periods
+    soft = dict(k=100.0, h=1e-4, steps=int(2 * math.pi * 10 / 10.0 / 1e-4))
+    assert abs(amplitude_after(**soft, scheme="auto") - 0.1) < 2e-4
+    assert amplitude_after(**soft, scheme="implicit") < 0.1 * (1 - 1e-3)  # damped
+    # stiff: ω h = 10
+    stiff = dict(k=1e8, h=1e-3, steps=200)
+    assert amplitude_after(**stiff, scheme="auto") <= 0.1 + 1e-12
+    with np.errstate(all="ignore"):
+        a = amplitude_after(**stiff, scheme="explicit")
+    assert not (a < 1.0)
 
 
 @pytest.mark.parametrize("solver,iters", [("direct", 100), ("bb", 2000)])
