@@ -15,9 +15,19 @@ rho_b = rho_g + (r_b - g) . grad rho_g.  When the matrix is near-singular
 (|det| below ``threshold``, 1e-3) the Shepard value sum m w / sum V w is
 used; with a kernel sum sum V w at g not above ``MdbcThreshold`` (no fluid
 there) the density is left as it is.  As with DBC the result
-is clamped to rho >= rho0.  Slip mode 1 (boundary velocity = its own
-velocity) is the only one implemented.  Particles with N_b = 0 keep plain
-DBC behaviour.
+is clamped to rho >= rho0.  Particles with N_b = 0 keep plain DBC
+behaviour.
+
+Slip modes (``SlipMode``) set the velocity a boundary particle shows the
+fluid (continuity, viscosity), from the velocity v_g interpolated at its
+ghost node with the same corrected system (right-hand side sum V v w,
+sum V v grad w) and the wall velocity v_w (the particle's own velocity):
+
+* 1, DBC velocity: v_b = v_w;
+* 2, no-slip: v_b = 2 v_w - v_g (the velocity is odd about the wall, so the
+  interpolated velocity vanishes relative to the wall on the surface);
+* 3, free-slip: v_b = v_w + u - 2 (u.n) n with u = v_g - v_w and n the unit
+  normal (tangential velocity even, normal velocity odd about the wall).
 """
 import math
 
@@ -64,8 +74,79 @@ def _solve_small(a, b, n):
 
 
 @njit(cache=True, error_model="numpy")
+def _solve_multi(a, bm, n):
+    """Solve a[:n,:n] X = bm[:n, :] (three right-hand sides) in place by
+    Gaussian elimination with partial pivoting; returns |det a|."""
+    det = 1.0
+    m = bm.shape[1]
+    for k in range(n):
+        p = k
+        for r in range(k + 1, n):
+            if abs(a[r, k]) > abs(a[p, k]):
+                p = r
+        if a[p, k] == 0.0:
+            return 0.0
+        if p != k:
+            for cc in range(n):
+                t = a[k, cc]
+                a[k, cc] = a[p, cc]
+                a[p, cc] = t
+            for cc in range(m):
+                t = bm[k, cc]
+                bm[k, cc] = bm[p, cc]
+                bm[p, cc] = t
+        det *= a[k, k]
+        for r in range(k + 1, n):
+            f = a[r, k] / a[k, k]
+            for cc in range(k, n):
+                a[r, cc] -= f * a[k, cc]
+            for cc in range(m):
+                bm[r, cc] -= f * bm[k, cc]
+    for k in range(n - 1, -1, -1):
+        for cc in range(m):
+            s = bm[k, cc]
+            for q in range(k + 1, n):
+                s -= a[k, q] * bm[q, cc]
+            bm[k, cc] = s / a[k, k]
+    return abs(det)
+
+
+@njit(cache=True)
+def _packed_vel(nb, j, is2d, out):
+    """Velocity (x, y, z) of packed particle j."""
+    if is2d:
+        out[0] = nb[j, 2]
+        out[1] = 0.0
+        out[2] = nb[j, 3]
+    else:
+        out[0] = nb[j, 3]
+        out[1] = nb[j, 4]
+        out[2] = nb[j, 5]
+
+
+@njit(cache=True)
+def _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i):
+    """Velocity of boundary particle i seen by the fluid (module docstring)."""
+    if slip == 2:
+        for c in range(3):
+            bvel[i, c] = 2.0 * vw[c] - vg[c]
+        return
+    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+    ex = nx / nn
+    ey = ny / nn
+    ez = nz / nn
+    ux = vg[0] - vw[0]
+    uy = vg[1] - vw[1]
+    uz = vg[2] - vw[2]
+    un = ux * ex + uy * ey + uz * ez
+    bvel[i, 0] = vw[0] + ux - 2.0 * un * ex
+    bvel[i, 1] = vw[1] + uy - 2.0 * un * ey
+    bvel[i, 2] = vw[2] + uz - 2.0 * un * ez
+
+
+@njit(cache=True, error_model="numpy")
 def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell,
-                ncx, ncy, ncz, cst, threshold, ksum_min, rhop):
+                ncx, ncy, ncz, cst, threshold, ksum_min, rhop, slip, bvel):
     h = cst[0]
     r2max = cst[1]
     alpha = cst[3]
@@ -75,9 +156,16 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
     n = dim + 1
     a = np.zeros((4, 4))
     b = np.zeros(4)
+    bv = np.zeros((4, 3))      # right-hand sides of the velocity (slip modes 2, 3)
+    vw = np.zeros(3)
+    vg = np.zeros(3)
     for i in range(i0, i1):
         if ptype[i] >= 2:
             continue
+        if slip > 1:
+            _packed_vel(nb, i, is2d, vw)
+            for c in range(3):
+                bvel[i, c] = vw[c]
         nx = normals[i, 0]
         ny = normals[i, 1]
         nz = normals[i, 2]
@@ -101,6 +189,8 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
             b[r] = 0.0
             for cc in range(4):
                 a[r, cc] = 0.0
+            for cc in range(3):
+                bv[r, cc] = 0.0
         rs = int(cst[18])
         for z in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
             for y in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
@@ -163,9 +253,26 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
                         a[3, 2] += vj * gw2 * d1
                         a[3, 3] += vj * gw2 * d2
                         b[3] += mj * gw2
+                    if slip > 1:
+                        _packed_vel(nb, j, is2d, vg)
+                        for cc in range(3):
+                            bv[0, cc] += vj * w * vg[cc]
+                            bv[1, cc] += vj * gw0 * vg[cc]
+                            bv[2, cc] += vj * gw1 * vg[cc]
+                            if not is2d:
+                                bv[3, cc] += vj * gw2 * vg[cc]
         if a[0, 0] <= ksum_min or a[0, 0] <= 0.0:
             continue
         shepard = b[0] / a[0, 0]
+        if slip > 1:
+            # ghost-node velocity: the same system with the velocity sums
+            ac = a.copy()
+            for c in range(3):
+                vg[c] = bv[0, c] / a[0, 0]
+            if _solve_multi(ac, bv, n) >= threshold:
+                for c in range(3):
+                    vg[c] = bv[0, c]
+            _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i)
         det = _solve_small(a, b, n)
         if det >= threshold:
             if is2d:
@@ -178,7 +285,7 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
 
 
 @njit(cache=True, error_model="numpy")
-def _refresh_packed(i0, i1, is2d, ptype, rhop, cst, nb):
+def _refresh_packed(i0, i1, is2d, ptype, rhop, cst, nb, slip, bvel):
     for i in range(i0, i1):
         if ptype[i] >= 2:
             continue
@@ -188,32 +295,40 @@ def _refresh_packed(i0, i1, is2d, ptype, rhop, cst, nb):
             nb[i, 4] = rho
             nb[i, 5] = p
             nb[i, 7] = 1.0 / rho
+            if slip > 1:
+                nb[i, 2] = bvel[i, 0]
+                nb[i, 3] = bvel[i, 2]
         else:
             nb[i, 6] = rho
             nb[i, 7] = p
             nb[i, 9] = 1.0 / rho
+            if slip > 1:
+                for c in range(3):
+                    nb[i, 3 + c] = bvel[i, c]
 
 
 @njit(cache=True, error_model="numpy")
 def mdbc_serial(kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                cst, threshold, ksum_min, rhop):
+                cst, threshold, ksum_min, rhop, slip, bvel):
     """Set the density of every boundary particle with a normal (mDBC) and
-    refresh its packed density and pressure."""
+    refresh its packed density and pressure (and, for slip modes 2 and 3, the
+    velocity it shows the fluid; bvel (N, 3) is work space)."""
     n = nb.shape[0]
     _mdbc_range(0, n, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy,
-                ncz, cst, threshold, ksum_min, rhop)
-    _refresh_packed(0, n, is2d, ptype, rhop, cst, nb)
+                ncz, cst, threshold, ksum_min, rhop, slip, bvel)
+    _refresh_packed(0, n, is2d, ptype, rhop, cst, nb, slip, bvel)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def mdbc_parallel(kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                  cst, threshold, ksum_min, rhop):
+                  cst, threshold, ksum_min, rhop, slip, bvel):
     """Threaded :func:`mdbc_serial`."""
     n = nb.shape[0]
     nchunk = (n + 511) // 512
     for c in prange(nchunk):
         _mdbc_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, normals,
                     cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, threshold, ksum_min,
-                    rhop)
+                    rhop, slip, bvel)
     for c in prange(nchunk):
-        _refresh_packed(c * 512, min(n, (c + 1) * 512), is2d, ptype, rhop, cst, nb)
+        _refresh_packed(c * 512, min(n, (c + 1) * 512), is2d, ptype, rhop, cst, nb, slip,
+                        bvel)

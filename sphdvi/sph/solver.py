@@ -13,11 +13,11 @@ unknown keys are ignored):
   StepAlgorithm, VerletSteps, Kernel, ViscoTreatment, Visco,
   ViscoBoundFactor, DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
   CoefDtMin, DtIni, DtMin, DtFixed, RhopOutMin, RhopOutMax, Boundary,
-  SlipMode (1 only), MdbcThreshold and the periodic keys (XPeriodicIncY ...,
+  SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold and the periodic keys (XPeriodicIncY ...,
   XYPeriodic ...; see the ``periodic`` argument).
 
-Not implemented: Shifting 4 (advanced; runs as 3 with a warning), mDBC slip
-modes 2/3 and NoPenetration, DtFixedFile, DtAllParticles.
+Not implemented: Shifting 4 (advanced; runs as 3 with a warning), mDBC
+NoPenetration, DtFixedFile, DtAllParticles.
 """
 import warnings
 
@@ -127,8 +127,6 @@ class SPHSolver:
         if self.boundary == 2:
             if normals is None:
                 raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
-            if self.periodicity is not None:
-                raise NotImplementedError("mDBC with periodic boundaries is not implemented")
             self.normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(state.n, 3).copy()
         self._verlet_count = 0
         self._alloc()
@@ -150,9 +148,9 @@ class SPHSolver:
         self.boundary = int(p["Boundary"])
         if self.boundary not in (1, 2):
             raise ValueError("Boundary must be 1 (DBC) or 2 (mDBC)")
-        if self.boundary == 2 and int(p.get("SlipMode", 1) or 1) != 1:
-            raise NotImplementedError("mDBC SlipMode 2/3 (no-slip/free-slip) is not implemented; "
-                                      "use SlipMode=1")
+        self.slip = int(p.get("SlipMode", 1) or 1) if self.boundary == 2 else 1
+        if self.slip not in (1, 2, 3):
+            raise ValueError("SlipMode must be 1 (DBC velocity), 2 (no-slip) or 3 (free-slip)")
         self.mdbc_ksum = float(p.get("MdbcThreshold") or 0.0)
         self.kernel = int(p["Kernel"])
         self.visco_kind = int(p["ViscoTreatment"])
@@ -377,10 +375,17 @@ class SPHSolver:
             ncx, ncy, ncz = self.cells.shape
             fn(self.kernel, self.is2d, self.nb, s.ptype, self.normals, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, s.rhop)
+               self.mdbc_ksum, s.rhop, self.slip, self._mdbc_work(s.n))
         k["rates"](*self._rates_args())
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
+
+    def _mdbc_work(self, n):
+        """(n, 3) work array for the slip-mode velocities (kept between steps)."""
+        w = getattr(self, "_bvel", None)
+        if w is None or w.shape[0] < n:
+            w = self._bvel = np.zeros((max(n, 1), 3))
+        return w
 
     def _compute_rates_periodic(self):
         """Rates with ghost copies across the periodic boundaries (no reordering
@@ -413,6 +418,17 @@ class SPHSolver:
         k = self._kernels(par)
         k["pack"](self.is2d, pos_e, vel_e, rhop_e, mass_e, self.cst, nb)
         ncx, ncy, ncz = self.cells.shape
+        if self.boundary == 2:
+            # mDBC on the extended set: ghost copies see the fluid across the
+            # periodic boundary; the real boundary particles keep their density
+            from . import mdbc
+            fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
+            normals_e = np.ascontiguousarray(self.normals[idx])
+            fn(self.kernel, self.is2d, nb, ptype_e, normals_e, self.cells.cell_start,
+               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
+               self.mdbc_ksum, rhop_e, self.slip, self._mdbc_work(ne))
+            bound = (order < n) & (ptype_e < 2)
+            s.rhop[order[bound]] = rhop_e[bound]
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
         k["rates"](self.kernel, self.visco_kind, self.ddt, self.shift, nb, ptype_e, cell_e,
                    self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,

@@ -185,9 +185,10 @@ def test_resume_bitwise_with_floating_body(tmp_path):
     assert len(rows) == 1 + 5 and float(rows[-1].split(",")[4]) != float(rows[1].split(",")[4])
 
 
-def test_mdbc_from_case(tmp_path):
-    """Boundary=2 (mDBC): normals are computed from the particles; with three wall layers the
-    dam break runs without losing particles through the walls."""
+@pytest.mark.parametrize("slip", [1, 2, 3])
+def test_mdbc_from_case(tmp_path, slip):
+    """Boundary=2 (mDBC) with each SlipMode: normals are computed from the particles; with
+    three wall layers the dam break runs without losing particles through the walls."""
     text = DAMBREAK.read_text().replace('dp="0.01"', 'dp="0.04"').replace(
         "<boxfill>bottom | left | right | front | back</boxfill>",
         '<boxfill>bottom | left | right | front | back</boxfill><layers vdp="0,1,2" />')
@@ -195,7 +196,7 @@ def test_mdbc_from_case(tmp_path):
     case.write_text(text)
     out = tmp_path / "o"
     r = invoke(["run", case, "-o", out, "--tmax", "0.5", "--tout", "0.1", "--threads", "1", "-q",
-                "--set", "Boundary=2"])
+                "--set", "Boundary=2", "--set", f"SlipMode={slip}"])
     assert r.exit_code == 0, r.output
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "completed" and sum(meta["excluded"].values()) == 0
