@@ -316,8 +316,12 @@ class SPHRun:
         if int(params.get("Boundary", 1)) == 2:
             from .case.normals import boundary_normals
             self.normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]))
+        dt_table = None
+        if str(params.get("DtFixedFile", "NONE")).upper() != "NONE":
+            from .case.datafiles import read_dt_table
+            dt_table = read_dt_table(str(params["DtFixedFile"]))
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
-                                normals=self.normals0)
+                                normals=self.normals0, dt_table=dt_table)
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.dtmin_run = 0
         self.dtmin_seen = 0
@@ -673,6 +677,8 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
     files.write_json(status=status, message=message, steps=int(sol.nstep), physical_time=float(sol.time),
                      runtime_s=runtime, excluded=dict(sol.n_excluded), dtmin_steps=int(sol.n_dtmin),
                      particles_final=int(sol.state.n),
+                     **({"dtfixedfile_max_excess_s": float(sol.dt_error)}
+                        if sol.dt_table is not None and np.isfinite(sol.dt_error) else {}),
                      us_per_particle_step=(1e6 * (runtime - wall_prev)
                                            / max(1, sol.nstep - steps_at_start) / max(1, sol.state.n)))
     return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)

@@ -14,6 +14,7 @@ import os
 import numpy as np
 
 from ..errors import CaseError
+from .datafiles import read_dt_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
 from .parameters import PARAMETERS, DEPRECATED, closest_key, coerce, default_parameters
@@ -583,6 +584,14 @@ def read_parameters(reader, execution):
             raise reader.error(p, f"parameter {key}: {exc}", _expected_for(key)) from None
         if key in DEPRECATED:
             reader.warn(p, f"parameter '{key}' is deprecated in DualSPHysics")
+        if key == "DtFixedFile" and str(value).upper() != "NONE":
+            value = reader.resolve_path(p, "value")
+            try:
+                read_dt_table(value)
+            except CaseError as exc:
+                raise reader.error(p, f"{exc.message} ({value}"
+                                   + (f", line {exc.line}" if exc.line else "") + ")",
+                                   exc.expected) from None
         params[key] = value
         set_keys.append(key)
     if params["RhopOutMin"] >= params["RhopOutMax"]:

@@ -12,12 +12,15 @@ Physics sees arrays only: no files, no CLI.  Built from two plain dicts:
 unknown keys are ignored):
   StepAlgorithm, VerletSteps, Kernel, ViscoTreatment, Visco,
   ViscoBoundFactor, DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
-  CoefDtMin, DtIni, DtMin, DtFixed, RhopOutMin, RhopOutMax, Boundary,
+  CoefDtMin, DtIni, DtMin, DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
   SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold and the periodic keys (XPeriodicIncY ...,
   XYPeriodic ...; see the ``periodic`` argument).
 
+DtFixedFile is passed as ``dt_table`` (the case reader loads the file);
+DtAllParticles selects the particles whose speed limits dt.
+
 Not implemented: Shifting 4 (advanced; runs as 3 with a warning), mDBC
-NoPenetration, DtFixedFile, DtAllParticles.
+NoPenetration.
 """
 import warnings
 
@@ -93,6 +96,11 @@ class SPHSolver:
         vector from a boundary particle to the boundary surface (DualSPHysics
         convention, ghost node = r + 2 N); zero rows keep DBC.  Required for
         Boundary=2.  See :mod:`sphdvi.sph.mdbc`.
+    dt_table : (n, 2) array or None
+        ``DtFixedFile`` as (time [s], dt [s]) rows: the time step is
+        interpolated linearly at the start of each step (end values outside),
+        as DualSPHysics's JSphDtFixed does; ``dt_error`` keeps the largest
+        excess of the imposed dt over the variable (CFL) one.
 
     After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
     accelerations, density rates and pressures of the last interaction, in
@@ -103,9 +111,11 @@ class SPHSolver:
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
                  parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None,
-                 cell_mode="2h"):
+                 cell_mode="2h", dt_table=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
+        self.dt_table = None if dt_table is None else np.asarray(dt_table, float).reshape(-1, 2)
+        self.dt_error = -np.inf
         self.state = state
         self.constants = dict(constants)
         self.params = resolve_params(params)
@@ -194,6 +204,8 @@ class SPHSolver:
         self.dtmin = float(p["DtMin"]) or float(p["CoefDtMin"]) * h / self.cs0
         self.dtini = float(p["DtIni"]) or h / self.cs0
         self.dtfixed = float(p["DtFixed"] or 0.0)
+        # DtAllParticles 1: every particle's speed limits dt; 0: fluid and floating
+        self.dt_vel_type = 0 if int(p.get("DtAllParticles") or 0) else 2
         self.sps_smag = (0.12 * self.dp) ** 2
         self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
         self.shift_tfs = float(p["ShiftTFS"])
@@ -445,11 +457,25 @@ class SPHSolver:
             self.gradvel[dst] = gradvel[real]
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
 
-    def _variable_dt(self):
+    def _fixed_dt(self, t):
+        """DtFixed, or the DtFixedFile value at time t; 0 when dt is variable."""
         if self.dtfixed > 0.0:
             return self.dtfixed
-        a2, v2, cv = _ts.dt_terms(self.ace, self.state.vel, self.viscdt, self.state.ptype)
+        if self.dt_table is not None:
+            return float(np.interp(t, self.dt_table[:, 0], self.dt_table[:, 1]))
+        return 0.0
+
+    def _variable_dt(self, t):
+        """The dt of a step starting at time t (eq. 10, or the imposed one)."""
+        fixed = self._fixed_dt(t)
+        if fixed > 0.0 and self.dt_table is None:
+            return fixed
+        a2, v2, cv = _ts.dt_terms(self.ace, self.state.vel, self.viscdt, self.state.ptype,
+                                  self.dt_vel_type)
         dt = _ts.variable_dt(a2, v2, cv, self.h, self.cs0, self.cfl)
+        if fixed > 0.0:
+            self.dt_error = max(self.dt_error, fixed - dt)
+            return fixed
         if dt < self.dtmin:
             dt = self.dtmin
             self.n_dtmin += 1
@@ -481,7 +507,7 @@ class SPHSolver:
 
     def _step_verlet(self):
         self.compute_rates()
-        dt = self._variable_dt()
+        dt = self._variable_dt(self.time)
         self._set_ip(dt)
         euler = self._verlet_count >= self.verlet_steps
         self._verlet_count = 0 if euler else self._verlet_count + 1
@@ -492,7 +518,7 @@ class SPHSolver:
         return dt
 
     def _step_symplectic(self):
-        dt = self.dtfixed if self.dtfixed > 0.0 else self.dt_pre
+        dt = self._fixed_dt(self.time) or self.dt_pre
         self._set_ip(dt)
         s = self.state
         self.compute_rates()
@@ -502,7 +528,7 @@ class SPHSolver:
         self.compute_rates()
         k = self._kernels(self._use_parallel())
         nout = k["sym_corr"](*self._corr_args())
-        self.dt_pre = self._variable_dt()
+        self.dt_pre = self._variable_dt(self.time + dt)
         if nout:
             self._exclude()
         return dt

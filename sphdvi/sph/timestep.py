@@ -5,8 +5,9 @@ r"""Variable time step (Monaghan & Kos 1999; DualSPHysics eq. 10).
   dt    = CFL min(dt_f, dt_cv),
 
 limited below by DtMin (0 => CoefDtMin h/c0); ``DtFixed`` > 0 replaces it.
-The maxima run over fluid particles for |f| and |v| and over all particles
-for the viscous term, as DualSPHysics does.
+The maxima run over fluid particles for |f|, over fluid and floating
+particles for |v| (all particles with DtAllParticles = 1) and over all
+particles for the viscous term, as DualSPHysics does.
 """
 import math
 
@@ -15,8 +16,10 @@ from numba import njit
 
 
 @njit(cache=True, error_model="numpy")
-def dt_terms(ace, vel, viscdt, ptype):
-    """(max |a|^2 over fluid, max |v|^2 over fluid, max viscdt over all)."""
+def dt_terms(ace, vel, viscdt, ptype, vel_type=2):
+    """(max |a|^2 over fluid, max |v|^2 over particles with ptype >= vel_type
+    (2: fluid and floating, DualSPHysics's default; 0: all, DtAllParticles=1),
+    max viscdt over all)."""
     amax = 0.0
     vmax = 0.0
     cmax = 0.0
@@ -25,9 +28,10 @@ def dt_terms(ace, vel, viscdt, ptype):
             cmax = viscdt[i]
         if ptype[i] == 3:
             a = ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
-            v = vel[i, 0] ** 2 + vel[i, 1] ** 2 + vel[i, 2] ** 2
             if a > amax:
                 amax = a
+        if ptype[i] >= vel_type:
+            v = vel[i, 0] ** 2 + vel[i, 1] ** 2 + vel[i, 2] ** 2
             if v > vmax:
                 vmax = v
     return amax, vmax, cmax

@@ -206,3 +206,28 @@ def test_mdbc_from_case(tmp_path, slip):
     lengths = np.linalg.norm(normals[ptype == 0], axis=1)
     layered = np.isin(np.round(lengths / 0.04, 6), (0.5, 1.5, 2.5))
     assert layered.mean() > 0.9 and np.isclose(lengths.min(), 0.02)   # walls; corners and tops differ
+
+
+def test_dtfixedfile_from_case(tmp_path):
+    """DtFixedFile: a (time [s], dt [ms]) file next to the case sets every dt; a
+    missing or malformed file is a case error (exit 2) naming the file."""
+    (tmp_path / "dt.csv").write_text("# time;dt\n0;0.1\n0.01;0.2\n")
+    case = small_case(tmp_path, extra_params='<parameter key="DtFixedFile" value="dt.csv" />')
+    out = tmp_path / "o"
+    r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.01", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    rows = [l.split(",") for l in (out / "run.csv").read_text().splitlines()[1:]]
+    head = "part,time,steps,particles,excluded,dtmin,dtmax,walltime".split(",")
+    last = dict(zip(head, rows[-1]))
+    assert float(last["dtmin"]) == pytest.approx(2e-4) and float(last["dtmax"]) == pytest.approx(2e-4)
+    first = dict(zip(head, rows[1]))
+    assert 1e-4 <= float(first["dtmin"]) < float(first["dtmax"]) <= 2e-4
+    meta = json.loads((out / "run.json").read_text())
+    assert "dtfixedfile_max_excess_s" in meta
+    (tmp_path / "dt.csv").write_text("0;0.1\n")
+    r = invoke(["gencase", case, "-o", tmp_path / "g"])
+    assert r.exit_code == 2 and "DtFixedFile" in r.output and "two" in r.output
+    assert "Traceback" not in r.output
+    case2 = small_case(tmp_path, extra_params='<parameter key="DtFixedFile" value="nofile.csv" />')
+    r = invoke(["gencase", case2, "-o", tmp_path / "g2"])
+    assert r.exit_code == 2 and "nofile.csv" in r.output

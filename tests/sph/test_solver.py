@@ -181,3 +181,46 @@ def test_state_arrays_are_coerced_before_the_kernels():
     sol.step()
     assert np.array_equal(ref.state.pos, sol.state.pos)
     assert sol.state.ptype.dtype == np.int8
+
+
+@pytest.mark.parametrize("alg", [1, 2])
+def test_dt_table_is_interpolated_at_each_step(alg):
+    """DtFixedFile: dt interpolated linearly in (time, dt) at the start of each
+    step, end values outside the table; dt_error = max(imposed − CFL dt)."""
+    st, c = small_tank()
+    table = np.array([[0.0, 1e-4], [0.01, 3e-4]])
+    sol = SPHSolver(st, c, {"StepAlgorithm": alg}, dt_table=table)
+    for _ in range(60):
+        t0 = sol.time
+        dt = sol.step()
+        assert dt == pytest.approx(np.interp(t0, table[:, 0], table[:, 1]), rel=1e-12)
+    assert sol.time > 0.01 and sol.last_dt == pytest.approx(3e-4)
+    assert np.isfinite(sol.dt_error)
+
+
+def test_dt_all_particles_counts_moving_boundaries():
+    """DtAllParticles = 1: a fast moving boundary particle limits dt; by
+    default only fluid and floating particles do."""
+    from sphdvi.sph.timestep import dt_terms
+    ace = np.zeros((3, 3))
+    vel = np.array([[50.0, 0, 0], [0, 0, 3.0], [0, 4.0, 0]])
+    ptype = np.array([1, 2, 3], np.int8)
+    visc = np.zeros(3)
+    assert dt_terms(ace, vel, visc, ptype)[1] == 16.0              # fluid + floating
+    assert dt_terms(ace, vel, visc, ptype, 0)[1] == 2500.0         # all
+    assert dt_terms(ace, vel, visc, ptype, 3)[1] == 16.0
+    st, c = small_tank()
+    fluid = st.pos[st.ptype == 3]
+    far = [i for i in np.nonzero(st.ptype == 0)[0]
+           if np.min(np.linalg.norm(fluid - st.pos[i], axis=1)) > 3 * c["h"]]
+    moving = np.array(far[:5])
+    assert len(moving) == 5
+    st.ptype[moving] = 1
+    st.vel[moving, 0] = 20.0 * c["cs0"]
+    dts = []
+    for flag in (0, 1):
+        sol = SPHSolver(st.copy(), c, {"StepAlgorithm": 2, "DtAllParticles": flag, "DtMin": 1e-12})
+        sol.step()
+        sol.step()
+        dts.append(sol.last_dt)
+    assert dts[1] < 0.05 * dts[0]      # 0.2 h / (10 |v|) with |v| = 20 c0

@@ -1,0 +1,48 @@
+"""Plain data files a case refers to (DualSPHysics JReadDatafile conventions:
+columns separated by ';', ',', spaces or tabs; '#' starts a comment)."""
+import numpy as np
+
+from ..errors import CaseError
+
+
+def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
+    """Numeric rows of ``path`` with at least ``ncols`` columns -> (n, ncols)."""
+    rows = []
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for lineno, line in enumerate(f, 1):
+                text = line.split("#", 1)[0].replace(";", " ").replace(",", " ").split()
+                if not text:
+                    continue
+                try:
+                    vals = [float(v) for v in text[:ncols]]
+                except ValueError:
+                    if not rows:      # a header line
+                        continue
+                    raise CaseError(f"{what}: '{line.strip()}' is not numeric", file=path,
+                                    line=lineno, expected=f"{ncols} numbers per line") from None
+                if len(vals) < ncols:
+                    raise CaseError(f"{what}: {len(vals)} column(s)", file=path, line=lineno,
+                                    expected=f"{ncols} numbers per line")
+                rows.append(vals)
+    except OSError as exc:
+        raise CaseError(f"{what}: cannot read the file ({exc.strerror})", file=path,
+                        expected="a readable file") from None
+    return np.asarray(rows, float).reshape(-1, ncols)
+
+
+def read_dt_table(path: str) -> np.ndarray:
+    """``DtFixedFile``: rows (time [s], dt [ms]) -> (n, 2) array of (time, dt [s]),
+    as DualSPHysics's JSphDtFixed reads it (at least two rows, times rising,
+    dt > 0; linear interpolation in between, the end values outside)."""
+    a = read_columns(path, 2, "DtFixedFile")
+    if a.shape[0] < 2:
+        raise CaseError("DtFixedFile: fewer than two (time, dt) rows", file=path,
+                        expected="at least two lines 'time[s] dt[ms]'")
+    if np.any(np.diff(a[:, 0]) < 0):
+        raise CaseError("DtFixedFile: times decrease", file=path, expected="rising times")
+    if np.any(~np.isfinite(a)) or np.any(a[:, 1] <= 0):
+        raise CaseError("DtFixedFile: dt must be finite and > 0", file=path,
+                        expected="dt values in milliseconds > 0")
+    a[:, 1] *= 1e-3
+    return a
