@@ -17,9 +17,10 @@ def linear_period(length: float, depth: float, g: float = 9.81, mode: int = 1) -
 
 
 def sloshing_particles(length=1.0, depth=0.5, amplitude=0.02, dp=0.0125, rhop0=1000.0, gamma=7.0,
-                       coefsound=20.0, g=9.81):
-    """Fluid lattice under η = a cos(kx) in a tank with one layer of boundary particles
-    (bottom, left, right) and the matching constants (DualSPHysics rules, coefh 1.0)."""
+                       coefsound=20.0, g=9.81, layers=1):
+    """Fluid lattice under η = a cos(kx) in a tank with ``layers`` layers of boundary
+    particles (bottom, left, right; the tank walls lie dp/2 inside the first layer) and
+    the matching constants (DualSPHysics rules, coefh 1.0)."""
     k = math.pi / length
     nx = int(round(length / dp))
     xs = (np.arange(nx) + 0.5) * dp
@@ -35,12 +36,15 @@ def sloshing_particles(length=1.0, depth=0.5, amplitude=0.02, dp=0.0125, rhop0=1
     rho_f = rhop0 * (1 + rhop0 * g * (ftop - fz) / b) ** (1 / gamma)
     # one layer of boundary particles one dp from the fluid lattice: bottom at z = −dp/2,
     # walls at x = −dp/2 and x = L + dp/2 (the fluid occupies [0, L] x [0, η])
-    bottom_x = (np.arange(-1, nx + 1) + 0.5) * dp
-    bottom = np.column_stack([bottom_x, np.full(bottom_x.size, -0.5 * dp)])
-    wall_z = (np.arange(0, int(depth * 1.6 / dp)) + 0.5) * dp
-    left = np.column_stack([np.full(wall_z.size, -0.5 * dp), wall_z])
-    right = np.column_stack([np.full(wall_z.size, length + 0.5 * dp), wall_z])
-    bnd = np.vstack([bottom, left, right])
+    parts = []
+    for m in range(layers):
+        off = (m + 0.5) * dp
+        bottom_x = (np.arange(-1 - m, nx + 1 + m) + 0.5) * dp
+        parts.append(np.column_stack([bottom_x, np.full(bottom_x.size, -off)]))
+        wall_z = (np.arange(0, int(depth * 1.6 / dp)) + 0.5) * dp
+        parts.append(np.column_stack([np.full(wall_z.size, -off), wall_z]))
+        parts.append(np.column_stack([np.full(wall_z.size, length + off), wall_z]))
+    bnd = np.vstack(parts)
     n_b, n_f = bnd.shape[0], fx.size
     pos = np.zeros((n_b + n_f, 3))
     pos[:n_b, 0], pos[:n_b, 2] = bnd[:, 0], bnd[:, 1]
