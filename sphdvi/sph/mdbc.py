@@ -40,45 +40,10 @@ from .kernels import kernel_fac, kernel_w
 
 
 @njit(cache=True, error_model="numpy")
-def _solve_small(a, b, n):
-    """Solve a[:n,:n] x = b[:n] by Gaussian elimination with partial pivoting
-    (in place); returns the absolute determinant."""
-    det = 1.0
-    for k in range(n):
-        p = k
-        for r in range(k + 1, n):
-            if abs(a[r, k]) > abs(a[p, k]):
-                p = r
-        if a[p, k] == 0.0:
-            return 0.0
-        if p != k:
-            for cc in range(n):
-                t = a[k, cc]
-                a[k, cc] = a[p, cc]
-                a[p, cc] = t
-            t = b[k]
-            b[k] = b[p]
-            b[p] = t
-        det *= a[k, k]
-        for r in range(k + 1, n):
-            f = a[r, k] / a[k, k]
-            for cc in range(k, n):
-                a[r, cc] -= f * a[k, cc]
-            b[r] -= f * b[k]
-    for k in range(n - 1, -1, -1):
-        s = b[k]
-        for cc in range(k + 1, n):
-            s -= a[k, cc] * b[cc]
-        b[k] = s / a[k, k]
-    return abs(det)
-
-
-@njit(cache=True, error_model="numpy")
-def _solve_multi(a, bm, n):
-    """Solve a[:n,:n] X = bm[:n, :] (three right-hand sides) in place by
+def _solve_multi(a, bm, n, m):
+    """Solve a[:n,:n] X = bm[:n, :m] (m right-hand sides) in place by
     Gaussian elimination with partial pivoting; returns |det a|."""
     det = 1.0
-    m = bm.shape[1]
     for k in range(n):
         p = k
         for r in range(k + 1, n):
@@ -155,8 +120,9 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
     dim = 2 if is2d else 3
     n = dim + 1
     a = np.zeros((4, 4))
-    b = np.zeros(4)
-    bv = np.zeros((4, 3))      # right-hand sides of the velocity (slip modes 2, 3)
+    # right-hand sides: column 0 the density, columns 1-3 the velocity (slip modes 2, 3)
+    b = np.zeros((4, 4))
+    nrhs = 4 if slip > 1 else 1
     vw = np.zeros(3)
     vg = np.zeros(3)
     for i in range(i0, i1):
@@ -186,11 +152,9 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
         cy = min(max(int((gy - pmin[1]) * inv_cell), 0), ncy - 1) if not is2d else 0
         cz = min(max(int((gz - pmin[2]) * inv_cell), 0), ncz - 1)
         for r in range(4):
-            b[r] = 0.0
             for cc in range(4):
                 a[r, cc] = 0.0
-            for cc in range(3):
-                bv[r, cc] = 0.0
+                b[r, cc] = 0.0
         rs = int(cst[18])
         for z in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
             for y in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
@@ -235,15 +199,15 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
                     a[0, 0] += vj * w
                     a[0, 1] += vj * w * d0
                     a[0, 2] += vj * w * d1
-                    b[0] += mj * w
+                    b[0, 0] += mj * w
                     a[1, 0] += vj * gw0
                     a[1, 1] += vj * gw0 * d0
                     a[1, 2] += vj * gw0 * d1
-                    b[1] += mj * gw0
+                    b[1, 0] += mj * gw0
                     a[2, 0] += vj * gw1
                     a[2, 1] += vj * gw1 * d0
                     a[2, 2] += vj * gw1 * d1
-                    b[2] += mj * gw1
+                    b[2, 0] += mj * gw1
                     if not is2d:
                         a[0, 3] += vj * w * d2
                         a[1, 3] += vj * gw0 * d2
@@ -252,36 +216,31 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
                         a[3, 1] += vj * gw2 * d0
                         a[3, 2] += vj * gw2 * d1
                         a[3, 3] += vj * gw2 * d2
-                        b[3] += mj * gw2
+                        b[3, 0] += mj * gw2
                     if slip > 1:
                         _packed_vel(nb, j, is2d, vg)
                         for cc in range(3):
-                            bv[0, cc] += vj * w * vg[cc]
-                            bv[1, cc] += vj * gw0 * vg[cc]
-                            bv[2, cc] += vj * gw1 * vg[cc]
+                            b[0, 1 + cc] += vj * w * vg[cc]
+                            b[1, 1 + cc] += vj * gw0 * vg[cc]
+                            b[2, 1 + cc] += vj * gw1 * vg[cc]
                             if not is2d:
-                                bv[3, cc] += vj * gw2 * vg[cc]
+                                b[3, 1 + cc] += vj * gw2 * vg[cc]
         if a[0, 0] <= ksum_min or a[0, 0] <= 0.0:
             continue
-        shepard = b[0] / a[0, 0]
-        if slip > 1:
-            # ghost-node velocity: the same system with the velocity sums
-            ac = a.copy()
-            for c in range(3):
-                vg[c] = bv[0, c] / a[0, 0]
-            if _solve_multi(ac, bv, n) >= threshold:
-                for c in range(3):
-                    vg[c] = bv[0, c]
-            _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i)
-        det = _solve_small(a, b, n)
-        if det >= threshold:
+        # Shepard values, kept where the corrected system is near-singular
+        rho = b[0, 0] / a[0, 0]
+        for c in range(3):
+            vg[c] = b[0, 1 + c] / a[0, 0]
+        if _solve_multi(a, b, n, nrhs) >= threshold:
             if is2d:
-                rho = b[0] - 2.0 * (nx * b[1] + nz * b[2])
+                rho = b[0, 0] - 2.0 * (nx * b[1, 0] + nz * b[2, 0])
             else:
-                rho = b[0] - 2.0 * (nx * b[1] + ny * b[2] + nz * b[3])
-        else:
-            rho = shepard
+                rho = b[0, 0] - 2.0 * (nx * b[1, 0] + ny * b[2, 0] + nz * b[3, 0])
+            for c in range(3):
+                vg[c] = b[0, 1 + c]
         rhop[i] = max(rho, rhop0)
+        if slip > 1:
+            _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i)
 
 
 @njit(cache=True, error_model="numpy")
