@@ -135,10 +135,9 @@ _FILE_CACHE: dict = {}
 def _load_table(m):
     key = (m["file"], tuple(sorted(m.get("fields", {}).items())))
     if key not in _FILE_CACHE:
-        data = np.genfromtxt(m["file"], delimiter=";" if open(m["file"]).read(4096).count(";") else None,
-                             comments="#", invalid_raise=False)
-        data = data[~np.isnan(data).any(axis=1)] if data.ndim == 2 else data
-        _FILE_CACHE[key] = data
+        from .case.datafiles import read_columns
+        ncols = 1 + max([1, *m.get("fields", {}).values()])
+        _FILE_CACHE[key] = read_columns(m["file"], ncols, f"{m['type']} file")
     return _FILE_CACHE[key]
 
 

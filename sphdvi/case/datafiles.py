@@ -6,7 +6,9 @@ from ..errors import CaseError
 
 
 def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
-    """Numeric rows of ``path`` with at least ``ncols`` columns -> (n, ncols)."""
+    """Numeric rows of ``path``, each with at least ``ncols`` columns -> (n, k):
+    k is the smallest column count over the rows; leading non-numeric lines
+    are headers, a non-numeric line after the data is an error."""
     rows = []
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
@@ -15,7 +17,7 @@ def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
                 if not text:
                     continue
                 try:
-                    vals = [float(v) for v in text[:ncols]]
+                    vals = [float(v) for v in text]
                 except ValueError:
                     if not rows:      # a header line
                         continue
@@ -28,14 +30,15 @@ def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
     except OSError as exc:
         raise CaseError(f"{what}: cannot read the file ({exc.strerror})", file=path,
                         expected="a readable file") from None
-    return np.asarray(rows, float).reshape(-1, ncols)
+    k = min((len(r) for r in rows), default=ncols)
+    return np.asarray([r[:k] for r in rows], float).reshape(-1, k)
 
 
 def read_dt_table(path: str) -> np.ndarray:
     """``DtFixedFile``: rows (time [s], dt [ms]) -> (n, 2) array of (time, dt [s]),
     as DualSPHysics's JSphDtFixed reads it (at least two rows, times rising,
     dt > 0; linear interpolation in between, the end values outside)."""
-    a = read_columns(path, 2, "DtFixedFile")
+    a = read_columns(path, 2, "DtFixedFile")[:, :2].copy()
     if a.shape[0] < 2:
         raise CaseError("DtFixedFile: fewer than two (time, dt) rows", file=path,
                         expected="at least two lines 'time[s] dt[ms]'")
