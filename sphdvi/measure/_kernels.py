@@ -20,6 +20,7 @@ from numba import njit
 
 from ..sph.cells import bounding_box  # noqa: F401  (re-exported for the measurement tools)
 from ..sph.kernels import kernel_alpha, kernel_fac, kernel_w  # noqa: F401
+from ..sph.linalg import solve_pivoted
 
 
 @njit(cache=True)
@@ -91,41 +92,6 @@ def _dist2(is2d, x, y, z, pos, j):
 # interpolation at points
 # ---------------------------------------------------------------------------------
 @njit(cache=True)
-def _solve_small(a, b, n, tol):
-    """Gauss elimination with partial pivoting of a[:n,:n] x = b[:n,:]; False if singular."""
-    m = b.shape[1]
-    for k in range(n):
-        p = k
-        for i in range(k + 1, n):
-            if abs(a[i, k]) > abs(a[p, k]):
-                p = i
-        if abs(a[p, k]) < tol:
-            return False
-        if p != k:
-            for j in range(n):
-                t = a[k, j]
-                a[k, j] = a[p, j]
-                a[p, j] = t
-            for j in range(m):
-                t = b[k, j]
-                b[k, j] = b[p, j]
-                b[p, j] = t
-        for i in range(k + 1, n):
-            f = a[i, k] / a[k, k]
-            for j in range(k, n):
-                a[i, j] -= f * a[k, j]
-            for j in range(m):
-                b[i, j] -= f * b[k, j]
-    for k in range(n - 1, -1, -1):
-        for j in range(m):
-            s = b[k, j]
-            for i in range(k + 1, n):
-                s -= a[k, i] * b[i, j]
-            b[k, j] = s / a[k, k]
-    return True
-
-
-@njit(cache=True)
 def interpolate_points(points, spos, svol, sfields, cell_start, pmin, inv_cs, ncx, ncy, ncz, is2d,
                        kind, h, alpha, order, out, ksum):
     """Kernel interpolation of ``sfields`` (sorted particles) at ``points``.
@@ -189,7 +155,7 @@ def interpolate_points(points, spos, svol, sfields, cell_start, pmin, inv_cs, nc
         done = False
         if order == 1:
             b0 = b[0, :].copy()
-            done = _solve_small(a, b, nd, 1e-6 * ks)
+            done = solve_pivoted(a, b, nd, b.shape[1], 1e-6 * ks) > 0.0
             if not done:
                 b[0, :] = b0
         if done:

@@ -37,43 +37,7 @@ from numba import njit, prange
 
 from .interaction import tait_pressure
 from .kernels import kernel_fac, kernel_w
-
-
-@njit(cache=True, error_model="numpy")
-def _solve_multi(a, bm, n, m):
-    """Solve a[:n,:n] X = bm[:n, :m] (m right-hand sides) in place by
-    Gaussian elimination with partial pivoting; returns |det a|."""
-    det = 1.0
-    for k in range(n):
-        p = k
-        for r in range(k + 1, n):
-            if abs(a[r, k]) > abs(a[p, k]):
-                p = r
-        if a[p, k] == 0.0:
-            return 0.0
-        if p != k:
-            for cc in range(n):
-                t = a[k, cc]
-                a[k, cc] = a[p, cc]
-                a[p, cc] = t
-            for cc in range(m):
-                t = bm[k, cc]
-                bm[k, cc] = bm[p, cc]
-                bm[p, cc] = t
-        det *= a[k, k]
-        for r in range(k + 1, n):
-            f = a[r, k] / a[k, k]
-            for cc in range(k, n):
-                a[r, cc] -= f * a[k, cc]
-            for cc in range(m):
-                bm[r, cc] -= f * bm[k, cc]
-    for k in range(n - 1, -1, -1):
-        for cc in range(m):
-            s = bm[k, cc]
-            for q in range(k + 1, n):
-                s -= a[k, q] * bm[q, cc]
-            bm[k, cc] = s / a[k, k]
-    return abs(det)
+from .linalg import solve_pivoted
 
 
 @njit(cache=True)
@@ -231,7 +195,7 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
         rho = b[0, 0] / a[0, 0]
         for c in range(3):
             vg[c] = b[0, 1 + c] / a[0, 0]
-        if _solve_multi(a, b, n, nrhs) >= threshold:
+        if solve_pivoted(a, b, n, nrhs, 0.0) >= threshold:
             if is2d:
                 rho = b[0, 0] - 2.0 * (nx * b[1, 0] + nz * b[2, 0])
             else:
