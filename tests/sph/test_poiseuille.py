@@ -153,17 +153,60 @@ def test_channel_mdbc_dbc_velocity_mode():
     assert 1.08 < r["uc"] < 1.2
 
 
+def monaghan_lattice_ratio(coefh=1.0, eta2=0.01, approaching_only=True):
+    """nu_eff / (alpha h c0 / 8) of DualSPHysics's artificial viscosity
+    (Monaghan 1992, Pi_ab = -alpha c h (v_ab.r_ab)/(rho (r^2 + eta^2)))
+    on a square lattice in a shear flow u(z) (Wendland 2D).
+
+    The pair acceleration along x is alpha c0 h (du x_ab)/(r^2 + eta^2) x_ab
+    F(r) V_b with du = u'z - u''z^2/2; the u' terms cancel, leaving
+    nu_eff = -alpha c0 h/2 sum V_b x^2 z^2 F/(r^2 + eta^2).  In the continuum
+    the sum is -1/4 and nu_eff = alpha h c0/8 (Monaghan 2005, 2D).  With the
+    switch v_ab.r_ab < 0 only approaching pairs act; for each row z exactly
+    one of the two sides +-x approaches, so the sum halves."""
+    dp = 1.0
+    h = coefh * math.sqrt(2) * dp
+    r = int(2 * h / dp) + 1
+    i, j = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1))
+    x, z = (i * dp).ravel(), (j * dp).ravel()
+    rr = np.hypot(x, z)
+    keep = (rr > 0) & (rr < 2 * h)
+    x, z, rr = x[keep], z[keep], rr[keep]
+    q = rr / h
+    f = 7 / (4 * math.pi * h * h) * (-5 * q) * (1 - q / 2) ** 3 / (h * rr)
+    ratio = -0.5 * h * float(np.sum(dp * dp * x * x * z * z * f / (rr * rr + eta2 * h * h))) * 8 / h
+    return ratio * (0.5 if approaching_only else 1.0)
+
+
+def test_monaghan_lattice_ratio_continuum_limit():
+    """The lattice sum tends to the continuum value (ratio 1 without the
+    switch) as h/dp grows: checks the sum used by the S10 prediction."""
+    assert abs(monaghan_lattice_ratio(4.0, eta2=0.0, approaching_only=False) - 1) < 2e-3
+    assert abs(monaghan_lattice_ratio(1.0) - 0.4262) < 1e-4
+
+
 def test_s10_artificial_viscosity_equivalence():
-    """S10: the same flow driven with artificial viscosity only, alpha chosen so
-    that alpha h c0 / 8 = nu.  DualSPHysics's Monaghan term acts only on
-    approaching pairs (v_ab . r_ab < 0), so in a steady shear flow roughly half
-    the pairs contribute: the measured centre-line speed is 2.53 u_max (n = 20),
-    i.e. nu_eff ~ 0.4 alpha h c0 / 8, far outside the ~10 % judgement of
-    TOLERANCES S10.  The particles also leave their rows (vertical speeds up to
-    ~0.5 u_max).  Asserted as a regression band around the measured value."""
-    r = run_poiseuille(20, artificial=True)
-    assert 2.2 < r["uc"] < 2.9
-    assert r["n"] == r["n0"]
+    """S10: the flow driven with artificial viscosity only, alpha chosen so
+    that alpha h c0 / 8 = nu, mDBC no-slip walls.
+
+    DualSPHysics's Monaghan term acts only on approaching pairs
+    (v_ab . r_ab < 0), which halves the viscosity of a shear flow, and on the
+    square lattice at h = sqrt(2) dp the pair sum is 0.852 of its continuum
+    value: nu_eff = 0.426 alpha h c0/8 (coefh 1.0), 0.459 (coefh 1.2), so the
+    centre-line speed is u_max/0.426 = 2.346 u_max.  Measured 2.441 (20
+    across), 2.468 (30), 2.255 at coefh 1.2 (predicted 2.179): +4, +5,
+    +3.5 %, inside the ~10 % judgement of TOLERANCES S10 against this
+    prediction.  The rest is the particle disorder the switch allows
+    (vertical speeds ~0.4-0.5 u_max: receding pairs feel no viscosity).
+    Against the literal nu_eff = alpha h c0/8 of TOLERANCES S10 the flow is
+    2.4x too fast (strict xfail below)."""
+    for n, coefh in ((20, 1.0), (30, 1.0), (20, 1.2)):
+        r = run_poiseuille(n, artificial=True, slip=2, coefh=coefh)
+        pred = 1 / monaghan_lattice_ratio(coefh)
+        print("S10 n=%d coefh %.1f: centre-line %.4f u_max, predicted %.4f (%+.1f %%)"
+              % (n, coefh, r["uc"], pred, 100 * (r["uc"] / pred - 1)))
+        assert r["n"] == r["n0"]
+        assert abs(r["uc"] / pred - 1) < 0.10
 
 
 @pytest.mark.slow
@@ -180,7 +223,8 @@ def test_s9_tolerance_1_percent():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S10: nu_eff = alpha h c0/8 within ~10 %; measured ~0.4x")
+@pytest.mark.xfail(strict=True, reason="TOLERANCES S10: nu_eff = alpha h c0/8 within ~10 %; DualSPHysics's "
+                                        "approaching-pairs switch and the lattice give 0.43x (measured ~0.41x)")
 def test_s10_tolerance_10_percent():
     assert abs(run_poiseuille(20, artificial=True)["uc"] - 1) < 0.1
 
