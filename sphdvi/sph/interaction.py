@@ -91,27 +91,67 @@ def tait_pressure(rho, b, rhop0, gamma):
 
 
 @njit(cache=True, error_model="numpy")
+def _pack_row(k, i, is2d, pos, vel, rhop, mass, cst, nb):
+    """Packed row k from particle i, with the pressure from Tait's EOS."""
+    rho = rhop[i]
+    p = tait_pressure(rho, cst[16], cst[10], cst[17])
+    if is2d:
+        nb[k, 0] = pos[i, 0]
+        nb[k, 1] = pos[i, 2]
+        nb[k, 2] = vel[i, 0]
+        nb[k, 3] = vel[i, 2]
+        nb[k, 4] = rho
+        nb[k, 5] = p
+        nb[k, 6] = mass[i]
+        nb[k, 7] = 1.0 / rho
+    else:
+        for m in range(3):
+            nb[k, m] = pos[i, m]
+            nb[k, 3 + m] = vel[i, m]
+        nb[k, 6] = rho
+        nb[k, 7] = p
+        nb[k, 8] = mass[i]
+        nb[k, 9] = 1.0 / rho
+
+
+@njit(cache=True, error_model="numpy")
 def _pack_range(i0, i1, is2d, pos, vel, rhop, mass, cst, nb):
     for i in range(i0, i1):
-        rho = rhop[i]
-        p = tait_pressure(rho, cst[16], cst[10], cst[17])
-        if is2d:
-            nb[i, 0] = pos[i, 0]
-            nb[i, 1] = pos[i, 2]
-            nb[i, 2] = vel[i, 0]
-            nb[i, 3] = vel[i, 2]
-            nb[i, 4] = rho
-            nb[i, 5] = p
-            nb[i, 6] = mass[i]
-            nb[i, 7] = 1.0 / rho
-        else:
-            for k in range(3):
-                nb[i, k] = pos[i, k]
-                nb[i, 3 + k] = vel[i, k]
-            nb[i, 6] = rho
-            nb[i, 7] = p
-            nb[i, 8] = mass[i]
-            nb[i, 9] = 1.0 / rho
+        _pack_row(i, i, is2d, pos, vel, rhop, mass, cst, nb)
+
+
+@njit(cache=True, error_model="numpy")
+def _sort_pack_range(k0, k1, order, is2d, cst, nb, pos, vel, rhop, mass, ptype, ptype_s,
+                     cell, cell_s, tau, tau_s):
+    sps = tau_s.shape[0] == order.shape[0]
+    for k in range(k0, k1):
+        i = order[k]
+        _pack_row(k, i, is2d, pos, vel, rhop, mass, cst, nb)
+        ptype_s[k] = ptype[i]
+        cell_s[k] = cell[i]
+        if sps:
+            for m in range(6):
+                tau_s[k, m] = tau[i, m]
+
+
+@njit(cache=True, error_model="numpy")
+def sort_pack_serial(order, is2d, cst, nb, pos, vel, rhop, mass, ptype, ptype_s, cell, cell_s,
+                     tau, tau_s):
+    """Fill the packed neighbour array in cell order without moving the
+    particles: row k holds particle order[k]; the type, cell (and, when tau_s
+    has N rows, the SPS stress) are gathered alongside."""
+    _sort_pack_range(0, order.shape[0], order, is2d, cst, nb, pos, vel, rhop, mass, ptype,
+                     ptype_s, cell, cell_s, tau, tau_s)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def sort_pack_parallel(order, is2d, cst, nb, pos, vel, rhop, mass, ptype, ptype_s, cell, cell_s,
+                       tau, tau_s):
+    """Threaded :func:`sort_pack_serial`."""
+    n = order.shape[0]
+    for c in prange((n + 1023) // 1024):
+        _sort_pack_range(c * 1024, min(n, (c + 1) * 1024), order, is2d, cst, nb, pos, vel, rhop,
+                         mass, ptype, ptype_s, cell, cell_s, tau, tau_s)
 
 
 @njit(cache=True, error_model="numpy")
@@ -132,7 +172,7 @@ def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel):
     kern = literally(kern)
@@ -155,6 +195,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
     rs = int(cst[18])  # stencil radius in cells: 1 (cells of 2h) or 2 (cells of h)
 
     for i in range(i0, i1):
+        o = oi[i]   # row of particle i in the output arrays
         xi = nb[i, 0]
         zi = nb[i, 1]
         vxi = nb[i, 2]
@@ -189,11 +230,11 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                     dot = (vxi - nb[j, 2]) * dx + (vzi - nb[j, 3]) * dz
                     arp += nb[j, 6] * fac * dot * nb[j, 7]
                     vmax = max(vmax, dot / (r2 + eta2))
-            ace[i, 0] = 0.0
-            ace[i, 1] = 0.0
-            ace[i, 2] = 0.0
-            ar[i] = rhoi * arp
-            viscdt[i] = vmax
+            ace[o, 0] = 0.0
+            ace[o, 1] = 0.0
+            ace[o, 2] = 0.0
+            ar[o] = rhoi * arp
+            viscdt[o] = vmax
             continue
 
         acex = 0.0
@@ -296,34 +337,34 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                     shdet -= mr * r2
         arp *= rhoi
         if pti == 3:
-            ace[i, 0] = acex + cst[12]
-            ace[i, 1] = cst[13]
-            ace[i, 2] = acez + cst[14]
+            ace[o, 0] = acex + cst[12]
+            ace[o, 1] = cst[13]
+            ace[o, 2] = acez + cst[14]
             if ddt != 0 and not ddt_off:
                 arp += cst[8] * deltap
         else:
-            ace[i, 0] = acex
-            ace[i, 1] = 0.0
-            ace[i, 2] = acez
-        ar[i] = arp
-        viscdt[i] = vmax
+            ace[o, 0] = acex
+            ace[o, 1] = 0.0
+            ace[o, 2] = acez
+        ar[o] = arp
+        viscdt[o] = vmax
         if shift > 0:
             if sh_off or pti != 3:
-                shiftpos[i, 0] = 0.0
-                shiftpos[i, 2] = 0.0
+                shiftpos[o, 0] = 0.0
+                shiftpos[o, 2] = 0.0
             else:
-                shiftpos[i, 0] = shx
-                shiftpos[i, 2] = shz
-            shiftpos[i, 1] = 0.0
-            shiftdet[i] = shdet
+                shiftpos[o, 0] = shx
+                shiftpos[o, 2] = shz
+            shiftpos[o, 1] = 0.0
+            shiftdet[o] = shdet
         if visco == 2:
-            gradvel[i, 0] = gxx
-            gradvel[i, 2] = gxz
-            gradvel[i, 5] = gzz
+            gradvel[o, 0] = gxx
+            gradvel[o, 2] = gxz
+            gradvel[o, 5] = gzz
 
 
 @njit(cache=True, error_model="numpy")
-def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
+def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx,
                     ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Serial driver of the 2D interaction (use below ~10k particles)."""
     kern = literally(kern)
@@ -331,12 +372,12 @@ def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
     ddt = literally(ddt)
     shift = literally(shift)
     _rates_range_2d(0, nb.shape[0], kern, visco, ddt, shift, nb, ptype, cell,
-                    cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
+                    oi, cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
                     shiftpos, shiftdet, gradvel)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
+def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx,
                       ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Threaded driver of the 2D interaction (prange over particles)."""
     kern = literally(kern)
@@ -346,7 +387,7 @@ def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
     n = nb.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
         _rates_range_2d(c * CHUNK, min(n, (c + 1) * CHUNK), kern, visco, ddt, shift,
-                        nb, ptype, cell, cell_start, ncx, ncz, cst, tau, ace, ar,
+                        nb, ptype, cell, oi, cell_start, ncx, ncz, cst, tau, ace, ar,
                         viscdt,
                         shiftpos, shiftdet, gradvel)
 
@@ -355,7 +396,7 @@ def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
 # 3D
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start,
+def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel):
     kern = literally(kern)
@@ -378,6 +419,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
     rs = int(cst[18])  # stencil radius in cells: 1 (cells of 2h) or 2 (cells of h)
 
     for i in range(i0, i1):
+        o = oi[i]   # row of particle i in the output arrays
         xi = nb[i, 0]
         yi = nb[i, 1]
         zi = nb[i, 2]
@@ -419,11 +461,11 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                                + (vzi - nb[j, 5]) * dz)
                         arp += nb[j, 8] * fac * dot * nb[j, 9]
                         vmax = max(vmax, dot / (r2 + eta2))
-            ace[i, 0] = 0.0
-            ace[i, 1] = 0.0
-            ace[i, 2] = 0.0
-            ar[i] = rhoi * arp
-            viscdt[i] = vmax
+            ace[o, 0] = 0.0
+            ace[o, 1] = 0.0
+            ace[o, 2] = 0.0
+            ar[o] = rhoi * arp
+            viscdt[o] = vmax
             continue
 
         acex = 0.0
@@ -547,38 +589,38 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, cell_start
                         shdet -= mr * r2
         arp *= rhoi
         if pti == 3:
-            ace[i, 0] = acex + cst[12]
-            ace[i, 1] = acey + cst[13]
-            ace[i, 2] = acez + cst[14]
+            ace[o, 0] = acex + cst[12]
+            ace[o, 1] = acey + cst[13]
+            ace[o, 2] = acez + cst[14]
             if ddt != 0 and not ddt_off:
                 arp += cst[8] * deltap
         else:
-            ace[i, 0] = acex
-            ace[i, 1] = acey
-            ace[i, 2] = acez
-        ar[i] = arp
-        viscdt[i] = vmax
+            ace[o, 0] = acex
+            ace[o, 1] = acey
+            ace[o, 2] = acez
+        ar[o] = arp
+        viscdt[o] = vmax
         if shift > 0:
             if sh_off or pti != 3:
-                shiftpos[i, 0] = 0.0
-                shiftpos[i, 1] = 0.0
-                shiftpos[i, 2] = 0.0
+                shiftpos[o, 0] = 0.0
+                shiftpos[o, 1] = 0.0
+                shiftpos[o, 2] = 0.0
             else:
-                shiftpos[i, 0] = shx
-                shiftpos[i, 1] = shy
-                shiftpos[i, 2] = shz
-            shiftdet[i] = shdet
+                shiftpos[o, 0] = shx
+                shiftpos[o, 1] = shy
+                shiftpos[o, 2] = shz
+            shiftdet[o] = shdet
         if visco == 2:
-            gradvel[i, 0] = gxx
-            gradvel[i, 1] = gxy
-            gradvel[i, 2] = gxz
-            gradvel[i, 3] = gyy
-            gradvel[i, 4] = gyz
-            gradvel[i, 5] = gzz
+            gradvel[o, 0] = gxx
+            gradvel[o, 1] = gxy
+            gradvel[o, 2] = gxz
+            gradvel[o, 3] = gyy
+            gradvel[o, 4] = gyz
+            gradvel[o, 5] = gzz
 
 
 @njit(cache=True, error_model="numpy")
-def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, ncy,
+def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx, ncy,
                     ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows)."""
     kern = literally(kern)
@@ -586,12 +628,12 @@ def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, n
     ddt = literally(ddt)
     shift = literally(shift)
     _rates_range_3d(0, nb.shape[0], kern, visco, ddt, shift, nb, ptype, cell,
-                    cell_start, ncx, ncy, ncz, cst, tau, ace, ar, viscdt,
+                    oi, cell_start, ncx, ncy, ncz, cst, tau, ace, ar, viscdt,
                     shiftpos, shiftdet, gradvel)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx, ncy,
+def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx, ncy,
                       ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
     """Threaded driver of the 3D interaction."""
     kern = literally(kern)
@@ -601,7 +643,7 @@ def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, cell_start, ncx,
     n = nb.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
         _rates_range_3d(c * CHUNK, min(n, (c + 1) * CHUNK), kern, visco, ddt, shift,
-                        nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, tau, ace,
+                        nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst, tau, ace,
                         ar, viscdt,
                         shiftpos, shiftdet, gradvel)
 

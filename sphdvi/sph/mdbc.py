@@ -74,7 +74,7 @@ def _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i):
 
 
 @njit(cache=True, error_model="numpy")
-def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell,
+def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell,
                 ncx, ncy, ncz, cst, threshold, ksum_min, rhop, slip, bvel):
     h = cst[0]
     r2max = cst[1]
@@ -96,9 +96,10 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
             _packed_vel(nb, i, is2d, vw)
             for c in range(3):
                 bvel[i, c] = vw[c]
-        nx = normals[i, 0]
-        ny = normals[i, 1]
-        nz = normals[i, 2]
+        o = oi[i]   # row of particle i in normals and rhop
+        nx = normals[o, 0]
+        ny = normals[o, 1]
+        nz = normals[o, 2]
         if nx == 0.0 and ny == 0.0 and nz == 0.0:
             continue
         if is2d:
@@ -202,17 +203,17 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_ce
                 rho = b[0, 0] - 2.0 * (nx * b[1, 0] + ny * b[2, 0] + nz * b[3, 0])
             for c in range(3):
                 vg[c] = b[0, 1 + c]
-        rhop[i] = max(rho, rhop0)
+        rhop[o] = max(rho, rhop0)
         if slip > 1:
             _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i)
 
 
 @njit(cache=True, error_model="numpy")
-def _refresh_packed(i0, i1, is2d, ptype, rhop, cst, nb, slip, bvel):
+def _refresh_packed(i0, i1, is2d, ptype, oi, rhop, cst, nb, slip, bvel):
     for i in range(i0, i1):
         if ptype[i] >= 2:
             continue
-        rho = rhop[i]
+        rho = rhop[oi[i]]
         p = tait_pressure(rho, cst[16], cst[10], cst[17])
         if is2d:
             nb[i, 4] = rho
@@ -231,27 +232,27 @@ def _refresh_packed(i0, i1, is2d, ptype, rhop, cst, nb, slip, bvel):
 
 
 @njit(cache=True, error_model="numpy")
-def mdbc_serial(kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
+def mdbc_serial(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
                 cst, threshold, ksum_min, rhop, slip, bvel):
     """Set the density of every boundary particle with a normal (mDBC) and
     refresh its packed density and pressure (and, for slip modes 2 and 3, the
     velocity it shows the fluid; bvel (N, 3) is work space)."""
     n = nb.shape[0]
-    _mdbc_range(0, n, kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy,
+    _mdbc_range(0, n, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy,
                 ncz, cst, threshold, ksum_min, rhop, slip, bvel)
-    _refresh_packed(0, n, is2d, ptype, rhop, cst, nb, slip, bvel)
+    _refresh_packed(0, n, is2d, ptype, oi, rhop, cst, nb, slip, bvel)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def mdbc_parallel(kern, is2d, nb, ptype, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
+def mdbc_parallel(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
                   cst, threshold, ksum_min, rhop, slip, bvel):
     """Threaded :func:`mdbc_serial`."""
     n = nb.shape[0]
     nchunk = (n + 511) // 512
     for c in prange(nchunk):
-        _mdbc_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, normals,
+        _mdbc_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, oi, normals,
                     cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, threshold, ksum_min,
                     rhop, slip, bvel)
     for c in prange(nchunk):
-        _refresh_packed(c * 512, min(n, (c + 1) * 512), is2d, ptype, rhop, cst, nb, slip,
+        _refresh_packed(c * 512, min(n, (c + 1) * 512), is2d, ptype, oi, rhop, cst, nb, slip,
                         bvel)

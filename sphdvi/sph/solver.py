@@ -48,6 +48,12 @@ DEFAULT_PARAMS = {
 PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ",
                  "ZPeriodicIncX", "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
 PARALLEL_THRESHOLD = 10000
+# Steps between moves of the particle arrays into cell order.  In between, the
+# neighbour data are gathered into cell order each step and the particles stay
+# put (a full permutation of every array costs ~5 % of a 2D step and does not
+# speed up on 2 threads; the gather is a third of it).
+REORDER_EVERY = 16
+LIGHT_THRESHOLD = 50000
 
 # Compiled entry points shared by all solvers, keyed by the feature flags
 # (kept off the instances so that solvers can be deep-copied and pickled).
@@ -139,6 +145,8 @@ class SPHSolver:
                 raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
             self.normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(state.n, 3).copy()
         self._verlet_count = 0
+        self.reorder_every = REORDER_EVERY
+        self._reorder_next = False
         self._alloc()
         self.dt_pre = self.dtini
 
@@ -270,6 +278,11 @@ class SPHSolver:
         self.viscdt = np.zeros(n)
         self.out = np.zeros(n, np.int8)
         self.cell_sorted = np.zeros(n, np.int64)
+        self.ptype_s = np.zeros(n, np.int8)
+        self.tau_s = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
+        self._identity = np.arange(n, dtype=np.int64)
+        # the rows the last interaction read its particles from (cell order)
+        self._rows = (s.ptype, self._identity, self.tau)
         if self.shift:
             self.shiftpos = np.zeros((n, 3))
             self.shiftdet = np.zeros(n)
@@ -280,13 +293,19 @@ class SPHSolver:
         self._bufs = {}
 
     # ------------------------------------------------------------------ kernels
-    def _use_parallel(self):
-        return self.state.n >= self.parallel_threshold and numba.get_num_threads() > 1
+    def _use_parallel(self, light=False):
+        """Threaded kernels for this N?  ``light`` kernels (packing, the
+        integrators: a few ns per particle) only pay for the wake-up of the
+        threads (~30-50 us on a passive OpenMP pool) above LIGHT_THRESHOLD."""
+        n = self.state.n
+        if light:
+            n = n if n >= LIGHT_THRESHOLD else 0
+        return n >= self.parallel_threshold and numba.get_num_threads() > 1
 
     def _kernels(self, parallel):
-        """Entry points of the compiled kernels for this run's flags."""
-        key = (self.is2d, self.kernel, self.visco_kind, self.ddt, self.shift,
-               self.step_algorithm, bool(parallel))
+        """Entry points of the compiled interaction kernels for this run's flags."""
+        key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.shift,
+               bool(parallel))
         if key in _ENTRY_CACHE:
             return _ENTRY_CACHE[key]
         sfx = "parallel" if parallel else "serial"
@@ -296,6 +315,16 @@ class SPHSolver:
             "pack": getattr(_ia, "pack_" + sfx),
             "sps": getattr(_sps, "sps_tau_" + sfx),
         }
+        _ENTRY_CACHE[key] = k
+        return k
+
+    def _integrators(self, parallel):
+        """Entry points of the compiled integrators for this run's flags."""
+        key = ("int", self.shift, self.step_algorithm, bool(parallel))
+        if key in _ENTRY_CACHE:
+            return _ENTRY_CACHE[key]
+        sfx = "parallel" if parallel else "serial"
+        k = {}
         if self.step_algorithm == 1:
             k["verlet"] = specialised(getattr(_int, "verlet_" + sfx), self._verlet_args(False), (0,))
         else:
@@ -307,11 +336,11 @@ class SPHSolver:
 
     def _rates_args(self):
         ncx, ncy, ncz = self.cells.shape
-        s = self.state
+        ptype_rows, oi, tau_rows = self._rows
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        return ((self.kernel, self.visco_kind, self.ddt, self.shift, self.nb, s.ptype,
-                 self.cell_sorted, self.cells.cell_start) + geo
-                + (self.cst, self.tau, self.ace, self.ar, self.viscdt, self.shiftpos,
+        return ((self.kernel, self.visco_kind, self.ddt, self.shift, self.nb, ptype_rows,
+                 self.cell_sorted, oi, self.cells.cell_start) + geo
+                + (self.cst, tau_rows, self.ace, self.ar, self.viscdt, self.shiftpos,
                    self.shiftdet, self.gradvel))
 
     def _verlet_args(self, euler):
@@ -364,7 +393,7 @@ class SPHSolver:
             if buf is None or buf.shape != a.shape:
                 buf = np.empty_like(a)
             dst[name] = buf
-        fn = _ia.reorder_pack_parallel if self._use_parallel() else _ia.reorder_pack_serial
+        fn = _ia.reorder_pack_parallel if self._use_parallel(light=True) else _ia.reorder_pack_serial
         fn(order, self.is2d, self.cst, self.nb, tuple(src[k] for k in f2), tuple(dst[k] for k in f2),
            tuple(src[k] for k in f1), tuple(dst[k] for k in f1), src["ptype"], dst["ptype"],
            src["idp"], dst["idp"], src["mk"], dst["mk"], self.cells.cell, self.cell_sorted)
@@ -372,20 +401,44 @@ class SPHSolver:
             setattr(holder[name], name, dst[name])
             self._bufs[name] = src[name]
 
+    def _sort_and_pack(self):
+        """Sort the particles into cells and fill the packed neighbour array in
+        cell order, leaving the particle arrays where they are (row k of the
+        packed array is particle ``order[k]``; the interaction writes its
+        results back to the particles' own rows)."""
+        self._check_state_arrays()
+        s = self.state
+        if self._domain is not None:
+            order = self.cells.build(s.pos, self._domain[0], self._domain[1])
+        else:
+            order = self.cells.build(s.pos)
+        fn = _ia.sort_pack_parallel if self._use_parallel(light=True) else _ia.sort_pack_serial
+        fn(order, self.is2d, self.cst, self.nb, s.pos, s.vel, s.rhop, s.mass, s.ptype, self.ptype_s,
+           self.cells.cell, self.cell_sorted, self.tau, self.tau_s)
+        self._rows = (self.ptype_s, order, self.tau_s)
+
     def compute_rates(self):
-        """Reorder, then evaluate accelerations, density rates and dt terms."""
+        """Sort into cells (every ``reorder_every`` steps also moving the
+        particles into cell order, for memory locality), then evaluate
+        accelerations, density rates and dt terms."""
         if self.periodicity is not None:
             self._compute_rates_periodic()
             return
-        self._reorder_and_pack()
+        if self._reorder_next:
+            self._reorder_and_pack()
+            self._rows = (self.state.ptype, self._identity, self.tau)
+        else:
+            self._sort_and_pack()
+        self._reorder_next = False
         par = self._use_parallel()
         k = self._kernels(par)
         s = self.state
+        ptype_rows, oi, _ = self._rows
         if self.boundary == 2:
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             ncx, ncy, ncz = self.cells.shape
-            fn(self.kernel, self.is2d, self.nb, s.ptype, self.normals, self.cells.cell_start,
+            fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.normals, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
                self.mdbc_ksum, s.rhop, self.slip, self._mdbc_work(s.n))
         k["rates"](*self._rates_args())
@@ -436,14 +489,14 @@ class SPHSolver:
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             normals_e = np.ascontiguousarray(self.normals[idx])
-            fn(self.kernel, self.is2d, nb, ptype_e, normals_e, self.cells.cell_start,
+            fn(self.kernel, self.is2d, nb, ptype_e, np.arange(ne), normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
                self.mdbc_ksum, rhop_e, self.slip, self._mdbc_work(ne))
             bound = (order < n) & (ptype_e < 2)
             s.rhop[order[bound]] = rhop_e[bound]
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
         k["rates"](self.kernel, self.visco_kind, self.ddt, self.shift, nb, ptype_e, cell_e,
-                   self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,
+                   np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,
                    shiftdet, gradvel)
         real = order < n
         dst = order[real]
@@ -492,6 +545,9 @@ class SPHSolver:
 
     def step(self):
         """Advance one time step; returns dt."""
+        # move the particles into cell order every reorder_every steps (a
+        # function of the step number, so that a resumed run does the same)
+        self._reorder_next = self.nstep % self.reorder_every == 0
         if self.step_algorithm == 1:
             dt = self._step_verlet()
         else:
@@ -511,7 +567,7 @@ class SPHSolver:
         self._set_ip(dt)
         euler = self._verlet_count >= self.verlet_steps
         self._verlet_count = 0 if euler else self._verlet_count + 1
-        k = self._kernels(self._use_parallel())
+        k = self._integrators(self._use_parallel(light=True))
         nout = k["verlet"](*self._verlet_args(euler))
         if nout:
             self._exclude()
@@ -522,11 +578,10 @@ class SPHSolver:
         self._set_ip(dt)
         s = self.state
         self.compute_rates()
-        k = self._kernels(self._use_parallel())
+        k = self._integrators(self._use_parallel(light=True))
         k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
                      self.ace, self.ar, s.ptype, self.ip)
         self.compute_rates()
-        k = self._kernels(self._use_parallel())
         nout = k["sym_corr"](*self._corr_args())
         self.dt_pre = self._variable_dt(self.time + dt)
         if nout:
