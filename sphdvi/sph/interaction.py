@@ -168,6 +168,35 @@ def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
         _pack_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, pos, vel, rhop, mass, cst, nb)
 
 
+@njit(cache=True, error_model="numpy")
+def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c):
+    """Time-step terms of rows i0..i1 (eq. 10; DualSPHysics ``DtVariable``):
+    dtmax[c] = (max |a|^2 over fluid, max |v|^2 over ptype >= vel_type, max
+    viscdt), read while the rows are in cache."""
+    amax = 0.0
+    vmax = 0.0
+    cmax = 0.0
+    for i in range(i0, i1):
+        o = oi[i]
+        if viscdt[o] > cmax:
+            cmax = viscdt[o]
+        pt = ptype[i]
+        if pt == 3:
+            a = ace[o, 0] ** 2 + ace[o, 1] ** 2 + ace[o, 2] ** 2
+            if a > amax:
+                amax = a
+        if pt >= vel_type:
+            if is2d:
+                v = nb[i, 2] ** 2 + nb[i, 3] ** 2
+            else:
+                v = nb[i, 3] ** 2 + nb[i, 4] ** 2 + nb[i, 5] ** 2
+            if v > vmax:
+                vmax = v
+    dtmax[c, 0] = amax
+    dtmax[c, 1] = vmax
+    dtmax[c, 2] = cmax
+
+
 # --------------------------------------------------------------------------
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
@@ -365,31 +394,41 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
 
 @njit(cache=True, error_model="numpy")
 def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
-    """Serial driver of the 2D interaction (use below ~10k particles)."""
-    kern = literally(kern)
-    visco = literally(visco)
-    ddt = literally(ddt)
-    shift = literally(shift)
-    _rates_range_2d(0, nb.shape[0], kern, visco, ddt, shift, nb, ptype, cell,
-                    oi, cell_start, ncx, ncz, cst, tau, ace, ar, viscdt,
-                    shiftpos, shiftdet, gradvel)
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
+    """Serial driver of the 2D interaction (use below ~10k particles).
 
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
-    """Threaded driver of the 2D interaction (prange over particles)."""
+    Chunk c of CHUNK rows also leaves its time-step maxima in dtmax[c]
+    (cst[19] is the lowest particle type whose speed counts)."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
     n = nb.shape[0]
+    vel_type = int(cst[19])
+    for c in range((n + CHUNK - 1) // CHUNK):
+        i0 = c * CHUNK
+        i1 = min(n, i0 + CHUNK)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
+    """Threaded driver of the 2D interaction (prange over chunks of particles)."""
+    kern = literally(kern)
+    visco = literally(visco)
+    ddt = literally(ddt)
+    shift = literally(shift)
+    n = nb.shape[0]
+    vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
-        _rates_range_2d(c * CHUNK, min(n, (c + 1) * CHUNK), kern, visco, ddt, shift,
-                        nb, ptype, cell, oi, cell_start, ncx, ncz, cst, tau, ace, ar,
-                        viscdt,
-                        shiftpos, shiftdet, gradvel)
+        i0 = c * CHUNK
+        i1 = min(n, i0 + CHUNK)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 # --------------------------------------------------------------------------
@@ -621,31 +660,39 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
 
 @njit(cache=True, error_model="numpy")
 def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
-    """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows)."""
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
+    """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows);
+    time-step maxima per chunk in dtmax as :func:`rates_2d_serial`."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
-    _rates_range_3d(0, nb.shape[0], kern, visco, ddt, shift, nb, ptype, cell,
-                    oi, cell_start, ncx, ncy, ncz, cst, tau, ace, ar, viscdt,
-                    shiftpos, shiftdet, gradvel)
+    n = nb.shape[0]
+    vel_type = int(cst[19])
+    for c in range((n + CHUNK - 1) // CHUNK):
+        i0 = c * CHUNK
+        i1 = min(n, i0 + CHUNK)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel):
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
     """Threaded driver of the 3D interaction."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
     n = nb.shape[0]
+    vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
-        _rates_range_3d(c * CHUNK, min(n, (c + 1) * CHUNK), kern, visco, ddt, shift,
-                        nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst, tau, ace,
-                        ar, viscdt,
-                        shiftpos, shiftdet, gradvel)
+        i0 = c * CHUNK
+        i1 = min(n, i0 + CHUNK)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 # --------------------------------------------------------------------------

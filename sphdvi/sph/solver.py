@@ -94,9 +94,10 @@ class SPHSolver:
         the caller knows; here an axis is periodic when it is listed, when one
         of its Inc keys is non-zero, or when XYPeriodic/XZPeriodic/YZPeriodic
         is 1.  See :mod:`sphdvi.sph.periodic`.
-    cell_mode : "2h" or "h"
+    cell_mode : "auto" (default), "2h" or "h"
         Cell size of the neighbour search (DualSPHysics ``-cellmode``: full = 2h,
-        half = h).
+        half = h); ``auto`` takes h unless the grid would be sparse (see
+        :meth:`_choose_cell_mode`).
     normals : (N, 3) array or None
         mDBC (``Boundary=2``): per particle (in the order of ``state``), the
         vector from a boundary particle to the boundary surface (DualSPHysics
@@ -117,7 +118,7 @@ class SPHSolver:
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
                  parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None,
-                 cell_mode="2h", dt_table=None):
+                 cell_mode="auto", dt_table=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.dt_table = None if dt_table is None else np.asarray(dt_table, float).reshape(-1, 2)
@@ -137,9 +138,10 @@ class SPHSolver:
         self._domain = None
         if domain is not None:
             self._domain = (np.array(domain[0], float), np.array(domain[1], float))
-        self.cells = _cells.CellList(self.h, self.is2d, half=cell_mode == "h")
-        self.cst[18] = self.cells.stencil
         self.periodicity = self._setup_periodic(periodic)
+        self.cell_mode = self._choose_cell_mode(cell_mode)
+        self.cells = _cells.CellList(self.h, self.is2d, half=self.cell_mode == "h")
+        self.cst[18] = self.cells.stencil
         if self.boundary == 2:
             if normals is None:
                 raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
@@ -190,7 +192,7 @@ class SPHSolver:
             raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
         self.verlet_steps = int(p["VerletSteps"])
         alpha = kernel_alpha(self.kernel, h, self.is2d)
-        cst = np.zeros(19)
+        cst = np.zeros(20)
         cst[0] = h
         cst[1] = 4.0 * h * h
         cst[2] = (0.1 * h) ** 2
@@ -214,6 +216,7 @@ class SPHSolver:
         self.dtfixed = float(p["DtFixed"] or 0.0)
         # DtAllParticles 1: every particle's speed limits dt; 0: fluid and floating
         self.dt_vel_type = 0 if int(p.get("DtAllParticles") or 0) else 2
+        cst[19] = self.dt_vel_type
         self.sps_smag = (0.12 * self.dp) ** 2
         self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
         self.shift_tfs = float(p["ShiftTFS"])
@@ -223,6 +226,32 @@ class SPHSolver:
         self.ip[3] = float(p["RhopOutMax"])
         self.ip[4] = float(p["ShiftCoef"]) * h
         self.ip[5] = self.shift_tfs
+
+    def _choose_cell_mode(self, mode):
+        """Cells of h (5x5 / 125-cell stencil) where the grid stays small, else 2h.
+
+        Cells of h leave fewer candidates per particle (2D: 47 instead of 68
+        for ~21 neighbours); on a developed 2D dam break the interaction is
+        ~25 % faster, in 3D ~15 %.  Their grid has 2^d times more cells, so
+        ``auto`` takes them only while the grid has at most 8 cells per
+        particle (a sparse domain would otherwise spend memory and time on
+        empty cells)."""
+        if mode in ("h", "2h"):
+            return mode
+        if mode != "auto":
+            raise ValueError("cell_mode must be 'auto', 'h' or '2h'")
+        pos = self.state.pos
+        if pos.shape[0] == 0:
+            return "2h"
+        lo, hi = pos.min(axis=0), pos.max(axis=0)
+        if self._domain is not None:
+            dlo, dhi = self._domain
+            lo = np.where(np.isfinite(dlo), np.minimum(dlo, lo), lo)
+            hi = np.where(np.isfinite(dhi), np.maximum(dhi, hi), hi)
+        ext = np.floor((hi - lo) / self.h) + 1.0
+        if self.is2d:
+            ext[1] = 1.0
+        return "h" if float(np.prod(ext)) <= 8.0 * pos.shape[0] else "2h"
 
     def _setup_periodic(self, periodic):
         p = self.params
@@ -290,6 +319,7 @@ class SPHSolver:
             self.shiftpos = np.zeros((1, 3))
             self.shiftdet = np.zeros(1)
         self.gradvel = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
+        self.dtmax = np.zeros(((n + _ia.CHUNK - 1) // _ia.CHUNK, 3))
         self._bufs = {}
 
     # ------------------------------------------------------------------ kernels
@@ -341,7 +371,7 @@ class SPHSolver:
         return ((self.kernel, self.visco_kind, self.ddt, self.shift, self.nb, ptype_rows,
                  self.cell_sorted, oi, self.cells.cell_start) + geo
                 + (self.cst, tau_rows, self.ace, self.ar, self.viscdt, self.shiftpos,
-                   self.shiftdet, self.gradvel))
+                   self.shiftdet, self.gradvel, self.dtmax))
 
     def _verlet_args(self, euler):
         s = self.state
@@ -497,7 +527,7 @@ class SPHSolver:
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
         k["rates"](self.kernel, self.visco_kind, self.ddt, self.shift, nb, ptype_e, cell_e,
                    np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,
-                   shiftdet, gradvel)
+                   shiftdet, gradvel, np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)))
         real = order < n
         dst = order[real]
         self.ace[dst] = ace[real]
@@ -509,6 +539,9 @@ class SPHSolver:
         if self.visco_kind == 2:
             self.gradvel[dst] = gradvel[real]
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
+        # time-step terms of the real particles only (a ghost at the edge of the
+        # extended set misses neighbours and has a meaningless acceleration)
+        self.dtmax = np.array([_ts.dt_terms(self.ace, s.vel, self.viscdt, s.ptype, self.dt_vel_type)])
 
     def _fixed_dt(self, t):
         """DtFixed, or the DtFixedFile value at time t; 0 when dt is variable."""
@@ -523,8 +556,7 @@ class SPHSolver:
         fixed = self._fixed_dt(t)
         if fixed > 0.0 and self.dt_table is None:
             return fixed
-        a2, v2, cv = _ts.dt_terms(self.ace, self.state.vel, self.viscdt, self.state.ptype,
-                                  self.dt_vel_type)
+        a2, v2, cv = self.dtmax.max(axis=0)     # left by the interaction (dt_terms)
         dt = _ts.variable_dt(a2, v2, cv, self.h, self.cs0, self.cfl)
         if fixed > 0.0:
             self.dt_error = max(self.dt_error, fixed - dt)
