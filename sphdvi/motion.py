@@ -26,6 +26,7 @@ Madsen (1971). A linear ramp over ``ramp`` periods starts the motion.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -255,6 +256,10 @@ class WavePaddle:
             m1 = flap_height_to_stroke(self.k, d)
             self.stroke = H / m1 * self.gain
             self.second = 0.0
+            if spec.get("waveorder", 1) == 2:
+                # DualSPHysics generates second-order waves with pistons only (Madsen 1971)
+                warnings.warn("flap mkbound=%s: waveorder=2 is implemented for pistons only; "
+                              "the flap moves with first-order theory" % spec.get("mkbound"))
             self.hinge_depth = d + spec.get("variabledraft", 0.0)
             p0, p1 = np.asarray(spec["flapaxis0"], float), np.asarray(spec["flapaxis1"], float)
             self.p0, self.axis = p0, (p1 - p0) / np.linalg.norm(p1 - p0)

@@ -95,3 +95,15 @@ def test_flap_rotates_about_hinge():
     assert hinge == pytest.approx([0, 0, 0], abs=1e-12)
     top = T.apply(np.array([[0.0, 0.0, 1.0]]))[0][0]
     assert top[0] == pytest.approx(p.stroke_position(0.5)[0] / math.hypot(1, p.stroke_position(0.5)[0]), rel=1e-9)
+
+
+def test_flap_second_order_warns_and_runs_first_order():
+    """DualSPHysics generates second-order waves with pistons only: a flap
+    asking waveorder 2 is told so and moves as the first-order flap."""
+    spec = {"type": "flap", "mkbound": 11, "depth": 1.0, "waveheight": 0.1, "waveperiod": 2.0, "ramp": 0,
+            "flapaxis0": [0, 0, 0], "flapaxis1": [0, 1, 0], "variabledraft": 0.0}
+    first = WavePaddle(spec)
+    with pytest.warns(UserWarning, match="pistons only"):
+        second = WavePaddle({**spec, "waveorder": 2})
+    for t in (0.3, 0.7, 1.9):
+        assert second.stroke_position(t) == first.stroke_position(t)
