@@ -3,6 +3,11 @@
 The free surface starts at η(x) = a cos(k x), k = π/L, at rest; linear theory gives the
 period T = 2π/ω with ω² = g k tanh(k d). The period is read from the horizontal
 centre of mass of the fluid, which oscillates with the mode.
+
+The case file ``cases/standingwave2d/CaseStandingWave2D_Def.xml`` is the same tank drawn by
+gencase; :func:`case_periods` reads a run of it. Its walls' surfaces lie dp/2 in front of
+their first particle layer, so the water fills L_eff = L − dp and its mean depth is the
+fluid area over L_eff: theory is evaluated for that geometry.
 """
 from __future__ import annotations
 
@@ -16,67 +21,63 @@ def linear_period(length: float, depth: float, g: float = 9.81, mode: int = 1) -
     return 2 * math.pi / math.sqrt(g * k * math.tanh(k * depth))
 
 
-def sloshing_particles(length=1.0, depth=0.5, amplitude=0.02, dp=0.0125, rhop0=1000.0, gamma=7.0,
-                       coefsound=20.0, g=9.81, layers=1):
-    """Fluid lattice under η = a cos(kx) in a tank with ``layers`` layers of boundary
-    particles (bottom, left, right; the tank walls lie dp/2 inside the first layer) and
-    the matching constants (DualSPHysics rules, coefh 1.0)."""
-    k = math.pi / length
-    nx = int(round(length / dp))
-    xs = (np.arange(nx) + 0.5) * dp
-    zs = (np.arange(int((depth + 2 * amplitude) / dp)) + 0.5) * dp
-    X, Z = np.meshgrid(xs, zs, indexing="ij")
-    surf = depth + amplitude * np.cos(k * X)
-    inside = Z <= surf
-    fx, fz = X[inside], Z[inside]
-    top = np.max(np.where(inside, Z, -np.inf), axis=1)[:, None] * np.ones_like(Z)
-    ftop = top[inside]
-    cs0 = coefsound * math.sqrt(g * depth)
-    b = cs0 * cs0 * rhop0 / gamma
-    rho_f = rhop0 * (1 + rhop0 * g * (ftop - fz) / b) ** (1 / gamma)
-    # one layer of boundary particles one dp from the fluid lattice: bottom at z = −dp/2,
-    # walls at x = −dp/2 and x = L + dp/2 (the fluid occupies [0, L] x [0, η])
-    parts = []
-    for m in range(layers):
-        off = (m + 0.5) * dp
-        bottom_x = (np.arange(-1 - m, nx + 1 + m) + 0.5) * dp
-        parts.append(np.column_stack([bottom_x, np.full(bottom_x.size, -off)]))
-        wall_z = (np.arange(0, int(depth * 1.6 / dp)) + 0.5) * dp
-        parts.append(np.column_stack([np.full(wall_z.size, -off), wall_z]))
-        parts.append(np.column_stack([np.full(wall_z.size, length + off), wall_z]))
-    bnd = np.vstack(parts)
-    n_b, n_f = bnd.shape[0], fx.size
-    pos = np.zeros((n_b + n_f, 3))
-    pos[:n_b, 0], pos[:n_b, 2] = bnd[:, 0], bnd[:, 1]
-    pos[n_b:, 0], pos[n_b:, 2] = fx, fz
-    rhop = np.concatenate([np.full(n_b, rhop0), rho_f])
-    ptype = np.concatenate([np.zeros(n_b, np.int8), np.full(n_f, 3, np.int8)])
-    mass = np.full(n_b + n_f, rhop0 * dp * dp)
-    constants = {"dp": dp, "h": math.sqrt(2) * dp, "b": b, "cs0": cs0, "rhop0": rhop0, "gamma": gamma,
-                 "gravity": [0.0, 0.0, -g], "is2d": True, "cflnumber": 0.2}
-    return pos, rhop, ptype, mass, constants
-
-
 def period_from_signal(t, x) -> tuple[float, float]:
     """Mean period from up-crossings of x − mean(x) (with hysteresis: the signal must swing
     below −30 % of its amplitude between two crossings, so noise does not count), and the
-    mean relative amplitude loss per period (from successive maxima)."""
+    relative amplitude loss per period, 1 − exp(−λ T), λ fitted to log |x − mean| at the
+    signal's extrema (maxima and minima alike, those beyond 30 % of its amplitude)."""
     t, y = np.asarray(t, float), np.asarray(x, float)
     y = y - y.mean()
     amp = np.abs(y).max()
     if amp == 0:
         return float("nan"), float("nan")
-    armed, cross, peaks, peak = False, [], [], 0.0
+    armed, cross = False, []
     for i in range(1, y.size):
         if y[i] < -0.3 * amp:
             armed = True
         if armed and y[i - 1] < 0 <= y[i]:
             cross.append(t[i - 1] - y[i - 1] * (t[i] - t[i - 1]) / (y[i] - y[i - 1]))
             armed = False
-            if len(cross) > 1:
-                peaks.append(peak)
-            peak = 0.0
-        peak = max(peak, y[i])
     period = float(np.mean(np.diff(cross))) if len(cross) >= 2 else float("nan")
-    decay = float(1 - np.mean(np.array(peaks[1:]) / np.array(peaks[:-1]))) if len(peaks) >= 2 else float("nan")
+    inner = np.arange(1, y.size - 1)
+    ext = inner[((y[inner] - y[inner - 1]) * (y[inner + 1] - y[inner]) <= 0) & (np.abs(y[inner]) > 0.3 * amp)
+                & (np.abs(y[inner]) >= np.abs(y[inner - 1])) & (np.abs(y[inner]) >= np.abs(y[inner + 1]))]
+    decay = float("nan")
+    if ext.size >= 3 and np.isfinite(period):
+        rate = np.polyfit(t[ext], np.log(np.abs(y[ext])), 1)[0]
+        decay = float(1.0 - np.exp(rate * period))
     return period, decay
+
+
+def case_periods(outdir: str, length: float = 1.0, gauge: str = "Left") -> dict:
+    """Periods of a run of the S7 case file: from the horizontal centre of mass of the fluid
+    at every output (``period_com``) and from the run-time elevation gauge ``gauge``
+    (``period_gauge``), beside linear theory for the effective tank (``period_theory``;
+    ``length_eff`` = L − dp, ``depth_eff`` = fluid area / L_eff) and the amplitude loss per
+    period of the centre-of-mass signal (``decay``)."""
+    import glob
+    import os
+
+    import h5py
+
+    from ..io.vtkhdf import read_step, step_times
+
+    case_h5 = [f for f in glob.glob(os.path.join(outdir, "*.h5")) if not f.endswith("restart.h5")]
+    with h5py.File(case_h5[0], "r") as f:
+        dp = float(f["constants"].attrs["dp"])
+        g = -float(f["constants"].attrs["gravity"][2])
+        nfluid = int(np.count_nonzero(f["particles/type"][:] == 3))
+    path = os.path.join(outdir, "particles.vtkhdf")
+    times = step_times(path)
+    xc = np.empty(times.size)
+    for k in range(times.size):
+        s = read_step(path, k)
+        xc[k] = s["points"][s["Type"] == 3, 0].mean()
+    length_eff = length - dp
+    depth_eff = nfluid * dp * dp / length_eff
+    period_com, decay = period_from_signal(times, xc)
+    gauge_csv = np.genfromtxt(os.path.join(outdir, f"GaugesSWL_{gauge}.csv"), delimiter=";", skip_header=1)
+    period_gauge, _ = period_from_signal(gauge_csv[:, 0], gauge_csv[:, 3])
+    return {"period_theory": linear_period(length_eff, depth_eff, g), "period_com": period_com,
+            "period_gauge": period_gauge, "decay": decay, "length_eff": length_eff, "depth_eff": depth_eff,
+            "dp": dp}

@@ -1,56 +1,73 @@
-"""S7: period of the first sloshing mode of a 2D tank (L = 1 m, d = 0.5 m, a/d = 0.04)
-against linear theory ω² = g k tanh(k d).
+"""S7: period of the first sloshing mode of a 2D tank against linear theory ω² = g k tanh(k d).
 
-Measured with mDBC and three wall layers (the walls' surfaces on the tank's faces):
-error −5.4 % (d/dp = 20), −4.5 % (d/dp = 40); with DBC and one layer −8.2 % / −6.1 % (the
-DBC gap at each wall shortens the tank). The error falls with dp (observed order printed);
-TOLERANCES S7 asks 1–2 % at d/dp ≥ 40, kept as a strict xfail below. Both tests are slow
-(about 2 minutes): ``python -m pytest -m slow tests/validation``.
+The case file cases/standingwave2d/CaseStandingWave2D_Def.xml (L = 1 m, d = 0.5 m, a/d = 0.04,
+mDBC, Symplectic, α = 0.01, Fourtakas δ = 0.1, coefh 1.2) runs at d/dp = 20 and 40; the
+period is read from the horizontal centre of mass of the water and compared with theory for
+the tank the particles fill (L_eff = L − dp). TOLERANCES S7: within 1–2 % at d/dp ≥ 40.
+
+Measured: −1.46 % (d/dp = 20), −0.79 % (d/dp = 40). At coefh 1.0 (h = √2 dp) the period
+is ~5 % short at every resolution and does not converge with dp (−5.4 %, −4.6 %), with or
+without walls, whatever the initial condition, boundary condition, density diffusion, c0 or
+integrator; coefh 1.2, 1.5, 1.75, 2.0 give −1.1, +0.3, 0.0, +0.5 % (periodic channel,
+d/dp = 20). Amplitude loss per period 9.3 % (d/dp = 20) and 8.0 % (d/dp = 40), above the
+~5 % TOLERANCES judges normal at α = 0.01 (strict xfail). Slow (about 2 minutes): ``python -m pytest -m slow tests/validation``.
 """
 import math
+from pathlib import Path
 
-import numpy as np
 import pytest
+from click.testing import CliRunner
 
-from sphdvi.case.normals import boundary_normals
-from sphdvi.sph.solver import SPHSolver
-from sphdvi.sph.state import FluidState
-from sphdvi.validation.sloshing import linear_period, period_from_signal, sloshing_particles
+from sphdvi.cli import main
+from sphdvi.validation.sloshing import case_periods
 
-
-def slosh_period(dp, periods=2.4):
-    pos, rhop, ptype, mass, consts = sloshing_particles(dp=dp, layers=3)
-    sol = SPHSolver(FluidState(pos, None, rhop, mass, ptype), consts,
-                    {"StepAlgorithm": 2, "Visco": 0.01, "DensityDT": 2, "DensityDTvalue": 0.1,
-                     "Boundary": 2}, normals=boundary_normals(pos, ptype, dp, True))
-    t0 = linear_period(1.0, 0.5)
-    ts, xc = [], []
-    while sol.time < periods * t0:
-        sol.step()
-        if sol.nstep % 10 == 0:
-            f = sol.state.ptype == 3
-            ts.append(sol.time)
-            xc.append(np.average(sol.state.pos[f, 0], weights=sol.state.mass[f]))
-    period, decay = period_from_signal(ts, xc)
-    return (period - t0) / t0, decay
+REPO = Path(__file__).resolve().parents[2]
+CASE = REPO / "cases" / "standingwave2d" / "CaseStandingWave2D_Def.xml"
 
 
 @pytest.fixture(scope="module")
-def errors():
-    return {dp: slosh_period(dp, periods=2.4) for dp in (0.025, 0.0125)}
+def runs(tmp_path_factory):
+    out = {}
+    for dp in (0.025, 0.0125):
+        d = tmp_path_factory.mktemp(f"sw{dp}")
+        r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(d), "--dp", str(dp), "--threads", "2", "-q"])
+        assert r.exit_code == 0, r.output
+        out[dp] = case_periods(str(d))
+    return out
+
+
+def _error(r, key="period_com"):
+    return (r[key] - r["period_theory"]) / r["period_theory"]
 
 
 @pytest.mark.slow
-def test_sloshing_period_converges(errors):
-    e1, e2 = abs(errors[0.025][0]), abs(errors[0.0125][0])
-    order = math.log(e1 / e2) / math.log(2)
-    print(f"S7 period error: d/dp=20 {100 * errors[0.025][0]:+.2f} %, d/dp=40 {100 * errors[0.0125][0]:+.2f} %, "
-          f"observed order {order:.2f}; amplitude loss per period {100 * errors[0.0125][1]:.1f} %")
-    assert e2 < e1
-    assert e2 < 0.05
+def test_sloshing_period_within_2_percent_and_converging(runs):
+    e1, e2 = _error(runs[0.025]), _error(runs[0.0125])
+    print(f"S7 period error (centre of mass): d/dp=20 {100 * e1:+.2f} %, d/dp=40 {100 * e2:+.2f} %, "
+          f"observed order {math.log(abs(e1) / abs(e2)) / math.log(2):.2f}; "
+          f"gauge 'Left': {100 * _error(runs[0.0125], 'period_gauge'):+.2f} %")
+    assert abs(e2) <= 0.02                       # TOLERANCES S7: 1-2 % at d/dp >= 40
+    assert abs(e2) < abs(e1)                     # error falls with dp
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="measured −4.5 % at d/dp = 40 (mDBC); TOLERANCES S7 asks 1–2 %")
-def test_sloshing_period_within_2_percent(errors):
-    assert abs(errors[0.0125][0]) <= 0.02
+def test_damping_falls_with_dp(runs):
+    """Amplitude loss per period (fitted to the extrema): no growth, and less with finer dp,
+    as the artificial viscosity (ν ∝ α h c0) and the density diffusion shrink with h."""
+    d1, d2 = runs[0.025]["decay"], runs[0.0125]["decay"]
+    print(f"S7 amplitude loss per period: d/dp=20 {100 * d1:.1f} %, d/dp=40 {100 * d2:.1f} %")
+    assert 0.0 < d2 < d1
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="TOLERANCES S7 judgement: no damping above ~5 %/period at alpha = 0.01; "
+                                        "measured 9.3 % (d/dp = 20), 8.0 % (d/dp = 40)")
+def test_damping_below_5_percent_per_period(runs):
+    assert runs[0.0125]["decay"] <= 0.05
+
+
+@pytest.mark.slow
+def test_elevation_gauge_sees_the_same_mode(runs):
+    """The run-time SWL gauge 0.05 m from the left wall oscillates with the mode; its crossings
+    carry the free second mode the finite-amplitude start excites, so only 5 % is asked."""
+    assert abs(_error(runs[0.0125], "period_gauge")) < 0.05
