@@ -23,6 +23,8 @@ position, 3 not finite); the drivers return how many were flagged.
 Shifting (Lind et al. 2012, DualSPHysics form): dr_s = A h |v| dt grad C,
 set to zero where the free-surface detector div r < ShiftTFS.  It is added to
 the fluid displacement (Verlet step, Symplectic corrector) when ``shift`` is on.
+With ``shift`` 4 (advanced shifting) ``shiftpos`` already holds the displacement
+(:mod:`sphdvi.sph.shifting_adv`).
 
 ``ip`` holds the step parameters: [dt, rhop0, RhopOutMin, RhopOutMax,
 ShiftCoef*h, ShiftTFS, use_domain, xmin, ymin, zmin, xmax, ymax, zmax,
@@ -90,7 +92,9 @@ def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar
         rhop_m1[i] = r
         if pt == 3:
             sf = 0.0
-            if shift > 0:
+            if shift == 4:
+                sf = 1.0        # advanced shifting: shiftpos is the displacement itself
+            elif shift > 0:
                 sf = _shift_factor(vel[i, 0], vel[i, 1], vel[i, 2], shiftdet[i],
                                    coefh, tfs, dt)
             for k in range(3):
@@ -213,7 +217,9 @@ def _sym_corr_range(i0, i1, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, a
         rn = rhop_pre[i] * (2.0 - eps) / (2.0 + eps)
         if pt == 3:
             sf = 0.0
-            if shift > 0:
+            if shift == 4:
+                sf = 1.0        # advanced shifting: shiftpos is the displacement itself
+            elif shift > 0:
                 sf = _shift_factor(vel[i, 0], vel[i, 1], vel[i, 2], shiftdet[i],
                                    coefh, tfs, dt)
             rhop[i] = rn

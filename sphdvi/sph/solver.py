@@ -12,15 +12,16 @@ Physics sees arrays only: no files, no CLI.  Built from two plain dicts:
 unknown keys are ignored):
   StepAlgorithm, VerletSteps, Kernel, ViscoTreatment, Visco,
   ViscoBoundFactor, DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
-  CoefDtMin, DtIni, DtMin, DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
+  ShiftAdvCoef (Shifting 4, :mod:`sphdvi.sph.shifting_adv`), CoefDtMin, DtIni, DtMin,
+  DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
   SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold and the periodic keys (XPeriodicIncY ...,
   XYPeriodic ...; see the ``periodic`` argument).
 
 DtFixedFile is passed as ``dt_table`` (the case reader loads the file);
 DtAllParticles selects the particles whose speed limits dt.
 
-Not implemented: Shifting 4 (advanced; runs as 3 with a warning), mDBC
-NoPenetration.
+Not implemented: ShiftAdvALE and ShiftAdvNCPress of Shifting 4 (warned and
+ignored), mDBC NoPenetration.
 """
 import warnings
 
@@ -41,7 +42,7 @@ from .state import FLUID, FluidState
 DEFAULT_PARAMS = {
     "StepAlgorithm": 1, "VerletSteps": 40, "Kernel": 2, "ViscoTreatment": 1,
     "Visco": 0.01, "ViscoBoundFactor": 1.0, "DensityDT": 0, "DensityDTvalue": 0.1,
-    "Shifting": 0, "ShiftCoef": -2.0, "ShiftTFS": 0.0, "CoefDtMin": 0.05,
+    "Shifting": 0, "ShiftCoef": -2.0, "ShiftTFS": 0.0, "ShiftAdvCoef": -0.01, "CoefDtMin": 0.05,
     "DtIni": 0.0, "DtMin": 0.0, "DtFixed": 0.0, "RhopOutMin": 700.0,
     "RhopOutMax": 1300.0, "Boundary": 1,
 }
@@ -182,11 +183,17 @@ class SPHSolver:
             raise ValueError("ViscoTreatment must be 1, 2 or 3")
         if self.ddt not in (0, 1, 2, 3):
             raise ValueError("DensityDT must be 0..3")
-        if self.shift == 4:
-            warnings.warn("Shifting=4 (advanced) is not implemented; using 3 (full)")
-            self.shift = 3
-        if self.shift not in (0, 1, 2, 3):
+        if self.shift not in (0, 1, 2, 3, 4):
             raise ValueError("Shifting must be 0..4")
+        # Shifting 4 (advanced, sphdvi.sph.shifting_adv) runs its own pass; the
+        # interaction computes the classic shifting terms of modes 1-3 only
+        self.rates_shift = self.shift if self.shift < 4 else 0
+        self.shift_adv_coef = float(p["ShiftAdvCoef"])
+        self._need_shift_adv = True     # False in the Symplectic predictor (its shift is unused)
+        if self.shift == 4:
+            for key in ("ShiftAdvALE", "ShiftAdvNCPress"):
+                if int(p.get(key) or 0):
+                    warnings.warn(f"{key}=1 is not implemented; advanced shifting runs without it")
         self.step_algorithm = int(p["StepAlgorithm"])
         if self.step_algorithm not in (1, 2):
             raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
@@ -318,6 +325,11 @@ class SPHSolver:
         else:
             self.shiftpos = np.zeros((1, 3))
             self.shiftdet = np.zeros(1)
+        if self.shift == 4:
+            # per particle: 0 interior (shifted), 1 near the free surface, 2 on it, 3 isolated
+            self.fstype = np.zeros(n, np.int8)
+            self.fsnormal = np.zeros((n, 3))
+            self._fs_work = self._shift_adv_work(n)
         self.gradvel = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
         self.dtmax = np.zeros(((n + _ia.CHUNK - 1) // _ia.CHUNK, 3))
         self._bufs = {}
@@ -334,7 +346,7 @@ class SPHSolver:
 
     def _kernels(self, parallel):
         """Entry points of the compiled interaction kernels for this run's flags."""
-        key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.shift,
+        key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.rates_shift,
                bool(parallel))
         if key in _ENTRY_CACHE:
             return _ENTRY_CACHE[key]
@@ -368,7 +380,7 @@ class SPHSolver:
         ncx, ncy, ncz = self.cells.shape
         ptype_rows, oi, tau_rows = self._rows
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        return ((self.kernel, self.visco_kind, self.ddt, self.shift, self.nb, ptype_rows,
+        return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.nb, ptype_rows,
                  self.cell_sorted, oi, self.cells.cell_start) + geo
                 + (self.cst, tau_rows, self.ace, self.ar, self.viscdt, self.shiftpos,
                    self.shiftdet, self.gradvel, self.dtmax))
@@ -474,6 +486,26 @@ class SPHSolver:
         k["rates"](*self._rates_args())
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
+        if self.shift == 4 and self._need_shift_adv:
+            self._advanced_shift(par, self.nb, ptype_rows, self.cell_sorted, oi, self.shiftpos, self.fstype,
+                                 self.fsnormal, self._fs_work)
+
+    @staticmethod
+    def _shift_adv_work(n):
+        """Work arrays of the advanced shifting, one row per packed row: type, normal, grad C,
+        near-surface flag, boundary-contact flag."""
+        return (np.zeros(n, np.int8), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n, np.int8),
+                np.zeros(n, np.int8))
+
+    def _advanced_shift(self, par, nb, ptype_rows, cell_rows, oi, shiftpos, fstype, fsnormal, work,
+                        src_row=None):
+        """Shifting 4: free-surface detection and displacement (sphdvi.sph.shifting_adv)."""
+        from . import shifting_adv as _sa
+        fn = _sa.advanced_shift_parallel if par else _sa.advanced_shift_serial
+        ncx, ncy, ncz = self.cells.shape
+        fn(self.kernel, self.is2d, nb, ptype_rows, cell_rows, oi, self.cells.cell_start, ncx, ncy, ncz,
+           self.cst, _sa.full_support_neighbours(self.h, self.dp, self.is2d), self.shift_adv_coef, self.dp,
+           *work, shiftpos, fstype, fsnormal, np.zeros(0, np.int64) if src_row is None else src_row)
 
     def _mdbc_work(self, n):
         """(n, 3) work array for the slip-mode velocities (kept between steps)."""
@@ -525,7 +557,7 @@ class SPHSolver:
             bound = (order < n) & (ptype_e < 2)
             s.rhop[order[bound]] = rhop_e[bound]
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        k["rates"](self.kernel, self.visco_kind, self.ddt, self.shift, nb, ptype_e, cell_e,
+        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, nb, ptype_e, cell_e,
                    np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,
                    shiftdet, gradvel, np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)))
         real = order < n
@@ -533,6 +565,16 @@ class SPHSolver:
         self.ace[dst] = ace[real]
         self.ar[dst] = ar[real]
         self.viscdt[dst] = viscdt[real]
+        if self.shift == 4 and self._need_shift_adv:
+            fstype = np.zeros(ne, np.int8)
+            fsnormal = np.zeros((ne, 3))
+            row_of = np.empty(n, np.int64)
+            row_of[order[real]] = np.flatnonzero(real)
+            self._advanced_shift(par, nb, ptype_e, cell_e, np.arange(ne), shiftpos, fstype, fsnormal,
+                                 self._shift_adv_work(ne),
+                                 src_row=row_of[idx])
+            self.fstype[dst] = fstype[real]
+            self.fsnormal[dst] = fsnormal[real]
         if self.shift:
             self.shiftpos[dst] = shiftpos[real]
             self.shiftdet[dst] = shiftdet[real]
@@ -609,7 +651,9 @@ class SPHSolver:
         dt = self._fixed_dt(self.time) or self.dt_pre
         self._set_ip(dt)
         s = self.state
+        self._need_shift_adv = False
         self.compute_rates()
+        self._need_shift_adv = True
         k = self._integrators(self._use_parallel(light=True))
         k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
                      self.ace, self.ar, s.ptype, self.ip)
