@@ -47,7 +47,6 @@ here.
 import math
 
 from . import _env  # noqa: F401
-import numpy as np
 from numba import njit, prange
 
 from .kernels import kernel_fac
