@@ -32,6 +32,8 @@ PARAMETERS: dict[str, Param] = {
     "Kernel": Param("int", 2, "1:cubic spline, 2:Wendland", (1, 2)),
     "ViscoTreatment": Param("int", 1, "1:artificial, 2:laminar+SPS, 3:laminar", (1, 2, 3)),
     "Visco": Param("float", 0.01, "viscosity value (alpha or kinematic viscosity)", (), 0.0, 1e6),
+    "ViscoLaminarEta": Param("float", 0.1, "sphdvi: regulariser eta/h of the laminar term r^2/(r^2+eta^2) "
+                             "(DualSPHysics 0.1; 0: the exact Morris operator)", (), 0.0, 1.0),
     "ViscoBoundFactor": Param("float", 1.0, "multiplier of Visco for fluid-boundary pairs", (), 0.0, 1e6),
     "DensityDT": Param("int", 0, "density diffusion 0:none, 1:Molteni, 2:Fourtakas, 3:Fourtakas full", (0, 1, 2, 3)),
     "DensityDTvalue": Param("float", 0.1, "density diffusion coefficient delta", (), 0.0, 1.0),

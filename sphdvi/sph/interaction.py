@@ -212,6 +212,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
     inv_h = 1.0 / h
     r2max = cst[1]
     eta2 = cst[2]
+    eta2l = cst[20]
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -327,7 +328,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
                     coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
                 else:
                     # Lo & Shao laminar viscosity
-                    vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
+                    vtemp = mfac * 4.0 * vis * r2 / ((r2 + eta2l) * (rhoi + rhoj))
                     acex += vtemp * dvx
                     acez += vtemp * dvz
                     if visco == 2 and not boundj:
@@ -446,6 +447,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
     inv_h = 1.0 / h
     r2max = cst[1]
     eta2 = cst[2]
+    eta2l = cst[20]
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -578,7 +580,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
                     if visco == 1:
                         coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
                     else:
-                        vtemp = mfac * 4.0 * vis * r2 * ir2e / (rhoi + rhoj)
+                        vtemp = mfac * 4.0 * vis * r2 / ((r2 + eta2l) * (rhoi + rhoj))
                         acex += vtemp * dvx
                         acey += vtemp * dvy
                         acez += vtemp * dvz

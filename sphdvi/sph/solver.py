@@ -11,7 +11,9 @@ Physics sees arrays only: no files, no CLI.  Built from two plain dicts:
 §2.8; missing keys take the DualSPHysics defaults in :data:`DEFAULT_PARAMS`,
 unknown keys are ignored):
   StepAlgorithm, VerletSteps, Kernel, ViscoTreatment, Visco,
-  ViscoBoundFactor, DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
+  ViscoBoundFactor, ViscoLaminarEta (sphdvi's own key: eta/h of the laminar term's
+  r^2/(r^2 + eta^2), DualSPHysics's 0.1 by default; 0 gives the exact Morris operator,
+  finite because grad W / r is finite at r = 0), DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
   ShiftAdvCoef (Shifting 4, :mod:`sphdvi.sph.shifting_adv`), CoefDtMin, DtIni, DtMin,
   DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
   SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold and the periodic keys (XPeriodicIncY ...,
@@ -41,7 +43,7 @@ from .state import FLUID, FluidState
 
 DEFAULT_PARAMS = {
     "StepAlgorithm": 1, "VerletSteps": 40, "Kernel": 2, "ViscoTreatment": 1,
-    "Visco": 0.01, "ViscoBoundFactor": 1.0, "DensityDT": 0, "DensityDTvalue": 0.1,
+    "Visco": 0.01, "ViscoBoundFactor": 1.0, "ViscoLaminarEta": 0.1, "DensityDT": 0, "DensityDTvalue": 0.1,
     "Shifting": 0, "ShiftCoef": -2.0, "ShiftTFS": 0.0, "ShiftAdvCoef": -0.01, "CoefDtMin": 0.05,
     "DtIni": 0.0, "DtMin": 0.0, "DtFixed": 0.0, "RhopOutMin": 700.0,
     "RhopOutMax": 1300.0, "Boundary": 1,
@@ -199,7 +201,7 @@ class SPHSolver:
             raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
         self.verlet_steps = int(p["VerletSteps"])
         alpha = kernel_alpha(self.kernel, h, self.is2d)
-        cst = np.zeros(20)
+        cst = np.zeros(21)
         cst[0] = h
         cst[1] = 4.0 * h * h
         cst[2] = (0.1 * h) ** 2
@@ -224,6 +226,8 @@ class SPHSolver:
         # DtAllParticles 1: every particle's speed limits dt; 0: fluid and floating
         self.dt_vel_type = 0 if int(p.get("DtAllParticles") or 0) else 2
         cst[19] = self.dt_vel_type
+        # laminar term r^2/(r^2 + eta^2): DualSPHysics eta = 0.1 h (ViscoLaminarEta)
+        cst[20] = (float(p.get("ViscoLaminarEta", 0.1)) * h) ** 2
         self.sps_smag = (0.12 * self.dp) ** 2
         self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
         self.shift_tfs = float(p["ShiftTFS"])

@@ -16,8 +16,11 @@ neighbour terms by ~1.2 %, the lattice sum of the Wendland kernel at
 h = sqrt(2) dp by 0.8 %) plus the DBC wall offset.  With mDBC no-slip
 (SlipMode 2) the wall offset is gone and the centre-line speed is +2.1 % at
 20, 30 and 40 across, the operator's bias predicted by its lattice sum
-(1/0.9802).  The Verlet integrator is unstable here (leapfrog applied to
-diffusion), as expected.
+(1/0.9802).  ViscoLaminarEta 0 (sphdvi's key; the exact Morris operator)
+removes the regulariser's 1.2 %: +0.86 % at 30 across, +0.84 % at 40, inside
+the 1 % of S9; the start-up transient follows the Morris et al. series within
+0.6 % of u_max (1.4 % with DualSPHysics's operator).  The Verlet integrator is
+unstable here (leapfrog applied to diffusion), as expected.
 """
 import math
 
@@ -33,11 +36,24 @@ F = 2e-4
 UMAX = F * D * D / (8 * NU)
 
 
+def series_profile(z, t, terms=200):
+    """Transient start-up Poiseuille flow from rest (Morris, Fox & Zhu 1997, eq. 21):
+    u(z,t) = F z (d - z)/(2 nu) - sum_n 4 F d^2/(nu pi^3 (2n+1)^3) sin((2n+1) pi z/d)
+    exp(-(2n+1)^2 pi^2 nu t/d^2)."""
+    k = 2 * np.arange(terms)[:, None] + 1
+    z = np.asarray(z)[None, :]
+    modes = 4 * F * D * D / (NU * math.pi ** 3 * k ** 3) * np.sin(k * math.pi * z / D) \
+        * np.exp(-(k * math.pi) ** 2 * NU * t / (D * D))
+    return F * z[0] * (D - z[0]) / (2 * NU) - modes.sum(0)
+
+
 def run_poiseuille(n, t_end=D * D / NU, nx=12, layers=3, artificial=False, coefh=1.0,
-                   slip=None):
+                   slip=None, eta=None, sample_times=()):
     """slip None: DBC walls with their first layer on z = 0 and z = d.  slip
     1/2/3: mDBC (SlipMode) with the walls' surfaces on z = 0 and z = d, the
-    wall particles dp/2, 3dp/2, ... outside and n fluid rows inside."""
+    wall particles dp/2, 3dp/2, ... outside and n fluid rows inside.  ``eta``:
+    ViscoLaminarEta (None: DualSPHysics's 0.1).  ``sample_times`` (units of
+    d^2/nu): the largest |u - series|/u_max at each is returned in "transient"."""
     dp = D / n
     xs = np.arange(nx) * dp
     if slip is None:
@@ -67,8 +83,16 @@ def run_poiseuille(n, t_end=D * D / NU, nx=12, layers=3, artificial=False, coefh
         normals = np.zeros((len(pos), 3))
         nbd = len(bd)
         normals[:nbd, 2] = np.where(bd[:, 2] < 0, -bd[:, 2], D - bd[:, 2])
+    if eta is not None:
+        extra["ViscoLaminarEta"] = eta
     sol = SPHSolver(st, c, {"StepAlgorithm": 2, "DtFixed": 0.1 * h * h / NU, **visc, **extra},
                     periodic="x", normals=normals)
+    transient = []
+    for ts in sample_times:
+        sol.run(ts * D * D / NU)
+        f = sol.state.ptype == 3
+        ua = series_profile(sol.state.pos[f, 2], sol.time)
+        transient.append(float(np.abs(sol.state.vel[f, 0] - ua).max() / UMAX))
     sol.run(t_end)
     s = sol.state
     f = s.ptype == 3
@@ -80,7 +104,7 @@ def run_poiseuille(n, t_end=D * D / NU, nx=12, layers=3, artificial=False, coefh
            "wmax": float(np.abs(s.vel[f, 2]).max() / UMAX),
            "spread": float((u.max() - u.min()) / abs(u.mean())),
            "xspan": float(s.pos[:, 0].max() - s.pos[:, 0].min()), "n": int(f.sum()),
-           "n0": int((pt == 3).sum())}
+           "n0": int((pt == 3).sum()), "transient": transient}
     print("Poiseuille n=%d: %s" % (n, res))
     return res
 
@@ -215,11 +239,39 @@ def test_poiseuille_40_across():
     assert abs(r["uc"] - 1) < 0.035
 
 
-@pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S9: centre-line speed within 1 % at 30-40 across; "
-                                        "measured +3.0 % (30, DBC), +2.1 % (30, mDBC no-slip)")
-def test_s9_tolerance_1_percent():
-    assert abs(run_poiseuille(30, slip=2)["uc"] - 1) < 0.01
+def test_s9_tolerance_1_percent_exact_laminar_operator():
+    """TOLERANCES S9: steady centre-line speed within 1 % at 30-40 across, the
+    transient series within 2 %.  With DualSPHysics's regulariser
+    (ViscoLaminarEta 0.1) the laminar operator is 1.2 % too weak on the
+    nearest neighbours and the centre-line speed is +2.1 % at every
+    resolution (test above); ViscoLaminarEta 0 gives the exact Morris
+    operator (grad W / r is finite at r = 0, nothing to regularise) and leaves
+    only the lattice sum's own bias (predicted 1/|sum| = 1.0078 at coefh 1.0,
+    1.0062 at 1.2).  mDBC no-slip walls.  Measured centre-line +0.92 / +0.86 /
+    +0.84 % (20 / 30 / 40 across, coefh 1.0), +0.82 / +0.70 / +0.66 %
+    (coefh 1.2); largest transient error 0.72 / 0.60 / 0.55 % of u_max."""
+    times = (0.0225, 0.045, 0.1125, 0.225)      # Morris et al. 1997 Fig. 2, t nu / d^2
+    for n, coefh in ((30, 1.0), (30, 1.2)):
+        r = run_poiseuille(n, slip=2, eta=0.0, coefh=coefh, sample_times=times)
+        pred = 1.0 / abs(laplacian_lattice_sum(coefh, eta2=0.0))
+        print("S9 n=%d coefh %.1f ViscoLaminarEta 0: centre-line %+.2f %% (lattice prediction %+.2f %%), "
+              "transient max error %s %% of u_max"
+              % (n, coefh, 100 * (r["uc"] - 1), 100 * (pred - 1), [round(100 * e, 2) for e in r["transient"]]))
+        assert r["n"] == r["n0"] and r["wmax"] < 1e-3
+        assert abs(r["uc"] - 1) < 0.01
+        assert abs(r["uc"] - pred) < 1.5e-3
+        assert max(r["transient"]) < 0.02
+
+
+def test_s9_transient_series_dualsphysics_operator():
+    """The start-up transient against the Morris et al. (1997) series with
+    DualSPHysics's own operator (eta = 0.1 h): within 2 % of u_max at
+    t nu/d^2 = 0.0225 ... 0.225 (measured 0.18 / 0.23 / 0.59 / 1.38 % at 30
+    across); the error grows with t towards the steady +2.1 % bias."""
+    r = run_poiseuille(30, slip=2, sample_times=(0.0225, 0.045, 0.1125, 0.225), t_end=0.225 * D * D / NU)
+    print("S9 transient, eta 0.1 h: max error %s %% of u_max" % [round(100 * e, 2) for e in r["transient"]])
+    assert max(r["transient"]) < 0.02
+    assert r["transient"][0] < r["transient"][-1]
 
 
 @pytest.mark.slow
