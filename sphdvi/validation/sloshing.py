@@ -81,3 +81,29 @@ def case_periods(outdir: str, length: float = 1.0, gauge: str = "Left") -> dict:
     return {"period_theory": linear_period(length_eff, depth_eff, g), "period_com": period_com,
             "period_gauge": period_gauge, "decay": decay, "length_eff": length_eff, "depth_eff": depth_eff,
             "dp": dp}
+
+
+def viscous_decay_per_period(length: float, depth: float, nu: float, g: float = 9.81,
+                             no_slip_walls: bool = True) -> dict:
+    """Linear-theory amplitude loss per period of sloshing mode 1 in a 2D tank of viscosity ν.
+
+    Bulk dissipation of the potential flow decays the amplitude at 2νk² (Lamb 1932 §348);
+    no-slip walls add Stokes layers, each dissipating (ρ/2)√(νω/2)|U|² per unit area and
+    time (time-averaged, U the amplitude of the potential-flow slip velocity). With
+    φ ∝ cos(kx) cosh k(z + d), the bottom carries |U| = Ak|sin kx| and each end wall
+    |U| = Ak sinh k(z + d), Ak = aω/sinh kd; the standing wave holds E = ρ g a² L/4 per unit
+    width, and the amplitude decays at P/(2E). Returns the loss per period 1 − e^(−γT) of the
+    bulk, the walls (bottom and both end walls) and both together."""
+    k = math.pi / length
+    omega = 2 * math.pi / linear_period(length, depth, g)
+    period = 2 * math.pi / omega
+    gamma_bulk = 2 * nu * k * k
+    gamma_walls = 0.0
+    if no_slip_walls:
+        stokes = math.sqrt(nu * omega / 2)
+        ak2 = (omega / math.sinh(k * depth)) ** 2                     # (A k / a)^2
+        area = length / 2 + 2 * (math.sinh(2 * k * depth) - 2 * k * depth) / (4 * k)
+        power = 0.5 * stokes * ak2 * area                             # / (rho a^2)
+        gamma_walls = power / (2 * g * length / 4)
+    loss = lambda gam: 1.0 - math.exp(-gam * period)                  # noqa: E731
+    return {"bulk": loss(gamma_bulk), "walls": loss(gamma_walls), "total": loss(gamma_bulk + gamma_walls)}

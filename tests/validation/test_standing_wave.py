@@ -5,12 +5,15 @@ mDBC, Symplectic, α = 0.01, Fourtakas δ = 0.1, coefh 1.2) runs at d/dp = 20 an
 period is read from the horizontal centre of mass of the water and compared with theory for
 the tank the particles fill (L_eff = L − dp). TOLERANCES S7: within 1–2 % at d/dp ≥ 40.
 
-Measured: −1.46 % (d/dp = 20), −0.79 % (d/dp = 40). At coefh 1.0 (h = √2 dp) the period
-is ~5 % short at every resolution and does not converge with dp (−5.4 %, −4.6 %), with or
-without walls, whatever the initial condition, boundary condition, density diffusion, c0 or
-integrator; coefh 1.2, 1.5, 1.75, 2.0 give −1.1, +0.3, 0.0, +0.5 % (periodic channel,
-d/dp = 20). Amplitude loss per period 9.3 % (d/dp = 20) and 8.0 % (d/dp = 40), above the
-~5 % TOLERANCES judges normal at α = 0.01 (strict xfail). Slow (about 2 minutes): ``python -m pytest -m slow tests/validation``.
+Free-slip walls (mDBC SlipMode 3), as the inviscid theory assumes. Measured: −0.88 % (d/dp = 20),
+−0.71 % (d/dp = 40); amplitude loss 4.2 % and 4.0 % per period. With the default SlipMode 1 the
+walls carry Stokes layers of the artificial viscosity (ν_eff ≈ 0.46 α h c0/8 ≈ 1.1e-3 m²/s at
+d/dp = 20): period −1.46 / −0.72 %, loss 9.3 / 8.0 % per period, against 8.7 / 5.7 % from linear
+theory with ν_eff (bulk 2νk² plus the walls' Stokes layers, :func:`viscous_decay_per_period`).
+At coefh 1.0 (h = √2 dp) the period is ~5 % short at every resolution and does not converge with
+dp (−5.4 %, −4.6 %), with or without walls, whatever the initial condition, boundary condition,
+density diffusion, c0 or integrator; coefh 1.2, 1.5, 1.75, 2.0 give −1.1, +0.3, 0.0, +0.5 %
+(periodic channel, d/dp = 20). Slow (about 2 minutes): ``python -m pytest -m slow tests/validation``.
 """
 import math
 from pathlib import Path
@@ -19,7 +22,7 @@ import pytest
 from click.testing import CliRunner
 
 from sphdvi.cli import main
-from sphdvi.validation.sloshing import case_periods
+from sphdvi.validation.sloshing import case_periods, viscous_decay_per_period
 
 REPO = Path(__file__).resolve().parents[2]
 CASE = REPO / "cases" / "standingwave2d" / "CaseStandingWave2D_Def.xml"
@@ -52,18 +55,21 @@ def test_sloshing_period_within_2_percent_and_converging(runs):
 
 @pytest.mark.slow
 def test_damping_falls_with_dp(runs):
-    """Amplitude loss per period (fitted to the extrema): no growth, and less with finer dp,
-    as the artificial viscosity (ν ∝ α h c0) and the density diffusion shrink with h."""
+    """Amplitude loss per period (fitted to the extrema): no growth, and less with finer dp
+    (measured 4.2 → 4.0 %: barely; linear theory puts the bulk loss of ν_eff at 2.6 → 1.3 %,
+    the rest does not shrink with h and is not explained)."""
     d1, d2 = runs[0.025]["decay"], runs[0.0125]["decay"]
     print(f"S7 amplitude loss per period: d/dp=20 {100 * d1:.1f} %, d/dp=40 {100 * d2:.1f} %")
     assert 0.0 < d2 < d1
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S7 judgement: no damping above ~5 %/period at alpha = 0.01; "
-                                        "measured 9.3 % (d/dp = 20), 8.0 % (d/dp = 40)")
 def test_damping_below_5_percent_per_period(runs):
-    assert runs[0.0125]["decay"] <= 0.05
+    """TOLERANCES S7: no anomalous damping above ~5 %/period at alpha = 0.01 (free-slip walls);
+    at least the bulk loss linear theory gives for ν_eff (1.3 % at d/dp = 40)."""
+    bulk = viscous_decay_per_period(1 - 0.0125, 0.5, 0.46 * 0.01 * 1.2 * math.sqrt(2) * 0.0125 * 45 / 8,
+                                    no_slip_walls=False)["bulk"]
+    assert bulk < runs[0.0125]["decay"] <= 0.05
 
 
 @pytest.mark.slow
