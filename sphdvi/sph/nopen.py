@@ -52,6 +52,7 @@ step restarts the corrected components from it).
 import math
 
 from . import _env  # noqa: F401
+import numpy as np
 from numba import njit, prange
 
 from .integrators import _out_code
@@ -61,14 +62,39 @@ NCOL = 7
 
 
 @njit(cache=True, error_model="numpy")
+def _mark_range(j0, j1, ptype, cell, oi, normals, ncx, ncy, ncz, rs, dp, near):
+    """Flag the cells within ``rs`` cells of a first-layer wall particle."""
+    nlim2 = (0.875 * dp) ** 2
+    for j in range(j0, j1):
+        if ptype[j] >= 2:
+            continue
+        ob = oi[j]
+        n2 = normals[ob, 0] ** 2 + normals[ob, 1] ** 2 + normals[ob, 2] ** 2
+        if n2 == 0.0 or n2 >= nlim2:
+            continue
+        c = cell[j]
+        cx = c % ncx
+        cy = (c // ncx) % ncy
+        cz = c // (ncx * ncy)
+        for z in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
+            for y in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
+                row = (z * ncy + y) * ncx
+                for x in range(max(cx - rs, 0), min(cx + rs, ncx - 1) + 1):
+                    near[row + x] = 1
+
+
+@njit(cache=True, error_model="numpy")
 def _detect_range(i0, i1, is2d, nb, ptype, cell, oi, normals, wallvel, pos, cell_start,
-                  ncx, ncy, ncz, rs, dp, npshift):
+                  ncx, ncy, ncz, rs, dp, near, npshift):
     r2lim = (1.25 * dp) ** 2
     nlim = 0.875 * dp          # 2 |N| < 1.75 dp: first wall layer
     for i in range(i0, i1):
         if ptype[i] != 3:
             continue
         o = oi[i]
+        npshift[o, 3] = 0.0
+        if near[cell[i]] == 0:  # no first-layer wall particle within reach
+            continue
         if is2d:
             xi = nb[i, 0]
             yi = 0.0
@@ -140,8 +166,6 @@ def _detect_range(i0, i1, is2d, nb, ptype, cell, oi, normals, wallvel, pos, cell
             npshift[o, 3] = 1.0
             for k in range(3):
                 npshift[o, 4 + k] = pos[o, k]
-        else:
-            npshift[o, 3] = 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -150,9 +174,13 @@ def detect_serial(is2d, nb, ptype, cell, oi, normals, wallvel, pos, cell_start, 
     """Fill ``npshift`` (rows ``oi``) for every fluid row of the packed array ``nb``.
 
     ``ptype``, ``cell`` are per packed row; ``normals``, ``wallvel`` (the
-    boundary particles' own velocities) and ``pos`` per particle row."""
-    _detect_range(0, nb.shape[0], is2d, nb, ptype, cell, oi, normals, wallvel, pos, cell_start,
-                  ncx, ncy, ncz, rs, dp, npshift)
+    boundary particles' own velocities) and ``pos`` per particle row.  ``rs``
+    is the stencil radius in cells that covers 1.25 dp."""
+    n = nb.shape[0]
+    near = np.zeros(ncx * ncy * ncz, np.uint8)
+    _mark_range(0, n, ptype, cell, oi, normals, ncx, ncy, ncz, rs, dp, near)
+    _detect_range(0, n, is2d, nb, ptype, cell, oi, normals, wallvel, pos, cell_start,
+                  ncx, ncy, ncz, rs, dp, near, npshift)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -160,9 +188,14 @@ def detect_parallel(is2d, nb, ptype, cell, oi, normals, wallvel, pos, cell_start
                     ncz, rs, dp, npshift):
     """Threaded :func:`detect_serial`."""
     n = nb.shape[0]
-    for c in prange((n + CHUNK - 1) // CHUNK):
+    nchunk = (n + CHUNK - 1) // CHUNK
+    near = np.zeros(ncx * ncy * ncz, np.uint8)
+    for c in prange(nchunk):        # every writer stores 1: no race on the result
+        _mark_range(c * CHUNK, min(n, (c + 1) * CHUNK), ptype, cell, oi, normals, ncx, ncy, ncz,
+                    rs, dp, near)
+    for c in prange(nchunk):
         _detect_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, nb, ptype, cell, oi, normals,
-                      wallvel, pos, cell_start, ncx, ncy, ncz, rs, dp, npshift)
+                      wallvel, pos, cell_start, ncx, ncy, ncz, rs, dp, near, npshift)
 
 
 @njit(cache=True, error_model="numpy")

@@ -528,8 +528,10 @@ class SPHSolver:
         from . import nopen
         fn = nopen.detect_parallel if par else nopen.detect_serial
         ncx, ncy, ncz = self.cells.shape
+        # the correction reaches 1.25 dp: fewer cells than the 2h stencil when cells are of h
+        rs = min(int(self.cells.stencil), int(np.ceil(1.25 * self.dp / self.cells.cellsize - 1e-9)))
         fn(self.is2d, nb, ptype_rows, cell_rows, oi, normals, wallvel, pos, self.cells.cell_start,
-           ncx, ncy, ncz, int(self.cells.stencil), self.dp, npshift)
+           ncx, ncy, ncz, max(rs, 1), self.dp, npshift)
 
     def _nopen_apply(self, symplectic):
         """Apply the NoPenetration corrections after the integrator; returns the
