@@ -28,6 +28,9 @@ sum V v grad w) and the wall velocity v_w (the particle's own velocity):
   interpolated velocity vanishes relative to the wall on the surface);
 * 3, free-slip: v_b = v_w + u - 2 (u.n) n with u = v_g - v_w and n the unit
   normal (tangential velocity even, normal velocity odd about the wall).
+
+``NoPenetration`` (slip modes 2 and 3) corrects the fluid particles next to
+the walls, not the boundary particles: :mod:`sphdvi.sph.nopen`.
 """
 import math
 

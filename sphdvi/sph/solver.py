@@ -16,14 +16,17 @@ unknown keys are ignored):
   finite because grad W / r is finite at r = 0), DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
   ShiftAdvCoef (Shifting 4, :mod:`sphdvi.sph.shifting_adv`), CoefDtMin, DtIni, DtMin,
   DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
-  SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold and the periodic keys (XPeriodicIncY ...,
+  SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold,
+  NoPenetration (mDBC no-penetration correction of the fluid next to the walls,
+  :mod:`sphdvi.sph.nopen`; as DualSPHysics, only with Boundary=2 and SlipMode 2
+  or 3: otherwise it is warned and ignored) and the periodic keys (XPeriodicIncY ...,
   XYPeriodic ...; see the ``periodic`` argument).
 
 DtFixedFile is passed as ``dt_table`` (the case reader loads the file);
 DtAllParticles selects the particles whose speed limits dt.
 
 Not implemented: ShiftAdvALE and ShiftAdvNCPress of Shifting 4 (warned and
-ignored), mDBC NoPenetration.
+ignored).
 """
 import warnings
 
@@ -175,6 +178,13 @@ class SPHSolver:
         if self.slip not in (1, 2, 3):
             raise ValueError("SlipMode must be 1 (DBC velocity), 2 (no-slip) or 3 (free-slip)")
         self.mdbc_ksum = float(p.get("MdbcThreshold") or 0.0)
+        # NoPenetration: DualSPHysics reads it only for its mDBC2 slip modes (2, 3)
+        self.nopen = bool(int(p.get("NoPenetration") or 0))
+        if self.nopen and (self.boundary != 2 or self.slip == 1):
+            warnings.warn("NoPenetration=1 needs Boundary=2 (mDBC) with SlipMode 2 or 3; "
+                          "ignored (as DualSPHysics)")
+            self.nopen = False
+        self._need_nopen = True         # False in the Symplectic predictor (not corrected)
         self.kernel = int(p["Kernel"])
         self.visco_kind = int(p["ViscoTreatment"])
         self.ddt = int(p["DensityDT"])
@@ -335,6 +345,9 @@ class SPHSolver:
             self.fsnormal = np.zeros((n, 3))
             self._fs_work = self._shift_adv_work(n)
         self.gradvel = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
+        if self.nopen:
+            from .nopen import NCOL
+            self.npshift = np.zeros((n, NCOL))
         self.dtmax = np.zeros(((n + _ia.CHUNK - 1) // _ia.CHUNK, 3))
         self._bufs = {}
 
@@ -487,6 +500,9 @@ class SPHSolver:
             fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.normals, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
                self.mdbc_ksum, s.rhop, self.slip, self._mdbc_work(s.n))
+            if self.nopen and self._need_nopen:
+                self._nopen_detect(par, self.nb, ptype_rows, self.cell_sorted, oi, self.normals,
+                                   s.vel, s.pos, self.npshift)
         k["rates"](*self._rates_args())
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
@@ -510,6 +526,29 @@ class SPHSolver:
         fn(self.kernel, self.is2d, nb, ptype_rows, cell_rows, oi, self.cells.cell_start, ncx, ncy, ncz,
            self.cst, _sa.full_support_neighbours(self.h, self.dp, self.is2d), self.shift_adv_coef, self.dp,
            *work, shiftpos, fstype, fsnormal, np.zeros(0, np.int64) if src_row is None else src_row)
+
+    def _nopen_detect(self, par, nb, ptype_rows, cell_rows, oi, normals, wallvel, pos, npshift):
+        """NoPenetration: corrections of the fluid next to the walls (sphdvi.sph.nopen)."""
+        from . import nopen
+        fn = nopen.detect_parallel if par else nopen.detect_serial
+        ncx, ncy, ncz = self.cells.shape
+        # the correction reaches 1.25 dp: fewer cells than the 2h stencil when cells are of h
+        rs = min(int(self.cells.stencil), int(np.ceil(1.25 * self.dp / self.cells.cellsize - 1e-9)))
+        fn(self.is2d, nb, ptype_rows, cell_rows, oi, normals, wallvel, pos, self.cells.cell_start,
+           ncx, ncy, ncz, max(rs, 1), self.dp, npshift)
+
+    def _nopen_apply(self, symplectic):
+        """Apply the NoPenetration corrections after the integrator; returns the
+        change in the number of particles flagged for exclusion."""
+        from . import nopen
+        s = self.state
+        par = self._use_parallel(light=True)
+        if symplectic:
+            fn = nopen.apply_symplectic_parallel if par else nopen.apply_symplectic_serial
+            return fn(s.pos, s.vel, self.pos_pre, self.vel_pre, s.rhop, s.ptype, self.npshift,
+                      self.ip, self.out)
+        fn = nopen.apply_verlet_parallel if par else nopen.apply_verlet_serial
+        return fn(s.pos, s.vel, self.vel_m1, s.rhop, s.ptype, self.npshift, self.ip, self.out)
 
     def _mdbc_work(self, n):
         """(n, 3) work array for the slip-mode velocities (kept between steps)."""
@@ -560,6 +599,12 @@ class SPHSolver:
                self.mdbc_ksum, rhop_e, self.slip, self._mdbc_work(ne))
             bound = (order < n) & (ptype_e < 2)
             s.rhop[order[bound]] = rhop_e[bound]
+            if self.nopen and self._need_nopen:
+                ar_e = np.arange(ne)
+                npshift = np.zeros((ne, self.npshift.shape[1]))
+                self._nopen_detect(par, nb, ptype_e, cell_e, ar_e, normals_e, vel_e, pos_e, npshift)
+                real_rows = order < n
+                self.npshift[order[real_rows]] = npshift[real_rows]
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
         k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, nb, ptype_e, cell_e,
                    np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,
@@ -647,6 +692,8 @@ class SPHSolver:
         self._verlet_count = 0 if euler else self._verlet_count + 1
         k = self._integrators(self._use_parallel(light=True))
         nout = k["verlet"](*self._verlet_args(euler))
+        if self.nopen:
+            nout += self._nopen_apply(False)
         if nout:
             self._exclude()
         return dt
@@ -656,13 +703,17 @@ class SPHSolver:
         self._set_ip(dt)
         s = self.state
         self._need_shift_adv = False
+        self._need_nopen = False
         self.compute_rates()
         self._need_shift_adv = True
+        self._need_nopen = True
         k = self._integrators(self._use_parallel(light=True))
         k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
                      self.ace, self.ar, s.ptype, self.ip)
         self.compute_rates()
         nout = k["sym_corr"](*self._corr_args())
+        if self.nopen:
+            nout += self._nopen_apply(True)
         self.dt_pre = self._variable_dt(self.time + dt)
         if nout:
             self._exclude()
