@@ -24,14 +24,25 @@ kernel sums over its neighbours ``b`` found through the cell list:
   fluid-fluid pairs on all fluid particles;
 * the viscous time-step term max_b h v_ab.r_ab/(r_ab^2+eta^2);
 * shifting sums (Lind et al. 2012): grad C_a = sum_b m_b/rho_b grad_a W_ab and
-  the free-surface detector div r_a = -sum_b m_b/rho_b r_ab.grad_a W_ab.
+  the free-surface detector div r_a = -sum_b m_b/rho_b r_ab.grad_a W_ab;
+* advanced shifting options (``adv``, Shifting 4; DualSPHysics 5.4, Sun et al.
+  2019), fluid particles only, V_b = m_b/rho_b, dv = shiftpos/dt (cst[20] = 1/dt;
+  dv_b = 0 for boundary and floating b):
+  ALE (adv & 1): drho_a/dt += sum_b V_b (rho_a dv_a + rho_b dv_b).grad_a W_ab
+  + rho_a sum_b V_b (dv_a - dv_b).grad_a W_ab (SPH forms of div(rho dv) - rho div dv),
+  dv_a/dt += rho0/rho_a sum_b V_b (v_a dv_a + v_b dv_b).grad_a W_ab
+  + v_a sum_b V_b (dv_a - dv_b).grad_a W_ab (of (div(rho v (x) dv) - v div(rho dv))/rho);
+  NCPress (adv & 2): where ``nctype`` is 1 and the Shepard sum
+  sum_b V_b W_ab + V_a W(0) exceeds 0.95, the pressure term is
+  L^-1 sum_b m_b (p_a - p_b)/(rho_a rho_b) grad_a W_ab, L = -sum_b V_b r_ab (x) grad_a W_ab
+  (exact for a linear pressure field), instead of the symmetric one.
 
 Boundary particles (DBC; ptype 0 fixed, 1 moving) get continuity only, from
 their fluid and floating neighbours.  Floating particles (ptype 2) interact
 with fluid only; their ``ace`` excludes gravity (the body solver adds it).
 
 Feature flags are ``numba.literally`` arguments (compile-time constants):
-kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3.  The 2D (x-z plane) and 3D
+kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, adv 0..3.  The 2D (x-z plane) and 3D
 paths are separate functions.
 """
 import math

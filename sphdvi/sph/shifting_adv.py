@@ -33,16 +33,41 @@ Marrone et al. 2010):
 
 Particle types written to ``fstype``: 0 interior (shifted), 1 near the free
 surface, 2 free surface, 3 isolated or touching a boundary; ``fsnormal`` gets the unit normal of
-types 2 and 3 (zero elsewhere).  DualSPHysics's optional ALE terms
-(``ShiftAdvALE``, which also shifts surface particles tangentially) and
-non-conservative pressure (``ShiftAdvNCPress``) are not implemented; the
-solver warns when a case asks for them.  Where DualSPHysics's 2D umbrella test
+types 2 and 3 (zero elsewhere).  Where DualSPHysics's 2D umbrella test
 and isolated-particle test differ from the papers' definitions, the papers'
 are used.  DualSPHysics also shifts interior particles next to a wall; near a
 thin DBC wall, whose missing kernel support makes grad C point away from it,
 that pushes particles through (17 of 5,500 left the 2D dam break through its
 one-layer walls in 0.72 s), so particles touching a boundary are not shifted
 here.
+
+``ShiftAdvALE`` / ``ShiftAdvNCPress`` (DualSPHysics 5.4, ``JSphCpu_preloop.cpp``
+ComputeShiftingVel and ``JSphCpu.cpp`` InteractionForcesFluid; Sun et al. 2019)
+use :func:`advanced_shift_ale_serial`, which follows DualSPHysics's
+classification: a near-surface particle touching a boundary is type 3; the
+interior type-0 particles are flagged in ``nctype`` for the non-conservative
+pressure gradient (with DBC walls only those without a boundary particle in
+their support, see :func:`_displace_ale_range`).  With ALE:
+
+* near-surface (1) and surface (2) particles are shifted too, along
+  :math:`\mathbf s = \nabla C - \theta\,\mathbf n(\mathbf n\cdot\nabla C)`,
+  :math:`\theta = \min(1, \max(0, (2h - d)/h))`, d the distance to the
+  nearest surface particle (2h when none); the normal of a type-1 particle is
+  the :math:`V_j W_{ij}`-weighted mean of its surface neighbours' normals;
+  surface particles touching a boundary or whose normal turns by more than
+  0.52 rad against a neighbouring candidate's are not shifted;
+* the magnitude is :math:`u = \min(A h, \epsilon/(2 |\nabla C\cdot\mathbf s| m))\,m`,
+  :math:`m = \min(h, d)` (= h for the interior, as above), capped at 0.1 dp per
+  component;
+* the interaction (:mod:`sphdvi.sph.interaction`) adds the ALE terms with the
+  shifting velocity :math:`\delta\mathbf v = \delta\mathbf r/\Delta t`.
+
+In these runs the shift and types are computed before the interaction that
+uses them: in the Symplectic predictor, from the positions at t^n, kept for the
+corrector and applied in it (DualSPHysics's order; plain Shifting 4 evaluates
+them in the corrector, at the half step); with Verlet every step, the ALE
+velocity taking the previous step's dt (DualSPHysics runs advanced shifting with
+Symplectic only: its Verlet step ignores it).
 """
 import math
 
@@ -388,14 +413,17 @@ def _ale_scan_range(i0, i1, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, n
 
 
 @njit(cache=True, error_model="numpy")
-def _displace_ale_range(i0, i1, is2d, ale, ptype, oi, cst, coef, dp, fst, nrm, gc, near, bnd, mind, nsm,
-                        curv, shiftpos, fstype_out, normal_out, nctype_out):
+def _displace_ale_range(i0, i1, is2d, ale, nc_bnd, ptype, oi, cst, coef, dp, fst, nrm, gc, near, bnd, mind,
+                        nsm, curv, shiftpos, fstype_out, normal_out, nctype_out):
     """Final type, displacement, normal and non-conservative-pressure flag of rows i0..i1
     when ShiftAdvALE or ShiftAdvNCPress is on (DualSPHysics ComputeShiftingVel).
 
     ``nctype_out`` is 1 for DualSPHysics's interior type (not a surface, near-surface
-    or isolated particle; a boundary in the support does not matter), the particles
-    on which ShiftAdvNCPress may use the non-conservative pressure gradient.  With
+    or isolated particle), the particles on which ShiftAdvNCPress may use the
+    non-conservative pressure gradient; those with a boundary particle in their
+    support only when ``nc_bnd`` (mDBC: with DBC walls the non-conservative form,
+    which lacks the p_a + p_b repulsion that DBC relies on, draws fluid into the
+    walls wherever a wall particle's pressure is below the fluid's).  With
     ``ale`` the near-surface (type 1) and surface (type 2) particles are shifted too,
     along s = grad C - theta n (n . grad C), theta = clamp((2h - d)/h, 0, 1), d the
     distance to the nearest surface particle; the magnitude is scaled by min(h, d)
@@ -421,7 +449,8 @@ def _displace_ale_range(i0, i1, is2d, ale, ptype, oi, cst, coef, dp, fst, nrm, g
                     for k in range(3):
                         normal_out[o, k] = nsm[i, k] / sn
         if t == 0:
-            nctype_out[o] = 1
+            if nc_bnd or not bnd[i]:
+                nctype_out[o] = 1
             if bnd[i]:
                 t = 3       # sphdvi: interior particles touching a boundary are not shifted
         fstype_out[o] = t
@@ -458,8 +487,20 @@ def _displace_ale_range(i0, i1, is2d, ale, ptype, oi, cst, coef, dp, fst, nrm, g
 
 
 @njit(cache=True, error_model="numpy")
-def advanced_shift_ale_serial(kern, is2d, ale, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst, nzero,
-                              coef, dp, fst, nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out,
+def _copy_source_normals(nrm, src_row):
+    """Periodic copies take their real particle's normal (their own, from a support
+    truncated by the end of the extended set, may point anywhere)."""
+    n = nrm.shape[0]
+    if src_row.shape[0] == n:
+        for i in range(n):
+            r = src_row[i]
+            for k in range(3):
+                nrm[i, k] = nrm[r, k]
+
+
+@njit(cache=True, error_model="numpy")
+def advanced_shift_ale_serial(kern, is2d, ale, nc_bnd, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst,
+                              nzero, coef, dp, fst, nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out,
                               normal_out, nctype_out, src_row):
     """:func:`advanced_shift_serial` for ShiftAdvALE / ShiftAdvNCPress runs (see
     :func:`_displace_ale_range`)."""
@@ -467,15 +508,16 @@ def advanced_shift_ale_serial(kern, is2d, ale, nb, ptype, cell, oi, cell_start, 
     _detect_range(0, n, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, nzero, fst, nrm, gc,
                   near, bnd)
     _copy_source_types(fst, src_row)
+    _copy_source_normals(nrm, src_row)
     _ale_scan_range(0, n, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, fst, nrm, near, mind,
                     nsm, curv)
-    _displace_ale_range(0, n, is2d, ale, ptype, oi, cst, coef, dp, fst, nrm, gc, near, bnd, mind, nsm, curv,
-                        shiftpos, fstype_out, normal_out, nctype_out)
+    _displace_ale_range(0, n, is2d, ale, nc_bnd, ptype, oi, cst, coef, dp, fst, nrm, gc, near, bnd, mind, nsm,
+                        curv, shiftpos, fstype_out, normal_out, nctype_out)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def advanced_shift_ale_parallel(kern, is2d, ale, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst, nzero,
-                                coef, dp, fst, nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out,
+def advanced_shift_ale_parallel(kern, is2d, ale, nc_bnd, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst,
+                                nzero, coef, dp, fst, nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out,
                                 normal_out, nctype_out, src_row):
     """Threaded :func:`advanced_shift_ale_serial`."""
     n = nb.shape[0]
@@ -484,12 +526,13 @@ def advanced_shift_ale_parallel(kern, is2d, ale, nb, ptype, cell, oi, cell_start
         _detect_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype, cell, cell_start,
                       ncx, ncy, ncz, cst, nzero, fst, nrm, gc, near, bnd)
     _copy_source_types(fst, src_row)
+    _copy_source_normals(nrm, src_row)
     for c in prange(nchunk):
         _ale_scan_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype, cell, cell_start,
                         ncx, ncy, ncz, cst, fst, nrm, near, mind, nsm, curv)
     for c in prange(nchunk):
-        _displace_ale_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, ale, ptype, oi, cst, coef, dp, fst, nrm,
-                            gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out, normal_out, nctype_out)
+        _displace_ale_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, ale, nc_bnd, ptype, oi, cst, coef, dp, fst,
+                            nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out, normal_out, nctype_out)
 
 
 def full_support_neighbours(h, dp, is2d):

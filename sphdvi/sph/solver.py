@@ -521,9 +521,10 @@ class SPHSolver:
         nzero = _sa.full_support_neighbours(self.h, self.dp, self.is2d)
         if self.adv:
             fn = _sa.advanced_shift_ale_parallel if par else _sa.advanced_shift_ale_serial
-            fn(self.kernel, self.is2d, bool(self.adv & 1), nb, ptype_rows, cell_rows, oi, self.cells.cell_start,
-               ncx, ncy, ncz, self.cst, nzero, self.shift_adv_coef, self.dp, *work, shiftpos, fstype, fsnormal,
-               nctype, src)
+            # NCPress next to walls only with mDBC (see shifting_adv._displace_ale_range)
+            fn(self.kernel, self.is2d, bool(self.adv & 1), self.boundary == 2, nb, ptype_rows, cell_rows, oi,
+               self.cells.cell_start, ncx, ncy, ncz, self.cst, nzero, self.shift_adv_coef, self.dp, *work,
+               shiftpos, fstype, fsnormal, nctype, src)
             return
         fn = _sa.advanced_shift_parallel if par else _sa.advanced_shift_serial
         fn(self.kernel, self.is2d, nb, ptype_rows, cell_rows, oi, self.cells.cell_start, ncx, ncy, ncz,
