@@ -386,6 +386,56 @@ def test_options_are_validated_and_not_warned():
         periodic_box(6, 6, {"ShiftAdvALE": 2})
 
 
+@pytest.mark.parametrize("alg", [1, 2])
+def test_ale_ncpress_parallel_kernels_bitwise_equal_serial(alg):
+    """Gather form: the threaded shifting pass and interaction give bitwise the serial result."""
+    import numba
+    st, c = tank_2d(0.4, 0.4, 0.2, 0.3, 0.02)
+    p = {"StepAlgorithm": alg, "DensityDT": 2, "Shifting": 4, "ShiftAdvALE": 1, "ShiftAdvNCPress": 1}
+    ser = SPHSolver(st.copy(), c, p, parallel_threshold=10 ** 9)
+    par = SPHSolver(st.copy(), c, p, parallel_threshold=0)
+    old = numba.get_num_threads()
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    try:
+        for _ in range(30):
+            assert ser.step() == par.step()
+    finally:
+        numba.set_num_threads(old)
+    a, b = ser.state.sorted_by_idp(), par.state.sorted_by_idp()
+    assert np.array_equal(a.pos, b.pos) and np.array_equal(a.vel, b.vel)
+    assert np.array_equal(a.rhop, b.rhop)
+
+
+def test_periodic_ale_ncpress_rates_do_not_depend_on_where_the_period_starts():
+    """x-periodic layer with a free surface on top and bottom, perturbed: moving every
+    particle by a third of the period (wrapped) changes neither the types, the shift,
+    the non-conservative flags nor the rates of any particle (ghost copies take their
+    real particle's type, normal, shift and flag)."""
+    rng = np.random.default_rng(11)
+    pos0 = lattice(30, 16) + rng.uniform(-0.1, 0.1, (480, 3)) * DP * np.array([1, 0, 1])
+    n = pos0.shape[0]
+    vel = rng.normal(0, 0.1, (n, 3)) * np.array([1, 0, 1])
+    out = []
+    for off in (0.0, 10 * DP):
+        pos = pos0.copy()
+        pos[:, 0] = (pos[:, 0] + off) % (30 * DP)
+        st = FluidState(pos, vel, np.full(n, RHO0), np.full(n, RHO0 * DP * DP), np.full(n, 3, np.int8))
+        sol = SPHSolver(st, consts(), {"Shifting": 4, "ShiftAdvALE": 1, "ShiftAdvNCPress": 1, "DensityDT": 0,
+                                       "XPeriodicIncZ": 0.0}, periodic=["x"])
+        # the period starts at the lowest coordinate, so both runs have the same box length
+        sol.periodicity.lo[0] = 0.0
+        sol.periodicity.length[0] = sol.periodicity.shift[0, 0] = 30 * DP
+        sol.cst[20] = 1.0 / 1e-3
+        sol.compute_rates()
+        out.append(sol)
+    a, b = out
+    assert np.array_equal(a.fstype, b.fstype) and np.array_equal(a.nctype, b.nctype)
+    assert a.nctype.sum() > 50 and (a.fstype == 1).sum() > 50
+    np.testing.assert_allclose(a.shiftpos, b.shiftpos, rtol=0, atol=1e-12 * DP)
+    np.testing.assert_allclose(a.ace, b.ace, rtol=0, atol=1e-9 * np.abs(a.ace).max())
+    np.testing.assert_allclose(a.ar, b.ar, rtol=0, atol=1e-9 * np.abs(a.ar).max())
+
+
 # --------------------------------------------------------------------------
 # Settling tanks
 # --------------------------------------------------------------------------
