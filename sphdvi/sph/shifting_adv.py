@@ -362,23 +362,26 @@ def _ale_scan_range(i0, i1, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, n
     fluid particle is within the support, ``mind`` the distance to the nearest one
     (2h when none), ``nsm`` their normals summed with weights V_j W_ij, and ``curv`` 1
     when i is a candidate (type 2 or 3) with a candidate neighbour whose normal makes
-    more than 0.52 rad with its own."""
+    more than 0.52 rad with its own.  Only the rows that :func:`_mark_near_range`
+    flagged (``near`` on entry) and the candidates are scanned: the others have none
+    of these neighbours."""
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
     alpha = cst[3]
     rs = int(cst[18])
     for i in range(i0, i1):
+        flagged = near[i] != 0
         near[i] = 0
         curv[i] = 0
         mind[i] = 2.0 * h
         for k in range(3):
             nsm[i, k] = 0.0
-        if ptype[i] != 3:
+        cand = fst[i] >= 2
+        if ptype[i] != 3 or not (flagged or cand):
             continue
         xi, yi, zi = _row_xyz(nb, i, is2d)
         cx, cy, cz = _cell_xyz(cell[i], ncx, ncy)
-        cand = fst[i] >= 2
         dmin2 = r2max
         nx = 0.0
         ny = 0.0
@@ -509,6 +512,7 @@ def advanced_shift_ale_serial(kern, is2d, ale, nc_bnd, nb, ptype, cell, oi, cell
                   near, bnd)
     _copy_source_types(fst, src_row)
     _copy_source_normals(nrm, src_row)
+    _mark_near_range(0, n, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, fst, near)
     _ale_scan_range(0, n, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, fst, nrm, near, mind,
                     nsm, curv)
     _displace_ale_range(0, n, is2d, ale, nc_bnd, ptype, oi, cst, coef, dp, fst, nrm, gc, near, bnd, mind, nsm,
@@ -527,6 +531,9 @@ def advanced_shift_ale_parallel(kern, is2d, ale, nc_bnd, nb, ptype, cell, oi, ce
                       ncx, ncy, ncz, cst, nzero, fst, nrm, gc, near, bnd)
     _copy_source_types(fst, src_row)
     _copy_source_normals(nrm, src_row)
+    for c in prange(nchunk):
+        _mark_near_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, nb, ptype, cell, cell_start,
+                         ncx, ncy, ncz, cst, fst, near)
     for c in prange(nchunk):
         _ale_scan_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype, cell, cell_start,
                         ncx, ncy, ncz, cst, fst, nrm, near, mind, nsm, curv)
