@@ -123,21 +123,26 @@ def test_poiseuille_laminar_periodic():
     assert e30 < e20
 
 
-def laplacian_lattice_sum(coefh=1.0, eta2=0.01):
-    """sum_b V_b z_ab^2 (r_ab . grad W_ab) / (r_ab^2 + eta^2 h^2) on a square
-    lattice (Wendland 2D): -1 for an exact Laplacian of a quadratic profile.
-    The laminar term's steady centre-line speed is u_max / |sum|."""
-    dp = 1.0
-    h = coefh * math.sqrt(2) * dp
-    r = int(2 * h / dp) + 1
+def wendland_lattice_pairs(coefh):
+    """Neighbours of a particle on a unit square lattice (dp = 1, V_b = 1) within 2h,
+    h = coefh sqrt(2): h, x, z, r and F(r) = (dW/dr)/r of the 2D Wendland kernel."""
+    h = coefh * math.sqrt(2)
+    r = int(2 * h) + 1
     i, j = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1))
-    x, z = (i * dp).ravel(), (j * dp).ravel()
+    x, z = i.ravel().astype(float), j.ravel().astype(float)
     rr = np.hypot(x, z)
     keep = (rr > 0) & (rr < 2 * h)
     x, z, rr = x[keep], z[keep], rr[keep]
     q = rr / h
-    dwdr = 7 / (4 * math.pi * h * h) * (-5 * q) * (1 - q / 2) ** 3 / h
-    return float(np.sum(dp * dp * z * z * rr * dwdr / (rr * rr + eta2 * h * h)))
+    return h, x, z, rr, 7 / (4 * math.pi * h * h) * (-5 * q) * (1 - q / 2) ** 3 / (h * rr)
+
+
+def laplacian_lattice_sum(coefh=1.0, eta2=0.01):
+    """sum_b V_b z_ab^2 (r_ab . grad W_ab) / (r_ab^2 + eta^2 h^2) on a square
+    lattice (Wendland 2D): -1 for an exact Laplacian of a quadratic profile.
+    The laminar term's steady centre-line speed is u_max / |sum|."""
+    h, x, z, rr, f = wendland_lattice_pairs(coefh)
+    return float(np.sum(z * z * rr * rr * f / (rr * rr + eta2 * h * h)))
 
 
 def test_poiseuille_mdbc_no_slip():
@@ -188,17 +193,8 @@ def monaghan_lattice_ratio(coefh=1.0, eta2=0.01, approaching_only=True):
     the sum is -1/4 and nu_eff = alpha h c0/8 (Monaghan 2005, 2D).  With the
     switch v_ab.r_ab < 0 only approaching pairs act; for each row z exactly
     one of the two sides +-x approaches, so the sum halves."""
-    dp = 1.0
-    h = coefh * math.sqrt(2) * dp
-    r = int(2 * h / dp) + 1
-    i, j = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1))
-    x, z = (i * dp).ravel(), (j * dp).ravel()
-    rr = np.hypot(x, z)
-    keep = (rr > 0) & (rr < 2 * h)
-    x, z, rr = x[keep], z[keep], rr[keep]
-    q = rr / h
-    f = 7 / (4 * math.pi * h * h) * (-5 * q) * (1 - q / 2) ** 3 / (h * rr)
-    ratio = -0.5 * h * float(np.sum(dp * dp * x * x * z * z * f / (rr * rr + eta2 * h * h))) * 8 / h
+    h, x, z, rr, f = wendland_lattice_pairs(coefh)
+    ratio = -0.5 * h * float(np.sum(x * x * z * z * f / (rr * rr + eta2 * h * h))) * 8 / h
     return ratio * (0.5 if approaching_only else 1.0)
 
 
