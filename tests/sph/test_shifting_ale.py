@@ -21,6 +21,8 @@ import math
 import numpy as np
 import pytest
 
+from _helpers import assert_threaded_equals_serial
+
 from sphdvi.sph import SPHSolver
 from sphdvi.sph.scenes import shepard_pressure, tank_2d
 from sphdvi.sph.state import FluidState
@@ -389,21 +391,9 @@ def test_options_are_validated_and_not_warned():
 @pytest.mark.parametrize("alg", [1, 2])
 def test_ale_ncpress_parallel_kernels_bitwise_equal_serial(alg):
     """Gather form: the threaded shifting pass and interaction give bitwise the serial result."""
-    import numba
     st, c = tank_2d(0.4, 0.4, 0.2, 0.3, 0.02)
-    p = {"StepAlgorithm": alg, "DensityDT": 2, "Shifting": 4, "ShiftAdvALE": 1, "ShiftAdvNCPress": 1}
-    ser = SPHSolver(st.copy(), c, p, parallel_threshold=10 ** 9)
-    par = SPHSolver(st.copy(), c, p, parallel_threshold=0)
-    old = numba.get_num_threads()
-    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    try:
-        for _ in range(30):
-            assert ser.step() == par.step()
-    finally:
-        numba.set_num_threads(old)
-    a, b = ser.state.sorted_by_idp(), par.state.sorted_by_idp()
-    assert np.array_equal(a.pos, b.pos) and np.array_equal(a.vel, b.vel)
-    assert np.array_equal(a.rhop, b.rhop)
+    assert_threaded_equals_serial(st, c, {"StepAlgorithm": alg, "DensityDT": 2, "Shifting": 4, "ShiftAdvALE": 1,
+                                          "ShiftAdvNCPress": 1})
 
 
 def test_periodic_ale_ncpress_rates_do_not_depend_on_where_the_period_starts():
