@@ -583,9 +583,21 @@ def _warm_up(sph: "SPHRun") -> float:
 
 
 def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start) -> RunResult:
+    """The SPH run on ``threads`` numba threads; the caller's thread count is
+    restored afterwards (an in-process run must not change it for the rest of
+    the process, e.g. a test session)."""
+    import numba
+    previous = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    try:
+        return _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
+    finally:
+        numba.set_num_threads(previous)
+
+
+def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start) -> RunResult:
     import numba
     from .io.vtkhdf import VTKHDFParticleWriter
-    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     sph = SPHRun(data, params, outdir)
     sol = sph.solver
     tmax, tout = float(params["TimeMax"]), float(params["TimeOut"])

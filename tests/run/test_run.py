@@ -67,6 +67,24 @@ def test_run_outputs(tmp_path):
     assert len(list((out / "vtp").glob("Part_*.vtp"))) == 5
 
 
+def test_run_restores_the_callers_thread_count(tmp_path):
+    """An in-process run sets numba's thread count for itself and puts the
+    caller's back (a test session would otherwise run on --threads 1 after it)."""
+    import numba
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba has one thread")
+    previous = numba.get_num_threads()
+    numba.set_num_threads(2)
+    try:
+        r = invoke(["run", small_case(tmp_path), "-o", tmp_path / "out", "--tmax", "0.004", "--tout", "0.002",
+                    "--threads", "1", "-q"])
+        assert r.exit_code == 0, r.output
+        assert json.loads((tmp_path / "out" / "run.json").read_text())["threads"] == 1
+        assert numba.get_num_threads() == 2
+    finally:
+        numba.set_num_threads(previous)
+
+
 def test_set_overrides_and_bad_set(tmp_path):
     case = small_case(tmp_path)
     r = invoke(["run", case, "-o", tmp_path / "o", "--tmax", "0.002", "--set", "Visco=0.05",
