@@ -30,8 +30,14 @@ Boundary particles (DBC; ptype 0 fixed, 1 moving) get continuity only, from
 their fluid and floating neighbours.  Floating particles (ptype 2) interact
 with fluid only; their ``ace`` excludes gravity (the body solver adds it).
 
+mDBC slip modes 2 and 3 (flag mdbc2 = 1, :mod:`sphdvi.sph.mdbc`): for a wall
+neighbour the continuity term keeps the wall's own (motion) velocity, while
+the viscosity and the viscous time-step term see the wall's tangential
+velocity ``tvel`` (one row per packed row); walls switched off by mDBC carry
+zero packed mass.
+
 Feature flags are ``numba.literally`` arguments (compile-time constants):
-kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3.  The 2D (x-z plane) and 3D
+kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, mdbc2 0/1.  The 2D (x-z plane) and 3D
 paths are separate functions.
 """
 import math
@@ -201,13 +207,14 @@ def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c):
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
+def _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
-                       gradvel):
+                       gradvel, tvel):
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    mdbc2 = literally(mdbc2)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
@@ -311,11 +318,16 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
                 dvx = vxi - nb[j, 2]
                 dvz = vzi - nb[j, 3]
                 dot = dvx * dx + dvz * dz
+                # continuity: rho_a m_b/rho_b v_ab.gradW (rho_a applied at the end)
+                arp += mfac * dot * irj
+                if mdbc2 == 1 and boundj:
+                    # mDBC2: the viscosity sees the wall's tangential velocity (sphdvi.sph.mdbc)
+                    dvx = vxi - tvel[j, 0]
+                    dvz = vzi - tvel[j, 2]
+                    dot = dvx * dx + dvz * dz
                 ir2e = 1.0 / (r2 + eta2)
                 dot_rr2 = dot * ir2e
                 vmax = max(vmax, dot_rr2)
-                # continuity: rho_a m_b/rho_b v_ab.gradW (rho_a applied at the end)
-                arp += mfac * dot * irj
                 # symmetric pressure term
                 coef = -(pi + pj) * iri * irj
                 if kern == 1:
@@ -394,8 +406,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
 
 
 @njit(cache=True, error_model="numpy")
-def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
+def rates_2d_serial(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
     """Serial driver of the 2D interaction (use below ~10k particles).
 
     Chunk c of CHUNK rows also leaves its time-step maxima in dtmax[c]
@@ -404,31 +416,33 @@ def rates_2d_serial(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, nc
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
-                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel)
         _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
+def rates_2d_parallel(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
     """Threaded driver of the 2D interaction (prange over chunks of particles)."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
-                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel)
         _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
@@ -436,13 +450,14 @@ def rates_2d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, 
 # 3D
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
+def _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
-                       gradvel):
+                       gradvel, tvel):
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    mdbc2 = literally(mdbc2)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
@@ -567,10 +582,15 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
                     dvy = vyi - nb[j, 4]
                     dvz = vzi - nb[j, 5]
                     dot = dvx * dx + dvy * dy + dvz * dz
+                    arp += mfac * dot * irj
+                    if mdbc2 == 1 and boundj:
+                        dvx = vxi - tvel[j, 0]
+                        dvy = vyi - tvel[j, 1]
+                        dvz = vzi - tvel[j, 2]
+                        dot = dvx * dx + dvy * dy + dvz * dz
                     ir2e = 1.0 / (r2 + eta2)
                     dot_rr2 = dot * ir2e
                     vmax = max(vmax, dot_rr2)
-                    arp += mfac * dot * irj
                     coef = -(pi + pj) * iri * irj
                     if kern == 1:
                         wr = kernel_w(1, q, alpha) * od_wdp
@@ -661,39 +681,43 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_s
 
 
 @njit(cache=True, error_model="numpy")
-def rates_3d_serial(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
+def rates_3d_serial(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
     """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows);
     time-step maxima per chunk in dtmax as :func:`rates_2d_serial`."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
-                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel,
+                        tvel)
         _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_3d_parallel(kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax):
+def rates_3d_parallel(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
     """Threaded driver of the 3D interaction."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, nb, ptype, cell, oi, cell_start,
-                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel,
+                        tvel)
         _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 

@@ -152,6 +152,12 @@ class SPHSolver:
             if normals is None:
                 raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
             self.normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(state.n, 3).copy()
+        # mDBC2 (SlipMode 2, 3) with moving walls: their acceleration, for the pressure cloning
+        self._wall_ace_on = self.boundary == 2 and self.slip > 1 and bool(np.any(state.ptype == 1))
+        if self._wall_ace_on:
+            self.wall_ace = np.zeros((state.n, 3))
+        self._no_wall_ace = np.zeros((1, 3))
+        self._no_tvel = np.zeros((1, 3))
         self._verlet_count = 0
         self.reorder_every = REORDER_EVERY
         self._reorder_next = False
@@ -307,6 +313,8 @@ class SPHSolver:
             names += ["tau"]
         if self.boundary == 2:
             names += ["normals"]
+            if self._wall_ace_on:
+                names += ["wall_ace"]
         return names
 
     def _alloc(self):
@@ -364,13 +372,13 @@ class SPHSolver:
     def _kernels(self, parallel):
         """Entry points of the compiled interaction kernels for this run's flags."""
         key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.rates_shift,
-               bool(parallel))
+               self._mdbc2_flag, bool(parallel))
         if key in _ENTRY_CACHE:
             return _ENTRY_CACHE[key]
         sfx = "parallel" if parallel else "serial"
         rates = getattr(_ia, ("rates_2d_" if self.is2d else "rates_3d_") + sfx)
         k = {
-            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3)),
+            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3, 4)),
             "pack": getattr(_ia, "pack_" + sfx),
             "sps": getattr(_sps, "sps_tau_" + sfx),
         }
@@ -397,10 +405,10 @@ class SPHSolver:
         ncx, ncy, ncz = self.cells.shape
         ptype_rows, oi, tau_rows = self._rows
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.nb, ptype_rows,
-                 self.cell_sorted, oi, self.cells.cell_start) + geo
+        return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self._mdbc2_flag, self.nb,
+                 ptype_rows, self.cell_sorted, oi, self.cells.cell_start) + geo
                 + (self.cst, tau_rows, self.ace, self.ar, self.viscdt, self.shiftpos,
-                   self.shiftdet, self.gradvel, self.dtmax))
+                   self.shiftdet, self.gradvel, self._tvel(self.nb.shape[0]), self.dtmax))
 
     def _verlet_args(self, euler):
         s = self.state
@@ -499,7 +507,8 @@ class SPHSolver:
             ncx, ncy, ncz = self.cells.shape
             fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.normals, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, s.rhop, self.slip, self._mdbc_work(s.n))
+               self.mdbc_ksum, s.rhop, self.slip, self.dp, self._tvel(s.n),
+               self.wall_ace if self._wall_ace_on else self._no_wall_ace)
             if self.nopen and self._need_nopen:
                 self._nopen_detect(par, self.nb, ptype_rows, self.cell_sorted, oi, self.normals,
                                    s.vel, s.pos, self.npshift)
@@ -550,11 +559,20 @@ class SPHSolver:
         fn = nopen.apply_verlet_parallel if par else nopen.apply_verlet_serial
         return fn(s.pos, s.vel, self.vel_m1, s.rhop, s.ptype, self.npshift, self.ip, self.out)
 
-    def _mdbc_work(self, n):
-        """(n, 3) work array for the slip-mode velocities (kept between steps)."""
-        w = getattr(self, "_bvel", None)
+    @property
+    def _mdbc2_flag(self):
+        """1 for the mDBC2 slip modes (2, 3): the interaction's compile-time flag."""
+        return 1 if self.boundary == 2 and self.slip > 1 else 0
+
+    def _tvel(self, n):
+        """mDBC2: (>= n, 3) work array, per packed row the tangential velocity a
+        wall particle shows the viscosity (set by sphdvi.sph.mdbc); a (1, 3)
+        dummy otherwise."""
+        if not self._mdbc2_flag:
+            return self._no_tvel
+        w = getattr(self, "_tvel_work", None)
         if w is None or w.shape[0] < n:
-            w = self._bvel = np.zeros((max(n, 1), 3))
+            w = self._tvel_work = np.zeros((max(n, 1), 3))
         return w
 
     def _compute_rates_periodic(self):
@@ -594,9 +612,10 @@ class SPHSolver:
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             normals_e = np.ascontiguousarray(self.normals[idx])
+            wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
             fn(self.kernel, self.is2d, nb, ptype_e, np.arange(ne), normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, rhop_e, self.slip, self._mdbc_work(ne))
+               self.mdbc_ksum, rhop_e, self.slip, self.dp, self._tvel(ne), wace_e)
             bound = (order < n) & (ptype_e < 2)
             s.rhop[order[bound]] = rhop_e[bound]
             if self.nopen and self._need_nopen:
@@ -606,9 +625,10 @@ class SPHSolver:
                 real_rows = order < n
                 self.npshift[order[real_rows]] = npshift[real_rows]
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, nb, ptype_e, cell_e,
-                   np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos,
-                   shiftdet, gradvel, np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)))
+        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self._mdbc2_flag, nb, ptype_e,
+                   cell_e, np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt,
+                   shiftpos, shiftdet, gradvel, self._tvel(ne),
+                   np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)))
         real = order < n
         dst = order[real]
         self.ace[dst] = ace[real]
@@ -681,7 +701,15 @@ class SPHSolver:
         self.nstep += 1
         self.last_dt = dt
         if self.motion_hook is not None:
-            self.motion_hook(self, self.time, dt)
+            if self._wall_ace_on:
+                # mDBC2 pressure cloning: wall acceleration (v^{n+1} - v^n)/dt of the moving
+                # particles, as DualSPHysics's CopyMotionVelAce
+                moving = self.state.ptype == 1
+                v0 = self.state.vel[moving]
+                self.motion_hook(self, self.time, dt)
+                self.wall_ace[moving] = (self.state.vel[moving] - v0) / dt
+            else:
+                self.motion_hook(self, self.time, dt)
         return dt
 
     def _step_verlet(self):
