@@ -16,7 +16,7 @@ unknown keys are ignored):
   finite because grad W / r is finite at r = 0), DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
   ShiftAdvCoef (Shifting 4, :mod:`sphdvi.sph.shifting_adv`), CoefDtMin, DtIni, DtMin,
   DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
-  SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold,
+  SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold (SlipMode 1),
   NoPenetration (mDBC no-penetration correction of the fluid next to the walls,
   :mod:`sphdvi.sph.nopen`; as DualSPHysics, only with Boundary=2 and SlipMode 2
   or 3: otherwise it is warned and ignored) and the periodic keys (XPeriodicIncY ...,
