@@ -29,7 +29,9 @@ CPU and GPU agree):
   fac <= 0), positive as soon as one fluid particle lies within the kernel
   support of g.  With s = 0 the ghost node is dry and the particle is
   switched off for the step: zero mass in the fluid's sums (pressure,
-  viscosity, continuity, density diffusion, shifting), rho_b = rho0.
+  viscosity, continuity, density diffusion, shifting), rho_b = rho0; as a
+  wall neighbour it still switches Fourtakas's diffusion (DensityDT 2) and
+  the shifting of modes 1-2 off, as in DualSPHysics.
 * Ghost density rho_g: the first row of the solution of the system above if
   the kernel sum sum V w >= 0.1, |det A| >= 1e-3 and the scaled condition
   number dp^2 |A|_inf |A^-1|_inf <= 50 (infinity norms: largest row sum);
@@ -51,6 +53,16 @@ CPU and GPU agree):
   viscous time-step term) sees the tangential part of v2,
   t = v2 - (v2 . e) e (``tvel``, per packed row).
 * ``MdbcThreshold`` is not used (DualSPHysics v5.4's mDBC2 has none).
+
+Consequences measured in tests/sph/test_poiseuille.py and test_mdbc_slip.py:
+near a wall the Shepard ghost velocity is a one-sided average, so a no-slip
+wall acts 0.13-0.15 dp inside the fluid (Poiseuille centre-line speed
+-4 x 0.14 dp/d; sphdvi's earlier first-order ghost velocity had no such
+offset); the linearised cloning (c0^2 (rho - rho0) for Tait's equation)
+overestimates the hydrostatic wall pressure by about 6 (g d / c0^2) rho0 g dz
+(0.3-0.75 % of rho0 g d at d/dp = 25-10); the scaled condition number is
+dimensional (dp in metres): it rejects no matrix at dp = 0.05 m and some at
+dp = 2 m.
 
 Deviations: a particle with N_b = 0 shows the viscosity its own velocity
 (DualSPHysics reads its TangenVel entry, which nothing sets).  DualSPHysics
