@@ -200,7 +200,7 @@ def _tensile(p, rho):
 
 @njit(cache=True)
 def fluid_force(tpos, tvel, trho, tpress, tmass, spos, svel, srho, spress, smass, cell_start, pmin,
-                inv_cs, ncx, ncy, ncz, is2d, kind, h, alpha, visco_kind, visco, cs0, wdp, out):
+                inv_cs, ncx, ncy, ncz, is2d, kind, h, alpha, visco_kind, visco, cs0, wdp, eta2l, out):
     """Force of the fluid (sorted particles b) on each target particle a:
 
     F_a = m_a sum_b m_b [-(p_a + p_b)/(rho_a rho_b) - R_ab f^4 + Pi_ab] grad_a W_ab
@@ -210,8 +210,8 @@ def fluid_force(tpos, tvel, trho, tpress, tmass, spos, svel, srho, spress, smass
     2015 eq. 4) with the tensile correction R_ab f^4 when ``kind=1``
     (f = W/W(dp), ``wdp`` = 1/W(dp)), and viscosity ``visco_kind`` 1:
     artificial, Pi_ab = visco c0 h min(v_ab.r_ab, 0)/(r^2+eta^2) 2/(rho_a+rho_b);
-    2 or 3: laminar (Lo & Shao 2002) m_b 4 nu r.gradW/((rho_a+rho_b)(r^2+eta^2)) v_ab;
-    0: none.  ``visco`` is Visco x ViscoBoundFactor.  Writes ``out`` (T, 3).
+    2 or 3: laminar (Lo & Shao 2002) m_b 4 nu r.gradW/((rho_a+rho_b)(r^2+eta_l^2)) v_ab
+    (``eta2l`` = eta_l^2, ViscoLaminarEta h squared); 0: none.  ``visco`` is Visco x ViscoBoundFactor.  Writes ``out`` (T, 3).
     """
     r2max = 4.0 * h * h
     inv_h = 1.0 / h
@@ -257,7 +257,7 @@ def fluid_force(tpos, tvel, trho, tpress, tmass, spos, svel, srho, spress, smass
                         dot = dvx * dx + dvy * dy + dvz * dz
                         coef += visco * cs0 * h * min(dot * ir2e, 0.0) * 2.0 / (rhoa + rhob)
                     elif visco_kind >= 2:
-                        vt = mfac * 4.0 * visco * r2 * ir2e / (rhoa + rhob)
+                        vt = mfac * 4.0 * visco * r2 / ((r2 + eta2l) * (rhoa + rhob))
                         fx += vt * dvx
                         fy += vt * dvy
                         fz += vt * dvz

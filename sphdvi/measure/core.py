@@ -40,6 +40,7 @@ class KernelSpec:
     visco_kind: int = 1
     visco_bound: float = 0.0     # Visco x ViscoBoundFactor (fluid-boundary pairs)
     massfluid: float = 0.0
+    laminar_eta: float = 0.1     # ViscoLaminarEta: eta/h of the laminar term
 
     @property
     def alpha(self) -> float:
@@ -71,7 +72,8 @@ class KernelSpec:
         return cls(kind=int(p.get("Kernel", 2) or 2), h=float(c["h"]), dp=float(c["dp"]),
                    is2d=bool(c["is2d"]), cs0=cs0, rhop0=rhop0, b=b, gamma=gamma,
                    visco_kind=int(p.get("ViscoTreatment", 1) or 1), visco_bound=visco,
-                   massfluid=float(c.get("massfluid") or 0.0))
+                   massfluid=float(c.get("massfluid") or 0.0),
+                   laminar_eta=float(p.get("ViscoLaminarEta", 0.1)))
 
     def tait_pressure(self, rhop):
         """Tait's equation of state p = B((rho/rho0)^gamma - 1)."""
@@ -205,7 +207,8 @@ def fluid_forces(grid: ParticleGrid, tpos, tvel, trhop, tpress, tmass, spec: Ker
     K.fluid_force(tpos, f8(tvel).reshape(-1, 3), f8(trhop), f8(tpress), f8(tmass), grid.pos,
                   grid.arrays["vel"].reshape(-1, 3), grid.arrays["rhop"], grid.arrays["press"],
                   grid.arrays["mass"], *grid.geometry(), spec.kind, spec.h, spec.alpha,
-                  spec.visco_kind if viscosity else 0, spec.visco_bound, spec.cs0, spec.wdp_inv, out)
+                  spec.visco_kind if viscosity else 0, spec.visco_bound, spec.cs0, spec.wdp_inv,
+                  (spec.laminar_eta * spec.h) ** 2, out)
     return out
 
 

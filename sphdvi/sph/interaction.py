@@ -24,7 +24,18 @@ kernel sums over its neighbours ``b`` found through the cell list:
   fluid-fluid pairs on all fluid particles;
 * the viscous time-step term max_b h v_ab.r_ab/(r_ab^2+eta^2);
 * shifting sums (Lind et al. 2012): grad C_a = sum_b m_b/rho_b grad_a W_ab and
-  the free-surface detector div r_a = -sum_b m_b/rho_b r_ab.grad_a W_ab.
+  the free-surface detector div r_a = -sum_b m_b/rho_b r_ab.grad_a W_ab;
+* advanced shifting options (``adv``, Shifting 4; DualSPHysics 5.4, Sun et al.
+  2019), fluid particles only, V_b = m_b/rho_b, dv = shiftpos/dt (cst[20] = 1/dt;
+  dv_b = 0 for boundary and floating b):
+  ALE (adv & 1): drho_a/dt += sum_b V_b (rho_a dv_a + rho_b dv_b).grad_a W_ab
+  + rho_a sum_b V_b (dv_a - dv_b).grad_a W_ab (SPH forms of div(rho dv) - rho div dv),
+  dv_a/dt += rho0/rho_a sum_b V_b (v_a dv_a + v_b dv_b).grad_a W_ab
+  + v_a sum_b V_b (dv_a - dv_b).grad_a W_ab (of (div(rho v (x) dv) - v div(rho dv))/rho);
+  NCPress (adv & 2): where ``nctype`` is 1 and the Shepard sum
+  sum_b V_b W_ab + V_a W(0) exceeds 0.95, the pressure term is
+  L^-1 sum_b m_b (p_a - p_b)/(rho_a rho_b) grad_a W_ab, L = -sum_b V_b r_ab (x) grad_a W_ab
+  (exact for a linear pressure field), instead of the symmetric one.
 
 Boundary particles (DBC; ptype 0 fixed, 1 moving) get continuity only, from
 their fluid and floating neighbours.  Floating particles (ptype 2) interact
@@ -37,7 +48,7 @@ velocity ``tvel`` (one row per packed row); walls switched off by mDBC carry
 zero packed mass.
 
 Feature flags are ``numba.literally`` arguments (compile-time constants):
-kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, mdbc2 0/1.  The 2D (x-z plane) and 3D
+kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, adv 0..3, mdbc2 0/1.  The 2D (x-z plane) and 3D
 paths are separate functions.
 """
 import math
@@ -207,19 +218,20 @@ def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c):
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
+def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
-                       gradvel, tvel):
+                       gradvel, tvel, nctype):
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    adv = literally(adv)
     mdbc2 = literally(mdbc2)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
     eta2 = cst[2]
-    eta2l = cst[20]
+    eta2l = cst[21]
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -297,6 +309,29 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
             txx_i = tau[i, 0]
             txz_i = tau[i, 2]
             tzz_i = tau[i, 5]
+        # advanced shifting (compile-time adv: 1 ALE, 2 non-conservative pressure)
+        ale_i = (adv & 1) != 0 and pti == 3
+        ncp_i = (adv & 2) != 0 and pti == 3
+        inv_dt = 0.0
+        sax = 0.0           # shifting velocity of i
+        saz = 0.0
+        s_a = 0.0           # sum V_b dv_a . grad W
+        s_b = 0.0           # sum V_b dv_b . grad W
+        s_vbx = 0.0         # sum V_b v_b (dv_b . grad W)
+        s_vbz = 0.0
+        s_rb = 0.0          # sum V_b rho_b (dv_b . grad W)
+        if ale_i:
+            inv_dt = cst[20]
+            sax = shiftpos[o, 0] * inv_dt
+            saz = shiftpos[o, 2] * inv_dt
+        psx = 0.0           # symmetric pressure term
+        psz = 0.0
+        pax = 0.0           # non-conservative pressure term
+        paz = 0.0
+        lxx = 0.0           # correction matrix L = -sum V_b r_ab (x) grad W
+        lxz = 0.0
+        lzz = 0.0
+        pou = 0.0           # Shepard sum
         for z in range(zlo, zhi + 1):
             row = z * ncx
             for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
@@ -334,6 +369,31 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
                     wr = kernel_w(1, q, alpha) * od_wdp
                     wr = wr * wr
                     coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
+                if ncp_i:
+                    # both pressure forms are kept; the viscous part stays in coef
+                    vf = mfac * irj
+                    psx += coef * mfac * dx
+                    psz += coef * mfac * dz
+                    pnc = (pi - pj) * iri * irj
+                    pax += pnc * mfac * dx
+                    paz += pnc * mfac * dz
+                    lxx -= vf * dx * dx
+                    lxz -= vf * dx * dz
+                    lzz -= vf * dz * dz
+                    pou += nb[j, 6] * irj * kernel_w(kern, q, alpha)
+                    coef = 0.0
+                if ale_i:
+                    vf = mfac * irj
+                    ds_a = (sax * dx + saz * dz) * vf
+                    ds_b = 0.0
+                    if ptj == 3:
+                        oj = oi[j]
+                        ds_b = (shiftpos[oj, 0] * dx + shiftpos[oj, 2] * dz) * inv_dt * vf
+                    s_a += ds_a
+                    s_b += ds_b
+                    s_vbx += nb[j, 2] * ds_b
+                    s_vbz += nb[j, 3] * ds_b
+                    s_rb += rhoj * ds_b
                 vis = vis_b if boundj else vis_f
                 if visco == 1:
                     # Monaghan artificial viscosity, active for approaching pairs
@@ -378,6 +438,21 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
                     shz += mr * dz
                     shdet -= mr * r2
         arp *= rhoi
+        if ncp_i:
+            pou += nb[i, 6] * iri * kernel_w(kern, 0.0, alpha)
+            det = lxx * lzz - lxz * lxz
+            if nctype[o] != 0 and pou > 0.95 and det != 0.0:
+                acex += (lzz * pax - lxz * paz) / det
+                acez += (lxx * paz - lxz * pax) / det
+            else:
+                acex += psx
+                acez += psz
+        if ale_i:
+            r0i = rhop0 * iri
+            sab = s_a - s_b
+            acex += r0i * (vxi * s_a + s_vbx) + vxi * sab
+            acez += r0i * (vzi * s_a + s_vbz) + vzi * sab
+            arp += rhoi * s_a + s_rb + rhoi * sab
         if pti == 3:
             ace[o, 0] = acex + cst[12]
             ace[o, 1] = cst[13]
@@ -406,8 +481,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
 
 
 @njit(cache=True, error_model="numpy")
-def rates_2d_serial(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
+def rates_2d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Serial driver of the 2D interaction (use below ~10k particles).
 
     Chunk c of CHUNK rows also leaves its time-step maxima in dtmax[c]
@@ -416,33 +491,35 @@ def rates_2d_serial(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_st
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    adv = literally(adv)
     mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
-                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_2d_parallel(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
+def rates_2d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Threaded driver of the 2D interaction (prange over chunks of particles)."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    adv = literally(adv)
     mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
-                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
@@ -450,19 +527,20 @@ def rates_2d_parallel(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_
 # 3D
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
+def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
-                       gradvel, tvel):
+                       gradvel, tvel, nctype):
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    adv = literally(adv)
     mdbc2 = literally(mdbc2)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
     eta2 = cst[2]
-    eta2l = cst[20]
+    eta2l = cst[21]
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -558,6 +636,37 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
             t3 = tau[i, 3]
             t4 = tau[i, 4]
             t5 = tau[i, 5]
+        # advanced shifting (compile-time adv: 1 ALE, 2 non-conservative pressure)
+        ale_i = (adv & 1) != 0 and pti == 3
+        ncp_i = (adv & 2) != 0 and pti == 3
+        inv_dt = 0.0
+        sax = 0.0
+        say = 0.0
+        saz = 0.0
+        s_a = 0.0
+        s_b = 0.0
+        s_vbx = 0.0
+        s_vby = 0.0
+        s_vbz = 0.0
+        s_rb = 0.0
+        if ale_i:
+            inv_dt = cst[20]
+            sax = shiftpos[o, 0] * inv_dt
+            say = shiftpos[o, 1] * inv_dt
+            saz = shiftpos[o, 2] * inv_dt
+        psx = 0.0
+        psy = 0.0
+        psz = 0.0
+        pax = 0.0
+        pay = 0.0
+        paz = 0.0
+        lxx = 0.0
+        lxy = 0.0
+        lxz = 0.0
+        lyy = 0.0
+        lyz = 0.0
+        lzz = 0.0
+        pou = 0.0
         for z in range(zlo, zhi + 1):
             for y in range(ylo, yhi + 1):
                 row = (z * ncy + y) * ncx
@@ -596,6 +705,37 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
                         wr = kernel_w(1, q, alpha) * od_wdp
                         wr = wr * wr
                         coef -= (tens_i + _tensile(pj, rhoj)) * (wr * wr)
+                    if ncp_i:
+                        vf = mfac * irj
+                        psx += coef * mfac * dx
+                        psy += coef * mfac * dy
+                        psz += coef * mfac * dz
+                        pnc = (pi - pj) * iri * irj
+                        pax += pnc * mfac * dx
+                        pay += pnc * mfac * dy
+                        paz += pnc * mfac * dz
+                        lxx -= vf * dx * dx
+                        lxy -= vf * dx * dy
+                        lxz -= vf * dx * dz
+                        lyy -= vf * dy * dy
+                        lyz -= vf * dy * dz
+                        lzz -= vf * dz * dz
+                        pou += nb[j, 8] * irj * kernel_w(kern, q, alpha)
+                        coef = 0.0
+                    if ale_i:
+                        vf = mfac * irj
+                        ds_a = (sax * dx + say * dy + saz * dz) * vf
+                        ds_b = 0.0
+                        if ptj == 3:
+                            oj = oi[j]
+                            ds_b = ((shiftpos[oj, 0] * dx + shiftpos[oj, 1] * dy + shiftpos[oj, 2] * dz)
+                                    * inv_dt * vf)
+                        s_a += ds_a
+                        s_b += ds_b
+                        s_vbx += nb[j, 3] * ds_b
+                        s_vby += nb[j, 4] * ds_b
+                        s_vbz += nb[j, 5] * ds_b
+                        s_rb += rhoj * ds_b
                     vis = vis_b if boundj else vis_f
                     if visco == 1:
                         coef += vis * cs0h * min(dot_rr2, 0.0) * 2.0 / (rhoi + rhoj)
@@ -649,6 +789,31 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
                         shz += mr * dz
                         shdet -= mr * r2
         arp *= rhoi
+        if ncp_i:
+            pou += nb[i, 8] * iri * kernel_w(kern, 0.0, alpha)
+            # L^-1 by cofactors (L is symmetric)
+            cxx = lyy * lzz - lyz * lyz
+            cxy = lxz * lyz - lxy * lzz
+            cxz = lxy * lyz - lxz * lyy
+            det = lxx * cxx + lxy * cxy + lxz * cxz
+            if nctype[o] != 0 and pou > 0.95 and det != 0.0:
+                cyy = lxx * lzz - lxz * lxz
+                cyz = lxy * lxz - lxx * lyz
+                czz = lxx * lyy - lxy * lxy
+                acex += (cxx * pax + cxy * pay + cxz * paz) / det
+                acey += (cxy * pax + cyy * pay + cyz * paz) / det
+                acez += (cxz * pax + cyz * pay + czz * paz) / det
+            else:
+                acex += psx
+                acey += psy
+                acez += psz
+        if ale_i:
+            r0i = rhop0 * iri
+            sab = s_a - s_b
+            acex += r0i * (vxi * s_a + s_vbx) + vxi * sab
+            acey += r0i * (vyi * s_a + s_vby) + vyi * sab
+            acez += r0i * (vzi * s_a + s_vbz) + vzi * sab
+            arp += rhoi * s_a + s_rb + rhoi * sab
         if pti == 3:
             ace[o, 0] = acex + cst[12]
             ace[o, 1] = acey + cst[13]
@@ -681,43 +846,43 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi,
 
 
 @njit(cache=True, error_model="numpy")
-def rates_3d_serial(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
+def rates_3d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows);
     time-step maxima per chunk in dtmax as :func:`rates_2d_serial`."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    adv = literally(adv)
     mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
-                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel,
-                        tvel)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_3d_parallel(kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax):
+def rates_3d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Threaded driver of the 3D interaction."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
+    adv = literally(adv)
     mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, mdbc2, nb, ptype, cell, oi, cell_start,
-                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel,
-                        tvel)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 

@@ -20,8 +20,8 @@ SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
     the result is clamped to rho >= rho0.  The wall particle shows the fluid its
     own (wall) velocity.
 
-SlipMode 2 (no-slip) and 3 (free-slip): DualSPHysics's mDBC2
-(``JSphCpu_mdbc.cpp`` InteractionMdbc2CorrectionT2, ``JSphGpu_mdbc_iker.cu``
+SlipMode 2 (no-slip) and 3 (free-slip): DualSPHysics's mDBC2 with a choice of
+ghost velocity (``JSphCpu_mdbc.cpp`` InteractionMdbc2CorrectionT2, ``JSphGpu_mdbc_iker.cu``
 KerInteractionMdbc2Correction_Fast, ``JSphCpu.cpp`` InteractionForcesFluid;
 CPU and GPU agree):
 
@@ -44,9 +44,13 @@ CPU and GPU agree):
   and the particle, and rho_b = rho0 + p_b / c0^2.  No clamping: rho_b may
   be below rho0.  a_w is (v_w^{n+1} - v_w^n)/dt of the moving particles as
   the motion sets them (DualSPHysics's CopyMotionVelAce), zero for fixed ones.
-* Ghost velocity: the plain kernel (Shepard) average v_g = sum V w v_j /
-  sum V w.  The wall particle's velocity v2 is 2 v_w - v_g (no-slip) or v_g
-  (free-slip), v_w its own (motion) velocity; dry: v2 = v_w.
+* Ghost velocity v_g (``MdbcGhostVelocity``, sphdvi's own key): 1 (default)
+  the first-order corrected interpolation at g, the first row of the solution
+  of the system above with right-hand sides (sum V w v_j, sum V grad w v_j),
+  where the density is corrected (else the Shepard average); 0 the plain
+  kernel (Shepard) average sum V w v_j / sum V w, as DualSPHysics.  The wall
+  particle's velocity v2 is 2 v_w - v_g (no-slip) or v_g (free-slip), v_w
+  its own (motion) velocity; dry: v2 = v_w.
 * In the fluid's interaction the wall particle keeps its motion velocity v_w
   in the continuity equation (DualSPHysics keeps it in ``velrho``,
   MDBC2_KEEPVEL), while the viscosity (artificial or laminar, and the
@@ -55,16 +59,17 @@ CPU and GPU agree):
 * ``MdbcThreshold`` is not used (DualSPHysics v5.4's mDBC2 has none).
 
 Consequences measured in tests/sph/test_poiseuille.py and test_mdbc_slip.py:
-near a wall the Shepard ghost velocity is a one-sided average, so a no-slip
-wall acts 0.13-0.15 dp inside the fluid (Poiseuille centre-line speed
--4 x 0.14 dp/d; sphdvi's earlier first-order ghost velocity had no such
-offset); the linearised cloning (c0^2 (rho - rho0) for Tait's equation)
-overestimates the hydrostatic wall pressure by about 6 (g d / c0^2) rho0 g dz
-(0.3-0.75 % of rho0 g d at d/dp = 25-10); the scaled condition number is
-dimensional (dp in metres): it rejects no matrix at dp = 0.05 m and some at
-dp = 2 m.
+near a wall the Shepard ghost velocity (MdbcGhostVelocity 0) is a one-sided
+average, so a no-slip wall acts 0.13-0.15 dp inside the fluid (Poiseuille
+centre-line speed -4 x 0.14 dp/d, -1 % at 30 across); the corrected one is
+exact for a linear velocity profile and has no such offset.  The linearised
+cloning (c0^2 (rho - rho0) for Tait's equation) overestimates the hydrostatic
+wall pressure by about 6 (g d / c0^2) rho0 g dz (0.3-0.75 % of rho0 g d at
+d/dp = 25-10); the scaled condition number is dimensional (dp in metres): it
+rejects no matrix at dp = 0.05 m and some at dp = 2 m.
 
-Deviations: a particle with N_b = 0 shows the viscosity its own velocity
+Deviations: the default ghost velocity is the corrected one (above).  A
+particle with N_b = 0 shows the viscosity its own velocity
 (DualSPHysics reads its TangenVel entry, which nothing sets).  DualSPHysics
 runs the correction in the Symplectic corrector only with MdbcCorrector=1
 (default 0: the predictor's wall values are kept); here it runs in every
@@ -108,8 +113,9 @@ def _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz
     """Sums over the fluid particles j near the ghost node g = (gx, gy, gz):
     the moment matrix a (see the module docstring), the right-hand side
     b[:, 0] = (sum m w, sum m grad w), and, when ``vsum`` has 4 entries (mDBC2),
-    sum V w v_j in vsum[0:3] and the submersion measure -sum V (g - r_j).grad w
-    in vsum[3]."""
+    sum V w v_j in vsum[0:3], the submersion measure -sum V (g - r_j).grad w
+    in vsum[3] and the velocity right-hand sides b[:, 1:4] = (sum V w v_j,
+    sum V grad w v_j) of the corrected ghost velocity."""
     h = cst[0]
     r2max = cst[1]
     alpha = cst[3]
@@ -189,14 +195,31 @@ def _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz
                     a[3, 3] += vj * gw2 * d2
                     b[3, 0] += mj * gw2
                 if mdbc2:
-                    vw = vj * w
                     if is2d:
-                        vsum[0] += vw * nb[j, 2]
-                        vsum[2] += vw * nb[j, 3]
+                        u0 = nb[j, 2]
+                        u1 = 0.0
+                        u2 = nb[j, 3]
                     else:
-                        vsum[0] += vw * nb[j, 3]
-                        vsum[1] += vw * nb[j, 4]
-                        vsum[2] += vw * nb[j, 5]
+                        u0 = nb[j, 3]
+                        u1 = nb[j, 4]
+                        u2 = nb[j, 5]
+                    vw = vj * w
+                    vsum[0] += vw * u0
+                    vsum[1] += vw * u1
+                    vsum[2] += vw * u2
+                    b[0, 1] += vw * u0
+                    b[0, 2] += vw * u1
+                    b[0, 3] += vw * u2
+                    b[1, 1] += vj * gw0 * u0
+                    b[1, 2] += vj * gw0 * u1
+                    b[1, 3] += vj * gw0 * u2
+                    b[2, 1] += vj * gw1 * u0
+                    b[2, 2] += vj * gw1 * u1
+                    b[2, 3] += vj * gw1 * u2
+                    if not is2d:
+                        b[3, 1] += vj * gw2 * u0
+                        b[3, 2] += vj * gw2 * u1
+                        b[3, 3] += vj * gw2 * u2
                     # -V (g - r_j).grad w = -V fac r^2 >= 0 (fac <= 0)
                     vsum[3] -= vj * fac * r2
 
@@ -273,17 +296,18 @@ def _set_packed(nb, i, is2d, rho, cst, dry):
 
 @njit(cache=True, error_model="numpy")
 def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell,
-                 ncx, ncy, ncz, cst, dp, rhop, slip, tvel, wace):
+                 ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel, tvel, wace):
     """SlipMode 2, 3 (DualSPHysics's mDBC2, module docstring): density with
     pressure cloning, zero mass for a dry ghost node, and the tangential velocity
-    the viscosity sees in tvel[i] (packed row i)."""
+    the viscosity sees in tvel[i] (packed row i); ghost velocity corrected
+    (``ghostvel`` 1) or the Shepard average (0, DualSPHysics)."""
     rhop0 = cst[10]
     cs02 = cst[5] * cst[5]
     n = 3 if is2d else 4
     has_ace = wace.shape[0] == rhop.shape[0]
     a = np.zeros((4, 4))
-    # right-hand sides: column 0 the density, columns 1..n the identity (inverse of a)
-    b = np.zeros((4, 5))
+    # right-hand sides: column 0 the density, 1-3 the velocity, 4..3+n the identity (inverse of a)
+    b = np.zeros((4, 8))
     vsum = np.zeros(4)
     vw = np.zeros(3)
     v2 = np.zeros(3)
@@ -331,6 +355,7 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
             continue
         ksum = a[0, 0]
         shepard = b[0, 0] / ksum
+        corrected = False
         if ksum < MDBC2_KSUM_MIN:
             rho_g = max(rhop0, shepard)
         else:
@@ -338,10 +363,11 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
             norm_a = _inf_norm(a, n, 0)
             for r in range(n):
                 for c in range(n):
-                    b[r, 1 + c] = 1.0 if r == c else 0.0
-            if solve_pivoted(a, b, n, n + 1, 0.0) >= MDBC2_DET_MIN:
-                if dp * dp * norm_a * _inf_norm(b, n, 1) <= MDBC2_COND_MAX:
+                    b[r, 4 + c] = 1.0 if r == c else 0.0
+            if solve_pivoted(a, b, n, n + 4, 0.0) >= MDBC2_DET_MIN:
+                if dp * dp * norm_a * _inf_norm(b, n, 4) <= MDBC2_COND_MAX:
                     rho_g = b[0, 0]
+                    corrected = True
         # pressure cloning: p_b = p_g + rho0 (g - a_w).e ((r_b - g).e), e the unit normal
         fx = cst[12]
         fy = cst[13]
@@ -356,9 +382,10 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
         rho = rhop0 + p_b / cs02
         rhop[o] = rho
         _set_packed(nb, i, is2d, rho, cst, False)
-        # ghost velocity: Shepard average; no-slip 2 v_w - v_g, free-slip v_g
+        # ghost velocity: corrected (the solution's first row) or the Shepard
+        # average; no-slip 2 v_w - v_g, free-slip v_g
         for c in range(3):
-            vg = vsum[c] / ksum
+            vg = b[0, 1 + c] if ghostvel == 1 and corrected else vsum[c] / ksum
             v2[c] = 2.0 * vw[c] - vg if slip == 2 else vg
         vn = v2[0] * ex + v2[1] * ey + v2[2] * ez
         tvel[i, 0] = v2[0] - vn * ex
@@ -376,7 +403,7 @@ def _refresh_packed(i0, i1, is2d, ptype, oi, rhop, cst, nb):
 
 @njit(cache=True, error_model="numpy")
 def mdbc_serial(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                cst, threshold, ksum_min, rhop, slip, dp, tvel, wace):
+                cst, threshold, ksum_min, rhop, slip, ghostvel, dp, tvel, wace):
     """Set the density of every boundary particle with a normal and refresh its
     packed row (module docstring).  SlipMode 2, 3 also set ``tvel`` (packed rows,
     3 columns: the velocity the viscosity sees) and zero the packed mass of the
@@ -390,12 +417,12 @@ def mdbc_serial(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, 
         _refresh_packed(0, n, is2d, ptype, oi, rhop, cst, nb)
     else:
         _mdbc2_range(0, n, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx,
-                     ncy, ncz, cst, dp, rhop, slip, tvel, wace)
+                     ncy, ncz, cst, dp, rhop, slip, ghostvel, tvel, wace)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def mdbc_parallel(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                  cst, threshold, ksum_min, rhop, slip, dp, tvel, wace):
+                  cst, threshold, ksum_min, rhop, slip, ghostvel, dp, tvel, wace):
     """Threaded :func:`mdbc_serial`."""
     n = nb.shape[0]
     nchunk = (n + 511) // 512
@@ -410,5 +437,5 @@ def mdbc_parallel(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell
         # reads only fluid rows of nb and writes only boundary rows: one pass
         for c in prange(nchunk):
             _mdbc2_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, oi, normals,
-                         cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, dp, rhop, slip, tvel,
-                         wace)
+                         cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel,
+                         tvel, wace)

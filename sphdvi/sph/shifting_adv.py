@@ -33,23 +33,48 @@ Marrone et al. 2010):
 
 Particle types written to ``fstype``: 0 interior (shifted), 1 near the free
 surface, 2 free surface, 3 isolated or touching a boundary; ``fsnormal`` gets the unit normal of
-types 2 and 3 (zero elsewhere).  DualSPHysics's optional ALE terms
-(``ShiftAdvALE``, which also shifts surface particles tangentially) and
-non-conservative pressure (``ShiftAdvNCPress``) are not implemented; the
-solver warns when a case asks for them.  Where DualSPHysics's 2D umbrella test
+types 2 and 3 (zero elsewhere).  Where DualSPHysics's 2D umbrella test
 and isolated-particle test differ from the papers' definitions, the papers'
 are used.  DualSPHysics also shifts interior particles next to a wall; near a
 thin DBC wall, whose missing kernel support makes grad C point away from it,
 that pushes particles through (17 of 5,500 left the 2D dam break through its
 one-layer walls in 0.72 s), so particles touching a boundary are not shifted
 here.
+
+``ShiftAdvALE`` / ``ShiftAdvNCPress`` (DualSPHysics 5.4, ``JSphCpu_preloop.cpp``
+ComputeShiftingVel and ``JSphCpu.cpp`` InteractionForcesFluid; Sun et al. 2019)
+use :func:`advanced_shift_ale_serial`, which follows DualSPHysics's
+classification: a near-surface particle touching a boundary is type 3; the
+interior type-0 particles are flagged in ``nctype`` for the non-conservative
+pressure gradient (with DBC walls only those without a boundary particle in
+their support, see :func:`_displace_ale_range`).  With ALE:
+
+* near-surface (1) and surface (2) particles are shifted too, along
+  :math:`\mathbf s = \nabla C - \theta\,\mathbf n(\mathbf n\cdot\nabla C)`,
+  :math:`\theta = \min(1, \max(0, (2h - d)/h))`, d the distance to the
+  nearest surface particle (2h when none); the normal of a type-1 particle is
+  the :math:`V_j W_{ij}`-weighted mean of its surface neighbours' normals;
+  surface particles touching a boundary or whose normal turns by more than
+  0.52 rad against a neighbouring candidate's are not shifted;
+* the magnitude is :math:`u = \min(A h, \epsilon/(2 |\nabla C\cdot\mathbf s| m))\,m`,
+  :math:`m = \min(h, d)` (= h for the interior, as above), capped at 0.1 dp per
+  component;
+* the interaction (:mod:`sphdvi.sph.interaction`) adds the ALE terms with the
+  shifting velocity :math:`\delta\mathbf v = \delta\mathbf r/\Delta t`.
+
+In these runs the shift and types are computed before the interaction that
+uses them: in the Symplectic predictor, from the positions at t^n, kept for the
+corrector and applied in it (DualSPHysics's order; plain Shifting 4 evaluates
+them in the corrector, at the half step); with Verlet every step, the ALE
+velocity taking the previous step's dt (DualSPHysics runs advanced shifting with
+Symplectic only: its Verlet step ignores it).
 """
 import math
 
 from . import _env  # noqa: F401
 from numba import njit, prange
 
-from .kernels import kernel_fac
+from .kernels import kernel_fac, kernel_w
 
 EPS_LIMIT = 1e-5
 CHUNK = 256
@@ -321,6 +346,200 @@ def advanced_shift_parallel(kern, is2d, nb, ptype, cell, oi, cell_start, ncx, nc
     for c in prange(nchunk):
         _displace_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, ptype, oi, cst, coef, dp, fst, nrm, gc,
                         near, bnd, shiftpos, fstype_out, normal_out)
+
+
+# --------------------------------------------------------------------------
+# ShiftAdvALE / ShiftAdvNCPress: the DualSPHysics classification and the
+# tangential shifting of (near-)surface particles
+# --------------------------------------------------------------------------
+COS_CURV = math.cos(0.52)     # surface particles whose normal turns more than 0.52 rad are not shifted
+
+
+@njit(cache=True, error_model="numpy")
+def _ale_scan_range(i0, i1, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, fst, nrm,
+                    near, mind, nsm, curv):
+    """For the fluid rows i0..i1 (gather form): ``near`` 1 when a free-surface (type 2)
+    fluid particle is within the support, ``mind`` the distance to the nearest one
+    (2h when none), ``nsm`` their normals summed with weights V_j W_ij, and ``curv`` 1
+    when i is a candidate (type 2 or 3) with a candidate neighbour whose normal makes
+    more than 0.52 rad with its own.  Only the rows that :func:`_mark_near_range`
+    flagged (``near`` on entry) and the candidates are scanned: the others have none
+    of these neighbours."""
+    h = cst[0]
+    inv_h = 1.0 / h
+    r2max = cst[1]
+    alpha = cst[3]
+    rs = int(cst[18])
+    for i in range(i0, i1):
+        flagged = near[i] != 0
+        near[i] = 0
+        curv[i] = 0
+        mind[i] = 2.0 * h
+        for k in range(3):
+            nsm[i, k] = 0.0
+        cand = fst[i] >= 2
+        if ptype[i] != 3 or not (flagged or cand):
+            continue
+        xi, yi, zi = _row_xyz(nb, i, is2d)
+        cx, cy, cz = _cell_xyz(cell[i], ncx, ncy)
+        dmin2 = r2max
+        nx = 0.0
+        ny = 0.0
+        nz = 0.0
+        for z in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
+            for y in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
+                row = (z * ncy + y) * ncx
+                for j in range(cell_start[row + max(cx - rs, 0)], cell_start[row + min(cx + rs, ncx - 1) + 1]):
+                    if ptype[j] != 3 or fst[j] < 2:
+                        continue
+                    xj, yj, zj = _row_xyz(nb, j, is2d)
+                    r2 = (xi - xj) ** 2 + (yi - yj) ** 2 + (zi - zj) ** 2
+                    if r2 >= r2max or r2 < 1e-18:
+                        continue
+                    if fst[j] == 2:
+                        near[i] = 1
+                        if r2 < dmin2:
+                            dmin2 = r2
+                        w = _row_volume(nb, j, is2d) * kernel_w(kern, math.sqrt(r2) * inv_h, alpha)
+                        nx += nrm[j, 0] * w
+                        ny += nrm[j, 1] * w
+                        nz += nrm[j, 2] * w
+                    if cand:
+                        c = nrm[i, 0] * nrm[j, 0] + nrm[i, 1] * nrm[j, 1] + nrm[i, 2] * nrm[j, 2]
+                        if c < COS_CURV:
+                            curv[i] = 1
+        if near[i]:
+            mind[i] = math.sqrt(dmin2)
+            nsm[i, 0] = nx
+            nsm[i, 1] = ny
+            nsm[i, 2] = nz
+
+
+@njit(cache=True, error_model="numpy")
+def _displace_ale_range(i0, i1, is2d, ale, nc_bnd, ptype, oi, cst, coef, dp, fst, nrm, gc, near, bnd, mind,
+                        nsm, curv, shiftpos, fstype_out, normal_out, nctype_out):
+    """Final type, displacement, normal and non-conservative-pressure flag of rows i0..i1
+    when ShiftAdvALE or ShiftAdvNCPress is on (DualSPHysics ComputeShiftingVel).
+
+    ``nctype_out`` is 1 for DualSPHysics's interior type (not a surface, near-surface
+    or isolated particle), the particles on which ShiftAdvNCPress may use the
+    non-conservative pressure gradient; those with a boundary particle in their
+    support only when ``nc_bnd`` (mDBC: with DBC walls the non-conservative form,
+    which lacks the p_a + p_b repulsion that DBC relies on, draws fluid into the
+    walls wherever a wall particle's pressure is below the fluid's).  With
+    ``ale`` the near-surface (type 1) and surface (type 2) particles are shifted too,
+    along s = grad C - theta n (n . grad C), theta = clamp((2h - d)/h, 0, 1), d the
+    distance to the nearest surface particle; the magnitude is scaled by min(h, d)
+    instead of h.  Surface particles touching a boundary or at a sharp corner
+    (``curv``) and near-surface particles touching a boundary are not shifted."""
+    h = cst[0]
+    cap = 0.1 * dp
+    for i in range(i0, i1):
+        o = oi[i]
+        nctype_out[o] = 0
+        for k in range(3):
+            shiftpos[o, k] = 0.0
+            normal_out[o, k] = nrm[i, k]
+        if ptype[i] != 3:
+            fstype_out[o] = 0
+            continue
+        t = fst[i]
+        if t == 0 and near[i]:
+            t = 3 if bnd[i] else 1
+            if ale:
+                sn = math.sqrt(nsm[i, 0] ** 2 + nsm[i, 1] ** 2 + nsm[i, 2] ** 2)
+                if sn > 0.0:
+                    for k in range(3):
+                        normal_out[o, k] = nsm[i, k] / sn
+        if t == 0:
+            if nc_bnd or not bnd[i]:
+                nctype_out[o] = 1
+            if bnd[i]:
+                t = 3       # sphdvi: interior particles touching a boundary are not shifted
+        fstype_out[o] = t
+        gx = gc[i, 0]
+        gy = gc[i, 1]
+        gz = gc[i, 2]
+        d = mind[i]
+        if t == 0:
+            sx = gx
+            sy = gy
+            sz = gz
+        elif ale and (t == 1 or (t == 2 and not bnd[i] and not curv[i])):
+            nx = normal_out[o, 0]
+            ny = normal_out[o, 1]
+            nz = normal_out[o, 2]
+            theta = min(1.0, max(0.0, (2.0 * h - d) / h))
+            gn = theta * (nx * gx + ny * gy + nz * gz)
+            sx = gx - gn * nx
+            sy = gy - gn * ny
+            sz = gz - gn * nz
+        else:
+            continue
+        if is2d:
+            sy = 0.0
+        m = min(h, d)
+        rv = abs(gx * sx + gy * sy + gz * sz) * m
+        u = coef * h
+        if rv > 0.0:
+            u = min(u, abs(EPS_LIMIT / (2.0 * rv)))
+        u *= m
+        dd = (u * sx, u * sy, u * sz)
+        for k in range(3):
+            shiftpos[o, k] = min(max(dd[k], -cap), cap)
+
+
+@njit(cache=True, error_model="numpy")
+def _copy_source_normals(nrm, src_row):
+    """Periodic copies take their real particle's normal (their own, from a support
+    truncated by the end of the extended set, may point anywhere)."""
+    n = nrm.shape[0]
+    if src_row.shape[0] == n:
+        for i in range(n):
+            r = src_row[i]
+            for k in range(3):
+                nrm[i, k] = nrm[r, k]
+
+
+@njit(cache=True, error_model="numpy")
+def advanced_shift_ale_serial(kern, is2d, ale, nc_bnd, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst,
+                              nzero, coef, dp, fst, nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out,
+                              normal_out, nctype_out, src_row):
+    """:func:`advanced_shift_serial` for ShiftAdvALE / ShiftAdvNCPress runs (see
+    :func:`_displace_ale_range`)."""
+    n = nb.shape[0]
+    _detect_range(0, n, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, nzero, fst, nrm, gc,
+                  near, bnd)
+    _copy_source_types(fst, src_row)
+    _copy_source_normals(nrm, src_row)
+    _mark_near_range(0, n, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, fst, near)
+    _ale_scan_range(0, n, kern, is2d, nb, ptype, cell, cell_start, ncx, ncy, ncz, cst, fst, nrm, near, mind,
+                    nsm, curv)
+    _displace_ale_range(0, n, is2d, ale, nc_bnd, ptype, oi, cst, coef, dp, fst, nrm, gc, near, bnd, mind, nsm,
+                        curv, shiftpos, fstype_out, normal_out, nctype_out)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def advanced_shift_ale_parallel(kern, is2d, ale, nc_bnd, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, cst,
+                                nzero, coef, dp, fst, nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out,
+                                normal_out, nctype_out, src_row):
+    """Threaded :func:`advanced_shift_ale_serial`."""
+    n = nb.shape[0]
+    nchunk = (n + CHUNK - 1) // CHUNK
+    for c in prange(nchunk):
+        _detect_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype, cell, cell_start,
+                      ncx, ncy, ncz, cst, nzero, fst, nrm, gc, near, bnd)
+    _copy_source_types(fst, src_row)
+    _copy_source_normals(nrm, src_row)
+    for c in prange(nchunk):
+        _mark_near_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, nb, ptype, cell, cell_start,
+                         ncx, ncy, ncz, cst, fst, near)
+    for c in prange(nchunk):
+        _ale_scan_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype, cell, cell_start,
+                        ncx, ncy, ncz, cst, fst, nrm, near, mind, nsm, curv)
+    for c in prange(nchunk):
+        _displace_ale_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, ale, nc_bnd, ptype, oi, cst, coef, dp, fst,
+                            nrm, gc, near, bnd, mind, nsm, curv, shiftpos, fstype_out, normal_out, nctype_out)
 
 
 def full_support_neighbours(h, dp, is2d):

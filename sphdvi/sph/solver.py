@@ -14,9 +14,14 @@ unknown keys are ignored):
   ViscoBoundFactor, ViscoLaminarEta (sphdvi's own key: eta/h of the laminar term's
   r^2/(r^2 + eta^2), DualSPHysics's 0.1 by default; 0 gives the exact Morris operator,
   finite because grad W / r is finite at r = 0), DensityDT, DensityDTvalue, Shifting, ShiftCoef, ShiftTFS,
-  ShiftAdvCoef (Shifting 4, :mod:`sphdvi.sph.shifting_adv`), CoefDtMin, DtIni, DtMin,
+  ShiftAdvCoef, ShiftAdvALE, ShiftAdvNCPress (Shifting 4, :mod:`sphdvi.sph.shifting_adv`),
+  CoefDtMin, DtIni, DtMin,
   DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
   SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold (SlipMode 1),
+  MdbcGhostVelocity (sphdvi's own key, SlipMode 2 and 3: 1, the default, interpolates
+  the velocity at the ghost node with the first-order corrected kernel, like the density;
+  0 takes DualSPHysics v5.4's plain Shepard average, which puts no-slip walls ~0.14 dp
+  inside the water; :mod:`sphdvi.sph.mdbc`),
   NoPenetration (mDBC no-penetration correction of the fluid next to the walls,
   :mod:`sphdvi.sph.nopen`; as DualSPHysics, only with Boundary=2 and SlipMode 2
   or 3: otherwise it is warned and ignored) and the periodic keys (XPeriodicIncY ...,
@@ -25,8 +30,6 @@ unknown keys are ignored):
 DtFixedFile is passed as ``dt_table`` (the case reader loads the file);
 DtAllParticles selects the particles whose speed limits dt.
 
-Not implemented: ShiftAdvALE and ShiftAdvNCPress of Shifting 4 (warned and
-ignored).
 """
 import warnings
 
@@ -184,6 +187,9 @@ class SPHSolver:
         if self.slip not in (1, 2, 3):
             raise ValueError("SlipMode must be 1 (DBC velocity), 2 (no-slip) or 3 (free-slip)")
         self.mdbc_ksum = float(p.get("MdbcThreshold") or 0.0)
+        self.ghostvel = int(p.get("MdbcGhostVelocity", 1))
+        if self.ghostvel not in (0, 1):
+            raise ValueError("MdbcGhostVelocity must be 0 (Shepard average) or 1 (corrected)")
         # NoPenetration: DualSPHysics reads it only for its mDBC2 slip modes (2, 3)
         self.nopen = bool(int(p.get("NoPenetration") or 0))
         if self.nopen and (self.boundary != 2 or self.slip == 1):
@@ -207,17 +213,27 @@ class SPHSolver:
         # interaction computes the classic shifting terms of modes 1-3 only
         self.rates_shift = self.shift if self.shift < 4 else 0
         self.shift_adv_coef = float(p["ShiftAdvCoef"])
-        self._need_shift_adv = True     # False in the Symplectic predictor (its shift is unused)
+        # ShiftAdvALE (bit 0) and ShiftAdvNCPress (bit 1) of Shifting 4: a compile-time flag
+        # of the interaction, 0 (nothing extra compiled) otherwise
+        self.adv = 0
         if self.shift == 4:
-            for key in ("ShiftAdvALE", "ShiftAdvNCPress"):
-                if int(p.get(key) or 0):
-                    warnings.warn(f"{key}=1 is not implemented; advanced shifting runs without it")
+            for bit, key in ((1, "ShiftAdvALE"), (2, "ShiftAdvNCPress")):
+                v = int(p.get(key) or 0)
+                if v not in (0, 1):
+                    raise ValueError(f"{key} must be 0 or 1")
+                if v:
+                    self.adv |= bit
+        # whether the next compute_rates runs the advanced-shifting pass: plain Shifting 4
+        # runs it in the Symplectic corrector, ALE / NCPress runs in the predictor
+        # (DualSPHysics order: shift and types from the positions at t^n, used by both
+        # interactions of the step); Verlet runs it every step
+        self._need_shift_adv = True
         self.step_algorithm = int(p["StepAlgorithm"])
         if self.step_algorithm not in (1, 2):
             raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
         self.verlet_steps = int(p["VerletSteps"])
         alpha = kernel_alpha(self.kernel, h, self.is2d)
-        cst = np.zeros(21)
+        cst = np.zeros(22)
         cst[0] = h
         cst[1] = 4.0 * h * h
         cst[2] = (0.1 * h) ** 2
@@ -235,6 +251,7 @@ class SPHSolver:
         cst[16] = self.b
         cst[17] = self.gamma
         cst[18] = 1.0
+        cst[20] = 0.0       # 1/dt of the shifting velocity (ShiftAdvALE), set each step
         self.cst = cst
         self.dtmin = float(p["DtMin"]) or float(p["CoefDtMin"]) * h / self.cs0
         self.dtini = float(p["DtIni"]) or h / self.cs0
@@ -243,7 +260,7 @@ class SPHSolver:
         self.dt_vel_type = 0 if int(p.get("DtAllParticles") or 0) else 2
         cst[19] = self.dt_vel_type
         # laminar term r^2/(r^2 + eta^2): DualSPHysics eta = 0.1 h (ViscoLaminarEta)
-        cst[20] = (float(p.get("ViscoLaminarEta", 0.1)) * h) ** 2
+        cst[21] = (float(p.get("ViscoLaminarEta", 0.1)) * h) ** 2
         self.sps_smag = (0.12 * self.dp) ** 2
         self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
         self.shift_tfs = float(p["ShiftTFS"])
@@ -352,6 +369,8 @@ class SPHSolver:
             self.fstype = np.zeros(n, np.int8)
             self.fsnormal = np.zeros((n, 3))
             self._fs_work = self._shift_adv_work(n)
+        # ShiftAdvNCPress: 1 where the non-conservative pressure gradient may be used
+        self.nctype = np.zeros(n if self.adv else 1, np.int8)
         self.gradvel = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
         if self.nopen:
             from .nopen import NCOL
@@ -371,14 +390,14 @@ class SPHSolver:
 
     def _kernels(self, parallel):
         """Entry points of the compiled interaction kernels for this run's flags."""
-        key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.rates_shift,
+        key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv,
                self._mdbc2_flag, bool(parallel))
         if key in _ENTRY_CACHE:
             return _ENTRY_CACHE[key]
         sfx = "parallel" if parallel else "serial"
         rates = getattr(_ia, ("rates_2d_" if self.is2d else "rates_3d_") + sfx)
         k = {
-            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3, 4)),
+            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3, 4, 5)),
             "pack": getattr(_ia, "pack_" + sfx),
             "sps": getattr(_sps, "sps_tau_" + sfx),
         }
@@ -405,10 +424,10 @@ class SPHSolver:
         ncx, ncy, ncz = self.cells.shape
         ptype_rows, oi, tau_rows = self._rows
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self._mdbc2_flag, self.nb,
-                 ptype_rows, self.cell_sorted, oi, self.cells.cell_start) + geo
+        return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag,
+                 self.nb, ptype_rows, self.cell_sorted, oi, self.cells.cell_start) + geo
                 + (self.cst, tau_rows, self.ace, self.ar, self.viscdt, self.shiftpos,
-                   self.shiftdet, self.gradvel, self._tvel(self.nb.shape[0]), self.dtmax))
+                   self.shiftdet, self.gradvel, self._tvel(self.nb.shape[0]), self.dtmax, self.nctype))
 
     def _verlet_args(self, euler):
         s = self.state
@@ -507,34 +526,46 @@ class SPHSolver:
             ncx, ncy, ncz = self.cells.shape
             fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.normals, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, s.rhop, self.slip, self.dp, self._tvel(s.n),
+               self.mdbc_ksum, s.rhop, self.slip, self.ghostvel, self.dp, self._tvel(s.n),
                self.wall_ace if self._wall_ace_on else self._no_wall_ace)
             if self.nopen and self._need_nopen:
                 self._nopen_detect(par, self.nb, ptype_rows, self.cell_sorted, oi, self.normals,
                                    s.vel, s.pos, self.npshift)
+        if self.shift == 4 and self._need_shift_adv:
+            # before the interaction, which reads the shift with ShiftAdvALE / NCPress
+            self._advanced_shift(par, self.nb, ptype_rows, self.cell_sorted, oi, self.shiftpos, self.fstype,
+                                 self.fsnormal, self._fs_work, nctype=self.nctype)
         k["rates"](*self._rates_args())
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
-        if self.shift == 4 and self._need_shift_adv:
-            self._advanced_shift(par, self.nb, ptype_rows, self.cell_sorted, oi, self.shiftpos, self.fstype,
-                                 self.fsnormal, self._fs_work)
 
-    @staticmethod
-    def _shift_adv_work(n):
+    def _shift_adv_work(self, n):
         """Work arrays of the advanced shifting, one row per packed row: type, normal, grad C,
-        near-surface flag, boundary-contact flag."""
-        return (np.zeros(n, np.int8), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n, np.int8),
-                np.zeros(n, np.int8))
+        near-surface flag, boundary-contact flag; with ALE / NCPress also the distance to the
+        surface, the smoothed normal and the curvature flag."""
+        w = (np.zeros(n, np.int8), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n, np.int8),
+             np.zeros(n, np.int8))
+        if self.adv:
+            w += (np.zeros(n), np.zeros((n, 3)), np.zeros(n, np.int8))
+        return w
 
     def _advanced_shift(self, par, nb, ptype_rows, cell_rows, oi, shiftpos, fstype, fsnormal, work,
-                        src_row=None):
+                        src_row=None, nctype=None):
         """Shifting 4: free-surface detection and displacement (sphdvi.sph.shifting_adv)."""
         from . import shifting_adv as _sa
-        fn = _sa.advanced_shift_parallel if par else _sa.advanced_shift_serial
         ncx, ncy, ncz = self.cells.shape
+        src = np.zeros(0, np.int64) if src_row is None else src_row
+        nzero = _sa.full_support_neighbours(self.h, self.dp, self.is2d)
+        if self.adv:
+            fn = _sa.advanced_shift_ale_parallel if par else _sa.advanced_shift_ale_serial
+            # NCPress next to walls only with mDBC (see shifting_adv._displace_ale_range)
+            fn(self.kernel, self.is2d, bool(self.adv & 1), self.boundary == 2, nb, ptype_rows, cell_rows, oi,
+               self.cells.cell_start, ncx, ncy, ncz, self.cst, nzero, self.shift_adv_coef, self.dp, *work,
+               shiftpos, fstype, fsnormal, nctype, src)
+            return
+        fn = _sa.advanced_shift_parallel if par else _sa.advanced_shift_serial
         fn(self.kernel, self.is2d, nb, ptype_rows, cell_rows, oi, self.cells.cell_start, ncx, ncy, ncz,
-           self.cst, _sa.full_support_neighbours(self.h, self.dp, self.is2d), self.shift_adv_coef, self.dp,
-           *work, shiftpos, fstype, fsnormal, np.zeros(0, np.int64) if src_row is None else src_row)
+           self.cst, nzero, self.shift_adv_coef, self.dp, *work, shiftpos, fstype, fsnormal, src)
 
     def _nopen_detect(self, par, nb, ptype_rows, cell_rows, oi, normals, wallvel, pos, npshift):
         """NoPenetration: corrections of the fluid next to the walls (sphdvi.sph.nopen)."""
@@ -615,7 +646,7 @@ class SPHSolver:
             wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
             fn(self.kernel, self.is2d, nb, ptype_e, np.arange(ne), normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, rhop_e, self.slip, self.dp, self._tvel(ne), wace_e)
+               self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
             bound = (order < n) & (ptype_e < 2)
             s.rhop[order[bound]] = rhop_e[bound]
             if self.nopen and self._need_nopen:
@@ -625,26 +656,37 @@ class SPHSolver:
                 real_rows = order < n
                 self.npshift[order[real_rows]] = npshift[real_rows]
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self._mdbc2_flag, nb, ptype_e,
-                   cell_e, np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt,
-                   shiftpos, shiftdet, gradvel, self._tvel(ne),
-                   np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)))
         real = order < n
         dst = order[real]
-        self.ace[dst] = ace[real]
-        self.ar[dst] = ar[real]
-        self.viscdt[dst] = viscdt[real]
         if self.shift == 4 and self._need_shift_adv:
             fstype = np.zeros(ne, np.int8)
             fsnormal = np.zeros((ne, 3))
+            nctype = np.zeros(ne if self.adv else 1, np.int8)
             row_of = np.empty(n, np.int64)
             row_of[order[real]] = np.flatnonzero(real)
             self._advanced_shift(par, nb, ptype_e, cell_e, np.arange(ne), shiftpos, fstype, fsnormal,
                                  self._shift_adv_work(ne),
-                                 src_row=row_of[idx])
+                                 src_row=row_of[idx], nctype=nctype)
             self.fstype[dst] = fstype[real]
             self.fsnormal[dst] = fsnormal[real]
-        if self.shift:
+            if self.adv:
+                self.shiftpos[dst] = shiftpos[real]
+                self.nctype[dst] = nctype[real]
+        shiftpos_r = shiftpos
+        nctype_r = self.nctype
+        if self.adv:
+            # the interaction reads the shift (ALE) and type (NCPress) of every row: a periodic
+            # copy takes its real particle's, as DualSPHysics does
+            shiftpos_r = np.ascontiguousarray(self.shiftpos[idx])
+            nctype_r = np.ascontiguousarray(self.nctype[idx])
+        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag, nb,
+                   ptype_e, cell_e, np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt,
+                   shiftpos_r, shiftdet, gradvel, self._tvel(ne), np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)),
+                   nctype_r)
+        self.ace[dst] = ace[real]
+        self.ar[dst] = ar[real]
+        self.viscdt[dst] = viscdt[real]
+        if self.shift and not self.adv:
             self.shiftpos[dst] = shiftpos[real]
             self.shiftdet[dst] = shiftdet[real]
         if self.visco_kind == 2:
@@ -713,6 +755,10 @@ class SPHSolver:
         return dt
 
     def _step_verlet(self):
+        if self.adv & 1:
+            # the shifting velocity of the ALE terms is dr/dt; Verlet's dt follows from
+            # this step's rates, so the previous step's (or the imposed) dt stands in
+            self.cst[20] = 1.0 / (self._fixed_dt(self.time) or self.last_dt or self.dt_pre)
         self.compute_rates()
         dt = self._variable_dt(self.time)
         self._set_ip(dt)
@@ -730,15 +776,18 @@ class SPHSolver:
         dt = self._fixed_dt(self.time) or self.dt_pre
         self._set_ip(dt)
         s = self.state
-        self._need_shift_adv = False
+        if self.adv & 1:
+            self.cst[20] = 1.0 / dt      # ALE: shifting velocity dr/dt of this step
+        self._need_shift_adv = bool(self.adv)
         self._need_nopen = False
         self.compute_rates()
-        self._need_shift_adv = True
+        self._need_shift_adv = not self.adv
         self._need_nopen = True
         k = self._integrators(self._use_parallel(light=True))
         k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
                      self.ace, self.ar, s.ptype, self.ip)
         self.compute_rates()
+        self._need_shift_adv = True
         nout = k["sym_corr"](*self._corr_args())
         if self.nopen:
             nout += self._nopen_apply(True)

@@ -87,9 +87,11 @@ def by_state_row(sol, packed):
 
 
 # --------------------------------------------------------------------------- reference
-def mdbc2_reference(sol, slip, wall_ace=None):
+def mdbc2_reference(sol, slip, wall_ace=None, ghostvel=1):
     """Independent numpy form of DualSPHysics's mDBC2 correction (2D, Wendland):
-    per wall particle with a normal, (rho_b, tangential velocity, branch)."""
+    per wall particle with a normal, (rho_b, tangential velocity, branch).
+    ``ghostvel`` 1: the ghost velocity from the corrected system where the
+    density is corrected (sphdvi's default), 0: the Shepard average."""
     s, c = sol.state, sol.constants
     h, dp, c0 = c["h"], c["dp"], c["cs0"]
     alpha = kernel_alpha(2, h, True)
@@ -120,6 +122,7 @@ def mdbc2_reference(sol, slip, wall_ace=None):
         A[1:, 0] = (V[:, None] * gw).sum(0)
         A[1:, 1:] = -np.einsum("j,ja,jb->ab", V, gw, d[:, [0, 2]])
         b = np.r_[(M * w).sum(), (M[:, None] * gw).sum(0)]
+        bv = np.vstack([(V[:, None] * w[:, None] * v).sum(0), np.einsum("j,ja,jc->ac", V, gw, v)])
         ksum = A[0, 0]
         shepard = b[0] / ksum
         if ksum < 0.1:
@@ -135,6 +138,8 @@ def mdbc2_reference(sol, slip, wall_ace=None):
         f = grav - (0.0 if wall_ace is None else wall_ace[i])
         rho_b = rho_g - 2 * RHO0 * (f[0] * N[0] + f[2] * N[2]) / c0 ** 2
         vg = (V[:, None] * w[:, None] * v).sum(0) / ksum
+        if ghostvel == 1 and branch == "corrected":
+            vg = (Ai @ bv)[0]
         v2 = 2 * vw - vg if slip == 2 else vg
         v2[1] = 0.0
         out[i] = (rho_b, v2 - (v2 @ e) * e, branch)
@@ -223,17 +228,19 @@ def test_wall_acceleration_from_the_motion():
 
 
 # --------------------------------------------------------------------------- all branches
-def test_every_branch_against_a_numpy_reference():
+@pytest.mark.parametrize("ghostvel", [1, 0])
+def test_every_branch_against_a_numpy_reference(ghostvel):
     """A sloshing tank at dp = 2 m after 0.4 periods (the scaled condition number
     dp^2 |A| |A^-1| is dimensional: at dp = 0.05 m no matrix exceeds 50, at 2 m
     some do): densities and tangential velocities of all wall particles match
     the numpy form of the method, with every branch taken (counts measured:
-    corrected 128, cond 13, ksum 12, dry 7, det 2)."""
+    corrected 128, cond 13, ksum 12, dry 7, det 2), for either ghost velocity
+    (MdbcGhostVelocity 1, corrected; 0, Shepard as DualSPHysics)."""
     dp = 2.0
-    sol = tank(dp, L=40.0, d=20.0, a=0.8)
+    sol = tank(dp, L=40.0, d=20.0, a=0.8, params={"MdbcGhostVelocity": ghostvel})
     sol.run(0.4 * linear_period(40.0, 20.0))
     sol.compute_rates()
-    ref = mdbc2_reference(sol, 2)
+    ref = mdbc2_reference(sol, 2, ghostvel=ghostvel)
     rows = np.array(sorted(ref))
     branches = [ref[i][2] for i in rows]
     counts = {b: branches.count(b) for b in set(branches)}

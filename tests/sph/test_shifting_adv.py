@@ -1,7 +1,6 @@
 """Shifting 4 (advanced): free-surface detection, normals, the interior displacement
 (sphdvi.sph.shifting_adv) and its wiring in the solver."""
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -125,10 +124,3 @@ def test_settling_block_keeps_its_surface_unshifted(algo):
     assert np.count_nonzero(sol2.state.ptype == 3) == n
     assert moved > 0
 
-
-def test_ale_and_ncpress_are_warned():
-    with warnings.catch_warnings(record=True) as w:
-        warnings.simplefilter("always")
-        block(6, 6, params={"ShiftAdvALE": 1, "ShiftAdvNCPress": 1})
-    msgs = [str(x.message) for x in w]
-    assert any("ShiftAdvALE" in m for m in msgs) and any("ShiftAdvNCPress" in m for m in msgs)

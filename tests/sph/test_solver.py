@@ -3,7 +3,6 @@ import math
 import subprocess
 import sys
 
-import numba
 import numpy as np
 import pytest
 
@@ -11,7 +10,7 @@ from sphdvi.sph import SPHSolver
 from sphdvi.sph.scenes import tank_2d
 from sphdvi.sph.state import FluidState
 
-from _helpers import constants, jittered_block, random_state
+from _helpers import assert_threaded_equals_serial, constants, jittered_block, random_state
 
 
 def small_tank(dp=0.02):
@@ -28,19 +27,7 @@ def test_import_does_not_load_numba():
 def test_parallel_kernels_bitwise_equal_serial(alg):
     """Gather form: the threaded kernels give bitwise the serial result."""
     st, c = small_tank()
-    p = {"StepAlgorithm": alg, "DensityDT": 2, "Shifting": 3, "ShiftTFS": 1.5}
-    ser = SPHSolver(st.copy(), c, p, parallel_threshold=10 ** 9)
-    par = SPHSolver(st.copy(), c, p, parallel_threshold=0)
-    old = numba.get_num_threads()
-    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    try:
-        for _ in range(30):
-            assert ser.step() == par.step()
-    finally:
-        numba.set_num_threads(old)
-    a, b = ser.state.sorted_by_idp(), par.state.sorted_by_idp()
-    assert np.array_equal(a.pos, b.pos) and np.array_equal(a.vel, b.vel)
-    assert np.array_equal(a.rhop, b.rhop)
+    assert_threaded_equals_serial(st, c, {"StepAlgorithm": alg, "DensityDT": 2, "Shifting": 3, "ShiftTFS": 1.5})
 
 
 def test_dam_break_runs_and_conserves_particles():
