@@ -25,7 +25,9 @@ PARAMETERS: dict[str, Param] = {
     "Boundary": Param("int", 1, "boundary method 1:DBC, 2:mDBC", (1, 2)),
     "SlipMode": Param("int", 1, "mDBC slip mode 1:DBC vel=0, 2:no-slip, 3:free slip", (1, 2, 3)),
     "MdbcFastSingle": Param("int", 1, "mDBC matrix solve in single precision", (0, 1)),
-    "MdbcThreshold": Param("float", 0.0, "mDBC kernel-sum threshold", (), 0.0, 1.0),
+    "MdbcThreshold": Param("float", 0.0, "mDBC kernel-sum threshold (SlipMode 1 only)", (), 0.0, 1.0),
+    "MdbcGhostVelocity": Param("int", 1, "sphdvi: mDBC SlipMode 2, 3 ghost-node velocity 1:first-order "
+                               "corrected, 0:Shepard average (DualSPHysics v5.4)", (0, 1)),
     "NoPenetration": Param("int", 0, "mDBC no-penetration correction (SlipMode 2, 3 only)", (0, 1)),
     "StepAlgorithm": Param("int", 1, "1:Verlet, 2:Symplectic", (1, 2)),
     "VerletSteps": Param("int", 40, "Verlet: steps between Euler steps", (), 1, 1e9),

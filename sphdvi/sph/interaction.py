@@ -41,8 +41,14 @@ Boundary particles (DBC; ptype 0 fixed, 1 moving) get continuity only, from
 their fluid and floating neighbours.  Floating particles (ptype 2) interact
 with fluid only; their ``ace`` excludes gravity (the body solver adds it).
 
+mDBC slip modes 2 and 3 (flag mdbc2 = 1, :mod:`sphdvi.sph.mdbc`): for a wall
+neighbour the continuity term keeps the wall's own (motion) velocity, while
+the viscosity and the viscous time-step term see the wall's tangential
+velocity ``tvel`` (one row per packed row); walls switched off by mDBC carry
+zero packed mass.
+
 Feature flags are ``numba.literally`` arguments (compile-time constants):
-kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, adv 0..3.  The 2D (x-z plane) and 3D
+kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, adv 0..3, mdbc2 0/1.  The 2D (x-z plane) and 3D
 paths are separate functions.
 """
 import math
@@ -212,14 +218,15 @@ def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c):
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start,
+def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
-                       gradvel, nctype):
+                       gradvel, tvel, nctype):
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
     adv = literally(adv)
+    mdbc2 = literally(mdbc2)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
@@ -346,11 +353,16 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, c
                 dvx = vxi - nb[j, 2]
                 dvz = vzi - nb[j, 3]
                 dot = dvx * dx + dvz * dz
+                # continuity: rho_a m_b/rho_b v_ab.gradW (rho_a applied at the end)
+                arp += mfac * dot * irj
+                if mdbc2 == 1 and boundj:
+                    # mDBC2: the viscosity sees the wall's tangential velocity (sphdvi.sph.mdbc)
+                    dvx = vxi - tvel[j, 0]
+                    dvz = vzi - tvel[j, 2]
+                    dot = dvx * dx + dvz * dz
                 ir2e = 1.0 / (r2 + eta2)
                 dot_rr2 = dot * ir2e
                 vmax = max(vmax, dot_rr2)
-                # continuity: rho_a m_b/rho_b v_ab.gradW (rho_a applied at the end)
-                arp += mfac * dot * irj
                 # symmetric pressure term
                 coef = -(pi + pj) * iri * irj
                 if kern == 1:
@@ -469,8 +481,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, c
 
 
 @njit(cache=True, error_model="numpy")
-def rates_2d_serial(kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start, ncx,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax, nctype):
+def rates_2d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Serial driver of the 2D interaction (use below ~10k particles).
 
     Chunk c of CHUNK rows also leaves its time-step maxima in dtmax[c]
@@ -480,32 +492,34 @@ def rates_2d_serial(kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_star
     ddt = literally(ddt)
     shift = literally(shift)
     adv = literally(adv)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start,
-                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, nctype)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_2d_parallel(kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start, ncx,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax, nctype):
+def rates_2d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Threaded driver of the 2D interaction (prange over chunks of particles)."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
     adv = literally(adv)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start,
-                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, nctype)
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
@@ -513,14 +527,15 @@ def rates_2d_parallel(kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_st
 # 3D
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start,
+def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
-                       gradvel, nctype):
+                       gradvel, tvel, nctype):
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
     adv = literally(adv)
+    mdbc2 = literally(mdbc2)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
@@ -676,10 +691,15 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, c
                     dvy = vyi - nb[j, 4]
                     dvz = vzi - nb[j, 5]
                     dot = dvx * dx + dvy * dy + dvz * dz
+                    arp += mfac * dot * irj
+                    if mdbc2 == 1 and boundj:
+                        dvx = vxi - tvel[j, 0]
+                        dvy = vyi - tvel[j, 1]
+                        dvz = vzi - tvel[j, 2]
+                        dot = dvx * dx + dvy * dy + dvz * dz
                     ir2e = 1.0 / (r2 + eta2)
                     dot_rr2 = dot * ir2e
                     vmax = max(vmax, dot_rr2)
-                    arp += mfac * dot * irj
                     coef = -(pi + pj) * iri * irj
                     if kern == 1:
                         wr = kernel_w(1, q, alpha) * od_wdp
@@ -826,8 +846,8 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, c
 
 
 @njit(cache=True, error_model="numpy")
-def rates_3d_serial(kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax, nctype):
+def rates_3d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+                    ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows);
     time-step maxima per chunk in dtmax as :func:`rates_2d_serial`."""
     kern = literally(kern)
@@ -835,32 +855,34 @@ def rates_3d_serial(kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_star
     ddt = literally(ddt)
     shift = literally(shift)
     adv = literally(adv)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start,
-                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, nctype)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_3d_parallel(kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start, ncx, ncy,
-                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, dtmax, nctype):
+def rates_3d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+                      ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Threaded driver of the 3D interaction."""
     kern = literally(kern)
     visco = literally(visco)
     ddt = literally(ddt)
     shift = literally(shift)
     adv = literally(adv)
+    mdbc2 = literally(mdbc2)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, nb, ptype, cell, oi, cell_start,
-                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, nctype)
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
         _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
 
 

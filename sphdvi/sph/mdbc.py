@@ -1,33 +1,92 @@
-r"""Modified dynamic boundary conditions, mDBC (English et al. 2022).
+r"""Modified dynamic boundary conditions, mDBC (English et al. 2022), as DualSPHysics v5.4.
 
 Each boundary particle b carries a normal vector N_b pointing from the
-particle to the boundary surface (DualSPHysics convention; |N_b| is the
-distance to the surface).  Its ghost node g = r_b + 2 N_b lies inside the
-fluid.  The fluid density and its gradient at g come from the first-order
-consistent kernel interpolation (Liu & Liu 2006)
+particle to the boundary surface (|N_b| is the distance to the surface;
+DualSPHysics stores 2 N_b).  Its ghost node g = r_b + 2 N_b lies inside the
+fluid.  Over the fluid particles j near g (V = m/rho, w = W(|g - r_j|), grad w
+its gradient with respect to g) the first-order consistent kernel
+interpolation (Liu & Liu 2006) gives the density and its gradient at g:
 
-  [ sum V w        sum V w (r_j-g)^T   ] [rho_g     ]   [ sum m w  ]
+  [ sum V w        sum V w (r_j-g)^T      ] [rho_g     ]   [ sum m w      ]
   [ sum V grad w   sum V grad w (r_j-g)^T ] [grad rho_g] = [ sum m grad w ]
 
-over the fluid particles j near g (V = m/rho, w = W(|g - r_j|), grad w its
-gradient with respect to g), and the boundary particle gets
-rho_b = rho_g + (r_b - g) . grad rho_g.  When the matrix is near-singular
-(|det| below ``threshold``, 1e-3) the Shepard value sum m w / sum V w is
-used; with a kernel sum sum V w at g not above ``MdbcThreshold`` (no fluid
-there) the density is left as it is.  As with DBC the result
-is clamped to rho >= rho0.  Particles with N_b = 0 keep plain DBC
-behaviour.
+with the matrix A on the left.  Particles with N_b = 0 keep plain DBC
+behaviour in every mode.
 
-Slip modes (``SlipMode``) set the velocity a boundary particle shows the
-fluid (continuity, viscosity), from the velocity v_g interpolated at its
-ghost node with the same corrected system (right-hand side sum V v w,
-sum V v grad w) and the wall velocity v_w (the particle's own velocity):
+SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
+    rho_b = rho_g + (r_b - g) . grad rho_g; the Shepard value
+    sum m w / sum V w where |det A| is below ``threshold`` (1e-3); with a kernel
+    sum sum V w at g not above ``MdbcThreshold`` the density is left as it is;
+    the result is clamped to rho >= rho0.  The wall particle shows the fluid its
+    own (wall) velocity.
 
-* 1, DBC velocity: v_b = v_w;
-* 2, no-slip: v_b = 2 v_w - v_g (the velocity is odd about the wall, so the
-  interpolated velocity vanishes relative to the wall on the surface);
-* 3, free-slip: v_b = v_w + u - 2 (u.n) n with u = v_g - v_w and n the unit
-  normal (tangential velocity even, normal velocity odd about the wall).
+SlipMode 2 (no-slip) and 3 (free-slip): DualSPHysics's mDBC2 with a choice of
+ghost velocity (``JSphCpu_mdbc.cpp`` InteractionMdbc2CorrectionT2, ``JSphGpu_mdbc_iker.cu``
+KerInteractionMdbc2Correction_Fast, ``JSphCpu.cpp`` InteractionForcesFluid;
+CPU and GPU agree):
+
+* Submersion: s = -sum V (g - r_j) . grad w (>= 0: grad w = fac (g - r_j),
+  fac <= 0), positive as soon as one fluid particle lies within the kernel
+  support of g.  With s = 0 the ghost node is dry and the particle is
+  switched off for the step: zero mass in the fluid's sums (pressure,
+  viscosity, continuity, density diffusion, shifting), rho_b = rho0; as a
+  wall neighbour it still switches Fourtakas's diffusion (DensityDT 2) and
+  the shifting of modes 1-2 off, as in DualSPHysics.
+* Ghost density rho_g: the first row of the solution of the system above if
+  the kernel sum sum V w >= 0.1, |det A| >= 1e-3 and the scaled condition
+  number dp^2 |A|_inf |A^-1|_inf <= 50 (infinity norms: largest row sum);
+  otherwise the Shepard value sum m w / sum V w (raised to rho0 when the
+  kernel sum is below 0.1).  The gradient is not used.
+* Pressure cloning: with e = N_b/|N_b|, p_g = c0^2 (rho_g - rho0) and a_w the
+  wall acceleration,
+      p_b = p_g + rho0 ((g_vec - a_w) . e) ((r_b - g) . e),
+  the hydrostatic (and inertial) pressure difference between the ghost node
+  and the particle, and rho_b = rho0 + p_b / c0^2.  No clamping: rho_b may
+  be below rho0.  a_w is (v_w^{n+1} - v_w^n)/dt of the moving particles as
+  the motion sets them (DualSPHysics's CopyMotionVelAce), zero for fixed ones.
+* Ghost velocity v_g (``MdbcGhostVelocity``, sphdvi's own key): 1 (default)
+  the first-order corrected interpolation at g, the first row of the solution
+  of the system above with right-hand sides (sum V w v_j, sum V grad w v_j),
+  where the density is corrected (else the Shepard average); 0 the plain
+  kernel (Shepard) average sum V w v_j / sum V w, as DualSPHysics.  The wall
+  particle's velocity v2 is 2 v_w - v_g (no-slip) or v_g (free-slip), v_w
+  its own (motion) velocity; dry: v2 = v_w.
+* In the fluid's interaction the wall particle keeps its motion velocity v_w
+  in the continuity equation (DualSPHysics keeps it in ``velrho``,
+  MDBC2_KEEPVEL), while the viscosity (artificial or laminar, and the
+  viscous time-step term) sees the tangential part of v2,
+  t = v2 - (v2 . e) e (``tvel``, per packed row).
+* ``MdbcThreshold`` is not used (DualSPHysics v5.4's mDBC2 has none).
+
+Consequences measured in tests/sph/test_poiseuille.py and test_mdbc_slip.py:
+near a wall the Shepard ghost velocity (MdbcGhostVelocity 0) is a one-sided
+average, so a no-slip wall acts 0.13-0.15 dp inside the fluid (Poiseuille
+centre-line speed -4 x 0.14 dp/d, -1 % at 30 across); the corrected one is
+exact for a linear velocity profile and has no such offset.  The linearised
+cloning (c0^2 (rho - rho0) for Tait's equation) overestimates the hydrostatic
+wall pressure by about 6 (g d / c0^2) rho0 g dz (0.3-0.75 % of rho0 g d at
+d/dp = 25-10); the scaled condition number is dimensional (dp in metres): it
+rejects no matrix at dp = 0.05 m and some at dp = 2 m.
+
+Deviations: the default ghost velocity is the corrected one (above).  A
+particle with N_b = 0 shows the viscosity its own velocity
+(DualSPHysics reads its TangenVel entry, which nothing sets).  DualSPHysics
+runs the correction in the Symplectic corrector only with MdbcCorrector=1
+(default 0: the predictor's wall values are kept); here it runs in every
+evaluation of the rates, in all slip modes.
+
+Why the ghost velocity is kept out of the continuity equation: the no-slip
+wall velocity 2 v_w - v_g is odd about the wall in its tangential component
+too.  In the continuity sum of a fluid particle next to a wall that turns
+the tangential derivative of the tangential velocity around (its mirror
+image has d(-v_t)/ds), so the wall half of the kernel measures a divergence
+dv_n/dn - dv_t/ds = 2 dv_n/dn where the flow has none.  In a sloshing tank
+that compresses and dilates the water along the side walls in phase with the
+wave: sphdvi's earlier SlipMode 2, which showed 2 v_w - v_g (first-order
+corrected v_g) to the continuity and the viscosity, shortened the period of
+the S7 case by 5.5 % (gauge 17 %) at d/dp = 20; the same with the wall
+velocity in the continuity gives -1.4 %, and this treatment -0.7 %
+(tests/sph/test_mdbc_slip.py checks a coarse tank).
 
 ``NoPenetration`` (slip modes 2 and 3) corrects the fluid particles next to
 the walls, not the boundary particles: :mod:`sphdvi.sph.nopen`.
@@ -42,63 +101,141 @@ from .interaction import tait_pressure
 from .kernels import kernel_fac, kernel_w
 from .linalg import solve_pivoted
 
-
-@njit(cache=True)
-def _packed_vel(nb, j, is2d, out):
-    """Velocity (x, y, z) of packed particle j."""
-    if is2d:
-        out[0] = nb[j, 2]
-        out[1] = 0.0
-        out[2] = nb[j, 3]
-    else:
-        out[0] = nb[j, 3]
-        out[1] = nb[j, 4]
-        out[2] = nb[j, 5]
-
-
-@njit(cache=True)
-def _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i):
-    """Velocity of boundary particle i seen by the fluid (module docstring)."""
-    if slip == 2:
-        for c in range(3):
-            bvel[i, c] = 2.0 * vw[c] - vg[c]
-        return
-    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
-    ex = nx / nn
-    ey = ny / nn
-    ez = nz / nn
-    ux = vg[0] - vw[0]
-    uy = vg[1] - vw[1]
-    uz = vg[2] - vw[2]
-    un = ux * ex + uy * ey + uz * ez
-    bvel[i, 0] = vw[0] + ux - 2.0 * un * ex
-    bvel[i, 1] = vw[1] + uy - 2.0 * un * ey
-    bvel[i, 2] = vw[2] + uz - 2.0 * un * ez
+# mDBC2 (SlipMode 2, 3) limits, DualSPHysics v5.4 (JSphCpu_mdbc.cpp, JSphGpu_mdbc_iker.cu)
+MDBC2_KSUM_MIN = 0.1      # kernel sum at the ghost node below which the Shepard density is used
+MDBC2_DET_MIN = 1e-3      # |det A| below which the Shepard density is used
+MDBC2_COND_MAX = 50.0     # scaled condition number dp^2 |A|_inf |A^-1|_inf above which likewise
 
 
 @njit(cache=True, error_model="numpy")
-def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell,
-                ncx, ncy, ncz, cst, threshold, ksum_min, rhop, slip, bvel):
+def _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
+                gx, gy, gz, a, b, vsum):
+    """Sums over the fluid particles j near the ghost node g = (gx, gy, gz):
+    the moment matrix a (see the module docstring), the right-hand side
+    b[:, 0] = (sum m w, sum m grad w), and, when ``vsum`` has 4 entries (mDBC2),
+    sum V w v_j in vsum[0:3], the submersion measure -sum V (g - r_j).grad w
+    in vsum[3] and the velocity right-hand sides b[:, 1:4] = (sum V w v_j,
+    sum V grad w v_j) of the corrected ghost velocity."""
     h = cst[0]
     r2max = cst[1]
     alpha = cst[3]
     alpha_h2 = cst[4]
+    mdbc2 = vsum.shape[0] == 4
+    for r in range(4):
+        for cc in range(b.shape[1]):
+            b[r, cc] = 0.0
+        for cc in range(4):
+            a[r, cc] = 0.0
+    if mdbc2:
+        for c in range(4):
+            vsum[c] = 0.0
+    cx = min(max(int((gx - pmin[0]) * inv_cell), 0), ncx - 1)
+    cy = min(max(int((gy - pmin[1]) * inv_cell), 0), ncy - 1) if not is2d else 0
+    cz = min(max(int((gz - pmin[2]) * inv_cell), 0), ncz - 1)
+    rs = int(cst[18])
+    for z in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
+        for y in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
+            row = (z * ncy + y) * ncx
+            for j in range(cell_start[row + max(cx - rs, 0)],
+                           cell_start[row + min(cx + rs, ncx - 1) + 1]):
+                if ptype[j] != 3:
+                    continue
+                if is2d:
+                    dx = gx - nb[j, 0]
+                    dy = 0.0
+                    dz = gz - nb[j, 1]
+                    mj = nb[j, 6]
+                    vj = mj * nb[j, 7]
+                else:
+                    dx = gx - nb[j, 0]
+                    dy = gy - nb[j, 1]
+                    dz = gz - nb[j, 2]
+                    mj = nb[j, 8]
+                    vj = mj * nb[j, 9]
+                r2 = dx * dx + dy * dy + dz * dz
+                if r2 >= r2max:
+                    continue
+                q = math.sqrt(r2) / h
+                w = kernel_w(kern, q, alpha)
+                fac = kernel_fac(kern, q, alpha_h2) if r2 > 1e-18 else 0.0
+                # gradient with respect to g, and r_j - g
+                if is2d:
+                    gw0 = fac * dx
+                    gw1 = fac * dz
+                    d0 = -dx
+                    d1 = -dz
+                    gw2 = 0.0
+                    d2 = 0.0
+                else:
+                    gw0 = fac * dx
+                    gw1 = fac * dy
+                    gw2 = fac * dz
+                    d0 = -dx
+                    d1 = -dy
+                    d2 = -dz
+                a[0, 0] += vj * w
+                a[0, 1] += vj * w * d0
+                a[0, 2] += vj * w * d1
+                b[0, 0] += mj * w
+                a[1, 0] += vj * gw0
+                a[1, 1] += vj * gw0 * d0
+                a[1, 2] += vj * gw0 * d1
+                b[1, 0] += mj * gw0
+                a[2, 0] += vj * gw1
+                a[2, 1] += vj * gw1 * d0
+                a[2, 2] += vj * gw1 * d1
+                b[2, 0] += mj * gw1
+                if not is2d:
+                    a[0, 3] += vj * w * d2
+                    a[1, 3] += vj * gw0 * d2
+                    a[2, 3] += vj * gw1 * d2
+                    a[3, 0] += vj * gw2
+                    a[3, 1] += vj * gw2 * d0
+                    a[3, 2] += vj * gw2 * d1
+                    a[3, 3] += vj * gw2 * d2
+                    b[3, 0] += mj * gw2
+                if mdbc2:
+                    if is2d:
+                        u0 = nb[j, 2]
+                        u1 = 0.0
+                        u2 = nb[j, 3]
+                    else:
+                        u0 = nb[j, 3]
+                        u1 = nb[j, 4]
+                        u2 = nb[j, 5]
+                    vw = vj * w
+                    vsum[0] += vw * u0
+                    vsum[1] += vw * u1
+                    vsum[2] += vw * u2
+                    b[0, 1] += vw * u0
+                    b[0, 2] += vw * u1
+                    b[0, 3] += vw * u2
+                    b[1, 1] += vj * gw0 * u0
+                    b[1, 2] += vj * gw0 * u1
+                    b[1, 3] += vj * gw0 * u2
+                    b[2, 1] += vj * gw1 * u0
+                    b[2, 2] += vj * gw1 * u1
+                    b[2, 3] += vj * gw1 * u2
+                    if not is2d:
+                        b[3, 1] += vj * gw2 * u0
+                        b[3, 2] += vj * gw2 * u1
+                        b[3, 3] += vj * gw2 * u2
+                    # -V (g - r_j).grad w = -V fac r^2 >= 0 (fac <= 0)
+                    vsum[3] -= vj * fac * r2
+
+
+@njit(cache=True, error_model="numpy")
+def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell,
+                ncx, ncy, ncz, cst, threshold, ksum_min, rhop):
+    """SlipMode 1: density only (module docstring)."""
     rhop0 = cst[10]
-    dim = 2 if is2d else 3
-    n = dim + 1
+    n = 3 if is2d else 4
     a = np.zeros((4, 4))
-    # right-hand sides: column 0 the density, columns 1-3 the velocity (slip modes 2, 3)
-    b = np.zeros((4, 4))
-    nrhs = 4 if slip > 1 else 1
-    vw = np.zeros(3)
-    vg = np.zeros(3)
+    b = np.zeros((4, 1))
+    novel = np.zeros(0)
     for i in range(i0, i1):
         if ptype[i] >= 2:
             continue
-        if slip > 1:
-            _packed_vel(nb, i, is2d, vw)
-            for c in range(3):
-                bvel[i, c] = vw[c]
         o = oi[i]   # row of particle i in normals and rhop
         nx = normals[o, 0]
         ny = normals[o, 1]
@@ -106,156 +243,199 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, in
         if nx == 0.0 and ny == 0.0 and nz == 0.0:
             continue
         if is2d:
-            bx = nb[i, 0]
-            by = 0.0
-            bz = nb[i, 1]
+            gx = nb[i, 0] + 2.0 * nx
+            gy = 0.0
+            gz = nb[i, 1] + 2.0 * nz
         else:
-            bx = nb[i, 0]
-            by = nb[i, 1]
-            bz = nb[i, 2]
-        gx = bx + 2.0 * nx
-        gy = by + 2.0 * ny
-        gz = bz + 2.0 * nz
-        cx = min(max(int((gx - pmin[0]) * inv_cell), 0), ncx - 1)
-        cy = min(max(int((gy - pmin[1]) * inv_cell), 0), ncy - 1) if not is2d else 0
-        cz = min(max(int((gz - pmin[2]) * inv_cell), 0), ncz - 1)
-        for r in range(4):
-            for cc in range(4):
-                a[r, cc] = 0.0
-                b[r, cc] = 0.0
-        rs = int(cst[18])
-        for z in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
-            for y in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
-                row = (z * ncy + y) * ncx
-                for j in range(cell_start[row + max(cx - rs, 0)],
-                               cell_start[row + min(cx + rs, ncx - 1) + 1]):
-                    if ptype[j] != 3:
-                        continue
-                    if is2d:
-                        dx = gx - nb[j, 0]
-                        dy = 0.0
-                        dz = gz - nb[j, 1]
-                        mj = nb[j, 6]
-                        vj = mj * nb[j, 7]
-                    else:
-                        dx = gx - nb[j, 0]
-                        dy = gy - nb[j, 1]
-                        dz = gz - nb[j, 2]
-                        mj = nb[j, 8]
-                        vj = mj * nb[j, 9]
-                    r2 = dx * dx + dy * dy + dz * dz
-                    if r2 >= r2max:
-                        continue
-                    q = math.sqrt(r2) / h
-                    w = kernel_w(kern, q, alpha)
-                    fac = kernel_fac(kern, q, alpha_h2) if r2 > 1e-18 else 0.0
-                    # gradient with respect to g, and r_j - g
-                    if is2d:
-                        gw0 = fac * dx
-                        gw1 = fac * dz
-                        d0 = -dx
-                        d1 = -dz
-                        gw2 = 0.0
-                        d2 = 0.0
-                    else:
-                        gw0 = fac * dx
-                        gw1 = fac * dy
-                        gw2 = fac * dz
-                        d0 = -dx
-                        d1 = -dy
-                        d2 = -dz
-                    a[0, 0] += vj * w
-                    a[0, 1] += vj * w * d0
-                    a[0, 2] += vj * w * d1
-                    b[0, 0] += mj * w
-                    a[1, 0] += vj * gw0
-                    a[1, 1] += vj * gw0 * d0
-                    a[1, 2] += vj * gw0 * d1
-                    b[1, 0] += mj * gw0
-                    a[2, 0] += vj * gw1
-                    a[2, 1] += vj * gw1 * d0
-                    a[2, 2] += vj * gw1 * d1
-                    b[2, 0] += mj * gw1
-                    if not is2d:
-                        a[0, 3] += vj * w * d2
-                        a[1, 3] += vj * gw0 * d2
-                        a[2, 3] += vj * gw1 * d2
-                        a[3, 0] += vj * gw2
-                        a[3, 1] += vj * gw2 * d0
-                        a[3, 2] += vj * gw2 * d1
-                        a[3, 3] += vj * gw2 * d2
-                        b[3, 0] += mj * gw2
-                    if slip > 1:
-                        _packed_vel(nb, j, is2d, vg)
-                        for cc in range(3):
-                            b[0, 1 + cc] += vj * w * vg[cc]
-                            b[1, 1 + cc] += vj * gw0 * vg[cc]
-                            b[2, 1 + cc] += vj * gw1 * vg[cc]
-                            if not is2d:
-                                b[3, 1 + cc] += vj * gw2 * vg[cc]
+            gx = nb[i, 0] + 2.0 * nx
+            gy = nb[i, 1] + 2.0 * ny
+            gz = nb[i, 2] + 2.0 * nz
+        _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
+                    gx, gy, gz, a, b, novel)
         if a[0, 0] <= ksum_min or a[0, 0] <= 0.0:
             continue
-        # Shepard values, kept where the corrected system is near-singular
+        # Shepard value, kept where the corrected system is near-singular
         rho = b[0, 0] / a[0, 0]
-        for c in range(3):
-            vg[c] = b[0, 1 + c] / a[0, 0]
-        if solve_pivoted(a, b, n, nrhs, 0.0) >= threshold:
+        if solve_pivoted(a, b, n, 1, 0.0) >= threshold:
             if is2d:
                 rho = b[0, 0] - 2.0 * (nx * b[1, 0] + nz * b[2, 0])
             else:
                 rho = b[0, 0] - 2.0 * (nx * b[1, 0] + ny * b[2, 0] + nz * b[3, 0])
-            for c in range(3):
-                vg[c] = b[0, 1 + c]
         rhop[o] = max(rho, rhop0)
-        if slip > 1:
-            _slip_velocity(slip, vw, vg, nx, ny, nz, bvel, i)
 
 
 @njit(cache=True, error_model="numpy")
-def _refresh_packed(i0, i1, is2d, ptype, oi, rhop, cst, nb, slip, bvel):
+def _inf_norm(a, n, c0):
+    """Largest row sum of |a[:n, c0:c0+n]|."""
+    m = 0.0
+    for r in range(n):
+        s = 0.0
+        for c in range(n):
+            s += abs(a[r, c0 + c])
+        m = max(m, s)
+    return m
+
+
+@njit(cache=True, error_model="numpy")
+def _set_packed(nb, i, is2d, rho, cst, dry):
+    """Packed density, pressure (Tait) and 1/rho of boundary row i; zero mass when dry."""
+    p = tait_pressure(rho, cst[16], cst[10], cst[17])
+    if is2d:
+        nb[i, 4] = rho
+        nb[i, 5] = p
+        nb[i, 7] = 1.0 / rho
+        if dry:
+            nb[i, 6] = 0.0
+    else:
+        nb[i, 6] = rho
+        nb[i, 7] = p
+        nb[i, 9] = 1.0 / rho
+        if dry:
+            nb[i, 8] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell,
+                 ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel, tvel, wace):
+    """SlipMode 2, 3 (DualSPHysics's mDBC2, module docstring): density with
+    pressure cloning, zero mass for a dry ghost node, and the tangential velocity
+    the viscosity sees in tvel[i] (packed row i); ghost velocity corrected
+    (``ghostvel`` 1) or the Shepard average (0, DualSPHysics)."""
+    rhop0 = cst[10]
+    cs02 = cst[5] * cst[5]
+    n = 3 if is2d else 4
+    has_ace = wace.shape[0] == rhop.shape[0]
+    a = np.zeros((4, 4))
+    # right-hand sides: column 0 the density, 1-3 the velocity, 4..3+n the identity (inverse of a)
+    b = np.zeros((4, 8))
+    vsum = np.zeros(4)
+    vw = np.zeros(3)
+    v2 = np.zeros(3)
     for i in range(i0, i1):
         if ptype[i] >= 2:
             continue
-        rho = rhop[oi[i]]
-        p = tait_pressure(rho, cst[16], cst[10], cst[17])
         if is2d:
-            nb[i, 4] = rho
-            nb[i, 5] = p
-            nb[i, 7] = 1.0 / rho
-            if slip > 1:
-                nb[i, 2] = bvel[i, 0]
-                nb[i, 3] = bvel[i, 2]
+            vw[0] = nb[i, 2]
+            vw[1] = 0.0
+            vw[2] = nb[i, 3]
         else:
-            nb[i, 6] = rho
-            nb[i, 7] = p
-            nb[i, 9] = 1.0 / rho
-            if slip > 1:
-                for c in range(3):
-                    nb[i, 3 + c] = bvel[i, c]
+            vw[0] = nb[i, 3]
+            vw[1] = nb[i, 4]
+            vw[2] = nb[i, 5]
+        for c in range(3):
+            tvel[i, c] = vw[c]          # no normal: DBC (the wall velocity)
+        o = oi[i]   # row of particle i in normals, rhop and wace
+        nx = normals[o, 0]
+        ny = normals[o, 1]
+        nz = normals[o, 2]
+        if nx == 0.0 and ny == 0.0 and nz == 0.0:
+            continue
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+        ex = nx / nn
+        ey = ny / nn
+        ez = nz / nn
+        if is2d:
+            gx = nb[i, 0] + 2.0 * nx
+            gy = 0.0
+            gz = nb[i, 1] + 2.0 * nz
+        else:
+            gx = nb[i, 0] + 2.0 * nx
+            gy = nb[i, 1] + 2.0 * ny
+            gz = nb[i, 2] + 2.0 * nz
+        _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
+                    gx, gy, gz, a, b, vsum)
+        if not vsum[3] > 0.0:
+            # dry ghost node: the particle is switched off (zero mass, rho0, wall velocity)
+            rhop[o] = rhop0
+            _set_packed(nb, i, is2d, rhop0, cst, True)
+            vn = vw[0] * ex + vw[1] * ey + vw[2] * ez
+            tvel[i, 0] = vw[0] - vn * ex
+            tvel[i, 1] = vw[1] - vn * ey
+            tvel[i, 2] = vw[2] - vn * ez
+            continue
+        ksum = a[0, 0]
+        shepard = b[0, 0] / ksum
+        corrected = False
+        if ksum < MDBC2_KSUM_MIN:
+            rho_g = max(rhop0, shepard)
+        else:
+            rho_g = shepard
+            norm_a = _inf_norm(a, n, 0)
+            for r in range(n):
+                for c in range(n):
+                    b[r, 4 + c] = 1.0 if r == c else 0.0
+            if solve_pivoted(a, b, n, n + 4, 0.0) >= MDBC2_DET_MIN:
+                if dp * dp * norm_a * _inf_norm(b, n, 4) <= MDBC2_COND_MAX:
+                    rho_g = b[0, 0]
+                    corrected = True
+        # pressure cloning: p_b = p_g + rho0 (g - a_w).e ((r_b - g).e), e the unit normal
+        fx = cst[12]
+        fy = cst[13]
+        fz = cst[14]
+        if has_ace:
+            fx -= wace[o, 0]
+            fy -= wace[o, 1]
+            fz -= wace[o, 2]
+        if is2d:
+            fy = 0.0
+        p_b = cs02 * (rho_g - rhop0) - rhop0 * (fx * ex + fy * ey + fz * ez) * 2.0 * nn
+        rho = rhop0 + p_b / cs02
+        rhop[o] = rho
+        _set_packed(nb, i, is2d, rho, cst, False)
+        # ghost velocity: corrected (the solution's first row) or the Shepard
+        # average; no-slip 2 v_w - v_g, free-slip v_g
+        for c in range(3):
+            vg = b[0, 1 + c] if ghostvel == 1 and corrected else vsum[c] / ksum
+            v2[c] = 2.0 * vw[c] - vg if slip == 2 else vg
+        vn = v2[0] * ex + v2[1] * ey + v2[2] * ez
+        tvel[i, 0] = v2[0] - vn * ex
+        tvel[i, 1] = v2[1] - vn * ey
+        tvel[i, 2] = v2[2] - vn * ez
+
+
+@njit(cache=True, error_model="numpy")
+def _refresh_packed(i0, i1, is2d, ptype, oi, rhop, cst, nb):
+    for i in range(i0, i1):
+        if ptype[i] >= 2:
+            continue
+        _set_packed(nb, i, is2d, rhop[oi[i]], cst, False)
 
 
 @njit(cache=True, error_model="numpy")
 def mdbc_serial(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                cst, threshold, ksum_min, rhop, slip, bvel):
-    """Set the density of every boundary particle with a normal (mDBC) and
-    refresh its packed density and pressure (and, for slip modes 2 and 3, the
-    velocity it shows the fluid; bvel (N, 3) is work space)."""
+                cst, threshold, ksum_min, rhop, slip, ghostvel, dp, tvel, wace):
+    """Set the density of every boundary particle with a normal and refresh its
+    packed row (module docstring).  SlipMode 2, 3 also set ``tvel`` (packed rows,
+    3 columns: the velocity the viscosity sees) and zero the packed mass of the
+    particles whose ghost node is dry; ``wace`` is the wall acceleration per
+    particle (rows as ``normals``), or an array of another length for none.
+    ``threshold`` and ``ksum_min`` serve SlipMode 1 only."""
     n = nb.shape[0]
-    _mdbc_range(0, n, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy,
-                ncz, cst, threshold, ksum_min, rhop, slip, bvel)
-    _refresh_packed(0, n, is2d, ptype, oi, rhop, cst, nb, slip, bvel)
+    if slip == 1:
+        _mdbc_range(0, n, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx,
+                    ncy, ncz, cst, threshold, ksum_min, rhop)
+        _refresh_packed(0, n, is2d, ptype, oi, rhop, cst, nb)
+    else:
+        _mdbc2_range(0, n, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx,
+                     ncy, ncz, cst, dp, rhop, slip, ghostvel, tvel, wace)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def mdbc_parallel(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                  cst, threshold, ksum_min, rhop, slip, bvel):
+                  cst, threshold, ksum_min, rhop, slip, ghostvel, dp, tvel, wace):
     """Threaded :func:`mdbc_serial`."""
     n = nb.shape[0]
     nchunk = (n + 511) // 512
-    for c in prange(nchunk):
-        _mdbc_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, oi, normals,
-                    cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, threshold, ksum_min,
-                    rhop, slip, bvel)
-    for c in prange(nchunk):
-        _refresh_packed(c * 512, min(n, (c + 1) * 512), is2d, ptype, oi, rhop, cst, nb, slip,
-                        bvel)
+    if slip == 1:
+        for c in prange(nchunk):
+            _mdbc_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, oi, normals,
+                        cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, threshold, ksum_min,
+                        rhop)
+        for c in prange(nchunk):
+            _refresh_packed(c * 512, min(n, (c + 1) * 512), is2d, ptype, oi, rhop, cst, nb)
+    else:
+        # reads only fluid rows of nb and writes only boundary rows: one pass
+        for c in prange(nchunk):
+            _mdbc2_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, oi, normals,
+                         cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel,
+                         tvel, wace)

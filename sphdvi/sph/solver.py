@@ -17,7 +17,11 @@ unknown keys are ignored):
   ShiftAdvCoef, ShiftAdvALE, ShiftAdvNCPress (Shifting 4, :mod:`sphdvi.sph.shifting_adv`),
   CoefDtMin, DtIni, DtMin,
   DtFixed, DtAllParticles, RhopOutMin, RhopOutMax, Boundary,
-  SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold,
+  SlipMode (1 DBC velocity, 2 no-slip, 3 free-slip), MdbcThreshold (SlipMode 1),
+  MdbcGhostVelocity (sphdvi's own key, SlipMode 2 and 3: 1, the default, interpolates
+  the velocity at the ghost node with the first-order corrected kernel, like the density;
+  0 takes DualSPHysics v5.4's plain Shepard average, which puts no-slip walls ~0.14 dp
+  inside the water; :mod:`sphdvi.sph.mdbc`),
   NoPenetration (mDBC no-penetration correction of the fluid next to the walls,
   :mod:`sphdvi.sph.nopen`; as DualSPHysics, only with Boundary=2 and SlipMode 2
   or 3: otherwise it is warned and ignored) and the periodic keys (XPeriodicIncY ...,
@@ -151,6 +155,12 @@ class SPHSolver:
             if normals is None:
                 raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
             self.normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(state.n, 3).copy()
+        # mDBC2 (SlipMode 2, 3) with moving walls: their acceleration, for the pressure cloning
+        self._wall_ace_on = self.boundary == 2 and self.slip > 1 and bool(np.any(state.ptype == 1))
+        if self._wall_ace_on:
+            self.wall_ace = np.zeros((state.n, 3))
+        self._no_wall_ace = np.zeros((1, 3))
+        self._no_tvel = np.zeros((1, 3))
         self._verlet_count = 0
         self.reorder_every = REORDER_EVERY
         self._reorder_next = False
@@ -177,6 +187,9 @@ class SPHSolver:
         if self.slip not in (1, 2, 3):
             raise ValueError("SlipMode must be 1 (DBC velocity), 2 (no-slip) or 3 (free-slip)")
         self.mdbc_ksum = float(p.get("MdbcThreshold") or 0.0)
+        self.ghostvel = int(p.get("MdbcGhostVelocity", 1))
+        if self.ghostvel not in (0, 1):
+            raise ValueError("MdbcGhostVelocity must be 0 (Shepard average) or 1 (corrected)")
         # NoPenetration: DualSPHysics reads it only for its mDBC2 slip modes (2, 3)
         self.nopen = bool(int(p.get("NoPenetration") or 0))
         if self.nopen and (self.boundary != 2 or self.slip == 1):
@@ -317,6 +330,8 @@ class SPHSolver:
             names += ["tau"]
         if self.boundary == 2:
             names += ["normals"]
+            if self._wall_ace_on:
+                names += ["wall_ace"]
         return names
 
     def _alloc(self):
@@ -376,13 +391,13 @@ class SPHSolver:
     def _kernels(self, parallel):
         """Entry points of the compiled interaction kernels for this run's flags."""
         key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv,
-               bool(parallel))
+               self._mdbc2_flag, bool(parallel))
         if key in _ENTRY_CACHE:
             return _ENTRY_CACHE[key]
         sfx = "parallel" if parallel else "serial"
         rates = getattr(_ia, ("rates_2d_" if self.is2d else "rates_3d_") + sfx)
         k = {
-            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3, 4)),
+            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3, 4, 5)),
             "pack": getattr(_ia, "pack_" + sfx),
             "sps": getattr(_sps, "sps_tau_" + sfx),
         }
@@ -409,10 +424,10 @@ class SPHSolver:
         ncx, ncy, ncz = self.cells.shape
         ptype_rows, oi, tau_rows = self._rows
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self.nb, ptype_rows,
-                 self.cell_sorted, oi, self.cells.cell_start) + geo
+        return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag,
+                 self.nb, ptype_rows, self.cell_sorted, oi, self.cells.cell_start) + geo
                 + (self.cst, tau_rows, self.ace, self.ar, self.viscdt, self.shiftpos,
-                   self.shiftdet, self.gradvel, self.dtmax, self.nctype))
+                   self.shiftdet, self.gradvel, self._tvel(self.nb.shape[0]), self.dtmax, self.nctype))
 
     def _verlet_args(self, euler):
         s = self.state
@@ -511,7 +526,8 @@ class SPHSolver:
             ncx, ncy, ncz = self.cells.shape
             fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.normals, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, s.rhop, self.slip, self._mdbc_work(s.n))
+               self.mdbc_ksum, s.rhop, self.slip, self.ghostvel, self.dp, self._tvel(s.n),
+               self.wall_ace if self._wall_ace_on else self._no_wall_ace)
             if self.nopen and self._need_nopen:
                 self._nopen_detect(par, self.nb, ptype_rows, self.cell_sorted, oi, self.normals,
                                    s.vel, s.pos, self.npshift)
@@ -574,11 +590,20 @@ class SPHSolver:
         fn = nopen.apply_verlet_parallel if par else nopen.apply_verlet_serial
         return fn(s.pos, s.vel, self.vel_m1, s.rhop, s.ptype, self.npshift, self.ip, self.out)
 
-    def _mdbc_work(self, n):
-        """(n, 3) work array for the slip-mode velocities (kept between steps)."""
-        w = getattr(self, "_bvel", None)
+    @property
+    def _mdbc2_flag(self):
+        """1 for the mDBC2 slip modes (2, 3): the interaction's compile-time flag."""
+        return 1 if self.boundary == 2 and self.slip > 1 else 0
+
+    def _tvel(self, n):
+        """mDBC2: (>= n, 3) work array, per packed row the tangential velocity a
+        wall particle shows the viscosity (set by sphdvi.sph.mdbc); a (1, 3)
+        dummy otherwise."""
+        if not self._mdbc2_flag:
+            return self._no_tvel
+        w = getattr(self, "_tvel_work", None)
         if w is None or w.shape[0] < n:
-            w = self._bvel = np.zeros((max(n, 1), 3))
+            w = self._tvel_work = np.zeros((max(n, 1), 3))
         return w
 
     def _compute_rates_periodic(self):
@@ -618,9 +643,10 @@ class SPHSolver:
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             normals_e = np.ascontiguousarray(self.normals[idx])
+            wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
             fn(self.kernel, self.is2d, nb, ptype_e, np.arange(ne), normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, rhop_e, self.slip, self._mdbc_work(ne))
+               self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
             bound = (order < n) & (ptype_e < 2)
             s.rhop[order[bound]] = rhop_e[bound]
             if self.nopen and self._need_nopen:
@@ -653,9 +679,10 @@ class SPHSolver:
             # copy takes its real particle's, as DualSPHysics does
             shiftpos_r = np.ascontiguousarray(self.shiftpos[idx])
             nctype_r = np.ascontiguousarray(self.nctype[idx])
-        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, nb, ptype_e, cell_e,
-                   np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt, shiftpos_r,
-                   shiftdet, gradvel, np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)), nctype_r)
+        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag, nb,
+                   ptype_e, cell_e, np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt,
+                   shiftpos_r, shiftdet, gradvel, self._tvel(ne), np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)),
+                   nctype_r)
         self.ace[dst] = ace[real]
         self.ar[dst] = ar[real]
         self.viscdt[dst] = viscdt[real]
@@ -716,7 +743,15 @@ class SPHSolver:
         self.nstep += 1
         self.last_dt = dt
         if self.motion_hook is not None:
-            self.motion_hook(self, self.time, dt)
+            if self._wall_ace_on:
+                # mDBC2 pressure cloning: wall acceleration (v^{n+1} - v^n)/dt of the moving
+                # particles, as DualSPHysics's CopyMotionVelAce
+                moving = self.state.ptype == 1
+                v0 = self.state.vel[moving]
+                self.motion_hook(self, self.time, dt)
+                self.wall_ace[moving] = (self.state.vel[moving] - v0) / dt
+            else:
+                self.motion_hook(self, self.time, dt)
         return dt
 
     def _step_verlet(self):
