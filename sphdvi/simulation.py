@@ -489,8 +489,17 @@ class SPHRun:
             for name in sol.state.FIELDS:
                 setattr(sol.state, name, np.ascontiguousarray(f["state"][name][...]))
             sol._alloc()
+            n = sol.state.n
             for name in sol._aux_names():
-                setattr(sol, name, np.ascontiguousarray(f["aux"][name][...]))
+                if name in f["aux"]:
+                    setattr(sol, name, np.ascontiguousarray(f["aux"][name][...]))
+                    continue
+                # written by an older sphdvi without this array (e.g. wall_ace of the
+                # mDBC2 slip modes): start it from zero; the run goes on, not bitwise
+                cur = getattr(sol, name)
+                setattr(sol, name, np.zeros((n,) + cur.shape[1:], cur.dtype))
+                import warnings
+                warnings.warn(f"checkpoint {path} has no '{name}' (older sphdvi); it restarts from zero")
             sc = f["scalars"].attrs
             for name in self.SCALARS:
                 value = sc[name]

@@ -120,3 +120,26 @@ def test_damping_zone_reduces_velocity():
     assert st.vel[1] == pytest.approx([1 - 0.1 * 0.25, 1 - 0.1 * 0.25, 1])
     assert st.vel[2] == pytest.approx([0.9, 0.9, 1]) and st.vel[3] == pytest.approx([0.9, 0.9, 1])
     assert st.vel[4] == pytest.approx([1, 1, 1])                  # boundary particle untouched
+
+
+def test_resume_from_a_checkpoint_without_wall_acceleration(tmp_path):
+    """mDBC SlipMode 2 with a moving wall keeps the wall acceleration (pressure cloning)
+    in the checkpoint; a checkpoint written before that array existed still resumes,
+    with a warning, the acceleration restarting from zero."""
+    import h5py
+    import json
+    case = tmp_path / "CaseMoving_Def.xml"
+    case.write_text(TANK.replace("MOTION", '<mvrect id="1" duration="-1"><vel x="0.5" y="0" z="0" /></mvrect>')
+                    .replace("SPECIAL", ""))
+    out = tmp_path / "out"
+    opts = ["--threads", "1", "-q", "--set", "Boundary=2", "--set", "SlipMode=2"]
+    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--tmax", "0.05", "--tout", "0.025"] + opts)
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "restart.h5", "a") as f:
+        assert f["aux/wall_ace"].shape[1] == 3
+        del f["aux/wall_ace"]
+    with pytest.warns(UserWarning, match="wall_ace"):
+        r = CliRunner().invoke(main, ["run", str(out), "--resume", "--tmax", "0.1", "--tout", "0.025"] + opts)
+    assert r.exit_code == 0, r.output
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "completed" and meta["physical_time"] >= 0.1
