@@ -13,12 +13,16 @@ kernel sums over its neighbours ``b`` found through the cell list:
   sum_b m_b 4 nu (r_ab.grad_a W_ab) / ((rho_a+rho_b)(r_ab^2+eta^2)) v_ab;
   2, laminar + SPS (Dalrymple & Rogers 2006), sum_b m_b (tau_a + tau_b).grad W
   with tau/rho^2 from :func:`sps_tau` (lagged by one evaluation, as DualSPHysics);
+  as DualSPHysics, wall neighbours take part with tau_b = 0 and enter the
+  velocity gradient of the fluid particle (their velocity: the wall's, or the
+  tangential ghost velocity of mDBC slip modes 2 and 3);
   ``ViscoBoundFactor`` multiplies Visco for fluid-boundary pairs;
 * continuity (Domínguez et al. 2022 eq. 6)
   drho_a/dt = rho_a sum_b (m_b/rho_b) v_ab . grad_a W_ab + D_a,
 * density diffusion D_a (``DensityDT``), as DualSPHysics applies it:
   1 Molteni & Colagrossi (2009) over fluid and floating neighbours, on fluid
-  particles with no fixed/moving boundary neighbour; 2 Fourtakas et al.
+  particles with no fixed/moving boundary neighbour (with mDBC walls, cst[22]
+  = 1, over the wall particles too, as DualSPHysics); 2 Fourtakas et al.
   (2019) with the hydrostatic correction, over fluid-fluid pairs, on fluid
   particles with no fixed/moving boundary neighbour; 3 the same over
   fluid-fluid pairs on all fluid particles;
@@ -232,6 +236,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
     r2max = cst[1]
     eta2 = cst[2]
     eta2l = cst[21]
+    ddt1_walls = cst[22] != 0.0     # Molteni DDT across mDBC walls (DualSPHysics: not DBC)
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -403,7 +408,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                     vtemp = mfac * 4.0 * vis * r2 / ((r2 + eta2l) * (rhoi + rhoj))
                     acex += vtemp * dvx
                     acez += vtemp * dvz
-                    if visco == 2 and not boundj:
+                    if visco == 2:
                         mj = nb[j, 6]
                         sxx = txx_i + tau[j, 0]
                         sxz = txz_i + tau[j, 2]
@@ -418,7 +423,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                 acez += coef * mfac * dz
                 # density diffusion
                 if ddt == 1:
-                    if boundj:
+                    if boundj and not ddt1_walls:
                         ddt_off = True
                     else:
                         deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac
@@ -541,6 +546,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
     r2max = cst[1]
     eta2 = cst[2]
     eta2l = cst[21]
+    ddt1_walls = cst[22] != 0.0     # Molteni DDT across mDBC walls (DualSPHysics: not DBC)
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -744,7 +750,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                         acex += vtemp * dvx
                         acey += vtemp * dvy
                         acez += vtemp * dvz
-                        if visco == 2 and not boundj:
+                        if visco == 2:
                             mj = nb[j, 8]
                             sxx = t0 + tau[j, 0]
                             sxy = t1 + tau[j, 1]
@@ -769,7 +775,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                     acey += coef * mfac * dy
                     acez += coef * mfac * dz
                     if ddt == 1:
-                        if boundj:
+                        if boundj and not ddt1_walls:
                             ddt_off = True
                         else:
                             deltap += (rhoi * irj - 1.0) * ir2e * r2 * mfac

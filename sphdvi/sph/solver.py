@@ -233,7 +233,7 @@ class SPHSolver:
             raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
         self.verlet_steps = int(p["VerletSteps"])
         alpha = kernel_alpha(self.kernel, h, self.is2d)
-        cst = np.zeros(22)
+        cst = np.zeros(23)
         cst[0] = h
         cst[1] = 4.0 * h * h
         cst[2] = (0.1 * h) ** 2
@@ -261,6 +261,9 @@ class SPHSolver:
         cst[19] = self.dt_vel_type
         # laminar term r^2/(r^2 + eta^2): DualSPHysics eta = 0.1 h (ViscoLaminarEta)
         cst[21] = (float(p.get("ViscoLaminarEta", 0.1)) * h) ** 2
+        # Molteni-Colagrossi DDT: DualSPHysics switches it off next to DBC walls but sums
+        # over mDBC walls (their density is the corrected one)
+        cst[22] = 1.0 if self.boundary == 2 else 0.0
         self.sps_smag = (0.12 * self.dp) ** 2
         self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
         self.shift_tfs = float(p["ShiftTFS"])

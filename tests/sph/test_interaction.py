@@ -70,8 +70,8 @@ def reference_rates(s, c, p):
                 ace[a] += mb * 4 * vis * (rab @ gradW) / ((ra + rb) * (r * r + eta2)) * vab
             ddt = p["DensityDT"]
             if ddt == 1:
-                if bound_b:
-                    ddt_off = True
+                if bound_b and p.get("Boundary", 1) != 2:
+                    ddt_off = True      # DBC walls switch Molteni's term off; mDBC walls take part
                 else:
                     # psi_ab = -2 (rho_b - rho_a) r_ab / (r^2 + eta^2)
                     psi = 2 * (ra - rb) * rab / (r * r + eta2)
@@ -125,6 +125,40 @@ def test_rates_match_reference(is2d, kernel, visco, ddt):
 
 
 @pytest.mark.parametrize("is2d", [True, False])
+def test_molteni_ddt_sums_over_mdbc_walls(is2d):
+    """DensityDT 1 (Molteni-Colagrossi) next to walls: DualSPHysics switches the term off
+    for a fluid particle with a DBC wall neighbour but, with mDBC (Boundary 2), sums over
+    the wall particles too, with their corrected density.  Against the reference."""
+    rng = np.random.default_rng(11)
+    dp = 0.02
+    nside = 11 if is2d else 6
+    fl = jittered_block(nside, dp, is2d, rng) + np.array([0, 0, 1.5 * dp])
+    g = np.arange(-2, nside + 2) * dp
+    if is2d:
+        bd = np.stack([g, 0 * g, 0 * g + 0.5 * dp], 1)
+    else:
+        X, Y = np.meshgrid(g, g)
+        bd = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel() + 0.5 * dp], 1)
+    pos = np.concatenate([bd, fl])
+    ptype = np.r_[np.zeros(len(bd), np.int8), np.full(len(fl), 3, np.int8)]
+    s = random_state(pos, dp, is2d, rng, ptype)
+    s.vel[ptype == 0] = 0.0
+    normals = np.zeros((len(pos), 3))
+    normals[:len(bd), 2] = 0.5 * dp            # wall surface at z = dp
+    c = constants(dp, is2d, g=9.81)
+    p = {"Visco": 0.05, "DensityDT": 1, "DensityDTvalue": 0.1, "Boundary": 2}
+    sol = SPHSolver(s, c, p, normals=normals)
+    sol.compute_rates()
+    ace_ref, ar_ref = reference_rates(sol.state, c, sol.params)
+    assert np.abs(sol.ar - ar_ref).max() <= 1e-11 * np.abs(ar_ref).max()
+    assert np.abs(sol.ace - ace_ref).max() <= 1e-11 * np.abs(ace_ref).max()
+    # the same particles with DBC walls: the wall neighbours' fluid loses the term
+    dbc = reference_rates(sol.state, c, {**sol.params, "Boundary": 1})[1]
+    near = (sol.state.ptype == 3) & (sol.state.pos[:, 2] < bd[0, 2] + 2 * c["h"])
+    assert np.abs(ar_ref[near] - dbc[near]).min() > 0
+
+
+@pytest.mark.parametrize("is2d", [True, False])
 @pytest.mark.parametrize("kernel,visco", [(2, 1), (1, 1), (2, 3), (2, 2)])
 def test_pair_forces_conserve_momentum(is2d, kernel, visco):
     """Fluid only, no gravity, random positions/velocities/densities/masses:
@@ -163,3 +197,68 @@ def test_fourtakas_correction_cancels_in_hydrostatic_column():
         rates[ddt] = np.sqrt(np.mean(sol.ar[inner] ** 2))
     print("rms drho/dt interior: Molteni %.3g, Fourtakas %.3g" % (rates[1], rates[2]))
     assert rates[2] < rates[1] / 20
+
+
+@pytest.mark.parametrize("is2d", [True, False])
+def test_sps_stress_and_velocity_gradient_include_walls(is2d):
+    """ViscoTreatment 2: the SPS term sum_b m_b (tau_a + tau_b) . grad W (tau_b = 0 for a
+    wall particle) and the velocity gradient sum_b -(m_b/rho_b) v_ab (x) grad W over all
+    neighbours, walls included (DualSPHysics), against an O(N^2) sum.  The stress used is
+    the one left by the previous evaluation."""
+    rng = np.random.default_rng(5)
+    dp = 0.02
+    nside = 11 if is2d else 6
+    fl = jittered_block(nside, dp, is2d, rng) + np.array([0, 0, 1.5 * dp])
+    g = np.arange(-2, nside + 2) * dp
+    if is2d:
+        bd = np.stack([g, 0 * g, 0 * g + 0.5 * dp], 1)
+    else:
+        X, Y = np.meshgrid(g, g)
+        bd = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel() + 0.5 * dp], 1)
+    pos = np.concatenate([bd, fl])
+    ptype = np.r_[np.zeros(len(bd), np.int8), np.full(len(fl), 3, np.int8)]
+    s = random_state(pos, dp, is2d, rng, ptype)
+    s.vel[ptype == 0] = 0.0
+    c = constants(dp, is2d, g=9.81)
+    p = {"ViscoTreatment": 2, "Visco": 1e-3, "DensityDT": 0}
+    sol = SPHSolver(s, c, p)
+    sol.compute_rates()
+    tau0 = sol.tau.copy()
+    assert np.abs(tau0).max() > 0
+    sol.compute_rates()                   # uses tau0; same particles, same order
+    st = sol.state
+    lam = sol.params.copy()
+    lam["ViscoTreatment"] = 3
+    ace_lam, _ = reference_rates(st, c, lam)
+    h = c["h"]
+    alpha = kernel_alpha(2, h, is2d)
+    comp = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
+    ace = ace_lam.copy()
+    grad = np.zeros((st.n, 6))
+    for a in np.flatnonzero(st.ptype == 3):
+        ta = np.zeros((3, 3))
+        for k, (i, j) in enumerate(comp):
+            ta[i, j] = ta[j, i] = tau0[a, k]
+        for b in range(st.n):
+            rab = st.pos[a] - st.pos[b]
+            if is2d:
+                rab[1] = 0.0
+            r = math.sqrt(rab @ rab)
+            if b == a or r >= 2 * h:
+                continue
+            gw = kernel_fac(2, r / h, alpha / h ** 2) * rab
+            tb = np.zeros((3, 3))
+            if st.ptype[b] == 3:
+                for k, (i, j) in enumerate(comp):
+                    tb[i, j] = tb[j, i] = tau0[b, k]
+            ace[a] += st.mass[b] * (ta + tb) @ gw
+            d = -st.mass[b] / st.rhop[b] * np.outer(st.vel[a] - st.vel[b], gw)   # d[i, j] = dv_i dW/dx_j
+            full = d + d.T
+            for k, (i, j) in enumerate(comp):
+                grad[a, k] += d[i, i] if i == j else full[i, j]
+    f = st.ptype == 3
+    keep = [0, 2, 5] if is2d else list(range(6))
+    assert np.abs(sol.ace[f] - ace[f]).max() <= 1e-11 * np.abs(ace[f]).max()
+    assert np.abs(sol.gradvel[f][:, keep] - grad[f][:, keep]).max() <= 1e-11 * np.abs(grad[f]).max()
+    near = f & (st.pos[:, 2] < 0.5 * dp + 2 * h)
+    assert near.any()
