@@ -109,13 +109,22 @@ MDBC2_COND_MAX = 50.0     # scaled condition number dp^2 |A|_inf |A^-1|_inf abov
 
 @njit(cache=True, error_model="numpy")
 def _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
-                gx, gy, gz, a, b, vsum):
-    """Sums over the fluid particles j near the ghost node g = (gx, gy, gz):
+                i, nx, ny, nz, a, b, vsum):
+    """Sums over the fluid particles j near the ghost node g = r_i + 2 N of
+    packed boundary row i with normal N = (nx, ny, nz):
     the moment matrix a (see the module docstring), the right-hand side
     b[:, 0] = (sum m w, sum m grad w), and, when ``vsum`` has 4 entries (mDBC2),
     sum V w v_j in vsum[0:3], the submersion measure -sum V (g - r_j).grad w
     in vsum[3] and the velocity right-hand sides b[:, 1:4] = (sum V w v_j,
     sum V grad w v_j) of the corrected ghost velocity."""
+    if is2d:
+        gx = nb[i, 0] + 2.0 * nx
+        gy = 0.0
+        gz = nb[i, 1] + 2.0 * nz
+    else:
+        gx = nb[i, 0] + 2.0 * nx
+        gy = nb[i, 1] + 2.0 * ny
+        gz = nb[i, 2] + 2.0 * nz
     h = cst[0]
     r2max = cst[1]
     alpha = cst[3]
@@ -242,16 +251,8 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, in
         nz = normals[o, 2]
         if nx == 0.0 and ny == 0.0 and nz == 0.0:
             continue
-        if is2d:
-            gx = nb[i, 0] + 2.0 * nx
-            gy = 0.0
-            gz = nb[i, 1] + 2.0 * nz
-        else:
-            gx = nb[i, 0] + 2.0 * nx
-            gy = nb[i, 1] + 2.0 * ny
-            gz = nb[i, 2] + 2.0 * nz
         _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
-                    gx, gy, gz, a, b, novel)
+                    i, nx, ny, nz, a, b, novel)
         if a[0, 0] <= ksum_min or a[0, 0] <= 0.0:
             continue
         # Shepard value, kept where the corrected system is near-singular
@@ -334,16 +335,8 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
         ex = nx / nn
         ey = ny / nn
         ez = nz / nn
-        if is2d:
-            gx = nb[i, 0] + 2.0 * nx
-            gy = 0.0
-            gz = nb[i, 1] + 2.0 * nz
-        else:
-            gx = nb[i, 0] + 2.0 * nx
-            gy = nb[i, 1] + 2.0 * ny
-            gz = nb[i, 2] + 2.0 * nz
         _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
-                    gx, gy, gz, a, b, vsum)
+                    i, nx, ny, nz, a, b, vsum)
         if not vsum[3] > 0.0:
             # dry ghost node: the particle is switched off (zero mass, rho0, wall velocity)
             rhop[o] = rhop0

@@ -92,24 +92,30 @@ def reference_rates(s, c, p):
     return ace, ar
 
 
-@pytest.mark.parametrize("is2d", [True, False])
-@pytest.mark.parametrize("kernel,visco,ddt", [(2, 1, 0), (2, 1, 2), (2, 1, 3), (1, 1, 1),
-                                              (2, 3, 2), (1, 3, 0)])
-def test_rates_match_reference(is2d, kernel, visco, ddt):
-    rng = np.random.default_rng(7)
-    dp = 0.02
+def block_over_a_wall(rng, dp, is2d, lift):
+    """A jittered fluid block ``lift`` above one layer of wall particles at z = dp/2
+    (two extra columns each side); returns positions, types (walls first) and the
+    number of wall particles."""
     nside = 11 if is2d else 6
-    fl = jittered_block(nside, dp, is2d, rng) + np.array([0, 0, 2 * dp])
-    # one layer of boundary particles below the block
+    fl = jittered_block(nside, dp, is2d, rng) + np.array([0, 0, lift])
     g = np.arange(-2, nside + 2) * dp
     if is2d:
         bd = np.stack([g, 0 * g, 0 * g + 0.5 * dp], 1)
     else:
         X, Y = np.meshgrid(g, g)
         bd = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel() + 0.5 * dp], 1)
-    pos = np.concatenate([bd, fl])
     ptype = np.r_[np.zeros(len(bd), np.int8), np.full(len(fl), 3, np.int8)]
-    ptype[len(bd) + len(fl) // 2 + np.arange(3)] = 2      # a few floating particles
+    return np.concatenate([bd, fl]), ptype, len(bd)
+
+
+@pytest.mark.parametrize("is2d", [True, False])
+@pytest.mark.parametrize("kernel,visco,ddt", [(2, 1, 0), (2, 1, 2), (2, 1, 3), (1, 1, 1),
+                                              (2, 3, 2), (1, 3, 0)])
+def test_rates_match_reference(is2d, kernel, visco, ddt):
+    rng = np.random.default_rng(7)
+    dp = 0.02
+    pos, ptype, nbd = block_over_a_wall(rng, dp, is2d, 2 * dp)
+    ptype[nbd + (len(pos) - nbd) // 2 + np.arange(3)] = 2      # a few floating particles
     s = random_state(pos, dp, is2d, rng, ptype)
     s.vel[ptype == 0] = 0.0
     c = constants(dp, is2d, g=9.81)
@@ -131,20 +137,11 @@ def test_molteni_ddt_sums_over_mdbc_walls(is2d):
     the wall particles too, with their corrected density.  Against the reference."""
     rng = np.random.default_rng(11)
     dp = 0.02
-    nside = 11 if is2d else 6
-    fl = jittered_block(nside, dp, is2d, rng) + np.array([0, 0, 1.5 * dp])
-    g = np.arange(-2, nside + 2) * dp
-    if is2d:
-        bd = np.stack([g, 0 * g, 0 * g + 0.5 * dp], 1)
-    else:
-        X, Y = np.meshgrid(g, g)
-        bd = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel() + 0.5 * dp], 1)
-    pos = np.concatenate([bd, fl])
-    ptype = np.r_[np.zeros(len(bd), np.int8), np.full(len(fl), 3, np.int8)]
+    pos, ptype, nbd = block_over_a_wall(rng, dp, is2d, 1.5 * dp)
     s = random_state(pos, dp, is2d, rng, ptype)
     s.vel[ptype == 0] = 0.0
     normals = np.zeros((len(pos), 3))
-    normals[:len(bd), 2] = 0.5 * dp            # wall surface at z = dp
+    normals[:nbd, 2] = 0.5 * dp                # wall surface at z = dp
     c = constants(dp, is2d, g=9.81)
     p = {"Visco": 0.05, "DensityDT": 1, "DensityDTvalue": 0.1, "Boundary": 2}
     sol = SPHSolver(s, c, p, normals=normals)
@@ -154,7 +151,7 @@ def test_molteni_ddt_sums_over_mdbc_walls(is2d):
     assert np.abs(sol.ace - ace_ref).max() <= 1e-11 * np.abs(ace_ref).max()
     # the same particles with DBC walls: the wall neighbours' fluid loses the term
     dbc = reference_rates(sol.state, c, {**sol.params, "Boundary": 1})[1]
-    near = (sol.state.ptype == 3) & (sol.state.pos[:, 2] < bd[0, 2] + 2 * c["h"])
+    near = (sol.state.ptype == 3) & (sol.state.pos[:, 2] < 0.5 * dp + 2 * c["h"])
     assert np.abs(ar_ref[near] - dbc[near]).min() > 0
 
 
@@ -207,16 +204,7 @@ def test_sps_stress_and_velocity_gradient_include_walls(is2d):
     the one left by the previous evaluation."""
     rng = np.random.default_rng(5)
     dp = 0.02
-    nside = 11 if is2d else 6
-    fl = jittered_block(nside, dp, is2d, rng) + np.array([0, 0, 1.5 * dp])
-    g = np.arange(-2, nside + 2) * dp
-    if is2d:
-        bd = np.stack([g, 0 * g, 0 * g + 0.5 * dp], 1)
-    else:
-        X, Y = np.meshgrid(g, g)
-        bd = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel() + 0.5 * dp], 1)
-    pos = np.concatenate([bd, fl])
-    ptype = np.r_[np.zeros(len(bd), np.int8), np.full(len(fl), 3, np.int8)]
+    pos, ptype, nbd = block_over_a_wall(rng, dp, is2d, 1.5 * dp)
     s = random_state(pos, dp, is2d, rng, ptype)
     s.vel[ptype == 0] = 0.0
     c = constants(dp, is2d, g=9.81)
