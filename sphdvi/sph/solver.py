@@ -460,15 +460,20 @@ class SPHSolver:
         if self.nb.shape[0] != n:
             self._alloc()
 
+    def _sorted_into_cells(self):
+        """Check the state arrays and counting-sort the particles into cells (over
+        the domain when one is set, else their bounding box); returns ``order``."""
+        self._check_state_arrays()
+        pos = self.state.pos
+        if self._domain is not None:
+            return self.cells.build(pos, self._domain[0], self._domain[1])
+        return self.cells.build(pos)
+
     def _reorder_and_pack(self):
         """Counting-sort the particles by cell, permute every per-particle array
         and fill the packed neighbour array, in one pass (one thread launch)."""
-        self._check_state_arrays()
         s = self.state
-        if self._domain is not None:
-            order = self.cells.build(s.pos, self._domain[0], self._domain[1])
-        else:
-            order = self.cells.build(s.pos)
+        order = self._sorted_into_cells()
         n = order.shape[0]
         aux = [a for a in self._aux_names() if getattr(self, a).shape[0] == n]
         f2 = ["pos", "vel"] + [a for a in aux if getattr(self, a).ndim == 2]
@@ -495,12 +500,8 @@ class SPHSolver:
         cell order, leaving the particle arrays where they are (row k of the
         packed array is particle ``order[k]``; the interaction writes its
         results back to the particles' own rows)."""
-        self._check_state_arrays()
         s = self.state
-        if self._domain is not None:
-            order = self.cells.build(s.pos, self._domain[0], self._domain[1])
-        else:
-            order = self.cells.build(s.pos)
+        order = self._sorted_into_cells()
         fn = _ia.sort_pack_parallel if self._use_parallel(light=True) else _ia.sort_pack_serial
         fn(order, self.is2d, self.cst, self.nb, s.pos, s.vel, s.rhop, s.mass, s.ptype, self.ptype_s,
            self.cells.cell, self.cell_sorted, self.tau, self.tau_s)
