@@ -24,6 +24,14 @@ def print_warnings(warnings) -> None:
         click.echo(w, err=True)
 
 
+def _user_warning_line(message, category, filename, lineno, line=None, _default=None):
+    """``warning: message`` for the library's UserWarnings (a user's case, not a code
+    location); Python's usual form for the rest."""
+    if issubclass(category, UserWarning):
+        return f"warning: {message}\n"
+    return _default(message, category, filename, lineno, line)
+
+
 @click.group(context_settings=CONTEXT)
 @click.version_option(__version__, "--version", prog_name="sphdvi")
 def main():
@@ -35,6 +43,10 @@ def main():
       sphdvi run out/dambreak2d --tmax 0.5
       sphdvi measure points out/dambreak2d --points "0.5,0,0.1" --vars vel,press
     """
+    import functools
+    import warnings
+    if not isinstance(warnings.formatwarning, functools.partial):
+        warnings.formatwarning = functools.partial(_user_warning_line, _default=warnings.formatwarning)
 
 
 @main.command(context_settings=CONTEXT)

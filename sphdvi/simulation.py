@@ -23,6 +23,7 @@ import os
 import signal
 import sys
 import time as _time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -276,6 +277,35 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet) -> RunRe
 # ---------------------------------------------------------------------------------
 # SPH run
 # ---------------------------------------------------------------------------------
+class ExclusionWarnings:
+    """DualSPHysics's warnings on excluded particles (``WrnPartsOut``, JSph::SaveData): at
+    each output, when the particles excluded since the previous output reach P % of the
+    fluid (P = 1, then 2, 5, 10, 20, ...: each level warns once), and when all particles
+    excluded so far reach Q % of all particles (Q = 10, 20, ...)."""
+
+    def __init__(self, enabled: bool, case_nfluid: int, total_np: int):
+        self.enabled = enabled
+        self.case_nfluid = case_nfluid
+        self.total_np = total_np
+        self.part_pct = 1
+        self.total_pct = 10
+
+    def check(self, new_out: int, nfluid_now: int, total_out: int, t: float, nstep: int) -> list[str]:
+        """The warnings of one output (``new_out`` excluded since the previous one)."""
+        out = []
+        if not self.enabled or new_out <= 0:
+            return out
+        if self.part_pct <= 100 and new_out >= max(self.case_nfluid, nfluid_now) * self.part_pct / 100.0:
+            out.append(f"more than {self.part_pct}% of the fluid particles were excluded since the "
+                       f"previous output (t={t:.6g} s, step {nstep})")
+            self.part_pct = {1: 2, 2: 5, 5: 10}.get(self.part_pct, self.part_pct + 10)
+        if self.total_pct <= 100 and total_out >= self.total_np * self.total_pct / 100.0:
+            out.append(f"more than {self.total_pct}% of the particles were excluded "
+                       f"(t={t:.6g} s, step {nstep})")
+            self.total_pct += 10
+        return out
+
+
 class SPHRun:
     """One SPH run: the solver, its motion/body hook, the output schedule and the checks."""
 
@@ -498,7 +528,6 @@ class SPHRun:
                 # mDBC2 slip modes): start it from zero; the run goes on, not bitwise
                 cur = getattr(sol, name)
                 setattr(sol, name, np.zeros((n,) + cur.shape[1:], cur.dtype))
-                import warnings
                 warnings.warn(f"checkpoint {path} has no '{name}' (older sphdvi); it restarts from zero")
             sc = f["scalars"].attrs
             for name in self.SCALARS:
@@ -641,15 +670,23 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
         pos, arrays = sph.snapshot()
         writer.append(sol.time, pos, arrays)
         excl = sum(sol.n_excluded.values())
+        excl_lines = excl_warn.check(excl - excl_seen[0], sol.n_fluid, excl, sol.time, sol.nstep)
+        excl_seen[0] = excl
         wall = runtime + (_time.perf_counter() - t_loop)
         files.csv(f"{k},{sol.time:.9g},{sol.nstep},{sol.state.n},{excl},"
                   f"{dt_lo if dt_lo < math.inf else 0:.6g},{dt_hi:.6g},{wall:.3f}")
         files.log(f"Part {k:04d}  t={sol.time:.6f} s  steps={sol.nstep}  particles={sol.state.n}  "
                   f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s")
+        for line in excl_lines:
+            files.log("WARNING: " + line)
+            warnings.warn(line)
         if body_log is not None:
             body_log.record()
         sph.save_checkpoint(ckpt, {"part": k, "runtime_s": wall})
 
+    excl_seen = [sum(sol.n_excluded.values())]
+    excl_warn = ExclusionWarnings(int(params.get("WrnPartsOut", 1)) != 0, sph.n0_fluid,
+                                  int(data["particles"]["type"].size))
     gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
     body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None)
                 if sph.bodies is not None else None)

@@ -24,7 +24,11 @@ PARAMETERS: dict[str, Param] = {
     "SavePosDouble": Param("int", 0, "save positions in double precision", (0, 1)),
     "Boundary": Param("int", 1, "boundary method 1:DBC, 2:mDBC", (1, 2)),
     "SlipMode": Param("int", 1, "mDBC slip mode 1:DBC vel=0, 2:no-slip, 3:free slip", (1, 2, 3)),
-    "MdbcFastSingle": Param("int", 1, "mDBC matrix solve in single precision", (0, 1)),
+    "MDBCCorrector": Param("int", None, "mDBC correction also in the Symplectic corrector (DualSPHysics "
+                           "v5.0-5.2 key; not set: as v5.4, 0 with SlipMode 1, 1 with SlipMode 2, 3)", (0, 1)),
+    "MDBCFastSingle": Param("int", 1, "mDBC matrix solve in single precision (DualSPHysics GPU only; "
+                            "the CPU solves in double precision)", (0, 1)),
+    "MdbcFastSingle": Param("int", 1, "sphdvi's earlier spelling of MDBCFastSingle", (0, 1)),
     "MdbcThreshold": Param("float", 0.0, "mDBC kernel-sum threshold (SlipMode 1 only)", (), 0.0, 1.0),
     "MdbcGhostVelocity": Param("int", 1, "sphdvi: mDBC SlipMode 2, 3 ghost-node velocity 1:first-order "
                                "corrected, 0:Shepard average (DualSPHysics v5.4)", (0, 1)),

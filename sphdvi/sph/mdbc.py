@@ -70,10 +70,12 @@ rejects no matrix at dp = 0.05 m and some at dp = 2 m.
 
 Deviations: the default ghost velocity is the corrected one (above).  A
 particle with N_b = 0 shows the viscosity its own velocity
-(DualSPHysics reads its TangenVel entry, which nothing sets).  DualSPHysics
-runs the correction in the Symplectic corrector only with MdbcCorrector=1
-(default 0: the predictor's wall values are kept); here it runs in every
-evaluation of the rates, in all slip modes.
+(DualSPHysics reads its TangenVel entry, which nothing sets).
+
+In the Symplectic corrector the correction runs only with ``MDBCCorrector``
+(the solver's ``_mdbc_now``): not set, as DualSPHysics v5.4, it is off for
+SlipMode 1 (the corrector sees the wall densities the predictor integrated)
+and on for SlipMode 2, 3, where v5.4 always corrects (0 is warned and ignored).
 
 Why the ghost velocity is kept out of the continuity equation: the no-slip
 wall velocity 2 v_w - v_g is odd about the wall in its tangential component

@@ -21,7 +21,9 @@ unknown keys are ignored):
   MdbcGhostVelocity (sphdvi's own key, SlipMode 2 and 3: 1, the default, interpolates
   the velocity at the ghost node with the first-order corrected kernel, like the density;
   0 takes DualSPHysics v5.4's plain Shepard average, which puts no-slip walls ~0.14 dp
-  inside the water; :mod:`sphdvi.sph.mdbc`),
+  inside the water; :mod:`sphdvi.sph.mdbc`), MDBCCorrector (the correction also in the
+  Symplectic corrector; not set: as DualSPHysics v5.4, off with SlipMode 1, on with 2 and 3,
+  where 0 is warned and ignored),
   NoPenetration (mDBC no-penetration correction of the fluid next to the walls,
   :mod:`sphdvi.sph.nopen`; as DualSPHysics, only with Boundary=2 and SlipMode 2
   or 3: otherwise it is warned and ignored) and the periodic keys (XPeriodicIncY ...,
@@ -190,6 +192,16 @@ class SPHSolver:
         self.ghostvel = int(p.get("MdbcGhostVelocity", 1))
         if self.ghostvel not in (0, 1):
             raise ValueError("MdbcGhostVelocity must be 0 (Shepard average) or 1 (corrected)")
+        # the mDBC correction in the Symplectic corrector: DualSPHysics v5.0-5.2 read
+        # MDBCCorrector (default 0: the corrector keeps the predictor's wall densities);
+        # v5.4 sets it itself, off for SlipMode 1 and on for its mDBC2 modes (2, 3)
+        corr = p.get("MDBCCorrector")
+        self.mdbc_corrector = self.slip > 1 if corr is None else bool(int(corr))
+        if self.boundary == 2 and self.slip > 1 and not self.mdbc_corrector:
+            warnings.warn("MDBCCorrector=0 is ignored with SlipMode 2 or 3: the mDBC2 wall "
+                          "values are computed in every evaluation (as DualSPHysics v5.4)")
+            self.mdbc_corrector = True
+        self._in_corrector = False      # True while the Symplectic corrector evaluates the rates
         # NoPenetration: DualSPHysics reads it only for its mDBC2 slip modes (2, 3)
         self.nopen = bool(int(p.get("NoPenetration") or 0))
         if self.nopen and (self.boundary != 2 or self.slip == 1):
@@ -524,7 +536,7 @@ class SPHSolver:
         k = self._kernels(par)
         s = self.state
         ptype_rows, oi, _ = self._rows
-        if self.boundary == 2:
+        if self._mdbc_now():
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             ncx, ncy, ncz = self.cells.shape
@@ -594,6 +606,12 @@ class SPHSolver:
         fn = nopen.apply_verlet_parallel if par else nopen.apply_verlet_serial
         return fn(s.pos, s.vel, self.vel_m1, s.rhop, s.ptype, self.npshift, self.ip, self.out)
 
+    def _mdbc_now(self):
+        """Whether this evaluation of the rates runs the mDBC correction: always with
+        Boundary=2, except in the Symplectic corrector without MDBCCorrector, where the
+        walls keep the densities the predictor gave them (DualSPHysics's runmdbc)."""
+        return self.boundary == 2 and (self.mdbc_corrector or not self._in_corrector)
+
     @property
     def _mdbc2_flag(self):
         """1 for the mDBC2 slip modes (2, 3): the interaction's compile-time flag."""
@@ -641,7 +659,7 @@ class SPHSolver:
         k = self._kernels(par)
         k["pack"](self.is2d, pos_e, vel_e, rhop_e, mass_e, self.cst, nb)
         ncx, ncy, ncz = self.cells.shape
-        if self.boundary == 2:
+        if self._mdbc_now():
             # mDBC on the extended set: ghost copies see the fluid across the
             # periodic boundary; the real boundary particles keep their density
             from . import mdbc
@@ -790,7 +808,11 @@ class SPHSolver:
         k = self._integrators(self._use_parallel(light=True))
         k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
                      self.ace, self.ar, s.ptype, self.ip)
-        self.compute_rates()
+        self._in_corrector = True
+        try:
+            self.compute_rates()
+        finally:
+            self._in_corrector = False
         self._need_shift_adv = True
         nout = k["sym_corr"](*self._corr_args())
         if self.nopen:

@@ -10,7 +10,6 @@ def tank(dp=0.05, layers=1, is2d=True):
     for k in range(layers):
         off = k * dp
         xs = np.arange(-off, 1.0 + off + dp / 2, dp)
-        zs = np.arange(0, 0.6, dp)
         zw = np.arange(-off + dp, 0.6, dp)
         pts += [[x, 0, -off] for x in xs] + [[-off, 0, z] for z in zw] + [[1.0 + off, 0, z] for z in zw]
     types += [0] * len(pts)

@@ -1,5 +1,4 @@
 """The command line: help and version, start-up cost, exit codes, outputs."""
-import os
 import subprocess
 import sys
 import time
@@ -91,3 +90,16 @@ def test_gencase_errors_exit_2_without_traceback(tmp_path):
     missing = subprocess.run([sys.executable, "-m", "sphdvi", "gencase", str(tmp_path / "nope.xml")],
                              capture_output=True, text=True)
     assert missing.returncode == 2 and "not found" in missing.stderr
+
+
+def test_solver_warnings_print_as_one_line_without_a_code_location():
+    """A warning about the user's case (e.g. an option that does not apply) reads
+    'warning: ...' on the terminal, not a path into sphdvi's sources."""
+    import warnings
+    from sphdvi.cli import _user_warning_line
+    line = _user_warning_line("NoPenetration=1 needs Boundary=2", UserWarning, "/x/solver.py", 12,
+                              _default=warnings.formatwarning)
+    assert line == "warning: NoPenetration=1 needs Boundary=2\n"
+    other = _user_warning_line("old", DeprecationWarning, "/x/solver.py", 12, "",
+                               _default=warnings.formatwarning)
+    assert "/x/solver.py:12" in other

@@ -19,8 +19,8 @@ def test_run_bodies_writes_csv(tmp_path):
     links = [dict(kind="hinge", body1="flap", body2=None, point=(3, 0, 1.0), axis=(0, 1, 0),
                   stiffness=10.0, damping=0.1)]
     mats = [dict(name="rubber", friction=0.4, restitution=0.0)]
-    s = run_bodies(bodies, links, out_dir=str(tmp_path), tmax=0.2, tout=0.05, dt=1e-3,
-                   materials=mats, gravity=(0, 0, -G), solver="bb", max_iter=100)
+    run_bodies(bodies, links, out_dir=str(tmp_path), tmax=0.2, tout=0.05, dt=1e-3,
+               materials=mats, gravity=(0, 0, -G), solver="bb", max_iter=100)
     lines = (tmp_path / "bodies.csv").read_text().splitlines()
     assert lines[0] == BODIES_HEADER
     assert lines[0] == ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"

@@ -121,7 +121,6 @@ def _solve(P, solver, iters, tol=1e-13):
 def test_single_contact_ccp_pinned():
     """N = I, r = (-1, 2, 0), μ = 0.5: CCP gives γ = Π_K(−r) = (1.6, −0.8, 0)
     (exact Coulomb would give (1, −0.5, 0)): pins the convexified model."""
-    nb = 1
     J = np.zeros((3, 12))
     J[0, 2] = 1.0  # n = z
     J[1, 0] = 1.0  # u = x

@@ -249,3 +249,31 @@ def test_dtfixedfile_from_case(tmp_path):
     case2 = small_case(tmp_path, extra_params='<parameter key="DtFixedFile" value="nofile.csv" />')
     r = invoke(["gencase", case2, "-o", tmp_path / "g2"])
     assert r.exit_code == 2 and "nofile.csv" in r.output
+
+
+def test_exclusion_warnings_as_dualsphysics(tmp_path):
+    """WrnPartsOut: a warning (terminal and run.log) when the particles excluded since the
+    previous output reach 1 % of the fluid, then 2, 5, 10, 20 ... %, and when all excluded
+    reach 10, 20 ... % of the particles; WrnPartsOut=0 silences them."""
+    from sphdvi.simulation import ExclusionWarnings
+    w = ExclusionWarnings(True, 1000, 1200)
+    assert w.check(9, 1000, 9, 0.1, 10) == []
+    assert [x.split(" of")[0] for x in w.check(10, 990, 19, 0.2, 20)] == ["more than 1%"]
+    assert w.check(10, 980, 29, 0.3, 30) == []                     # the next level is 2 %
+    lines = w.check(100, 880, 129, 0.4, 40)                         # 10 % of the fluid, 10.75 % of all
+    assert [x.split(" of")[0] for x in lines] == ["more than 2%", "more than 10%"]
+    assert "particles were excluded (t=0.4 s, step 40)" in lines[1]
+    assert ExclusionWarnings(False, 1000, 1200).check(500, 500, 500, 0.1, 1) == []
+    # from a run: densities above RhopOutMax exclude ~7 % of the column's deepest particles
+    case = small_case(tmp_path)
+    import warnings
+    for flag, expect in (("1", True), ("0", False)):
+        out = tmp_path / f"o{flag}"
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            r = invoke(["run", case, "-o", out, "--tmax", "0.04", "--tout", "0.02", "--threads", "1", "-q",
+                        "--set", "RhopOutMax=1002.3", "--set", f"WrnPartsOut={flag}"])
+        assert r.exit_code == 0, r.output
+        log = (out / "run.log").read_text()
+        assert ("WARNING: more than 1% of the fluid particles were excluded" in log) == expect
+        assert any("more than 1%" in str(c.message) for c in caught) == expect

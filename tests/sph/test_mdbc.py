@@ -39,3 +39,72 @@ def test_mdbc_tank_runs_and_stays_still():
     fl = sol.state.ptype == 3
     assert sol.state.n == st.n
     assert np.abs(sol.state.vel[fl]).max() < 0.02
+
+
+def _mdbc_calls_per_step(monkeypatch, params, steps=3):
+    """Number of mDBC corrections the solver runs per time step (the serial kernel is
+    wrapped with a counter; the scene is below the threading threshold)."""
+    from sphdvi.sph import mdbc
+    calls = []
+    real = mdbc.mdbc_serial
+
+    def counted(*args):
+        calls.append(1)
+        return real(*args)
+
+    monkeypatch.setattr(mdbc, "mdbc_serial", counted)
+    dp = 0.02
+    st, c = tank_2d(0.3, 0.3, 0.3, 0.2, dp, layers=3, bound_hydrostatic=True)
+    sol = SPHSolver(st, c, {"Boundary": 2, "Visco": 0.05, **params}, normals=tank_normals_2d(st, 0.3, dp),
+                    parallel_threshold=10 ** 9)
+    for _ in range(steps):
+        sol.step()
+    return len(calls) / steps, sol
+
+
+def test_symplectic_corrector_runs_mdbc_as_dualsphysics(monkeypatch):
+    """DualSPHysics v5.4 (JSphCpuSingle::MdbcBoundCorrection): the correction runs before
+    every interaction except the Symplectic corrector's, unless MdbcCorrector, which v5.4
+    sets for its mDBC2 slip modes; v5.0-5.2 read it from the XML key MDBCCorrector."""
+    import pytest
+    assert _mdbc_calls_per_step(monkeypatch, {"StepAlgorithm": 1})[0] == 1
+    assert _mdbc_calls_per_step(monkeypatch, {"StepAlgorithm": 2})[0] == 1
+    assert _mdbc_calls_per_step(monkeypatch, {"StepAlgorithm": 2, "MDBCCorrector": 1})[0] == 2
+    assert _mdbc_calls_per_step(monkeypatch, {"StepAlgorithm": 2, "SlipMode": 3})[0] == 2
+    with pytest.warns(UserWarning, match="MDBCCorrector=0 is ignored"):
+        n, sol = _mdbc_calls_per_step(monkeypatch, {"StepAlgorithm": 2, "SlipMode": 2, "MDBCCorrector": 0})
+    assert n == 2 and sol.mdbc_corrector
+
+
+def test_corrector_without_mdbc_keeps_the_predicted_wall_density():
+    """Without MDBCCorrector the corrector's interaction sees the wall densities the
+    predictor integrated, rho_b = max(rho_mdbc + dt/2 ar_b, rho0): one step gives the same
+    state as a step whose corrector evaluation is handed exactly those densities."""
+    dp = 0.02
+    st, c = tank_2d(0.3, 0.3, 0.3, 0.2, dp, layers=3, bound_hydrostatic=True)
+    nor = tank_normals_2d(st, 0.3, dp)
+    params = {"Boundary": 2, "StepAlgorithm": 2, "Visco": 0.05, "DensityDT": 2}
+    a = SPHSolver(st.copy(), c, params, normals=nor)
+    b = SPHSolver(st.copy(), c, {**params, "MDBCCorrector": 1}, normals=nor)
+    a.step()
+    b.step()
+    assert not np.array_equal(a.state.vel, b.state.vel)      # the option acts
+    # replay a's step by hand: predictor with the correction, corrector without it
+    r = SPHSolver(st.copy(), c, {**params, "MDBCCorrector": 1}, normals=nor)
+    dt = r.dt_pre
+    r._set_ip(dt)
+    s = r.state
+    r._reorder_next = True         # as step() does on step 0
+    r.compute_rates()
+    k = r._integrators(False)
+    k["sym_pre"](s.pos, s.vel, s.rhop, r.pos_pre, r.vel_pre, r.rhop_pre, r.ace, r.ar, s.ptype, r.ip)
+    predicted = s.rhop.copy()
+    r.boundary = 1                 # the corrector's rates with the walls as they are
+    r.compute_rates()
+    r.boundary = 2
+    bw = s.ptype < 2
+    assert np.all(s.rhop[bw] == predicted[bw])
+    k["sym_corr"](*r._corr_args())
+    sa, sr = a.state.sorted_by_idp(), s.sorted_by_idp()
+    for x, y in ((sa.pos, sr.pos), (sa.vel, sr.vel), (sa.rhop, sr.rhop)):
+        assert np.array_equal(x, y)
