@@ -65,8 +65,9 @@ def default_threads() -> int:
 # ---------------------------------------------------------------------------------
 def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
     """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError."""
-    from .case.parameters import PARAMETERS, closest_key, coerce
+    from .case.parameters import GENCASE_ONLY, PARAMETERS, apply_delta_sph, closest_key, coerce
     out = dict(params)
+    given = []
     for item in sets or ():
         if "=" not in item:
             raise InputError(f"--set {item!r}: expected KEY=VALUE")
@@ -74,10 +75,18 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
         if key not in PARAMETERS:
             hint = closest_key(key)
             raise InputError(f"--set: unknown parameter '{key}'" + (f"; did you mean '{hint}'?" if hint else ""))
+        if key in GENCASE_ONLY:
+            raise InputError(f"--set {key}: it shapes the domain gencase writes; put it in the case file "
+                             "(or better a <simulationdomain>) and run gencase again")
         try:
             out[key] = coerce(key, value)
         except ValueError as exc:
             raise InputError(f"--set {key}: {exc}") from None
+        given.append(key)
+    try:
+        apply_delta_sph(out, given)
+    except ValueError as exc:
+        raise InputError(f"--set: {exc}") from None
     if tmax is not None:
         out["TimeMax"] = coerce("TimeMax", tmax)
     if tout is not None:
@@ -696,6 +705,9 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
             if not resume:
                 write_part(0)
             next_out = (part + 1) * tout
+            extra = params.get("TimeOutExtra")
+            extra = float(extra) if body_log is not None and extra is not None and extra < tout else None
+            next_extra = _next_multiple(sol.time, extra) if extra else 0.0
             while sol.time < tmax - 1e-12 * max(1.0, tmax):
                 sol.step()
                 dt_lo, dt_hi = min(dt_lo, sol.last_dt), max(dt_hi, sol.last_dt)
@@ -707,6 +719,13 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
                     write_part(part)
                     dt_lo, dt_hi = math.inf, 0.0
                     next_out = (part + 1) * tout
+                    if extra:
+                        next_extra = _next_multiple(sol.time, extra)
+                elif extra is not None and sol.time >= next_extra - 1e-12 * max(1.0, extra):
+                    # TimeOutExtra: floating-body rows between the outputs (0: every step)
+                    body_log.record(flush=False)
+                    if extra:
+                        next_extra = _next_multiple(sol.time, extra)
                 progress.update(sol.time, sol.nstep, sol.state.n)
                 if stop.signal is not None:
                     status, code = "interrupted", 1
@@ -742,6 +761,12 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
     return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)
 
 
+def _next_multiple(t: float, step: float) -> float:
+    """The first multiple of ``step`` after ``t`` (DualSPHysics's TimeOutExtraUpdate)."""
+    k = math.floor(t / step * (1 + 1e-12)) + 1
+    return k * step
+
+
 class BodyLog:
     """``bodies.csv`` and ``links.csv`` of an SPH run with floating bodies (one row per body
     and per link at every output time), rewritten atomically at each output."""
@@ -760,12 +785,15 @@ class BodyLog:
                             if float(line.split(",", 1)[0]) <= resume_time * (1 + 1e-12):
                                 rows.append(line + "\n")
 
-    def record(self) -> None:
+    def record(self, flush: bool = True) -> None:
+        """Add a row per body and link at the current time; write the files when ``flush``
+        (at every TimeOut output; the TimeOutExtra rows between outputs wait in memory)."""
         from .dvi.runner import _body_lines, _link_lines
         self.rows[0].extend(_body_lines(self.system, self.names))
         self.rows[1].extend(_link_lines(self.system))
-        for path, header, rows in zip(self.paths, self.headers, self.rows):
-            write_text_atomic(path, header + "\n" + "".join(rows))
+        if flush:
+            for path, header, rows in zip(self.paths, self.headers, self.rows):
+                write_text_atomic(path, header + "\n" + "".join(rows))
 
 
 def _make_gauges(data, params, outdir, resume, t):

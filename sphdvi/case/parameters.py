@@ -61,7 +61,8 @@ PARAMETERS: dict[str, Param] = {
     "DtAllParticles": Param("int", 0, "dt from all particles (1) or fluid/floating only (0)", (0, 1)),
     "TimeMax": Param("float", 1.0, "simulated time [s]", (), 0.0, 1e12),
     "TimeOut": Param("float", 0.01, "output interval [s]", (), 0.0, 1e12),
-    "TimeOutExtra": Param("float", 0.0, "extra floating output interval [s]", (), 0.0, 1e12),
+    "TimeOutExtra": Param("float", None, "interval of the extra floating-body outputs (bodies.csv, "
+                          "links.csv) between TimeOut outputs [s] (0: every step; not set: none)", (), 0.0, 1e12),
     "RhopOutMin": Param("float", 700.0, "minimum valid density [kg/m3]", (), 0.0, 1e9),
     "RhopOutMax": Param("float", 1300.0, "maximum valid density [kg/m3]", (), 0.0, 1e9),
     "PartsOutMax": Param("float", 1.0, "deprecated: fraction of fluid allowed out", (), 0.0, 1.0),
@@ -92,6 +93,64 @@ PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIn
                  "ZPeriodicIncX", "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
 DEPRECATED = {"PartsOutMax", "IncZ", "DomainFixed", "DeltaSPH", "PosDouble"} | {
     k for k in PARAMETERS if k.startswith("DomainFixed")}
+
+
+# accepted for DualSPHysics's files, without effect here: warned when set to another value
+NO_EFFECT = {
+    "FtSaveAce": "DualSPHysics's debug output of floating accelerations",
+    "FtIgnoreRadius": "the floating radius of DualSPHysics's periodic distance test; sphdvi does not use it",
+}
+
+DOMAIN_KEYS = ("IncZ", "DomainFixed", "DomainFixedXmin", "DomainFixedYmin", "DomainFixedZmin",
+               "DomainFixedXmax", "DomainFixedYmax", "DomainFixedZmax")
+GENCASE_ONLY = DOMAIN_KEYS        # they shape the domain that gencase writes
+
+
+def apply_delta_sph(params: dict, set_keys) -> None:
+    """The deprecated ``DeltaSPH`` as DualSPHysics reads it: a value > 0 selects Molteni's
+    density diffusion (DensityDT 1) with that coefficient; given with DensityDT it is an
+    error (raises ValueError)."""
+    if "DeltaSPH" not in set_keys:
+        return
+    if "DensityDT" in set_keys:
+        raise ValueError("the parameters 'DeltaSPH' and 'DensityDT' cannot be combined; use only DensityDT")
+    value = float(params.get("DeltaSPH") or 0.0)
+    if value > 0:
+        params["DensityDT"] = 1
+        params["DensityDTvalue"] = value
+
+
+def domain_from_deprecated(params: dict, set_keys, domain: dict) -> dict:
+    """The deprecated domain keys as DualSPHysics v5.4 applies them (JSph::LoadConfigParameters):
+    ``IncZ`` v raises the domain's top by v times its height (``default + 100 v %``);
+    ``DomainFixed`` "xmin:ymin:zmin:xmax:ymax:zmax" fixes all six limits (and replaces IncZ);
+    ``DomainFixedXmin`` ... fix one each.  Combined with a ``<simulationdomain>`` that is not
+    all default they are an error (raises ValueError).  Returns the domain specification."""
+    used = [k for k in DOMAIN_KEYS if k in set_keys and params.get(k) is not None
+            and not (k == "IncZ" and not params[k])]
+    if not used:
+        return domain
+    if any(spec != "default" for which in ("posmin", "posmax") for spec in domain[which]):
+        raise ValueError(f"{used[0]} cannot be combined with a <simulationdomain> in <parameters>; "
+                         "use only <simulationdomain>")
+    out = {"posmin": ["default"] * 3, "posmax": ["default"] * 3}
+    if "IncZ" in used:
+        out["posmax"][2] = f"default + {100.0 * float(params['IncZ']):.12g}%"
+    if "DomainFixed" in used:
+        parts = str(params["DomainFixed"]).replace(",", ":").split(":")
+        try:
+            values = [float(v) for v in parts]
+        except ValueError:
+            values = []
+        if len(values) != 6:
+            raise ValueError(f"DomainFixed={params['DomainFixed']!r}: expected six numbers "
+                             "xmin:ymin:zmin:xmax:ymax:zmax")
+        out = {"posmin": [f"{v:.17g}" for v in values[:3]], "posmax": [f"{v:.17g}" for v in values[3:]]}
+    for key in used:
+        if key.startswith("DomainFixed") and key != "DomainFixed":
+            axis = "xyz".index(key[11].lower())
+            out["posmin" if key.endswith("min") else "posmax"][axis] = f"{float(params[key]):.17g}"
+    return out
 
 
 def default_parameters() -> dict:

@@ -17,7 +17,8 @@ from ..errors import CaseError
 from .datafiles import read_dt_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
-from .parameters import PARAMETERS, DEPRECATED, closest_key, coerce, default_parameters
+from .parameters import (NO_EFFECT, PARAMETERS, DEPRECATED, apply_delta_sph, closest_key, coerce, default_parameters,
+                         domain_from_deprecated)
 from .schema import validate_structure
 from .xmldoc import CaseReader, load_xml, strip_disabled
 
@@ -584,6 +585,8 @@ def read_parameters(reader, execution):
             raise reader.error(p, f"parameter {key}: {exc}", _expected_for(key)) from None
         if key in DEPRECATED:
             reader.warn(p, f"parameter '{key}' is deprecated in DualSPHysics")
+        if key in NO_EFFECT and value != spec.default:
+            reader.warn(p, f"parameter '{key}' has no effect in sphdvi ({NO_EFFECT[key]})")
         if key == "DtFixedFile" and str(value).upper() != "NONE":
             value = reader.resolve_path(p, "value")
             try:
@@ -594,6 +597,11 @@ def read_parameters(reader, execution):
                                    exc.expected) from None
         params[key] = value
         set_keys.append(key)
+    try:
+        apply_delta_sph(params, set_keys)
+        domain = domain_from_deprecated(params, set_keys, domain)
+    except ValueError as exc:
+        raise reader.error(el, str(exc), "DualSPHysics v5.4's keys: DensityDT, <simulationdomain>") from None
     if params["RhopOutMin"] >= params["RhopOutMax"]:
         raise reader.error(el, f"RhopOutMin ({params['RhopOutMin']}) >= RhopOutMax ({params['RhopOutMax']})",
                            "RhopOutMin < RhopOutMax")

@@ -14,6 +14,7 @@ from sphdvi.errors import CaseError
 
 
 def build(tmp_path, **kw):
+    tmp_path.mkdir(parents=True, exist_ok=True)
     return build_case(write_case(tmp_path, case_xml(**kw)), str(tmp_path / "out"))
 
 
@@ -110,6 +111,53 @@ def test_simulation_domain(tmp_path):
     assert r.domain["posmin"][0] == pytest.approx(-0.4)
     assert r.domain["posmin"][2] == pytest.approx(-0.5)
     assert r.domain["posmax"][2] == pytest.approx(4.5)
+
+
+def test_deprecated_domain_keys_as_dualsphysics(tmp_path):
+    """IncZ v raises the top by v times the height (= posmax z "default + 100 v %"), DomainFixed
+    fixes all six limits and DomainFixedXmin ... one each (DualSPHysics v5.4 still applies them,
+    with a warning); with a <simulationdomain> they are an error."""
+    ref = build(tmp_path / "a", parameters='<simulationdomain><posmax z="default + 50%"/></simulationdomain>')
+    r = build(tmp_path / "b", parameters='<parameter key="IncZ" value="0.5"/>')
+    assert r.domain["posmax"][2] == pytest.approx(ref.domain["posmax"][2])
+    assert any("IncZ" in w and "deprecated" in w for w in r.warnings)
+    r = build(tmp_path / "c", parameters='<parameter key="DomainFixed" value="-0.5:-1:-0.25:2.5:1:3"/>'
+                                        '<parameter key="DomainFixedZmax" value="3.5"/>')
+    lo, hi = r.domain["posmin"], r.domain["posmax"]          # (a 2D case: y is its plane)
+    assert [lo[0], lo[2], hi[0], hi[2]] == pytest.approx([-0.5, -0.25, 2.5, 3.5])
+    r = build(tmp_path / "d", parameters='<parameter key="DomainFixedXmin" value="0"/>')
+    assert r.domain["posmin"][0] == 0.0
+    with pytest.raises(CaseError) as err:
+        build(tmp_path / "e", parameters='<parameter key="IncZ" value="0.5"/>'
+                                        '<simulationdomain><posmax z="default + 50%"/></simulationdomain>')
+    assert "IncZ cannot be combined with a <simulationdomain>" in str(err.value)
+    with pytest.raises(CaseError) as err:
+        build(tmp_path / "f", parameters='<parameter key="DomainFixed" value="1:2:3"/>')
+    assert "expected six numbers" in str(err.value)
+
+
+def test_keys_without_effect_are_warned(tmp_path):
+    r = build(tmp_path / "a", parameters='<parameter key="FtSaveAce" value="1"/>'
+                                        '<parameter key="FtIgnoreRadius" value="0"/>')
+    assert sum("has no effect in sphdvi" in w for w in r.warnings) == 1
+    assert any("'FtSaveAce' has no effect" in w for w in r.warnings)
+
+
+def test_deprecated_deltasph_selects_molteni_diffusion(tmp_path):
+    r = build(tmp_path / "a", parameters='<parameter key="DeltaSPH" value="0.12"/>')
+    assert r.case.parameters["DensityDT"] == 1 and r.case.parameters["DensityDTvalue"] == 0.12
+    r = build(tmp_path / "b", parameters='<parameter key="DeltaSPH" value="0"/>')
+    assert r.case.parameters["DensityDT"] == 0
+    with pytest.raises(CaseError) as err:
+        build(tmp_path / "c", parameters='<parameter key="DeltaSPH" value="0.1"/>'
+                                        '<parameter key="DensityDT" value="2"/>')
+    assert "'DeltaSPH' and 'DensityDT' cannot be combined" in str(err.value)
+    from sphdvi.errors import InputError
+    from sphdvi.simulation import apply_overrides
+    p = apply_overrides({"TimeOut": 0.1, "DensityDT": 0}, ["DeltaSPH=0.05"])
+    assert p["DensityDT"] == 1 and p["DensityDTvalue"] == 0.05
+    with pytest.raises(InputError, match="run gencase again"):
+        apply_overrides({"TimeOut": 0.1}, ["IncZ=0.5"])
 
 
 # -- special sections ----------------------------------------------------------------

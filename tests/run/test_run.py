@@ -277,3 +277,23 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
         log = (out / "run.log").read_text()
         assert ("WARNING: more than 1% of the fluid particles were excluded" in log) == expect
         assert any("more than 1%" in str(c.message) for c in caught) == expect
+
+
+def test_timeoutextra_floating_rows_between_outputs_and_resume(tmp_path):
+    """TimeOutExtra: bodies.csv gets a row per body at every multiple of TimeOutExtra
+    between the TimeOut outputs (the first step at or after it); a killed-and-resumed run
+    writes the same file."""
+    case = REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
+    common = ["--dp", "0.02", "--tout", "0.02", "--threads", "1", "-q", "--set", "FtPause=0",
+              "--set", "TimeOutExtra=0.005"]
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert invoke(["run", case, "-o", a, "--tmax", "0.04"] + common).exit_code == 0
+    assert invoke(["run", case, "-o", b, "--tmax", "0.02"] + common).exit_code == 0
+    r = invoke(["run", b, "--resume", "--tmax", "0.04"] + common[2:])
+    assert r.exit_code == 0, r.output
+    rows = (a / "bodies.csv").read_text().splitlines()
+    nbody = sum(1 for x in rows[1:] if float(x.split(",")[0]) == 0.0)
+    times = np.unique([float(x.split(",")[0]) for x in rows[1:]])
+    assert len(rows) == 1 + nbody * 9 and times.size == 9          # t = 0, 0.005, ..., 0.04
+    assert np.all(times - np.arange(9) * 0.005 >= -1e-12) and np.all(times - np.arange(9) * 0.005 < 2e-4)
+    assert (a / "bodies.csv").read_text() == (b / "bodies.csv").read_text()
