@@ -359,8 +359,12 @@ class SPHRun:
         if str(params.get("DtFixedFile", "NONE")).upper() != "NONE":
             from .case.datafiles import read_dt_table
             dt_table = read_dt_table(str(params["DtFixedFile"]))
+        visco_table = None
+        if str(params.get("ViscoTime") or "").strip():
+            from .case.datafiles import read_visco_table
+            visco_table = read_visco_table(str(params["ViscoTime"]))
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
-                                normals=self.normals0, dt_table=dt_table)
+                                normals=self.normals0, dt_table=dt_table, visco_table=visco_table)
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.dtmin_run = 0
         self.dtmin_seen = 0

@@ -34,6 +34,22 @@ def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
     return np.asarray([r[:k] for r in rows], float).reshape(-1, k)
 
 
+def read_visco_table(path: str) -> np.ndarray:
+    """``ViscoTime``: rows (time [s], Visco) -> (n, 2) array, as DualSPHysics's
+    JDsViscoInput reads it (at least two rows; linear interpolation in between, the
+    end values outside); times must rise and values be finite and >= 0."""
+    a = read_columns(path, 2, "ViscoTime")[:, :2].copy()
+    if a.shape[0] < 2:
+        raise CaseError("ViscoTime: fewer than two (time, visco) rows", file=path,
+                        expected="at least two lines 'time[s] visco'")
+    if np.any(np.diff(a[:, 0]) < 0):
+        raise CaseError("ViscoTime: times decrease", file=path, expected="rising times")
+    if np.any(~np.isfinite(a)) or np.any(a[:, 1] < 0):
+        raise CaseError("ViscoTime: values must be finite and >= 0", file=path,
+                        expected="viscosity values >= 0")
+    return a
+
+
 def read_dt_table(path: str) -> np.ndarray:
     """``DtFixedFile``: rows (time [s], dt [ms]) -> (n, 2) array of (time, dt [s]),
     as DualSPHysics's JSphDtFixed reads it (at least two rows, times rising,

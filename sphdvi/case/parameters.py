@@ -21,7 +21,8 @@ class Param:
 
 
 PARAMETERS: dict[str, Param] = {
-    "SavePosDouble": Param("int", 0, "save positions in double precision", (0, 1)),
+    "SavePosDouble": Param("int", 0, "save positions in double precision (sphdvi always does)", (0, 1)),
+    "SaveExtraParts": Param("str", "", "DualSPHysics: outputs with the extra restart data"),
     "Boundary": Param("int", 1, "boundary method 1:DBC, 2:mDBC", (1, 2)),
     "SlipMode": Param("int", 1, "mDBC slip mode 1:DBC vel=0, 2:no-slip, 3:free slip", (1, 2, 3)),
     "MDBCCorrector": Param("int", None, "mDBC correction also in the Symplectic corrector (DualSPHysics "
@@ -40,6 +41,8 @@ PARAMETERS: dict[str, Param] = {
     "Visco": Param("float", 0.01, "viscosity value (alpha or kinematic viscosity)", (), 0.0, 1e6),
     "ViscoLaminarEta": Param("float", 0.1, "sphdvi: regulariser eta/h of the laminar term r^2/(r^2+eta^2) "
                              "(DualSPHysics 0.1; 0: the exact Morris operator)", (), 0.0, 1.0),
+    "ViscoTime": Param("str", "", "file of (time [s], Visco) rows: Visco as a function of time, set at the "
+                       "start of each step (linear in between, the end values outside)"),
     "ViscoBoundFactor": Param("float", 1.0, "multiplier of Visco for fluid-boundary pairs", (), 0.0, 1e6),
     "DensityDT": Param("int", 0, "density diffusion 0:none, 1:Molteni, 2:Fourtakas, 3:Fourtakas full", (0, 1, 2, 3)),
     "DensityDTvalue": Param("float", 0.1, "density diffusion coefficient delta", (), 0.0, 1.0),
@@ -98,6 +101,7 @@ DEPRECATED = {"PartsOutMax", "IncZ", "DomainFixed", "DeltaSPH", "PosDouble"} | {
 # accepted for DualSPHysics's files, without effect here: warned when set to another value
 NO_EFFECT = {
     "FtSaveAce": "DualSPHysics's debug output of floating accelerations",
+    "SaveExtraParts": "sphdvi's restart.h5 always holds the whole state, written at every output",
     "FtIgnoreRadius": "the floating radius of DualSPHysics's periodic distance test; sphdvi does not use it",
 }
 

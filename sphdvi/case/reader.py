@@ -14,7 +14,7 @@ import os
 import numpy as np
 
 from ..errors import CaseError
-from .datafiles import read_dt_table
+from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
 from .parameters import (NO_EFFECT, PARAMETERS, DEPRECATED, apply_delta_sph, closest_key, coerce, default_parameters,
@@ -587,14 +587,8 @@ def read_parameters(reader, execution):
             reader.warn(p, f"parameter '{key}' is deprecated in DualSPHysics")
         if key in NO_EFFECT and value != spec.default:
             reader.warn(p, f"parameter '{key}' has no effect in sphdvi ({NO_EFFECT[key]})")
-        if key == "DtFixedFile" and str(value).upper() != "NONE":
-            value = reader.resolve_path(p, "value")
-            try:
-                read_dt_table(value)
-            except CaseError as exc:
-                raise reader.error(p, f"{exc.message} ({value}"
-                                   + (f", line {exc.line}" if exc.line else "") + ")",
-                                   exc.expected) from None
+        if key in DATA_FILE_KEYS and str(value).strip() and str(value).upper() != "NONE":
+            value = _checked_data_file(reader, p, DATA_FILE_KEYS[key])
         params[key] = value
         set_keys.append(key)
     try:
@@ -618,6 +612,21 @@ def _expected_for(key):
     if spec.hi is not None:
         rng.append(f"<= {spec.hi:g}")
     return ("a number " + " and ".join(rng)) if rng else "a number"
+
+
+DATA_FILE_KEYS = {"DtFixedFile": read_dt_table, "ViscoTime": read_visco_table}
+
+
+def _checked_data_file(reader, p, read_table) -> str:
+    """The absolute path of a parameter's data file (relative to the case), read once
+    now so that a bad file is an error of the case, with its line."""
+    path = reader.resolve_path(p, "value")
+    try:
+        read_table(path)
+    except CaseError as exc:
+        raise reader.error(p, f"{exc.message} ({path}" + (f", line {exc.line}" if exc.line else "") + ")",
+                           exc.expected) from None
+    return path
 
 
 def _domain_spec(reader, el, comp) -> str:

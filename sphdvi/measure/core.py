@@ -41,6 +41,14 @@ class KernelSpec:
     visco_bound: float = 0.0     # Visco x ViscoBoundFactor (fluid-boundary pairs)
     massfluid: float = 0.0
     laminar_eta: float = 0.1     # ViscoLaminarEta: eta/h of the laminar term
+    visco_table: tuple = ()      # ViscoTime: ((time, Visco x ViscoBoundFactor), ...) or ()
+
+    def visco_bound_at(self, t: float | None) -> float:
+        """Visco x ViscoBoundFactor at time ``t`` (ViscoTime: linear, end values outside)."""
+        if not self.visco_table or t is None:
+            return self.visco_bound
+        times, values = zip(*self.visco_table)
+        return float(np.interp(t, times, values))
 
     @property
     def alpha(self) -> float:
@@ -68,12 +76,17 @@ class KernelSpec:
         cs0 = float(c.get("cs0") or 0.0)
         rhop0 = float(c.get("rhop0") or 1000.0)
         b = float(c.get("b") or cs0 * cs0 * rhop0 / gamma)
-        visco = float(p.get("Visco", 0.01) or 0.0) * float(p.get("ViscoBoundFactor", 1.0) or 1.0)
+        factor = float(p.get("ViscoBoundFactor", 1.0) or 1.0)
+        visco = float(p.get("Visco", 0.01) or 0.0) * factor
+        table = ()
+        if str(p.get("ViscoTime") or "").strip():
+            from ..case.datafiles import read_visco_table
+            table = tuple((float(t), float(v) * factor) for t, v in read_visco_table(str(p["ViscoTime"])))
         return cls(kind=int(p.get("Kernel", 2) or 2), h=float(c["h"]), dp=float(c["dp"]),
                    is2d=bool(c["is2d"]), cs0=cs0, rhop0=rhop0, b=b, gamma=gamma,
                    visco_kind=int(p.get("ViscoTreatment", 1) or 1), visco_bound=visco,
                    massfluid=float(c.get("massfluid") or 0.0),
-                   laminar_eta=float(p.get("ViscoLaminarEta", 0.1)))
+                   laminar_eta=float(p.get("ViscoLaminarEta", 0.1)), visco_table=table)
 
     def tait_pressure(self, rhop):
         """Tait's equation of state p = B((rho/rho0)^gamma - 1)."""
@@ -195,10 +208,11 @@ def surface_along_lines(grid: ParticleGrid, p0, p1, step: float, threshold: floa
 
 
 def fluid_forces(grid: ParticleGrid, tpos, tvel, trhop, tpress, tmass, spec: KernelSpec,
-                 viscosity: bool = True) -> np.ndarray:
+                 viscosity: bool = True, t: float | None = None) -> np.ndarray:
     """Per-particle force (T, 3) of the fluid on the target particles (boundary or
     floating): pressure, tensile correction (cubic) and viscous terms of the
-    momentum equation, see :func:`_kernels.fluid_force`. Per metre of width in 2D."""
+    momentum equation, see :func:`_kernels.fluid_force`. Per metre of width in 2D.
+    ``t``: the time, for the viscosity of a ViscoTime case."""
     tpos = as_points(tpos)
     out = np.zeros((tpos.shape[0], 3))
     if grid.n == 0 or tpos.shape[0] == 0:
@@ -207,7 +221,7 @@ def fluid_forces(grid: ParticleGrid, tpos, tvel, trhop, tpress, tmass, spec: Ker
     K.fluid_force(tpos, f8(tvel).reshape(-1, 3), f8(trhop), f8(tpress), f8(tmass), grid.pos,
                   grid.arrays["vel"].reshape(-1, 3), grid.arrays["rhop"], grid.arrays["press"],
                   grid.arrays["mass"], *grid.geometry(), spec.kind, spec.h, spec.alpha,
-                  spec.visco_kind if viscosity else 0, spec.visco_bound, spec.cs0, spec.wdp_inv,
+                  spec.visco_kind if viscosity else 0, spec.visco_bound_at(t), spec.cs0, spec.wdp_inv,
                   (spec.laminar_eta * spec.h) ** 2, out)
     return out
 

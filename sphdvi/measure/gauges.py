@@ -185,7 +185,7 @@ class ForceGauge(Gauge):
     def compute(self, view):
         sel = np.flatnonzero((view.mk == self.mk) & (view.ptype != core.FLUID))
         f = core.fluid_forces(view.grid, view.pos[sel], view.vel[sel], view.rhop[sel], view.press[sel],
-                              view.mass[sel], self.spec)
+                              view.mass[sel], self.spec, t=view.time)
         total, _ = core.force_and_moment(view.pos[sel], f)
         return [float(np.sqrt(total @ total))] + list(total)
 

@@ -359,7 +359,7 @@ def step_force(run: RunOutput, snap: Snapshot, sel, grid=None, centre=None, axis
     grid = grid or run.fluid_grid(snap)
     press = snap.press if snap.press is not None else spec.tait_pressure(snap.rhop)
     f = core.fluid_forces(grid, snap.pos[sel], snap.vel[sel], snap.rhop[sel], press[sel], snap.mass[sel],
-                          spec, viscosity=viscosity)
+                          spec, viscosity=viscosity, t=snap.time)
     return core.force_and_moment(snap.pos[sel], f, centre=centre, axis=axis)
 
 

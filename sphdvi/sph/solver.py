@@ -119,6 +119,10 @@ class SPHSolver:
         interpolated linearly at the start of each step (end values outside),
         as DualSPHysics's JSphDtFixed does; ``dt_error`` keeps the largest
         excess of the imposed dt over the variable (CFL) one.
+    visco_table : (n, 2) array or None
+        ``ViscoTime`` as (time [s], Visco) rows: Visco (and Visco x
+        ViscoBoundFactor) is interpolated linearly at the start of each step
+        (end values outside), as DualSPHysics's JDsViscoInput.
 
     After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
     accelerations, density rates and pressures of the last interaction, in
@@ -129,11 +133,12 @@ class SPHSolver:
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
                  parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None,
-                 cell_mode="auto", dt_table=None):
+                 cell_mode="auto", dt_table=None, visco_table=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.dt_table = None if dt_table is None else np.asarray(dt_table, float).reshape(-1, 2)
         self.dt_error = -np.inf
+        self.visco_table = None if visco_table is None else np.asarray(visco_table, float).reshape(-1, 2)
         self.state = state
         self.constants = dict(constants)
         self.params = resolve_params(params)
@@ -252,8 +257,6 @@ class SPHSolver:
         cst[3] = alpha
         cst[4] = alpha / (h * h)
         cst[5] = self.cs0
-        cst[6] = float(p["Visco"])
-        cst[7] = float(p["Visco"]) * float(p["ViscoBoundFactor"])
         cst[8] = float(p["DensityDTvalue"]) * 2.0 * h * self.cs0
         cst[9] = self.rhop0 * self.gravity[2] / self.b
         cst[10] = self.rhop0
@@ -265,6 +268,7 @@ class SPHSolver:
         cst[18] = 1.0
         cst[20] = 0.0       # 1/dt of the shifting velocity (ShiftAdvALE), set each step
         self.cst = cst
+        self._set_visco(float(p["Visco"]))
         self.dtmin = float(p["DtMin"]) or float(p["CoefDtMin"]) * h / self.cs0
         self.dtini = float(p["DtIni"]) or h / self.cs0
         self.dtfixed = float(p["DtFixed"] or 0.0)
@@ -726,6 +730,12 @@ class SPHSolver:
             return float(np.interp(t, self.dt_table[:, 0], self.dt_table[:, 1]))
         return 0.0
 
+    def _set_visco(self, visco):
+        """Visco of the interaction: fluid-fluid pairs, and times ViscoBoundFactor for the
+        fluid-boundary ones."""
+        self.cst[6] = visco
+        self.cst[7] = visco * float(self.params["ViscoBoundFactor"])
+
     def _variable_dt(self, t):
         """The dt of a step starting at time t (eq. 10, or the imposed one)."""
         fixed = self._fixed_dt(t)
@@ -755,6 +765,8 @@ class SPHSolver:
         # move the particles into cell order every reorder_every steps (a
         # function of the step number, so that a resumed run does the same)
         self._reorder_next = self.nstep % self.reorder_every == 0
+        if self.visco_table is not None:
+            self._set_visco(float(np.interp(self.time, self.visco_table[:, 0], self.visco_table[:, 1])))
         if self.step_algorithm == 1:
             dt = self._step_verlet()
         else:

@@ -138,8 +138,9 @@ def test_deprecated_domain_keys_as_dualsphysics(tmp_path):
 
 def test_keys_without_effect_are_warned(tmp_path):
     r = build(tmp_path / "a", parameters='<parameter key="FtSaveAce" value="1"/>'
-                                        '<parameter key="FtIgnoreRadius" value="0"/>')
-    assert sum("has no effect in sphdvi" in w for w in r.warnings) == 1
+                                        '<parameter key="FtIgnoreRadius" value="0"/>'
+                                        '<parameter key="SaveExtraParts" value="10"/>')
+    assert sum("has no effect in sphdvi" in w for w in r.warnings) == 2
     assert any("'FtSaveAce' has no effect" in w for w in r.warnings)
 
 

@@ -178,3 +178,15 @@ def test_measure_help_imports_nothing_heavy():
             "heavy = [m for m in ('numba', 'h5py', 'numpy', 'matplotlib') if m in sys.modules]\n"
             "assert not heavy, heavy\n")
     subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
+
+
+def test_viscotime_viscosity_of_the_force_at_the_snapshot_time():
+    """ViscoTime cases: the viscous force term uses Visco x ViscoBoundFactor at the
+    snapshot's time (linear in the table, end values outside)."""
+    from sphdvi.measure.core import KernelSpec
+    spec = KernelSpec(kind=2, h=0.014, dp=0.01, is2d=True, visco_bound=0.01,
+                      visco_table=((0.0, 0.02), (1.0, 0.04)))
+    assert spec.visco_bound_at(None) == 0.01
+    assert spec.visco_bound_at(0.25) == pytest.approx(0.025)
+    assert spec.visco_bound_at(-1.0) == 0.02 and spec.visco_bound_at(5.0) == 0.04
+    assert KernelSpec(kind=2, h=0.014, dp=0.01, is2d=True, visco_bound=0.01).visco_bound_at(0.5) == 0.01

@@ -251,6 +251,27 @@ def test_dtfixedfile_from_case(tmp_path):
     assert r.exit_code == 2 and "nofile.csv" in r.output
 
 
+def test_viscotime_from_case(tmp_path):
+    """ViscoTime: a (time [s], Visco) file next to the case; a run with a constant table
+    ends bitwise as one with that Visco; a malformed file is a case error naming it."""
+    (tmp_path / "visco.txt").write_text("time visco\n0 0.05\n1 0.05\n")
+    case = small_case(tmp_path, extra_params='<parameter key="ViscoTime" value="visco.txt" />')
+    text = case.read_text().replace('<parameter key="Visco" value="0.02" />', '<parameter key="Visco" value="0.05" />')
+    text = text.replace('<parameter key="ViscoTime" value="visco.txt" />', "")
+    assert 'value="0.05"' in text
+    ref = tmp_path / "Ref_Def.xml"
+    ref.write_text(text)
+    common = ["--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q"]
+    assert invoke(["run", case, "-o", tmp_path / "a"] + common).exit_code == 0
+    assert invoke(["run", ref, "-o", tmp_path / "b"] + common).exit_code == 0
+    sa, _ = final_state(tmp_path / "a")
+    sb, _ = final_state(tmp_path / "b")
+    assert all(np.array_equal(sa[k], sb[k]) for k in sa)
+    (tmp_path / "visco.txt").write_text("0 0.05\n0.5 x\n")
+    r = invoke(["gencase", case, "-o", tmp_path / "g"])
+    assert r.exit_code == 2 and "ViscoTime" in r.output and "visco.txt" in r.output and "line 2" in r.output
+
+
 def test_exclusion_warnings_as_dualsphysics(tmp_path):
     """WrnPartsOut: a warning (terminal and run.log) when the particles excluded since the
     previous output reach 1 % of the fluid, then 2, 5, 10, 20 ... %, and when all excluded

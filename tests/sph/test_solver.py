@@ -185,6 +185,29 @@ def test_dt_table_is_interpolated_at_each_step(alg):
     assert np.isfinite(sol.dt_error)
 
 
+@pytest.mark.parametrize("alg", [1, 2])
+def test_visco_table_sets_the_viscosity_at_the_start_of_each_step(alg):
+    """ViscoTime: Visco interpolated in (time, Visco) at the start of each step (end values
+    outside), the boundary value times ViscoBoundFactor; a constant table 2 alpha runs
+    bitwise as Visco = 2 alpha."""
+    st, c = small_tank()
+    params = {"StepAlgorithm": alg, "Visco": 0.01, "ViscoBoundFactor": 0.5}
+    table = np.array([[0.0, 0.02], [0.004, 0.1]])
+    sol = SPHSolver(st.copy(), c, params, visco_table=table)
+    for _ in range(40):
+        t0 = sol.time
+        sol.step()
+        v = np.interp(t0, table[:, 0], table[:, 1])
+        assert sol.cst[6] == v and sol.cst[7] == v * 0.5
+    assert sol.time > 0.004 and sol.cst[6] == 0.1
+    a = SPHSolver(st.copy(), c, {**params, "Visco": 0.03})
+    b = SPHSolver(st.copy(), c, params, visco_table=np.array([[0.0, 0.03], [1.0, 0.03]]))
+    for _ in range(20):
+        a.step()
+        b.step()
+    assert np.array_equal(a.state.vel, b.state.vel) and np.array_equal(a.state.rhop, b.state.rhop)
+
+
 def test_dt_all_particles_counts_moving_boundaries():
     """DtAllParticles = 1: a fast moving boundary particle limits dt; by
     default only fluid and floating particles do."""
