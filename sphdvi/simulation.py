@@ -65,7 +65,7 @@ def default_threads() -> int:
 # ---------------------------------------------------------------------------------
 def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
     """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError."""
-    from .case.parameters import GENCASE_ONLY, PARAMETERS, apply_delta_sph, closest_key, coerce
+    from .case.parameters import DOMAIN_KEYS, PARAMETERS, apply_delta_sph, closest_key, coerce
     out = dict(params)
     given = []
     for item in sets or ():
@@ -75,7 +75,7 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
         if key not in PARAMETERS:
             hint = closest_key(key)
             raise InputError(f"--set: unknown parameter '{key}'" + (f"; did you mean '{hint}'?" if hint else ""))
-        if key in GENCASE_ONLY:
+        if key in DOMAIN_KEYS:
             raise InputError(f"--set {key}: it shapes the domain gencase writes; put it in the case file "
                              "(or better a <simulationdomain>) and run gencase again")
         try:

@@ -34,34 +34,33 @@ def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
     return np.asarray([r[:k] for r in rows], float).reshape(-1, k)
 
 
+def _time_table(path: str, what: str, name: str, unit: str, positive: bool) -> np.ndarray:
+    """(time [s], value) rows of a DualSPHysics time-series file -> (n, 2): at least two
+    rows, times rising, values finite and > 0 (``positive``) or >= 0."""
+    a = read_columns(path, 2, what)[:, :2].copy()
+    if a.shape[0] < 2:
+        raise CaseError(f"{what}: fewer than two (time, {name}) rows", file=path,
+                        expected=f"at least two lines 'time[s] {name}{unit}'")
+    if np.any(np.diff(a[:, 0]) < 0):
+        raise CaseError(f"{what}: times decrease", file=path, expected="rising times")
+    bad = a[:, 1] <= 0 if positive else a[:, 1] < 0
+    if np.any(~np.isfinite(a)) or np.any(bad):
+        limit = "> 0" if positive else ">= 0"
+        raise CaseError(f"{what}: {name} must be finite and {limit}", file=path,
+                        expected=f"{name} values {limit}")
+    return a
+
+
 def read_visco_table(path: str) -> np.ndarray:
     """``ViscoTime``: rows (time [s], Visco) -> (n, 2) array, as DualSPHysics's
-    JDsViscoInput reads it (at least two rows; linear interpolation in between, the
-    end values outside); times must rise and values be finite and >= 0."""
-    a = read_columns(path, 2, "ViscoTime")[:, :2].copy()
-    if a.shape[0] < 2:
-        raise CaseError("ViscoTime: fewer than two (time, visco) rows", file=path,
-                        expected="at least two lines 'time[s] visco'")
-    if np.any(np.diff(a[:, 0]) < 0):
-        raise CaseError("ViscoTime: times decrease", file=path, expected="rising times")
-    if np.any(~np.isfinite(a)) or np.any(a[:, 1] < 0):
-        raise CaseError("ViscoTime: values must be finite and >= 0", file=path,
-                        expected="viscosity values >= 0")
-    return a
+    JDsViscoInput reads it (linear interpolation in between, the end values outside)."""
+    return _time_table(path, "ViscoTime", "visco", "", positive=False)
 
 
 def read_dt_table(path: str) -> np.ndarray:
     """``DtFixedFile``: rows (time [s], dt [ms]) -> (n, 2) array of (time, dt [s]),
-    as DualSPHysics's JSphDtFixed reads it (at least two rows, times rising,
-    dt > 0; linear interpolation in between, the end values outside)."""
-    a = read_columns(path, 2, "DtFixedFile")[:, :2].copy()
-    if a.shape[0] < 2:
-        raise CaseError("DtFixedFile: fewer than two (time, dt) rows", file=path,
-                        expected="at least two lines 'time[s] dt[ms]'")
-    if np.any(np.diff(a[:, 0]) < 0):
-        raise CaseError("DtFixedFile: times decrease", file=path, expected="rising times")
-    if np.any(~np.isfinite(a)) or np.any(a[:, 1] <= 0):
-        raise CaseError("DtFixedFile: dt must be finite and > 0", file=path,
-                        expected="dt values in milliseconds > 0")
+    as DualSPHysics's JSphDtFixed reads it (linear interpolation in between, the end
+    values outside)."""
+    a = _time_table(path, "DtFixedFile", "dt", "[ms]", positive=True)
     a[:, 1] *= 1e-3
     return a

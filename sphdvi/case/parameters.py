@@ -105,9 +105,9 @@ NO_EFFECT = {
     "FtIgnoreRadius": "the floating radius of DualSPHysics's periodic distance test; sphdvi does not use it",
 }
 
+# the deprecated domain keys: they shape the domain that gencase writes
 DOMAIN_KEYS = ("IncZ", "DomainFixed", "DomainFixedXmin", "DomainFixedYmin", "DomainFixedZmin",
                "DomainFixedXmax", "DomainFixedYmax", "DomainFixedZmax")
-GENCASE_ONLY = DOMAIN_KEYS        # they shape the domain that gencase writes
 
 
 def apply_delta_sph(params: dict, set_keys) -> None:
