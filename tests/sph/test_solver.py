@@ -30,6 +30,28 @@ def test_parallel_kernels_bitwise_equal_serial(alg):
     assert_threaded_equals_serial(st, c, {"StepAlgorithm": alg, "DensityDT": 2, "Shifting": 3, "ShiftTFS": 1.5})
 
 
+def test_default_threshold_threads_a_few_thousand_particles():
+    """Two threads pay from about 500 particles on (x1.1 at 530-1,000, x1.35-1.58 at 1,900:
+    solver.PARALLEL_THRESHOLD); a few hundred stay serial, and the light kernels
+    (packing, integrators) stay serial below LIGHT_THRESHOLD."""
+    import numba
+    from sphdvi.sph import solver as sv
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("needs two numba threads")
+    rng = np.random.default_rng(3)
+    old = numba.get_num_threads()
+    numba.set_num_threads(2)
+    try:
+        for n_side, threaded in ((45, True), (20, False)):
+            pos = jittered_block(n_side, 0.01, True, rng)
+            sol = SPHSolver(random_state(pos, 0.01, True, rng), constants(0.01, True), {})
+            assert sol._use_parallel() is threaded, n_side
+            assert sol._use_parallel(light=True) is (threaded and n_side ** 2 >= sv.LIGHT_THRESHOLD)
+    finally:
+        numba.set_num_threads(old)
+    assert 1000 <= sv.PARALLEL_THRESHOLD <= 2000
+
+
 def test_dam_break_runs_and_conserves_particles():
     st, c = small_tank()
     sol = SPHSolver(st, c, {"DensityDT": 2, "Visco": 0.02})
