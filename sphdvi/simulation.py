@@ -65,7 +65,7 @@ def default_threads() -> int:
 # ---------------------------------------------------------------------------------
 def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
     """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError."""
-    from .case.parameters import DOMAIN_KEYS, PARAMETERS, apply_delta_sph, closest_key, coerce
+    from .case.parameters import DOMAIN_KEYS, PARAMETERS, apply_delta_sph, check_supported, closest_key, coerce
     out = dict(params)
     given = []
     for item in sets or ():
@@ -80,6 +80,7 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
                              "(or better a <simulationdomain>) and run gencase again")
         try:
             out[key] = coerce(key, value)
+            check_supported(key, out[key])
         except ValueError as exc:
             raise InputError(f"--set {key}: {exc}") from None
         given.append(key)

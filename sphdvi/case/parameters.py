@@ -90,6 +90,9 @@ PARAMETERS: dict[str, Param] = {
     "DomainFixedZmax": Param("float", None, "deprecated fixed domain limit"),
     "DeltaSPH": Param("float", 0.0, "deprecated: use DensityDT=1 and DensityDTvalue", (), 0.0, 1.0),
     "PosDouble": Param("int", 0, "deprecated precision option", (0, 1, 2)),
+    "DivCleaning": Param("int", 0, "divergence cleaning (optional build of DualSPHysics v5.4): not supported, 0 only",
+                         (0, 1)),
+    "DivCleanKp": Param("float", 0.0, "coefficient of divergence cleaning (no effect: not supported)"),
 }
 
 PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ",
@@ -103,7 +106,19 @@ NO_EFFECT = {
     "FtSaveAce": "DualSPHysics's debug output of floating accelerations",
     "SaveExtraParts": "sphdvi's restart.h5 always holds the whole state, written at every output",
     "FtIgnoreRadius": "the floating radius of DualSPHysics's periodic distance test; sphdvi does not use it",
+    "DivCleanKp": "the coefficient of divergence cleaning, which sphdvi does not implement",
 }
+
+# DualSPHysics options sphdvi does not implement: any value but the default is an error
+NOT_SUPPORTED = {
+    "DivCleaning": "divergence cleaning (an optional build feature of DualSPHysics v5.4) is not implemented in sphdvi",
+}
+
+
+def check_supported(key: str, value) -> None:
+    """Raise ValueError when ``value`` switches on an option sphdvi does not implement."""
+    if key in NOT_SUPPORTED and value != PARAMETERS[key].default:
+        raise ValueError(f"{key}={value} is not supported: {NOT_SUPPORTED[key]}")
 
 # the deprecated domain keys: they shape the domain that gencase writes
 DOMAIN_KEYS = ("IncZ", "DomainFixed", "DomainFixedXmin", "DomainFixedYmin", "DomainFixedZmin",

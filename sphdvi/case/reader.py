@@ -17,8 +17,8 @@ from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
-from .parameters import (NO_EFFECT, PARAMETERS, DEPRECATED, apply_delta_sph, closest_key, coerce, default_parameters,
-                         domain_from_deprecated)
+from .parameters import (NO_EFFECT, NOT_SUPPORTED, PARAMETERS, DEPRECATED, apply_delta_sph, check_supported, closest_key, coerce,
+                         default_parameters, domain_from_deprecated)
 from .schema import validate_structure
 from .xmldoc import CaseReader, load_xml, strip_disabled
 
@@ -581,6 +581,7 @@ def read_parameters(reader, execution):
                 value = coerce(key, raw)
             else:
                 value = coerce(key, reader.num(p, "value"))
+            check_supported(key, value)
         except ValueError as exc:
             raise reader.error(p, f"parameter {key}: {exc}", _expected_for(key)) from None
         if key in DEPRECATED:
@@ -604,6 +605,8 @@ def read_parameters(reader, execution):
 
 def _expected_for(key):
     spec = PARAMETERS[key]
+    if key in NOT_SUPPORTED:
+        return f"{spec.default} (off) or no such parameter"
     if spec.choices:
         return "one of " + ", ".join(str(c) for c in spec.choices)
     rng = []

@@ -1,5 +1,6 @@
 """Case reader: constants, parameters, special sections, materials, errors with file:line."""
 import math
+import re
 
 import numpy as np
 import pytest
@@ -142,6 +143,25 @@ def test_keys_without_effect_are_warned(tmp_path):
                                         '<parameter key="SaveExtraParts" value="10"/>')
     assert sum("has no effect in sphdvi" in w for w in r.warnings) == 2
     assert any("'FtSaveAce' has no effect" in w for w in r.warnings)
+
+
+def test_divergence_cleaning_is_refused_when_switched_on(tmp_path):
+    """DualSPHysics v5.4's optional divergence cleaning: off is accepted, on is a case error
+    (line, element, what to do), and so is --set; its coefficient alone is warned."""
+    r = build(tmp_path / "a", parameters='<parameter key="DivCleaning" value="0"/>'
+                                        '<parameter key="DivCleanKp" value="1"/>')
+    assert any("'DivCleanKp' has no effect" in w for w in r.warnings)
+    with pytest.raises(CaseError) as err:
+        build(tmp_path / "b", parameters='<parameter key="DivCleaning" value="1"/>')
+    msg = str(err.value)
+    assert re.search(r"Case_Def.xml:\d+: <parameter>: parameter DivCleaning: DivCleaning=1 is not supported: "
+                     "divergence cleaning", msg)
+    assert "0 (off) or no such parameter" in msg
+    from sphdvi.errors import InputError
+    from sphdvi.simulation import apply_overrides
+    with pytest.raises(InputError, match="--set DivCleaning: DivCleaning=1 is not supported"):
+        apply_overrides({"TimeOut": 0.1}, ["DivCleaning=1"])
+    assert apply_overrides({"TimeOut": 0.1}, ["DivCleaning=0"])["DivCleaning"] == 0
 
 
 def test_deprecated_deltasph_selects_molteni_diffusion(tmp_path):

@@ -1,9 +1,16 @@
-"""S4: water levels of the Lobovsky et al. (2014) dam break, H = 0.3 m (slow, about 2 minutes).
+"""S4: the Lobovsky et al. (2014) dam break, H = 0.3 m (slow, about 2 minutes).
 
 The case file cases/lobovsky2d/CaseLobovsky2D_Def.xml carries run-time SWL gauges at
 H1–H4 (x = 0.3, 0.865, 1.114, 1.3625 m); the level h(T), T = t √(g/H), is compared with
 both experimental repetitions over each gauge's window before the reflected bore arrives.
 Error measure: mean |h_sph − h_exp| / mean h_exp over the window.
+
+It also carries density gauges P1–P4 at the right-wall pressure sensors (z = 3, 15, 30,
+80 mm; probed 1.5h off the wall, sensor 1 also 1.5h above the floor, since DBC keeps the
+fluid about 1.5h from walls).  p = B((ρ/ρ0)^γ − 1) is scored as TOLERANCES S4 asks:
+the first impact (p/ρgH first above 0.1) within ±0.05 in T of the experiment's, and the
+quasi-static level after it (mean p/ρgH over T = 3–5) within 20 %.  Reference: the
+paper's representative repetition (Fig. 18, 'peak event 5').
 """
 import math
 from pathlib import Path
@@ -13,11 +20,15 @@ import pytest
 from click.testing import CliRunner
 
 from sphdvi.cli import main
+from sphdvi.io.casefile import read_case_h5
+from sphdvi.simulation import find_case_file
 
 REPO = Path(__file__).resolve().parents[2]
 CASE = REPO / "cases" / "lobovsky2d" / "CaseLobovsky2D_Def.xml"
-DATA = REPO.parent / "shared" / "reference" / "dambreak2d_lobovsky_2014" / "waterLevel"
+REF = REPO.parent / "shared" / "reference" / "dambreak2d_lobovsky_2014"
+DATA = REF / "waterLevel"
 H = 0.3
+G = 9.81
 WINDOWS = {"H1": ((0.0, 8.0), ("Fig16_WaterLevels_H1_2.dat",)),
            "H2": ((2.0, 7.0), ("Fig16_WaterLevels_H2_3.dat", "Fig16_WaterLevels_H2_4.dat")),
            "H3": ((2.5, 6.5), ("Fig16_WaterLevels_H3_3.dat", "Fig16_WaterLevels_H3_4.dat")),
@@ -40,16 +51,64 @@ def level_errors(outdir):
     return out
 
 
+SENSORS = {"P1": "Fig18_peak_event_5_sensors_5.dat", "P2": "Fig18_peak_event_5_sensors_4.dat",
+           "P3": "Fig18_peak_event_5_sensors_2.dat", "P4": "Fig18_peak_event_5_sensors_1.dat"}
+IMPACT_LEVEL = 0.1          # p/ρgH that marks the first impact
+PLATEAU = (3.0, 5.0)        # T window of the quasi-static level
+
+
+def wall_pressures(outdir):
+    """{sensor: (T, p/ρgH)} from the density gauges (no fluid at the probe: p = 0)."""
+    c = read_case_h5(find_case_file(str(outdir)))["constants"]
+    out = {}
+    for name in SENSORS:
+        sim = np.genfromtxt(Path(outdir) / f"GaugesMesh_{name}.csv", delimiter=";", skip_header=1)
+        p = c["b"] * ((sim[:, 1] / c["rhop0"]) ** c["gamma"] - 1.0) / (c["rhop0"] * G * H)
+        out[name] = (sim[:, 0] * math.sqrt(G / H), np.nan_to_num(p, nan=0.0))
+    return out
+
+
+def impact_and_plateau(T, p):
+    """(T of the first p/ρgH > IMPACT_LEVEL, mean p/ρgH over the PLATEAU window)."""
+    above = np.flatnonzero(p > IMPACT_LEVEL)
+    sel = (T >= PLATEAU[0]) & (T <= PLATEAU[1])
+    return (T[above[0]] if above.size else math.inf), float(np.mean(p[sel]))
+
+
+def pressure_scores(outdir):
+    """{sensor: (impact T sph, impact T exp, plateau sph, plateau exp)}."""
+    out = {}
+    for name, (T, p) in wall_pressures(outdir).items():
+        exp = np.loadtxt(REF / "pressure" / SENSORS[name], comments="#")
+        (ti, ps), (te, pe) = impact_and_plateau(T, p), impact_and_plateau(exp[:, 0], exp[:, 1])
+        out[name] = (ti, te, ps, pe)
+    return out
+
+
 @pytest.fixture(scope="module")
-def errors(tmp_path_factory):
+def run_dir(tmp_path_factory):
     if not DATA.is_dir():
         pytest.skip("reference data not found")
     out = tmp_path_factory.mktemp("lobovsky")
     r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--threads", "2", "-q"])
     assert r.exit_code == 0, r.output
-    errs = level_errors(out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def errors(run_dir):
+    errs = level_errors(run_dir)
     print("S4 water-level errors: " + ", ".join(f"{k} {100 * v:.1f} %" for k, v in errs.items()))
     return errs
+
+
+@pytest.fixture(scope="module")
+def pressures(run_dir):
+    scores = pressure_scores(run_dir)
+    for k, (ti, te, ps, pe) in scores.items():
+        print(f"S4 {k}: first impact T {ti:.3f} (exp {te:.3f}), level T 3-5 {ps:.3f} (exp {pe:.3f}, "
+              f"{100 * (ps / pe - 1):+.1f} %)")
+    return scores
 
 
 @pytest.mark.slow
@@ -59,8 +118,34 @@ def test_lobovsky_level_in_the_reservoir(errors):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S4 10 %: measured H2 10.7 %, H3 16.2 %, H4 12.3 % (DBC; "
-                                        "mDBC 10.6/15.9/13.3 %): the SPH surge is thicker and earlier")
+@pytest.mark.xfail(strict=True, reason="TOLERANCES S4 10 %: measured H2 10.5 %, H3 15.6 %, H4 12.3 % (DBC; "
+                                        "mDBC 10.6/15.9/13.3 %): the SPH surge is thicker (it reaches the wall on time: "
+                                        "see the pressure tests)")
 def test_lobovsky_levels_downstream(errors):
     for name in ("H2", "H3", "H4"):
         assert errors[name] <= 0.10, f"{name}: {100 * errors[name]:.1f} %"
+
+
+@pytest.mark.slow
+def test_lobovsky_first_impact_time(pressures):
+    """Measured T_sph - T_exp: P1 -0.010, P2 -0.015, P3 -0.019 (DBC, dp 5 mm)."""
+    for name in ("P1", "P2", "P3"):
+        ti, te, _, _ = pressures[name]
+        assert abs(ti - te) <= 0.05, f"{name}: {ti:.3f} vs {te:.3f}"
+
+
+@pytest.mark.slow
+def test_lobovsky_pressure_after_impact(pressures):
+    """Measured: P1 -7.3 %, P2 +1.5 %, P3 -10.3 % (mean p/ρgH over T = 3-5)."""
+    for name in ("P1", "P2", "P3"):
+        _, _, ps, pe = pressures[name]
+        assert abs(ps / pe - 1.0) <= 0.20, f"{name}: {ps:.3f} vs {pe:.3f}"
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="sensor 4 (z = 80 mm): measured level 0.204 vs 0.533 (-62 %) and "
+                                        "impact 0.07 early; in 2-D SPH the pressure falls off up the wall faster "
+                                        "than in the experiment (15/30/80 mm: 0.70/0.57/0.20 vs 0.69/0.64/0.53)")
+def test_lobovsky_pressure_at_sensor_4(pressures):
+    ti, te, ps, pe = pressures["P4"]
+    assert abs(ti - te) <= 0.05 and abs(ps / pe - 1.0) <= 0.20, f"{ti:.3f}/{te:.3f}, {ps:.3f}/{pe:.3f}"
