@@ -270,9 +270,12 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet) -> RunRe
     files.write_json(**meta, mode="bodies", status="running", message="", dt=dt, steps=0, physical_time=0.0,
                      runtime_s=0.0, startup_s=_time.perf_counter() - t_start, bodies=len(mech["bodies"]),
                      links=len(mech["links"]))
+    extra = params.get("TimeOutExtra")
     t0 = _time.perf_counter()
     system = run_bodies(mech["bodies"], mech["links"], out_dir=outdir, tmax=params["TimeMax"],
-                        tout=params["TimeOut"], dt=dt, materials=mech["materials"], **mech["system"])
+                        tout=params["TimeOut"], dt=dt, materials=mech["materials"],
+                        tout_extra=extra if extra is not None and extra < params["TimeOut"] else None,
+                        **mech["system"])
     runtime = _time.perf_counter() - t0
     steps = int(round(params["TimeMax"] / dt))
     finite = np.isfinite(system.pos).all() and np.isfinite(system.vel).all()

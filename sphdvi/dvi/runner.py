@@ -97,10 +97,12 @@ def _link_lines(s):
 
 
 def run_bodies(bodies, links=(), out_dir=".", tmax=1.0, tout=0.01, dt=1e-3, materials=(),
-               forces=None, flush_every=200, **system_kw):
+               forces=None, flush_every=200, tout_extra=None, **system_kw):
     """Run a body-only simulation and write ``out_dir/bodies.csv`` and
     ``out_dir/links.csv`` (one row per body/link per output time, including
-    t = 0).  ``forces``: optional callable (system) -> (F, T) arrays (nb, 3)
+    t = 0; with ``tout_extra`` (DualSPHysics's TimeOutExtra) also at its
+    multiples in between, 0 meaning every step).  ``forces``: optional
+    callable (system) -> (F, T) arrays (nb, 3)
     applied each step.  Extra keywords go to :class:`System` (gravity,
     solver, max_iter, tol, recovery_speed, envelope, contactmethod, ...).
     Returns the system at the end."""
@@ -114,13 +116,14 @@ def run_bodies(bodies, links=(), out_dir=".", tmax=1.0, tout=0.01, dt=1e-3, mate
     lrows = _link_lines(s)
     nsteps = int(round(tmax / dt))
     every = max(1, int(round(tout / dt)))
+    extra = every if tout_extra is None else max(1, int(round(tout_extra / dt)))
     nout = 0
     for k in range(1, nsteps + 1):
         F = T = None
         if forces is not None:
             F, T = forces(s)
         s.step(dt, F, T)
-        if k % every == 0 or k == nsteps:
+        if k % every == 0 or k % extra == 0 or k == nsteps:
             brows += _body_lines(s, names)
             lrows += _link_lines(s)
             nout += 1

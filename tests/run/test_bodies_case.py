@@ -45,3 +45,26 @@ def test_pendulum_case_period(tmp_path):
     links = read_rows(out / "links.csv")
     fz = np.array([float(r["fz"]) for r in links])
     assert np.median(np.abs(fz)) == pytest.approx(m * 9.81, rel=0.02)
+
+
+def test_pendulum_timeoutextra_rows_between_outputs(tmp_path):
+    """TimeOutExtra in a body-only run: rows at its multiples between the outputs (and the
+    output rows unchanged); 0 gives a row every step."""
+    case = tmp_path / "CasePendulum_Def.xml"
+    case.write_text(PENDULUM)
+    runs = {}
+    for name, sets in (("plain", []), ("extra", ["--set", "TimeOutExtra=0.01"]),
+                       ("every", ["--set", "TimeOutExtra=0", "--set", "DtFixed=0.002"])):
+        out = tmp_path / name
+        r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "-q", "--tmax", "0.2",
+                                      "--tout", "0.05"] + sets)
+        assert r.exit_code == 0, r.output
+        runs[name] = read_rows(out / "bodies.csv")
+    t_plain = [float(r["time"]) for r in runs["plain"]]
+    t_extra = np.array([float(r["time"]) for r in runs["extra"]])
+    assert np.allclose(t_plain, np.arange(5) * 0.05)
+    assert np.allclose(t_extra, np.arange(21) * 0.01)
+    for r in runs["plain"]:
+        same = [x for x in runs["extra"] if math.isclose(float(x["time"]), float(r["time"]), abs_tol=1e-9)]
+        assert same == [r]
+    assert np.allclose([float(r["time"]) for r in runs["every"]], np.arange(101) * 0.002)
