@@ -3,7 +3,11 @@
 The case file cases/lobovsky2d/CaseLobovsky2D_Def.xml carries run-time SWL gauges at
 H1–H4 (x = 0.3, 0.865, 1.114, 1.3625 m); the level h(T), T = t √(g/H), is compared with
 both experimental repetitions over each gauge's window before the reflected bore arrives.
-Error measure: mean |h_sph − h_exp| / mean h_exp over the window.
+Error measure: mean |h_sph − h_exp| / mean h_exp over the window.  The level is measured
+from the model's bed, dp/2 above the centres of the floor particles: GenCase puts the
+floor particles on the drawn floor z = 0 and the first fluid layer at z = dp, so the
+column of 60 layers spans z = dp/2 … 0.3 + dp/2 (the tank of the experiment shifted by
+dp/2, as the walls of cases/standingwave2d).
 
 It also carries density gauges P1–P4 at the right-wall pressure sensors (z = 3, 15, 30,
 80 mm; probed 1.5h off the wall, sensor 1 also 1.5h above the floor, since DBC keeps the
@@ -36,11 +40,12 @@ WINDOWS = {"H1": ((0.0, 8.0), ("Fig16_WaterLevels_H1_2.dat",)),
 
 
 def level_errors(outdir):
+    bed = 0.5 * read_case_h5(find_case_file(str(outdir)))["constants"]["dp"]
     out = {}
     for name, ((t0, t1), files) in WINDOWS.items():
         sim = np.genfromtxt(Path(outdir) / f"GaugesSWL_{name}.csv", delimiter=";", skip_header=1)
         T = sim[:, 0] * math.sqrt(9.81 / H)
-        h = np.nan_to_num(sim[:, 3] / H, nan=0.0)     # no surface found: dry
+        h = np.nan_to_num((sim[:, 3] - bed) / H, nan=0.0)     # no surface found: dry
         errs = []
         for f in files:
             exp = np.loadtxt(DATA / f, comments="#")
@@ -113,17 +118,19 @@ def pressures(run_dir):
 
 @pytest.mark.slow
 def test_lobovsky_level_in_the_reservoir(errors):
-    """H1 (inside the initial column): measured 1.2 % (DBC), 0.7 % (mDBC, 3 layers)."""
+    """H1 (inside the initial column): measured 1.0 % (DBC), 1.3 % (mDBC, 3 layers)."""
     assert errors["H1"] <= 0.10
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S4 10 %: measured H2 10.5 %, H3 15.6 %, H4 12.3 % (DBC; "
-                                        "mDBC 10.6/15.9/13.3 %): the SPH surge is thicker (it reaches the wall on time: "
-                                        "see the pressure tests)")
-def test_lobovsky_levels_downstream(errors):
-    for name in ("H2", "H3", "H4"):
-        assert errors[name] <= 0.10, f"{name}: {100 * errors[name]:.1f} %"
+@pytest.mark.parametrize("name", [
+    "H2", pytest.param("H3", marks=pytest.mark.xfail(
+        strict=True, reason="TOLERANCES S4 10 %: measured 12.2 % (DBC; mDBC, 3 layers: 12.6 %): the SPH layer "
+                            "is 0.02-0.04 H thicker (it reaches the wall on time: see the pressure tests)")),
+    "H4"])
+def test_lobovsky_levels_downstream(errors, name):
+    """Measured (DBC): H2 8.0 %, H4 8.2 %."""
+    assert errors[name] <= 0.10, f"{name}: {100 * errors[name]:.1f} %"
 
 
 @pytest.mark.slow
