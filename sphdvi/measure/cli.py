@@ -183,10 +183,11 @@ def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_p
 def bodies(outdir, first, last, every, csv_path, sep, plot):
     """Body motion and loads per body (FloatingInfo), and link forces.
 
-    From bodies.csv/links.csv when the run wrote them (body-only runs), else
-    derived from the floating particles of each snapshot: centre, surge/sway/
-    heave, roll/pitch/yaw [deg], linear and angular velocity, fluid force and
-    torque about the centre, contact force and torque (empty when not recorded).
+    Body-only runs: from bodies.csv/links.csv.  SPH runs: derived from the
+    floating particles of each snapshot (centre, surge/sway/heave, roll/pitch/
+    yaw [deg], linear and angular velocity, fluid force and torque about the
+    centre), with the contact force and torque and the link forces taken from
+    the run's bodies.csv/links.csv at the snapshot times (empty without them).
     """
     from .post import measure_bodies
     _emit(measure_bodies(outdir, first=first, last=last, every=every), csv_path, sep, plot)

@@ -463,9 +463,8 @@ def _body_table_columns(names, is2d, links=()):
     return cols, units
 
 
-def bodies_from_csv(outdir: str, is2d: bool) -> Table:
-    """The body table from bodies.csv / links.csv of a body-only run (no fluid:
-    the fluid force is zero)."""
+def _read_body_logs(outdir: str):
+    """Rows (dicts) of a run's bodies.csv and links.csv (no links.csv: none)."""
     import csv
     with open(os.path.join(outdir, "bodies.csv"), newline="") as fh:
         rows = list(csv.DictReader(fh))
@@ -474,6 +473,53 @@ def bodies_from_csv(outdir: str, is2d: bool) -> Table:
     if os.path.exists(lpath):
         with open(lpath, newline="") as fh:
             links = list(csv.DictReader(fh))
+    return rows, links
+
+
+def _time_index(times, t, rel=1e-8):
+    """Index of ``t`` in the sorted ``times`` (written with 9 digits), or None."""
+    i = int(np.searchsorted(times, t))
+    for k in (i - 1, i):
+        if 0 <= k < len(times) and abs(times[k] - t) <= rel * max(1.0, abs(t)):
+            return k
+    return None
+
+
+def with_logged_contacts(table: Table, outdir: str, data: dict, is2d: bool) -> Table:
+    """Fill the contact force and torque of the floating bodies, and add the link
+    forces, from the bodies.csv / links.csv an SPH run wrote at its output times
+    (the snapshots hold particles only)."""
+    from ..mechanism import mechanism_from_case
+    rows, links = _read_body_logs(outdir)
+    mech = mechanism_from_case(data)
+    name_of = {int(mkb): b["name"] for mkb, b in zip(mech["mkbounds"], mech["bodies"])}
+    mkbounds = [int(v) for v in data["bodies"]["mkbound"]]
+    lnames = list(dict.fromkeys(r["link"] for r in links))
+    cols, units = _body_table_columns([f"mkbound{m}" for m in mkbounds], is2d, lnames)
+    out = np.full((table.time.size, len(cols)), np.nan)
+    out[:, :table.data.shape[1]] = table.data
+    nb = len(BODY_COLUMNS)
+    contact = ("cfx", "cfy", "cfz", "ctx", "cty", "ctz")
+    for r in rows:
+        k = _time_index(table.time, float(r["time"]))
+        if k is None or r["body"] not in name_of.values():
+            continue
+        for b, m in enumerate(mkbounds):
+            if name_of.get(m) == r["body"]:
+                out[k, (b + 1) * nb - 6:(b + 1) * nb] = [float(r[c]) for c in contact]
+    base = len(mkbounds) * nb
+    for r in links:
+        k = _time_index(table.time, float(r["time"]))
+        if k is not None:
+            l = lnames.index(r["link"])
+            out[k, base + 6 * l: base + 6 * (l + 1)] = [float(r[c]) for c in ("fx", "fy", "fz", "tx", "ty", "tz")]
+    return Table(table.time, cols, units, out, table.part, title=table.title)
+
+
+def bodies_from_csv(outdir: str, is2d: bool) -> Table:
+    """The body table from bodies.csv / links.csv of a body-only run (no fluid:
+    the fluid force is zero)."""
+    rows, links = _read_body_logs(outdir)
     names = list(dict.fromkeys(r["body"] for r in rows))
     lnames = list(dict.fromkeys(r["link"] for r in links))
     times = sorted({float(r["time"]) for r in rows})
@@ -505,8 +551,8 @@ def bodies_from_csv(outdir: str, is2d: bool) -> Table:
 def bodies_from_snapshots(run: RunOutput, first=0, last=None, every=1) -> Table:
     """Body motion of the floating bodies from the particle snapshots (rigid fit of
     each body's particles to their initial positions), and the fluid force and
-    torque about the centre recomputed from the fluid (contact forces: not
-    recorded in SPH runs, left empty)."""
+    torque about the centre recomputed from the fluid (contact forces: left empty
+    here; :func:`with_logged_contacts` fills them from the run's bodies.csv)."""
     data = run.data
     bodies = data.get("bodies") or {}
     if "mk" not in bodies or len(bodies["mk"]) == 0:
@@ -553,7 +599,11 @@ def measure_bodies(outdir: str, first=0, last=None, every=1) -> Table:
     from ..io.casefile import read_case_h5
     from ..simulation import find_case_file
     data = read_case_h5(find_case_file(outdir))
-    has_fluid = bool(np.any(data["particles"]["type"] == core.FLUID))
-    if os.path.exists(os.path.join(outdir, "bodies.csv")) and not has_fluid:
+    logged = os.path.exists(os.path.join(outdir, "bodies.csv"))
+    if logged and not os.path.exists(os.path.join(outdir, "particles.vtkhdf")):
+        # a body-only run: no particle snapshots, the logs are the whole record
         return bodies_from_csv(outdir, bool(data["constants"]["is2d"]))
-    return bodies_from_snapshots(RunOutput(outdir), first=first, last=last, every=every)
+    table = bodies_from_snapshots(RunOutput(outdir), first=first, last=last, every=every)
+    if logged:
+        table = with_logged_contacts(table, outdir, data, bool(data["constants"]["is2d"]))
+    return table

@@ -55,7 +55,11 @@ def test_bodies_from_snapshots(tmp_path):
     write_case_h5(str(out / "Body.h5"), casename="Body", source_file="x", source_xml="<case/>", version="t",
                   particles=parts, constants=consts, parameters={"Kernel": 2, "TimeOut": 0.1},
                   domain={"posmin": [-1, -1, -1], "posmax": [1, 1, 1]}, bodies=[body],
-                  json_items={"mkconfig": {"fluidcount": 1}})
+                  json_items={"mkconfig": {"fluidcount": 1},
+                              "bodies_extra": [{"mkbound": 10, "mass": 0.1 * n, "inertia": np.eye(3).tolist(),
+                                                "center": c0.tolist(), "linearvelini": [0, 0, 0],
+                                                "angularvelini": [0, 0, 0], "translation_dof": [1, 1, 1],
+                                                "rotation_dof": [1, 1, 1]}]})
     w = VTKHDFParticleWriter(str(out / "particles.vtkhdf"), POINT_ARRAYS)
     motions = [((0, 0, 0), (0, 0, 0), (0, 0, 0), (0, 0, 0)),
                ((3.0, -5.0, 10.0), (0.1, -0.2, 0.3), (0.5, 0.0, -0.2), (0.1, 0.2, -0.3)),
@@ -80,9 +84,29 @@ def test_bodies_from_snapshots(tmp_path):
         np.testing.assert_allclose([col("vx"), col("vy"), col("vz")], v, atol=1e-6)
         np.testing.assert_allclose([col("wx"), col("wy"), col("wz")], w_, atol=1e-6)
         np.testing.assert_allclose([col("ffx"), col("ffy"), col("ffz")], 0.0)     # no fluid
-        assert np.isnan(col("cfx"))                                              # not recorded in SPH runs
+        assert np.isnan(col("cfx"))                            # not in the snapshots (no bodies.csv here)
     r = invoke("measure", "bodies", out, "--sep", ";")
     assert r.exit_code == 0 and "mkbound10_heave [m]" in r.stdout
+
+    # an SPH run with bodies also wrote bodies.csv / links.csv (at its outputs and, with
+    # TimeOutExtra, in between): the contact and link forces come from there
+    head = ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,fx,fy,fz,tx,ty,tz,"
+            "cfx,cfy,cfz,ctx,cty,ctz")
+    lines, links = [head], ["time,link,fx,fy,fz,tx,ty,tz"]
+    for k, tt in enumerate((0.0, 0.05, 0.1, 0.2)):
+        lines.append(f"{tt:.9g},floating10," + ",".join(["0"] * 22) + "," +
+                     ",".join(f"{k + 0.1 * j:.9g}" for j in range(6)))
+        links.append(f"{tt:.9g},spring1," + ",".join(f"{-k - 0.5 * j:.9g}" for j in range(6)))
+    (out / "bodies.csv").write_text("\n".join(lines) + "\n")
+    (out / "links.csv").write_text("\n".join(links) + "\n")
+    t2 = measure_bodies(str(out))
+    assert t2.time.tolist() == [0.0, 0.1, 0.2]
+    np.testing.assert_array_equal(t2.data[:, :t.data.shape[1] - 6], t.data[:, :t.data.shape[1] - 6])
+    for k, logged in enumerate((0, 2, 3)):                          # rows of t = 0, 0.1, 0.2
+        np.testing.assert_allclose([t2.column(f"mkbound10_{c}")[k] for c in ("cfx", "cfy", "cfz", "ctx", "cty", "ctz")],
+                                   logged + 0.1 * np.arange(6))
+        np.testing.assert_allclose([t2.column(f"spring1_{c}")[k] for c in ("fx", "fy", "fz", "tx", "ty", "tz")],
+                                   -logged - 0.5 * np.arange(6))
 
 
 def test_bodies_from_csv(tmp_path):
