@@ -30,7 +30,7 @@ import numpy as np
 
 from ._version import __version__
 from .errors import DivergenceError, InputError
-from .io.atomic import atomic_path, write_text_atomic
+from .io.atomic import append_text, atomic_path, complete_lines, write_text_atomic
 
 POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
                 "Press": (np.float32, 1), "Type": (np.uint8, 1), "Mk": (np.int32, 1)}
@@ -101,7 +101,8 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
 # run.json, run.log, run.csv
 # ---------------------------------------------------------------------------------
 class RunFiles:
-    """The small text outputs of a run, all written atomically."""
+    """The small text outputs of a run: run.json rewritten atomically; run.log and run.csv
+    appended a line at a time (a resume cuts run.csv back to its restart output)."""
 
     def __init__(self, outdir: str):
         self.outdir = outdir
@@ -109,30 +110,30 @@ class RunFiles:
         self.log_path = os.path.join(outdir, "run.log")
         self.csv_path = os.path.join(outdir, "run.csv")
         self.meta: dict = {}
-        self.log_lines: list[str] = []
-        self.csv_rows: list[str] = []
 
     def write_json(self, **updates) -> None:
         self.meta.update(updates)
         write_text_atomic(self.json_path, json.dumps(self.meta, indent=2, default=_jsonable) + "\n")
 
     def log(self, line: str) -> None:
-        self.log_lines.append(line)
-        write_text_atomic(self.log_path, "\n".join(self.log_lines) + "\n")
+        append_text(self.log_path, line + "\n")
 
     def csv(self, row: str) -> None:
-        self.csv_rows.append(row)
-        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n" + "\n".join(self.csv_rows) + "\n")
+        if not os.path.exists(self.csv_path):
+            write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
+        append_text(self.csv_path, row + "\n")
+
+    def start(self) -> None:
+        """A new run: empty run.log and run.csv (header only)."""
+        write_text_atomic(self.log_path, "")
+        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
 
     def load_existing(self, nparts: int) -> None:
-        """On resume: keep the log, and the CSV rows of the first ``nparts`` outputs."""
-        if os.path.exists(self.log_path):
-            with open(self.log_path) as fh:
-                self.log_lines = fh.read().splitlines()
-        if os.path.exists(self.csv_path):
-            with open(self.csv_path) as fh:
-                rows = fh.read().splitlines()[1:]
-            self.csv_rows = rows[:nparts]
+        """On resume: keep the log (without a torn last line), and the CSV rows of the first
+        ``nparts`` outputs."""
+        write_text_atomic(self.log_path, "".join(line + "\n" for line in complete_lines(self.log_path)))
+        rows = complete_lines(self.csv_path)[1:nparts + 1]
+        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n" + "".join(r + "\n" for r in rows))
         if os.path.exists(self.json_path):
             with open(self.json_path) as fh:
                 try:
@@ -672,6 +673,7 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
         files.log(f"resumed from part {part} at t={sol.time:.6g} s, step {sol.nstep}")
     else:
         writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS)
+        files.start()
     jit_s = _warm_up(sph)
     startup = _time.perf_counter() - t_start
     files.write_json(**meta, mode="sph", numba=numba.__version__, threading_layer=_threading_layer(),
@@ -777,31 +779,33 @@ def _next_multiple(t: float, step: float) -> float:
 
 class BodyLog:
     """``bodies.csv`` and ``links.csv`` of an SPH run with floating bodies (one row per body
-    and per link at every output time), rewritten atomically at each output."""
+    and per link at every output time, and at TimeOutExtra between outputs): the rows are
+    appended at each output; a resume cuts the files back to the restart time, atomically."""
 
     def __init__(self, outdir: str, system, names, resume_time: float | None = None):
         from .dvi.runner import BODIES_HEADER, LINKS_HEADER
         self.system, self.names = system, names
         self.paths = (os.path.join(outdir, "bodies.csv"), os.path.join(outdir, "links.csv"))
         self.headers = (BODIES_HEADER, LINKS_HEADER)
-        self.rows: tuple[list, list] = ([], [])
-        if resume_time is not None:
-            for rows, path in zip(self.rows, self.paths):
-                if os.path.exists(path):
-                    with open(path) as fh:
-                        for line in fh.read().splitlines()[1:]:
-                            if float(line.split(",", 1)[0]) <= resume_time * (1 + 1e-12):
-                                rows.append(line + "\n")
+        self.rows: tuple[list, list] = ([], [])        # rows not yet written
+        for path, header in zip(self.paths, self.headers):
+            kept = []
+            if resume_time is not None:
+                kept = [line + "\n" for line in complete_lines(path)[1:]
+                        if line and float(line.split(",", 1)[0]) <= resume_time * (1 + 1e-12)]
+            write_text_atomic(path, header + "\n" + "".join(kept))
 
     def record(self, flush: bool = True) -> None:
-        """Add a row per body and link at the current time; write the files when ``flush``
-        (at every TimeOut output; the TimeOutExtra rows between outputs wait in memory)."""
+        """Add a row per body and link at the current time; append the pending rows to the
+        files when ``flush`` (at every TimeOut output; TimeOutExtra rows wait in memory)."""
         from .dvi.runner import _body_lines, _link_lines
         self.rows[0].extend(_body_lines(self.system, self.names))
         self.rows[1].extend(_link_lines(self.system))
         if flush:
-            for path, header, rows in zip(self.paths, self.headers, self.rows):
-                write_text_atomic(path, header + "\n" + "".join(rows))
+            for path, rows in zip(self.paths, self.rows):
+                if rows:
+                    append_text(path, "".join(rows))
+                    rows.clear()
 
 
 def _make_gauges(data, params, outdir, resume, t):

@@ -22,8 +22,10 @@ Types and outputs (``;``-separated, first column ``time [s]``, in OUT):
 Each gauge is computed at ``t = 0`` and then at the first step reaching each
 multiple of ``computedt`` (default TimeOut; 0 = every step) inside
 ``computetime start end``; rows are kept every ``outputdt`` inside
-``outputtime``; ``output value="false"`` writes no file.  The files are
-rewritten atomically at every TimeOut and at the end.  The interpolation,
+``outputtime``; ``output value="false"`` writes no file.  The new rows are
+appended at every TimeOut and at the end, in one write each (the cost of an
+output does not grow with the rows written before); a resume cuts a file back
+to the restart time, atomically.  The interpolation,
 surface and force code is that of ``sphdvi measure`` (:mod:`.core`).
 """
 from __future__ import annotations
@@ -33,7 +35,7 @@ import os
 
 import numpy as np
 
-from ..io.atomic import write_text_atomic
+from ..io.atomic import append_text, complete_lines, write_text_atomic
 from . import core
 
 EPS_REL = 1e-12
@@ -262,17 +264,17 @@ GAUGE_TYPES = {"velocity": VelocityGauge, "swl": SwlGauge, "maxz": MaxZGauge, "f
 # the run-time driver
 # ---------------------------------------------------------------------------------
 class _Slot:
-    """A gauge with its schedules and rows."""
+    """A gauge with its schedules and the rows not yet written."""
 
     def __init__(self, gauge, compute, output, write, path):
         self.gauge, self.compute, self.output, self.write, self.path = gauge, compute, output, write, path
         self.rows: list = []
-        self.dirty = False
 
-    def text(self):
-        head = "time [s];" + ";".join(self.gauge.header)
-        lines = [head] + [";".join([f"{r[0]:.15g}"] + [_fmt(v) for v in r[1:]]) for r in self.rows]
-        return "\n".join(lines) + "\n"
+    def header(self) -> str:
+        return "time [s];" + ";".join(self.gauge.header) + "\n"
+
+    def pending_text(self) -> str:
+        return "".join(";".join([f"{r[0]:.15g}"] + [_fmt(v) for v in r[1:]]) + "\n" for r in self.rows)
 
 
 def _fmt(v) -> str:
@@ -280,18 +282,14 @@ def _fmt(v) -> str:
     return "" if not math.isfinite(v) else f"{v:.9g}"
 
 
-def _read_rows(path, tmax):
-    rows = []
-    if not os.path.exists(path):
-        return rows
-    with open(path, encoding="utf-8") as fh:
-        for line in fh.read().splitlines()[1:]:
-            if not line.strip():
-                continue
-            vals = [float(v) if v.strip() else math.nan for v in line.split(";")]
-            if vals[0] <= tmax:
-                rows.append(vals)
-    return rows
+def _lines_up_to(path, tmax):
+    """The complete data lines of a gauge file with time <= tmax (for a resume)."""
+    out = []
+    for line in complete_lines(path)[1:]:
+        head = line.split(";", 1)[0].strip()
+        if head and float(head) <= tmax:
+            out.append(line + "\n")
+    return out
 
 
 class RunGauges:
@@ -320,7 +318,10 @@ class RunGauges:
         self.next_flush = 1
         if resume:
             for s in self.slots:
-                s.rows = _read_rows(s.path, time + EPS_REL * max(1.0, time))
+                # the rows up to the restart time stay; anything later (or torn) is cut
+                if s.write:
+                    kept = _lines_up_to(s.path, time + EPS_REL * max(1.0, time))
+                    write_text_atomic(s.path, s.header() + "".join(kept))
                 s.compute.skip_to(time)
                 s.output.skip_to(time)
             self.next_flush = int(math.floor(time / self.tout + 1e-9)) + 1
@@ -337,7 +338,6 @@ class RunGauges:
                 row = s.gauge.compute(view)
                 if s.output.due(view.time):
                     s.rows.append([view.time] + [float(v) for v in row])
-                    s.dirty = True
 
     def after_step(self, solver):
         """Called after every time step with the SPH solver."""
@@ -352,11 +352,16 @@ class RunGauges:
             self.next_flush = int(math.floor(t / self.tout + 1e-9)) + 1
 
     def flush(self):
-        """Rewrite the CSV files that have new rows (atomically)."""
+        """Append the new rows to the CSV files (header first when a file is new)."""
         for s in self.slots:
-            if s.write and (s.dirty or not os.path.exists(s.path)):
-                write_text_atomic(s.path, s.text())
-                s.dirty = False
+            if not s.write:
+                s.rows = []
+                continue
+            if not os.path.exists(s.path):
+                write_text_atomic(s.path, s.header())
+            if s.rows:
+                append_text(s.path, s.pending_text())
+                s.rows = []
 
     def close(self):
         """Flush the CSV files."""

@@ -92,6 +92,8 @@ def test_resume_keeps_rows_and_appends(run_out, tmp_path):
     out = tmp_path / "copy"
     shutil.copytree(run_out, out)
     before = read_table(str(out / "GaugesVel_V1.csv"))
+    with open(out / "GaugesVel_V1.csv", "a") as fh:        # a row after the restart time, then a torn one
+        fh.write("0.5;1;2;3;0;0;0\n0.6;1;2")
     r = invoke("run", out, "--resume", "--tmax", "0.03", "--tout", "0.005", "--threads", "1", "-q")
     assert r.exit_code == 0, r.output
     after = read_table(str(out / "GaugesVel_V1.csv"))

@@ -140,6 +140,9 @@ def test_sigkill_then_resume(tmp_path):
     assert killed_early, "the run finished before it could be killed"
     meta = json.loads((killed / "run.json").read_text())
     assert meta["status"] == "running"
+    for name in ("run.csv", "run.log"):          # as if killed in the middle of an append
+        with open(killed / name, "a") as fh:
+            fh.write("99,0.0")
     r = invoke(["run", killed, "--resume"] + args)
     assert r.exit_code == 0, r.output
     s1, k1 = final_state(full)
@@ -149,6 +152,10 @@ def test_sigkill_then_resume(tmp_path):
         assert np.array_equal(s1[k], s2[k]), k
     from sphdvi.io.vtkhdf import step_times
     assert np.array_equal(step_times(str(full / "particles.vtkhdf")), step_times(str(killed / "particles.vtkhdf")))
+    # run.csv: the same rows as the uninterrupted run (but the wall time), the torn line cut
+    rows = [[r.rsplit(",", 1)[0] for r in (d / "run.csv").read_text().splitlines()] for d in (full, killed)]
+    assert rows[0] == rows[1]
+    assert "99,0.0" not in (killed / "run.log").read_text()
 
 
 def test_sigterm_stops_cleanly(tmp_path):
