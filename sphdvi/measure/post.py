@@ -494,6 +494,7 @@ def with_logged_contacts(table: Table, outdir: str, data: dict, is2d: bool) -> T
     mech = mechanism_from_case(data)
     name_of = {int(mkb): b["name"] for mkb, b in zip(mech["mkbounds"], mech["bodies"])}
     mkbounds = [int(v) for v in data["bodies"]["mkbound"]]
+    block_of = {name_of[m]: b for b, m in enumerate(mkbounds) if m in name_of}     # body name -> table block
     lnames = list(dict.fromkeys(r["link"] for r in links))
     cols, units = _body_table_columns([f"mkbound{m}" for m in mkbounds], is2d, lnames)
     out = np.full((table.time.size, len(cols)), np.nan)
@@ -502,11 +503,9 @@ def with_logged_contacts(table: Table, outdir: str, data: dict, is2d: bool) -> T
     contact = ("cfx", "cfy", "cfz", "ctx", "cty", "ctz")
     for r in rows:
         k = _time_index(table.time, float(r["time"]))
-        if k is None or r["body"] not in name_of.values():
-            continue
-        for b, m in enumerate(mkbounds):
-            if name_of.get(m) == r["body"]:
-                out[k, (b + 1) * nb - 6:(b + 1) * nb] = [float(r[c]) for c in contact]
+        b = block_of.get(r["body"])
+        if k is not None and b is not None:
+            out[k, (b + 1) * nb - 6:(b + 1) * nb] = [float(r[c]) for c in contact]
     base = len(mkbounds) * nb
     for r in links:
         k = _time_index(table.time, float(r["time"]))
