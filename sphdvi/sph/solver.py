@@ -251,6 +251,11 @@ class SPHSolver:
         self.step_algorithm = int(p["StepAlgorithm"])
         if self.step_algorithm not in (1, 2):
             raise ValueError("StepAlgorithm must be 1 (Verlet) or 2 (Symplectic)")
+        if self.shift == 4 and self.step_algorithm == 1:
+            warnings.warn("Shifting=4 with StepAlgorithm=1 (Verlet): DualSPHysics v5.4 refuses "
+                          "this combination ('Advanced shifting is not allowed with Verlet'); "
+                          "sphdvi shifts at every Verlet step, so results have no DualSPHysics "
+                          "counterpart (use StepAlgorithm=2)")
         self.verlet_steps = int(p["VerletSteps"])
         alpha = kernel_alpha(self.kernel, h, self.is2d)
         cst = np.zeros(23)

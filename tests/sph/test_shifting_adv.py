@@ -9,6 +9,10 @@ from sphdvi.sph.kernels import kernel_alpha, kernel_fac
 from sphdvi.sph.solver import SPHSolver
 from sphdvi.sph.state import FluidState
 
+# these tests run Shifting 4 under Verlet on purpose (sphdvi supports it; the solver warns
+# that DualSPHysics does not: tested in test_shifting_adv.py)
+pytestmark = pytest.mark.filterwarnings("ignore:Shifting=4 with StepAlgorithm=1")
+
 DP = 0.02
 
 
@@ -124,3 +128,14 @@ def test_settling_block_keeps_its_surface_unshifted(algo):
     assert np.count_nonzero(sol2.state.ptype == 3) == n
     assert moved > 0
 
+
+
+def test_shifting_4_with_verlet_is_warned_as_without_dualsphysics_counterpart():
+    """DualSPHysics v5.4 refuses Shifting 4 under Verlet (JSph: 'Advanced shifting is not
+    allowed with Verlet'); sphdvi runs it and says so.  Symplectic is not warned."""
+    with pytest.warns(UserWarning, match="Advanced shifting is not allowed with Verlet"):
+        block(4, 4, params={"StepAlgorithm": 1})
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        block(4, 4, params={"StepAlgorithm": 2})
