@@ -66,7 +66,12 @@ exact for a linear velocity profile and has no such offset.  The linearised
 cloning (c0^2 (rho - rho0) for Tait's equation) overestimates the hydrostatic
 wall pressure by about 6 (g d / c0^2) rho0 g dz (0.3-0.75 % of rho0 g d at
 d/dp = 25-10); the scaled condition number is dimensional (dp in metres): it
-rejects no matrix at dp = 0.05 m and some at dp = 2 m.
+rejects no matrix at dp = 0.05 m and some at dp = 2 m.  That is DualSPHysics
+v5.4's own rule, checked in its source: ``condinf = Dp*Dp*|A|_inf*|A^-1|_inf``
+on the unscaled matrix, ``Dp`` in metres, threshold 50 (JSphCpu_mdbc.cpp,
+InteractionMdbc2CorrectionT2; the GPU kernel alike); its determinant (1e-3)
+and kernel-sum (0.1) thresholds and the unclamped Shepard fallback are also
+the ones used here.
 
 Deviations: the default ghost velocity is the corrected one (above).  A
 particle with N_b = 0 shows the viscosity its own velocity
