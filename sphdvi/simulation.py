@@ -254,12 +254,14 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
         "fluid_particles": nfluid, "python": sys.version.split()[0], "numpy": np.__version__,
     }
     if nfluid == 0:
-        return _run_bodies_only(data, params, outdir, files, base_meta, t_start, quiet)
+        return _run_bodies_only(data, params, outdir, files, base_meta, t_start, quiet, resume)
     return _run_sph(data, params, outdir, files, base_meta, threads, resume, quiet, t_start)
 
 
-def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet) -> RunResult:
-    from .dvi import run_bodies
+def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=False) -> RunResult:
+    """A case with bodies and no fluid: the multibody engine alone, DtFixed steps (default
+    1e-3 s), with the outputs, logs, checks, checkpoints and resume of an SPH run."""
+    from .dvi.runner import StepSchedule, build_system
     from .mechanism import mechanism_from_case
     from .motion import MotionSet
     js = data["json"]
@@ -268,24 +270,227 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet) -> RunRe
     if not mech["bodies"]:
         raise InputError("the case has neither fluid nor bodies: nothing to simulate")
     dt = params["DtFixed"] if params["DtFixed"] > 0 else 1e-3
-    files.write_json(**meta, mode="bodies", status="running", message="", dt=dt, steps=0, physical_time=0.0,
-                     runtime_s=0.0, startup_s=_time.perf_counter() - t_start, bodies=len(mech["bodies"]),
-                     links=len(mech["links"]))
+    tout = float(params["TimeOut"])
     extra = params.get("TimeOutExtra")
-    t0 = _time.perf_counter()
-    system = run_bodies(mech["bodies"], mech["links"], out_dir=outdir, tmax=params["TimeMax"],
-                        tout=params["TimeOut"], dt=dt, materials=mech["materials"],
-                        tout_extra=extra if extra is not None and extra < params["TimeOut"] else None,
-                        **mech["system"])
-    runtime = _time.perf_counter() - t0
-    steps = int(round(params["TimeMax"] / dt))
-    finite = np.isfinite(system.pos).all() and np.isfinite(system.vel).all()
-    status, code, msg = ("completed", 0, "") if finite else ("diverged", 3, "body state is not finite")
-    files.write_json(status=status, message=msg, steps=steps, physical_time=float(system.time), runtime_s=runtime)
-    if not quiet:
-        print(f"bodies-only run: {len(mech['bodies'])} bodies, {len(mech['links'])} links, {steps} steps "
-              f"of {dt:g} s in {runtime:.2f} s -> {os.path.join(outdir, 'bodies.csv')}", file=sys.stderr)
-    return RunResult(status, msg, code, steps, float(system.time), runtime)
+    schedule = StepSchedule(float(params["TimeMax"]), tout, dt,
+                            extra if extra is not None and extra < tout else None)
+    system, names = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
+    if not system._packed:
+        system._pack()
+    run = BodiesOnlyRun(system, names, schedule, outdir, files)
+    if resume:
+        run.resume()
+    else:
+        files.start()
+    files.write_json(**meta, mode="bodies", status="running", message="", dt=dt, steps=run.step,
+                     physical_time=float(run.system.time), runtime_s=run.runtime,
+                     startup_s=_time.perf_counter() - t_start, bodies=len(names), links=len(system.links))
+    return run.run(float(params["TimeMax"]), quiet)
+
+
+BODIES_RESTART = "restart.pkl"
+_BODIES_RESTART_FORMAT = "sphdvi-bodies-restart-1"
+
+
+class BodiesOnlyRun:
+    """The time loop of a body-only run: one System step of ``schedule.dt`` at a time; at each
+    output a run.csv/run.log line, the bodies.csv/links.csv rows (:class:`BodyLog`, appended)
+    and the System pickled to ``restart.pkl`` (atomic); TimeOutExtra rows in between; the
+    first non-finite body state stops the run (diverged, exit 3); SIGTERM/SIGINT stop it at
+    the next step (interrupted, resumable)."""
+
+    def __init__(self, system, names, schedule, outdir: str, files: RunFiles):
+        self.system, self.names, self.schedule = system, list(names), schedule
+        self.outdir, self.files = outdir, files
+        self.ckpt = os.path.join(outdir, BODIES_RESTART)
+        self.part = 0            # outputs written (TimeOut), t = 0 being part 0
+        self.step = 0
+        self.runtime = 0.0       # wall time of the time stepping, over all the resumed pieces
+        self.resumed = False
+        self.refs = _callable_paths(system)
+
+    def resume(self) -> None:
+        """Continue from the last output: the System from restart.pkl, run.csv cut back to that
+        output (run.log kept); bodies.csv/links.csv are cut when the run starts."""
+        if not os.path.exists(self.ckpt):
+            raise InputError(f"--resume: no checkpoint {self.ckpt} in {self.outdir}")
+        saved = load_bodies_checkpoint(self.ckpt, self.system)
+        if saved["names"] != self.names:
+            raise InputError(f"--resume: {self.ckpt} holds the bodies {saved['names']}, the case {self.names}")
+        self.system = saved["system"]
+        self.refs = _callable_paths(self.system)
+        self.part, self.step, self.runtime = int(saved["part"]), int(saved["step"]), float(saved["runtime_s"])
+        self.resumed = True
+        self.files.load_existing(self.part + 1)
+        self.files.log(f"resumed from part {self.part} at t={self.system.time:.6g} s, step {self.step}")
+
+    def _write_part(self, wall: float, stepped: bool) -> None:
+        s, dt = self.system, self.schedule.dt if stepped else 0.0
+        self.files.csv(f"{self.part},{s.time:.9g},{self.step},0,0,{dt:.6g},{dt:.6g},{wall:.3f}")
+        self.files.log(f"Part {self.part:04d}  t={s.time:.6f} s  steps={self.step}  bodies={len(self.names)}  "
+                       f"links={len(s.links)}  dt={dt:.3g} s  wall={wall:.2f} s")
+        self.body_log.record()
+        save_bodies_checkpoint(self.ckpt, s, self.refs, part=self.part, step=self.step, runtime_s=wall,
+                               names=self.names)
+
+    def run(self, tmax: float, quiet: bool) -> RunResult:
+        s, sch, files = self.system, self.schedule, self.files
+        self.body_log = BodyLog(self.outdir, s, self.names, float(s.time) if self.resumed else None)
+        progress = Progress(tmax, quiet)
+        wall_prev = self.runtime
+        t_loop = _time.perf_counter()
+        status, code, message = "completed", 0, ""
+        with _Stop() as stop:
+            try:
+                if not self.resumed:
+                    self._write_part(wall_prev, stepped=False)
+                stepped = False
+                while self.step < sch.nsteps:
+                    s.step(sch.dt)
+                    self.step += 1
+                    stepped = True
+                    _check_bodies(s, self.names, self.step)
+                    if sch.is_output(self.step):
+                        self.part += 1
+                        self._write_part(wall_prev + (_time.perf_counter() - t_loop), stepped)
+                        stepped = False
+                    elif sch.is_row(self.step):
+                        self.body_log.record(flush=False)      # TimeOutExtra rows wait for the output
+                    progress.update(s.time, self.step, 0)
+                    if stop.signal is not None:
+                        status, code = "interrupted", 1
+                        message = (f"stopped by signal {stop.signal} at t={s.time:.6g} s; resume with "
+                                   f"'sphdvi run {self.outdir} --resume' from part {self.part}")
+                        break
+            except DivergenceError as exc:
+                status, code, message = "diverged", 3, str(exc)
+            except BaseException as exc:
+                self.runtime = wall_prev + (_time.perf_counter() - t_loop)
+                files.write_json(status="failed", message=f"{type(exc).__name__}: {exc}", steps=self.step,
+                                 physical_time=float(s.time), runtime_s=self.runtime)
+                raise
+        self.runtime = wall_prev + (_time.perf_counter() - t_loop)
+        progress.update(s.time, self.step, 0, force=True)
+        progress.close()
+        files.log(f"{status}: t={s.time:.6g} s, {self.step} steps, runtime {self.runtime:.2f} s"
+                  + (f" -- {message}" if message else ""))
+        files.write_json(status=status, message=message, steps=self.step, physical_time=float(s.time),
+                         runtime_s=self.runtime, outputs=self.part + 1)
+        return RunResult(status, message, code, self.step, float(s.time), self.runtime)
+
+
+def _check_bodies(s, names, step: int) -> None:
+    """Raise DivergenceError at the first non-finite body state (position, orientation,
+    velocity, angular velocity), naming the time, step, body and cause."""
+    if np.isfinite(s.pos).all() and np.isfinite(s.quat).all() and np.isfinite(s.vel).all() \
+            and np.isfinite(s.omega_b).all():
+        return
+    parts = (("position", s.pos), ("orientation", s.quat), ("velocity", s.vel), ("angular velocity", s.omega_b))
+    bad = {what: ~np.isfinite(a).all(axis=1) for what, a in parts}
+    i = int(np.flatnonzero(np.any(list(bad.values()), axis=0))[0])
+    nbad = int(np.count_nonzero(np.any(list(bad.values()), axis=0)))
+    what = ", ".join(w for w in bad if bad[w][i])
+    where = f" at {_fmt(s.pos[i])}" if np.isfinite(s.pos[i]).all() else ""
+    force, torque = s.total_force[i], s.total_torque[i]
+    loads = f"force {_fmt(force)} N, torque {_fmt(torque)} N m"
+    if not (np.isfinite(s.f_ext[i]).all() and np.isfinite(s.t_ext[i]).all()):
+        cause = f"its imposed load is not finite (force {_fmt(s.f_ext[i])} N, torque {_fmt(s.t_ext[i])} N m)"
+    elif not (np.isfinite(force).all() and np.isfinite(torque).all()):
+        cause = f"the forces on it are not finite ({loads}): the multibody solution blew up"
+    elif max(np.abs(force).max(), np.abs(torque).max()) > 1e100:
+        cause = f"the load on it is absurdly large ({loads})"
+    else:
+        cause = f"the multibody solution blew up ({loads})"
+    others = f" (and {nbad - 1} other bodies)" if nbad > 1 else ""
+    raise DivergenceError(
+        f"t={s.time:.6g} s, step {step}: body '{names[i]}'{where} has a non-finite {what} (NaN or inf)"
+        f"{others}; cause: {cause}; try a smaller DtFixed, or check the masses, loads and links")
+
+
+def _callable_paths(system) -> dict:
+    """id -> (function, where: attribute, then keys/indices) of each function a System holds
+    (imposed motions, stiffness or damping tables): they are not pickled but taken from the
+    System the case builds again on resume (the case fixes them; they are not state)."""
+    found: dict = {}
+
+    def walk(obj, path):
+        if isinstance(obj, dict):
+            items = obj.items()
+        elif isinstance(obj, (list, tuple)):
+            items = enumerate(obj)
+        else:
+            if callable(obj) and not isinstance(obj, type) and getattr(obj, "__self__", None) is not system:
+                found.setdefault(id(obj), (obj, path))
+            return
+        for key, value in items:
+            walk(value, path + (key,))
+
+    for name, value in sorted(vars(system).items()):
+        walk(value, (name,))
+    return found
+
+
+def _case_function(*where):
+    """Stands for a function of the case in a body-only checkpoint (see
+    :func:`load_bodies_checkpoint`); never called."""
+    raise RuntimeError(f"a body-only checkpoint refers to the case's function at {where}")
+
+
+def save_bodies_checkpoint(path: str, system, refs: dict | None = None, **extra) -> None:
+    """Pickle ``system`` (the whole object: every array it steps with, so that a resumed run is
+    bitwise an uninterrupted one) and ``extra`` to ``path`` atomically.  The functions it holds
+    are written as references (``refs``: :func:`_callable_paths`, computed when None)."""
+    import pickle
+    refs = _callable_paths(system) if refs is None else refs
+    payload = {"format": _BODIES_RESTART_FORMAT, "system": system, **extra}
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            if not refs:
+                pickle.dump(payload, fh, protocol=pickle.HIGHEST_PROTOCOL)
+                return
+
+            class _Pickler(pickle.Pickler):
+                def reducer_override(self, obj):
+                    hit = refs.get(id(obj))
+                    if hit is None or hit[0] is not obj:
+                        return NotImplemented
+                    return _case_function, hit[1]
+
+            _Pickler(fh, protocol=pickle.HIGHEST_PROTOCOL).dump(payload)
+
+
+def load_bodies_checkpoint(path: str, fresh) -> dict:
+    """Read a :func:`save_bodies_checkpoint` file; ``fresh``: the System built from the case
+    again, whose functions replace the references in the checkpoint."""
+    import pickle
+
+    def case_function(*where):
+        obj = getattr(fresh, where[0], None)
+        try:
+            for key in where[1:]:
+                obj = obj[key]
+        except (KeyError, IndexError, TypeError):
+            obj = None
+        if not callable(obj):
+            raise InputError(f"{path}: the checkpoint does not match the case (no function at {where})")
+        return obj
+
+    class _Unpickler(pickle.Unpickler):
+        def find_class(self, module, name):
+            if module == __name__ and name == "_case_function":
+                return case_function
+            return super().find_class(module, name)
+
+    try:
+        with open(path, "rb") as fh:
+            saved = _Unpickler(fh).load()
+    except InputError:
+        raise
+    except Exception as exc:
+        raise InputError(f"{path}: not a readable body-only checkpoint ({type(exc).__name__}: {exc})") from None
+    if not isinstance(saved, dict) or saved.get("format") != _BODIES_RESTART_FORMAT:
+        raise InputError(f"{path}: not a body-only checkpoint of this sphdvi")
+    return saved
 
 
 # ---------------------------------------------------------------------------------

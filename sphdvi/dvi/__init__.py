@@ -102,11 +102,14 @@ Stepping and state:
 
 Body-only runs:
 
-* ``run_bodies(bodies, links=(), out_dir=".", tmax, tout, dt=1e-3, materials=(), forces=None,
-  **system_kw) -> System`` writes ``bodies.csv`` (header :data:`BODIES_HEADER`,
-  one row per body per output time, angles in degrees, roll-pitch-yaw with
-  R = Rz(yaw) Ry(pitch) Rx(roll)) and ``links.csv`` (:data:`LINKS_HEADER`),
-  atomically.  ``build_system(bodies, links, materials, **system_kw)`` builds
+* ``run_bodies(bodies, links=(), tmax, tout, dt=1e-3, materials=(), forces=None, tout_extra=None,
+  **system_kw) -> BodyHistory`` steps a System built from plain dicts in memory and returns
+  its state at every output time (``time``, ``pos``, ``quat``, ``euler`` — degrees,
+  roll-pitch-yaw with R = Rz(yaw) Ry(pitch) Rx(roll) —, ``vel``, ``omega``, ``force``,
+  ``torque``, ``contact_force``, ``contact_torque``, ``link_force``, ``link_torque``, and
+  ``system`` at the end); it writes no file.  ``sphdvi run`` on a case with bodies and no
+  fluid writes them as ``bodies.csv`` (header :data:`BODIES_HEADER`) and ``links.csv``
+  (:data:`LINKS_HEADER`).  ``build_system(bodies, links, materials, **system_kw)`` builds
   the System from the same plain dicts (see :mod:`sphdvi.dvi.runner`).
 """
 from .runner import BODIES_HEADER, LINKS_HEADER, build_system, run_bodies  # noqa: F401

@@ -1,4 +1,6 @@
-"""Body-only simulation runner writing ``bodies.csv`` and ``links.csv``.
+"""Body-only runs: a System from plain structures, the fixed-step output schedule, the
+rows of ``bodies.csv`` and ``links.csv`` (as text lines and as arrays).  Nothing here writes
+a file: ``sphdvi run`` (:mod:`sphdvi.simulation`) does the I/O.
 
 Inputs are plain Python structures so that a case-file reader can feed them:
 
@@ -16,8 +18,6 @@ Inputs are plain Python structures so that a case-file reader can feed them:
   arguments of the link.
 * ``materials``: list of dicts for :meth:`System.add_material`.
 """
-import os
-
 import numpy as np
 
 from ._math import quat_to_euler_deg
@@ -66,15 +66,6 @@ def build_system(bodies, links=(), materials=(), **system_kw):
     return s, list(names)
 
 
-def _write_atomic(path, header, rows, fmt="%.9g"):
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(header + "\n")
-        for r in rows:
-            f.write(r)
-    os.replace(tmp, path)
-
-
 def _body_lines(s, names):
     t = s.time
     eul = quat_to_euler_deg(s.quat)
@@ -96,40 +87,80 @@ def _link_lines(s):
     return out
 
 
-def run_bodies(bodies, links=(), out_dir=".", tmax=1.0, tout=0.01, dt=1e-3, materials=(),
-               forces=None, flush_every=200, tout_extra=None, **system_kw):
-    """Run a body-only simulation and write ``out_dir/bodies.csv`` and
-    ``out_dir/links.csv`` (one row per body/link per output time, including
-    t = 0; with ``tout_extra`` (DualSPHysics's TimeOutExtra) also at its
-    multiples in between, 0 meaning every step).  ``forces``: optional
-    callable (system) -> (F, T) arrays (nb, 3)
-    applied each step.  Extra keywords go to :class:`System` (gravity,
-    solver, max_iter, tol, recovery_speed, envelope, contactmethod, ...).
-    Returns the system at the end."""
-    os.makedirs(out_dir, exist_ok=True)
+class StepSchedule:
+    """The fixed-step schedule of a body-only run: ``nsteps`` steps of ``dt``, an output every
+    ``every`` steps and at the last step, and with TimeOutExtra (``tout_extra``; None: none,
+    0: every step) a row every ``extra`` steps in between."""
+
+    def __init__(self, tmax, tout, dt, tout_extra=None):
+        self.dt = float(dt)
+        self.nsteps = int(round(tmax / dt))
+        self.every = max(1, int(round(tout / dt)))
+        self.extra = self.every if tout_extra is None else max(1, int(round(tout_extra / dt)))
+
+    def is_output(self, k):
+        """Step ``k`` (1-based) ends at an output time."""
+        return k % self.every == 0 or k == self.nsteps
+
+    def is_row(self, k):
+        """Step ``k`` ends at an output or a TimeOutExtra time."""
+        return k % self.every == 0 or k % self.extra == 0 or k == self.nsteps
+
+
+RECORD_FIELDS = ("pos", "quat", "euler", "vel", "omega", "force", "torque", "contact_force",
+                 "contact_torque", "link_force", "link_torque")
+
+
+def body_record(s):
+    """The arrays of one bodies.csv/links.csv row block: per body ``pos``, ``quat`` (w x y z),
+    ``euler`` (roll, pitch, yaw in degrees), ``vel``, ``omega`` (world), ``force``, ``torque``
+    (total, about the centre), ``contact_force``, ``contact_torque``; per link ``link_force``,
+    ``link_torque`` (reaction on body 1).  Copies."""
+    return {"pos": s.pos.copy(), "quat": s.quat.copy(), "euler": quat_to_euler_deg(s.quat),
+            "vel": s.vel.copy(), "omega": s.omega_world, "force": s.total_force.copy(),
+            "torque": s.total_torque.copy(), "contact_force": s.contact_force.copy(),
+            "contact_torque": s.contact_torque.copy(), "link_force": s.link_force.copy(),
+            "link_torque": s.link_torque.copy()}
+
+
+class BodyHistory:
+    """What :func:`run_bodies` returns: ``system`` (at the end), ``names`` (bodies),
+    ``link_names``, ``time`` (nrec,) and one array per :data:`RECORD_FIELDS` entry, shaped
+    (nrec, nbodies, 3|4) or (nrec, nlinks, 3), at the same times as the rows of bodies.csv."""
+
+    def __init__(self, system, names, time, records):
+        self.system = system
+        self.names = list(names)
+        self.link_names = [rec["name"] for rec in system.links]
+        self.time = np.asarray(time, float)
+        for field in RECORD_FIELDS:
+            setattr(self, field, np.stack([r[field] for r in records]))
+
+
+def run_bodies(bodies, links=(), tmax=1.0, tout=0.01, dt=1e-3, materials=(), forces=None,
+               tout_extra=None, **system_kw):
+    """Run a body-only simulation in memory and return a :class:`BodyHistory`: the state at
+    every output time, t = 0 included (and with ``tout_extra``, DualSPHysics's TimeOutExtra,
+    at its multiples in between, 0 meaning every step): the rows ``sphdvi run`` writes to
+    bodies.csv and links.csv.  ``forces``: optional callable (system) -> (F, T) arrays
+    (nb, 3) applied each step.  Extra keywords go to :class:`System` (gravity, solver,
+    max_iter, tol, recovery_speed, envelope, contactmethod, ...).  Writes no file (the
+    files of a body-only run are written by ``sphdvi run``, :mod:`sphdvi.simulation`)."""
+    for key in ("out_dir", "flush_every"):
+        if key in system_kw:
+            raise TypeError(f"run_bodies: '{key}' is gone: run_bodies writes no files and returns the "
+                            "records (BodyHistory); 'sphdvi run CASE.xml' writes bodies.csv/links.csv")
     s, names = build_system(bodies, links, materials, **system_kw)
     if not s._packed:
         s._pack()
-    nb_path = os.path.join(out_dir, "bodies.csv")
-    nl_path = os.path.join(out_dir, "links.csv")
-    brows = _body_lines(s, names)
-    lrows = _link_lines(s)
-    nsteps = int(round(tmax / dt))
-    every = max(1, int(round(tout / dt)))
-    extra = every if tout_extra is None else max(1, int(round(tout_extra / dt)))
-    nout = 0
-    for k in range(1, nsteps + 1):
+    schedule = StepSchedule(tmax, tout, dt, tout_extra)
+    times, records = [s.time], [body_record(s)]
+    for k in range(1, schedule.nsteps + 1):
         F = T = None
         if forces is not None:
             F, T = forces(s)
         s.step(dt, F, T)
-        if k % every == 0 or k % extra == 0 or k == nsteps:
-            brows += _body_lines(s, names)
-            lrows += _link_lines(s)
-            nout += 1
-            if nout % flush_every == 0:
-                _write_atomic(nb_path, BODIES_HEADER, brows)
-                _write_atomic(nl_path, LINKS_HEADER, lrows)
-    _write_atomic(nb_path, BODIES_HEADER, brows)
-    _write_atomic(nl_path, LINKS_HEADER, lrows)
-    return s
+        if schedule.is_row(k):
+            times.append(s.time)
+            records.append(body_record(s))
+    return BodyHistory(s, names, times, records)

@@ -1,4 +1,4 @@
-"""CSV runner and extra shape pairs."""
+"""Body-only runner (in memory) and extra shape pairs."""
 import math
 
 import numpy as np
@@ -9,7 +9,9 @@ from sphdvi.dvi import BODIES_HEADER, LINKS_HEADER, System, run_bodies
 G = 9.81
 
 
-def test_run_bodies_writes_csv(tmp_path):
+def test_run_bodies_records(tmp_path, monkeypatch):
+    """run_bodies steps in memory and returns the rows bodies.csv/links.csv would hold as
+    arrays (one per output time, t = 0 included); it writes no file."""
     bodies = [
         dict(name="ground", kind="fixed", shapes=[dict(shape="plane", point=(0, 0, 0), normal=(0, 0, 1))]),
         dict(name="ball", mass=2.0, inertia=(0.008,) * 3, pos=(0, 0, 1.0), vel=(1.0, 0, 0),
@@ -19,30 +21,32 @@ def test_run_bodies_writes_csv(tmp_path):
     links = [dict(kind="hinge", body1="flap", body2=None, point=(3, 0, 1.0), axis=(0, 1, 0),
                   stiffness=10.0, damping=0.1)]
     mats = [dict(name="rubber", friction=0.4, restitution=0.0)]
-    run_bodies(bodies, links, out_dir=str(tmp_path), tmax=0.2, tout=0.05, dt=1e-3,
-               materials=mats, gravity=(0, 0, -G), solver="bb", max_iter=100)
-    lines = (tmp_path / "bodies.csv").read_text().splitlines()
-    assert lines[0] == BODIES_HEADER
-    assert lines[0] == ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
-                        "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz")
-    assert len(lines) == 1 + 3 * 5  # t = 0, 0.05, ..., 0.2
-    data = np.genfromtxt(tmp_path / "bodies.csv", delimiter=",", names=True, dtype=None,
-                         encoding=None)
-    ball = data[data["body"] == "ball"]
-    np.testing.assert_allclose(ball["time"], [0, 0.05, 0.1, 0.15, 0.2], atol=1e-12)
-    t = ball["time"][-1]
-    assert ball["x"][-1] == pytest.approx(t, abs=1e-12)
-    assert ball["z"][-1] == pytest.approx(1 - 0.5 * G * t * t, abs=G * 1e-3 * t)
+    monkeypatch.chdir(tmp_path)
+    h = run_bodies(bodies, links, tmax=0.2, tout=0.05, dt=1e-3,
+                   materials=mats, gravity=(0, 0, -G), solver="bb", max_iter=100)
+    assert list(tmp_path.iterdir()) == []
+    assert BODIES_HEADER == ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
+                             "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz")
+    assert LINKS_HEADER == "time,link,fx,fy,fz,tx,ty,tz"
+    assert h.names == ["ground", "ball", "flap"] and len(h.link_names) == 1
+    np.testing.assert_allclose(h.time, [0, 0.05, 0.1, 0.15, 0.2], atol=1e-12)
+    assert h.pos.shape == (5, 3, 3) and h.quat.shape == (5, 3, 4) and h.link_force.shape == (5, 1, 3)
+    ball = 1
+    t = h.time[-1]
+    assert h.pos[-1, ball, 0] == pytest.approx(t, abs=1e-12)
+    assert h.pos[-1, ball, 2] == pytest.approx(1 - 0.5 * G * t * t, abs=G * 1e-3 * t)
     # total force on the free-flying ball = its weight; no contact
-    assert ball["fz"][-1] == pytest.approx(-2 * G, rel=1e-12)
-    assert ball["cfz"][-1] == 0.0
-    llines = (tmp_path / "links.csv").read_text().splitlines()
-    assert llines[0] == LINKS_HEADER
-    assert len(llines) == 1 + 5
-    assert not list(tmp_path.glob("*.tmp"))
+    assert h.force[-1, ball, 2] == pytest.approx(-2 * G, rel=1e-12)
+    assert h.contact_force[-1, ball, 2] == 0.0
     # the flap hangs below the hinge: reaction on body 1 balances gravity + inertia
-    ld = np.genfromtxt(tmp_path / "links.csv", delimiter=",", names=True, dtype=None, encoding=None)
-    assert ld["fz"][-1] > 0
+    assert h.link_force[-1, 0, 2] > 0
+    assert h.system.time == pytest.approx(0.2)
+    # TimeOutExtra: records at its multiples in between (0: every step)
+    every = run_bodies(bodies, links, tmax=0.01, tout=0.005, dt=1e-3, materials=mats, tout_extra=0,
+                       gravity=(0, 0, -G))
+    np.testing.assert_allclose(every.time, np.arange(11) * 1e-3, atol=1e-12)
+    with pytest.raises(TypeError, match="writes no files"):
+        run_bodies(bodies, links, out_dir=str(tmp_path), tmax=0.01, tout=0.005)
 
 
 def _drop(shape_a, shape_b, steps=1500):
