@@ -5,6 +5,11 @@ import contextlib
 import os
 import tempfile
 
+# the process's umask, read once (os.umask can only be read by setting it): atomically
+# written files get the mode a plain open() would give them, not mkstemp's 0600
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)
+
 
 @contextlib.contextmanager
 def atomic_path(path: str):
@@ -14,7 +19,10 @@ def atomic_path(path: str):
     """
     folder = os.path.dirname(os.path.abspath(path)) or "."
     fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
-    os.close(fd)
+    try:
+        os.fchmod(fd, 0o666 & ~_UMASK)
+    finally:
+        os.close(fd)
     try:
         yield tmp
         os.replace(tmp, path)
@@ -39,7 +47,7 @@ def append_text(path: str, text: str) -> None:
     which :func:`complete_lines` drops and a resume cuts (it rewrites the file atomically).
     """
     data = memoryview(text.encode("utf-8"))
-    fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+    fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
     try:
         while data:
             data = data[os.write(fd, data):]

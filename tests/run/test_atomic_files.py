@@ -1,0 +1,28 @@
+"""Outputs written atomically (temporary file + rename) or appended by rows get the
+permissions of a plain open(): 0666 less the umask, not mkstemp's private 0600, so that
+the users of a shared project folder can read a run's files."""
+import os
+import stat
+
+from sphdvi.io.atomic import append_text, atomic_path, write_text_atomic
+
+
+def mode(path):
+    return stat.S_IMODE(os.stat(path).st_mode)
+
+
+def test_atomic_and_appended_files_follow_the_umask(tmp_path):
+    umask = os.umask(0)
+    os.umask(umask)
+    a, b, c = tmp_path / "run.json", tmp_path / "run.csv", tmp_path / "restart.h5"
+    write_text_atomic(str(a), "{}\n")
+    append_text(str(b), "1,2\n")
+    with atomic_path(str(c)) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(b"x")
+    for p in (a, b, c):
+        assert mode(p) == 0o666 & ~umask, (p, oct(mode(p)))
+    write_text_atomic(str(a), "{\"k\": 1}\n")            # replacing keeps the same mode
+    assert mode(a) == 0o666 & ~umask and a.read_text() == "{\"k\": 1}\n"
+    assert not [n for n in os.listdir(tmp_path) if n.endswith(".tmp")]
+
