@@ -1,6 +1,6 @@
 """Body-only runs (bodies, no fluid) as `sphdvi run` runs: rows appended at each output,
 run.log / run.csv, divergence (exit 3), SIGTERM, SIGKILL + --resume (bitwise), the
-checkpoint of the multibody System."""
+checkpoint of the multibody System's state."""
 import json
 import os
 import re
@@ -245,29 +245,47 @@ def _mechanism():
 
 
 def test_checkpoint_round_trip_is_exact(tmp_path):
-    """The System pickled at an output and read back into the System the case builds again
-    steps bitwise as the original; its functions are the new System's."""
+    """The state written at an output and read back into the System the case builds again
+    steps bitwise as the original (a moving body, a stiffness table on a hinge, a spring)."""
     from sphdvi.dvi.runner import build_system
     bodies, links = _mechanism()
     a, _ = build_system(bodies, links, gravity=(0, 0, -9.81))
     for _ in range(300):
         a.step(1e-3)
-    path = str(tmp_path / "restart.pkl")
-    simulation.save_bodies_checkpoint(path, a, part=3, step=300, names=["arm", "driver", "bob"])
-    fresh, _ = build_system(*_mechanism(), gravity=(0, 0, -9.81))
-    saved = simulation.load_bodies_checkpoint(path, fresh)
-    b = saved["system"]
-    assert saved["part"] == 3 and saved["step"] == 300 and b is not fresh and b.time == a.time
-    assert b._motion[1] is fresh._motion[1] and b._springs[0]["k"] is fresh._springs[0]["k"]
+    path = str(tmp_path / "restart.h5")
+    simulation.save_bodies_checkpoint(path, a.get_state(), part=3, step=300, names=["arm", "driver", "bob"])
+    b, _ = build_system(*_mechanism(), gravity=(0, 0, -9.81))
+    saved = simulation.load_bodies_checkpoint(path, b)
+    assert saved == {"part": 3, "step": 300, "names": ["arm", "driver", "bob"]} and b.time == a.time
     for _ in range(300):
         a.step(1e-3)
         b.step(1e-3)
     for name in ("pos", "quat", "vel", "omega_b", "total_force", "link_force", "link_torque"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
     assert a.time == b.time
-    # a case whose System lacks a function the checkpoint refers to: a clear input error
-    bodies, links = _mechanism()
-    links[1]["stiffness"] = 100.0
-    other, _ = build_system(bodies, links, gravity=(0, 0, -9.81))
-    with pytest.raises(InputError, match="does not match the case"):
+    # a case with other bodies: a clear input error
+    other, _ = build_system(_mechanism()[0][:2], [], gravity=(0, 0, -9.81))
+    with pytest.raises(InputError, match="body-only checkpoint"):
         simulation.load_bodies_checkpoint(path, other)
+
+
+def test_checkpoint_throttled_to_wall_time(tmp_path, monkeypatch):
+    """restart.h5 is written at the first and the last output and, between, at most once per
+    BODIES_CHECKPOINT_EVERY_S of wall time (outputs a few steps apart would otherwise spend
+    most of the run writing it); 0 writes it at every output."""
+    saved = []
+    real = simulation.save_bodies_checkpoint
+    monkeypatch.setattr(simulation, "save_bodies_checkpoint",
+                        lambda path, state, **extra: (saved.append(extra["part"]), real(path, state, **extra)))
+    case = case_file(tmp_path)
+    for every, expected in ((1e9, [0, 10]), (0.0, list(range(11)))):
+        saved.clear()
+        monkeypatch.setattr(simulation, "BODIES_CHECKPOINT_EVERY_S", every)
+        out = tmp_path / f"out{every}"
+        r = invoke(["run", case, "-o", out, "-q", "--tmax", "0.1", "--tout", "0.01"])
+        assert r.exit_code == 0, r.output
+        assert saved == expected
+        # resuming a finished run from its checkpoint changes nothing
+        before = (out / "bodies.csv").read_bytes()
+        assert invoke(["run", out, "--resume", "-q", "--tmax", "0.1", "--tout", "0.01"]).exit_code == 0
+        assert (out / "bodies.csv").read_bytes() == before
