@@ -146,10 +146,6 @@ def run_bodies(bodies, links=(), tmax=1.0, tout=0.01, dt=1e-3, materials=(), for
     (nb, 3) applied each step.  Extra keywords go to :class:`System` (gravity, solver,
     max_iter, tol, recovery_speed, envelope, contactmethod, ...).  Writes no file (the
     files of a body-only run are written by ``sphdvi run``, :mod:`sphdvi.simulation`)."""
-    for key in ("out_dir", "flush_every"):
-        if key in system_kw:
-            raise TypeError(f"run_bodies: '{key}' is gone: run_bodies writes no files and returns the "
-                            "records (BodyHistory); 'sphdvi run CASE.xml' writes bodies.csv/links.csv")
     s, names = build_system(bodies, links, materials, **system_kw)
     if not s._packed:
         s._pack()
