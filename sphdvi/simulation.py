@@ -154,8 +154,9 @@ def _jsonable(obj):
 class Progress:
     """A progress line on a terminal; a log line every ``interval`` seconds otherwise."""
 
-    def __init__(self, tmax: float, quiet: bool, stream=None, interval: float = 30.0):
+    def __init__(self, tmax: float, quiet: bool, stream=None, interval: float = 30.0, counts: str = "particles"):
         self.tmax = tmax
+        self.counts = counts            # what the count ``n`` of update() counts
         self.quiet = quiet
         self.stream = stream or sys.stderr
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
@@ -176,10 +177,10 @@ class Progress:
         if self.tty:
             bar = "#" * int(30 * frac)
             self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t={t:.4f} s  steps={steps}  "
-                              f"np={n}  eta={eta:6.0f} s ")
+                              f"{self.counts}={n}  eta={eta:6.0f} s ")
             self.stream.flush()
         else:
-            self.stream.write(f"progress: t={t:.5g} s ({100 * frac:.1f}%) steps={steps} particles={n} "
+            self.stream.write(f"progress: t={t:.5g} s ({100 * frac:.1f}%) steps={steps} {self.counts}={n} "
                               f"wall={wall:.1f} s eta={eta:.0f} s\n")
             self.stream.flush()
 
@@ -353,7 +354,7 @@ class BodiesOnlyRun:
     def run(self, tmax: float, quiet: bool) -> RunResult:
         s, sch, files = self.system, self.schedule, self.files
         self.body_log = BodyLog(self.outdir, s, self.names, float(s.time) if self.resumed else None)
-        progress = Progress(tmax, quiet)
+        progress = Progress(tmax, quiet, counts="bodies")
         wall_prev = self.runtime
         t_loop = _time.perf_counter()
         status, code, message = "completed", 0, ""
@@ -374,7 +375,7 @@ class BodiesOnlyRun:
                         stepped = False
                     elif sch.is_row(self.step):
                         self.body_log.record(flush=False)      # TimeOutExtra rows wait for the output
-                    progress.update(s.time, self.step, 0)
+                    progress.update(s.time, self.step, len(self.names))
                     if stop.signal is not None:
                         status, code = "interrupted", 1
                         message = (f"stopped by signal {stop.signal} at t={s.time:.6g} s; resume with "
@@ -390,7 +391,7 @@ class BodiesOnlyRun:
                 raise
         self._checkpoint()           # the latest output, if the throttle held it back
         self.runtime = wall_prev + (_time.perf_counter() - t_loop)
-        progress.update(s.time, self.step, 0, force=True)
+        progress.update(s.time, self.step, len(self.names), force=True)
         progress.close()
         files.log(f"{status}: t={s.time:.6g} s, {self.step} steps, runtime {self.runtime:.2f} s"
                   + (f" -- {message}" if message else ""))

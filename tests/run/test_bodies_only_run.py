@@ -97,6 +97,9 @@ def test_run_log_and_csv_rows(tmp_path):
     assert meta["steps"] == 100 and meta["physical_time"] == pytest.approx(0.1) and meta["outputs"] == 6
     assert len(lines(out / "bodies.csv")) == 1 + 6 and len(lines(out / "links.csv")) == 1 + 6
     assert (out / simulation.BODIES_RESTART).exists()
+    # progress (not quiet) counts the bodies
+    r = invoke(["run", case_file(tmp_path), "-o", tmp_path / "out2", "--tmax", "0.02", "--tout", "0.02"])
+    assert r.exit_code == 0 and "steps=20 bodies=1 " in r.output
 
 
 def test_run_bodies_arrays_match_the_run_files(tmp_path):
