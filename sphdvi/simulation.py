@@ -377,9 +377,8 @@ class BodiesOnlyRun:
                         self.body_log.record(flush=False)      # TimeOutExtra rows wait for the output
                     progress.update(s.time, self.step, len(self.names))
                     if stop.signal is not None:
-                        status, code = "interrupted", 1
-                        message = (f"stopped by signal {stop.signal} at t={s.time:.6g} s; resume with "
-                                   f"'sphdvi run {self.outdir} --resume' from part {self.part}")
+                        status, code, message = "interrupted", 1, _interrupted(stop.signal, s.time, self.outdir,
+                                                                               self.part)
                         break
             except DivergenceError as exc:
                 status, code, message = "diverged", 3, str(exc)
@@ -398,6 +397,11 @@ class BodiesOnlyRun:
         files.write_json(status=status, message=message, steps=self.step, physical_time=float(s.time),
                          runtime_s=self.runtime, outputs=self.part + 1)
         return RunResult(status, message, code, self.step, float(s.time), self.runtime)
+
+
+def _interrupted(signum, t: float, outdir: str, part: int) -> str:
+    """The message of a run stopped by a signal."""
+    return f"stopped by signal {signum} at t={t:.6g} s; resume with 'sphdvi run {outdir} --resume' from part {part}"
 
 
 def _check_bodies(s, names, step: int) -> None:
@@ -897,9 +901,7 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
                         next_extra = _next_multiple(sol.time, extra)
                 progress.update(sol.time, sol.nstep, sol.state.n)
                 if stop.signal is not None:
-                    status, code = "interrupted", 1
-                    message = (f"stopped by signal {stop.signal} at t={sol.time:.6g} s; resume with "
-                               f"'sphdvi run {outdir} --resume' from part {part}")
+                    status, code, message = "interrupted", 1, _interrupted(stop.signal, sol.time, outdir, part)
                     break
         except DivergenceError as exc:
             status, code, message = "diverged", 3, str(exc)
