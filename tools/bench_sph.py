@@ -24,8 +24,8 @@ neighbour loop's cut-off test is no longer predictable and the kernel runs
 Threads wait passively between parallel regions (OMP_WAIT_POLICY=PASSIVE,
 conventions.md §6.4).  Below 50,000 particles a step has one parallel region
 (the interaction); cell sorting, packing and the integrator run serially
-there, since waking the sleeping thread (~30-50 us) costs what they would
-save.  Timings on a shared machine vary with the other processes: the script
+there, since waking the sleeping thread (5-8 us) and moving the cache lines
+between the cores cost what they would save.  Timings on a shared machine vary with the other processes: the script
 interleaves the thread counts on one solver and keeps the best of ``--rounds``.
 """
 import argparse
