@@ -939,7 +939,7 @@ def _next_multiple(t: float, step: float) -> float:
 
 
 class BodyLog:
-    """``bodies.csv`` and ``links.csv`` of an SPH run with floating bodies (one row per body
+    """``bodies.csv`` and ``links.csv`` of a run with bodies (one row per body
     and per link at every output time, and at TimeOutExtra between outputs): the rows are
     appended at each output; a resume cuts the files back to the restart time, atomically."""
 
@@ -959,9 +959,10 @@ class BodyLog:
     def record(self, flush: bool = True) -> None:
         """Add a row per body and link at the current time; append the pending rows to the
         files when ``flush`` (at every TimeOut output; TimeOutExtra rows wait in memory)."""
-        from .dvi.runner import _body_lines, _link_lines
-        self.rows[0].extend(_body_lines(self.system, self.names))
-        self.rows[1].extend(_link_lines(self.system))
+        from .dvi.runner import csv_rows
+        bodies, links = csv_rows(self.system, self.names)
+        self.rows[0].extend(bodies)
+        self.rows[1].extend(links)
         if flush:
             for path, rows in zip(self.paths, self.rows):
                 if rows:

@@ -66,27 +66,6 @@ def build_system(bodies, links=(), materials=(), **system_kw):
     return s, list(names)
 
 
-def _body_lines(s, names):
-    t = s.time
-    eul = quat_to_euler_deg(s.quat)
-    w = s.omega_world
-    out = []
-    for i, nm in enumerate(names):
-        vals = np.concatenate([s.pos[i], s.quat[i], eul[i], s.vel[i], w[i], s.total_force[i],
-                               s.total_torque[i], s.contact_force[i], s.contact_torque[i]])
-        out.append(f"{t:.9g},{nm}," + ",".join(f"{v:.9g}" for v in vals) + "\n")
-    return out
-
-
-def _link_lines(s):
-    t = s.time
-    out = []
-    for l, rec in enumerate(s.links):
-        vals = np.concatenate([s.link_force[l], s.link_torque[l]])
-        out.append(f"{t:.9g},{rec['name']}," + ",".join(f"{v:.9g}" for v in vals) + "\n")
-    return out
-
-
 class StepSchedule:
     """The fixed-step schedule of a body-only run: ``nsteps`` steps of ``dt``, an output every
     ``every`` steps and at the last step, and with TimeOutExtra (``tout_extra``; None: none,
@@ -107,8 +86,10 @@ class StepSchedule:
         return k % self.every == 0 or k % self.extra == 0 or k == self.nsteps
 
 
-RECORD_FIELDS = ("pos", "quat", "euler", "vel", "omega", "force", "torque", "contact_force",
-                 "contact_torque", "link_force", "link_torque")
+# the columns of bodies.csv after time and body, and of links.csv after time and link
+BODY_FIELDS = ("pos", "quat", "euler", "vel", "omega", "force", "torque", "contact_force", "contact_torque")
+LINK_FIELDS = ("link_force", "link_torque")
+RECORD_FIELDS = BODY_FIELDS + LINK_FIELDS
 
 
 def body_record(s):
@@ -121,6 +102,18 @@ def body_record(s):
             "torque": s.total_torque.copy(), "contact_force": s.contact_force.copy(),
             "contact_torque": s.contact_torque.copy(), "link_force": s.link_force.copy(),
             "link_torque": s.link_torque.copy()}
+
+
+def _csv_lines(t, names, record, fields):
+    return [f"{t:.9g},{nm}," + ",".join(f"{v:.9g}" for v in np.concatenate([record[f][i] for f in fields]))
+            + "\n" for i, nm in enumerate(names)]
+
+
+def csv_rows(s, names):
+    """The bodies.csv and links.csv rows (two lists of lines) of the System's current state."""
+    record = body_record(s)
+    return (_csv_lines(s.time, names, record, BODY_FIELDS),
+            _csv_lines(s.time, [rec["name"] for rec in s.links], record, LINK_FIELDS))
 
 
 class BodyHistory:
