@@ -1,8 +1,9 @@
 """The simulation loop of ``sphdvi run``: time stepping, outputs, stability checks, resume.
 
-Model (the SPH solver, imposed motions, floating bodies) ≠ simulation (this
-loop: output schedule, divergence checks, checkpoints, logs) ≠ writers
-(``sphdvi.io``). Outputs in OUT:
+Model (the SPH solver ``sphdvi.sph``, the multibody engine ``sphdvi.dvi``, their
+coupling ``sphdvi.coupling``) ≠ simulation (this loop: output schedule, divergence
+checks, when to checkpoint, resume) ≠ writers (``sphdvi.io``: particles.vtkhdf,
+restart.h5 in ``io.checkpoint``, the text outputs in ``io.runfiles``). Outputs in OUT:
 
 * ``particles.vtkhdf``: temporal VTKHDF PolyData, one step per TimeOut (live particles);
 * ``run.json``: provenance and status, written at the start and at the end;
@@ -17,7 +18,6 @@ time, step, particle id, position and cause; what was written before stays.
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 import signal
@@ -30,12 +30,14 @@ import numpy as np
 
 from ._version import __version__
 from .errors import DivergenceError, InputError
-from .io.atomic import append_text, atomic_path, complete_lines, write_text_atomic
-from .io.bodystate import read_body_state, write_body_state
+from .io.checkpoint import (load_bodies_checkpoint, load_sph_checkpoint, save_bodies_checkpoint,
+                            save_sph_checkpoint)
+from .io.runfiles import BodyLog, Progress, RunFiles
+from .sph.damping import damping_zones
 
 POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
                 "Press": (np.float32, 1), "Type": (np.uint8, 1), "Mk": (np.int32, 1)}
-RUN_CSV_HEADER = "part,time,steps,particles,excluded,dtmin,dtmax,walltime"
+
 DTMIN_STUCK_STEPS = 200
 DEFAULT_MAX_EXCLUDED_FRACTION = 0.5
 
@@ -101,94 +103,6 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
 # ---------------------------------------------------------------------------------
 # run.json, run.log, run.csv
 # ---------------------------------------------------------------------------------
-class RunFiles:
-    """The small text outputs of a run: run.json rewritten atomically; run.log and run.csv
-    appended a line at a time (a resume cuts run.csv back to its restart output)."""
-
-    def __init__(self, outdir: str):
-        self.outdir = outdir
-        self.json_path = os.path.join(outdir, "run.json")
-        self.log_path = os.path.join(outdir, "run.log")
-        self.csv_path = os.path.join(outdir, "run.csv")
-        self.meta: dict = {}
-
-    def write_json(self, **updates) -> None:
-        self.meta.update(updates)
-        write_text_atomic(self.json_path, json.dumps(self.meta, indent=2, default=_jsonable) + "\n")
-
-    def log(self, line: str) -> None:
-        append_text(self.log_path, line + "\n")
-
-    def csv(self, row: str) -> None:
-        if not os.path.exists(self.csv_path):
-            write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
-        append_text(self.csv_path, row + "\n")
-
-    def start(self) -> None:
-        """A new run: empty run.log and run.csv (header only)."""
-        write_text_atomic(self.log_path, "")
-        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
-
-    def load_existing(self, nparts: int) -> None:
-        """On resume: keep the log (without a torn last line), and the CSV rows of the first
-        ``nparts`` outputs."""
-        write_text_atomic(self.log_path, "".join(line + "\n" for line in complete_lines(self.log_path)))
-        rows = complete_lines(self.csv_path)[1:nparts + 1]
-        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n" + "".join(r + "\n" for r in rows))
-        if os.path.exists(self.json_path):
-            with open(self.json_path) as fh:
-                try:
-                    self.meta = json.load(fh)
-                except json.JSONDecodeError:
-                    self.meta = {}
-
-
-def _jsonable(obj):
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    return str(obj)
-
-
-class Progress:
-    """A progress line on a terminal; a log line every ``interval`` seconds otherwise."""
-
-    def __init__(self, tmax: float, quiet: bool, stream=None, interval: float = 30.0, counts: str = "particles"):
-        self.tmax = tmax
-        self.counts = counts            # what the count ``n`` of update() counts
-        self.quiet = quiet
-        self.stream = stream or sys.stderr
-        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
-        self.interval = interval
-        self.last = 0.0
-        self.t0 = _time.perf_counter()
-
-    def update(self, t: float, steps: int, n: int, force: bool = False) -> None:
-        if self.quiet:
-            return
-        now = _time.perf_counter()
-        if not force and now - self.last < (0.2 if self.tty else self.interval):
-            return
-        self.last = now
-        frac = min(1.0, t / self.tmax) if self.tmax > 0 else 1.0
-        wall = now - self.t0
-        eta = wall * (1 - frac) / frac if frac > 0 else float("nan")
-        if self.tty:
-            bar = "#" * int(30 * frac)
-            self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t={t:.4f} s  steps={steps}  "
-                              f"{self.counts}={n}  eta={eta:6.0f} s ")
-            self.stream.flush()
-        else:
-            self.stream.write(f"progress: t={t:.5g} s ({100 * frac:.1f}%) steps={steps} {self.counts}={n} "
-                              f"wall={wall:.1f} s eta={eta:.0f} s\n")
-            self.stream.flush()
-
-    def close(self):
-        if self.tty and not self.quiet:
-            self.stream.write("\n")
-
-
 # ---------------------------------------------------------------------------------
 # entry point
 # ---------------------------------------------------------------------------------
@@ -291,7 +205,6 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=F
 
 
 BODIES_RESTART = "restart.h5"
-_BODIES_RESTART_FORMAT = "sphdvi-bodies-restart"
 # wall time between two checkpoints of a body-only run: its outputs are often a few steps of
 # microseconds apart, and an HDF5 checkpoint costs ~0.85 ms (the pendulum case, 901 outputs:
 # 1.3 s with one at every output against 0.26 s without)
@@ -432,35 +345,6 @@ def _check_bodies(s, names, step: int) -> None:
         f"{others}; cause: {cause}; try a smaller DtFixed, or check the masses, loads and links")
 
 
-def save_bodies_checkpoint(path: str, state: dict, **extra) -> None:
-    """Write the state of a body-only run to ``path`` atomically: a System's dynamic state
-    (``System.get_state()``, in the layout of an SPH run's restart.h5) and the scalars
-    ``extra`` (part, step, runtime_s, names)."""
-    import h5py
-    with atomic_path(path) as tmp:
-        with h5py.File(tmp, "w") as f:
-            f.attrs["format"] = _BODIES_RESTART_FORMAT
-            f.attrs["extra"] = json.dumps(extra)
-            write_body_state(f.create_group("bodies"), state)
-
-
-def load_bodies_checkpoint(path: str, system) -> dict:
-    """Restore into ``system`` (built from the case) the state saved by
-    :func:`save_bodies_checkpoint`; returns its scalars."""
-    import h5py
-    try:
-        with h5py.File(path, "r") as f:
-            if f.attrs.get("format") != _BODIES_RESTART_FORMAT:
-                raise InputError(f"{path}: not a body-only checkpoint of this sphdvi")
-            extra = json.loads(f.attrs["extra"])
-            read_body_state(f["bodies"], system)
-    except InputError:
-        raise
-    except (OSError, KeyError, ValueError) as exc:
-        raise InputError(f"{path}: not a readable body-only checkpoint ({type(exc).__name__}: {exc})") from None
-    return extra
-
-
 # ---------------------------------------------------------------------------------
 # SPH run
 # ---------------------------------------------------------------------------------
@@ -499,6 +383,7 @@ class SPHRun:
     def __init__(self, data: dict, params: dict, outdir: str):
         from .motion import MotionSet
         from .sph.solver import SPHSolver
+        from .coupling import FloatingBodies, ImposedMotions
         from .sph.state import FluidState
         self.data = data
         self.params = params
@@ -506,33 +391,34 @@ class SPHRun:
         p = data["particles"]
         c = dict(data["constants"])
         self.consts = c
-        self.fluidcount = int(data["json"]["mkconfig"]["fluidcount"])
+        fluidcount = int(data["json"]["mkconfig"]["fluidcount"])
         state = FluidState(p["pos"], p["vel"], p["rhop"], p["mass"], p["type"], p["idp"], p["mk"],
                            rhop0=c["rhop0"])
         js = data["json"]
-        self.motions = MotionSet(js.get("motions", []), js.get("special", {}).get("wavepaddles", []),
-                                 g=float(np.linalg.norm(c["gravity"])))
-        self.pos0 = p["pos"].copy()                 # initial positions, indexed by idp
-        moving = p["type"] == 1
-        self.has_moving = bool(moving.any())
-        self.has_floating = bool((p["type"] == 2).any())
+        motions = MotionSet(js.get("motions", []), js.get("special", {}).get("wavepaddles", []),
+                            g=float(np.linalg.norm(c["gravity"])))
         domain = (np.asarray(data["domain"]["posmin"], float), np.asarray(data["domain"]["posmax"], float))
         if c["is2d"]:
             domain[0][1] -= c["h"]
             domain[1][1] += c["h"]
-        self.damping = damping_zones(js.get("special", {}).get("damping", []))
-        hook = self._hook if (self.has_moving or self.has_floating or self.damping) else None
-        self.bodies = None
-        if self.has_floating:
-            self._setup_bodies()
         periodic = periodic_axes(data, params)
         for k in periodic:
             i = "xyz".index(k)
             domain[1][i] += c["dp"]
-        self.normals0 = None
+        normals0 = None
         if int(params.get("Boundary", 1)) == 2:
             from .case.normals import boundary_normals
-            self.normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]))
+            normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]))
+        # the solids that move boundary particles, and the damping zones: each only when
+        # the case has it
+        self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)
+                       if (p["type"] == 1).any() else None)
+        self.floating = (FloatingBodies(data, motions, fluidcount, normals0, float(params.get("FtPause", 0.0)))
+                         if (p["type"] == 2).any() else None)
+        self.bodies = self.floating.system if self.floating is not None else None
+        self.body_names = self.floating.names if self.floating is not None else None
+        self.damping = damping_zones(js.get("special", {}).get("damping", []))
+        hook = self._hook if (self.moving is not None or self.floating is not None or self.damping) else None
         dt_table = None
         if str(params.get("DtFixedFile", "NONE")).upper() != "NONE":
             from .case.datafiles import read_dt_table
@@ -542,82 +428,19 @@ class SPHRun:
             from .case.datafiles import read_visco_table
             visco_table = read_visco_table(str(params["ViscoTime"]))
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
-                                normals=self.normals0, dt_table=dt_table, visco_table=visco_table)
+                                normals=normals0, dt_table=dt_table, visco_table=visco_table)
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.dtmin_run = 0
         self.dtmin_seen = 0
 
-    # -- coupling: imposed motions and floating bodies ------------------------------
-    def _setup_bodies(self):
-        """Floating bodies integrated by the multibody engine, driven by the fluid force."""
-        from .dvi.runner import build_system
-        from .mechanism import mechanism_from_case
-        mech = mechanism_from_case(self.data, self.motions)
-        system, names = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
-        self.bodies = system
-        self.body_names = names
-        p = self.data["particles"]
-        label = p["mk"].astype(np.int64) - self.fluidcount - 1
-        self.body_sel = []          # per body: idp of its particles and body-frame offsets
-        for i, mkb in enumerate(mech["mkbounds"]):
-            idp = p["idp"][(p["type"] != 3) & (label == mkb)]
-            R = _quat_matrix(system.quat[i])
-            local = (p["pos"][idp] - system.pos[i]) @ R
-            self.body_sel.append((mkb, idp, local, system.kind[i]))
-        self.body_R0 = [_quat_matrix(q) for q in system.quat]
-        self.idp_body = np.full(p["idp"].size, -1, np.int64)
-        for i, (_, idp, _, _) in enumerate(self.body_sel):
-            self.idp_body[idp] = i
-
     def _hook(self, solver, t, dt):
-        s = solver.state
-        if self.has_moving:
-            sel = np.flatnonzero(s.ptype == 1)
-            label = s.mk[sel].astype(np.int64) - self.fluidcount - 1
-            for mkb in np.unique(label):
-                rows = sel[label == mkb]
-                rig = self.motions.transform(int(mkb), t)
-                x, v = rig.apply(self.pos0[s.idp[rows]])
-                s.pos[rows] = x
-                s.vel[rows] = v
-                if self.normals0 is not None:
-                    solver.normals[rows] = self.normals0[s.idp[rows]] @ rig.R.T
-        if self.bodies is not None:
-            self._step_bodies(solver, dt)
+        """The end of each step: imposed motions, floating bodies, damping zones."""
+        if self.moving is not None:
+            self.moving.apply(solver, t)
+        if self.floating is not None:
+            self.floating.step(solver, dt)
         for zone in self.damping:
-            zone.apply(s, dt)
-
-    def _step_bodies(self, solver, dt):
-        s = solver.state
-        sel = np.flatnonzero(s.ptype == 2)
-        body = self.idp_body[s.idp[sel]]
-        nb = self.bodies.nb
-        f = s.mass[sel, None] * solver.ace[sel]
-        F = np.zeros((nb, 3))
-        T = np.zeros((nb, 3))
-        np.add.at(F, body, f)
-        r = s.pos[sel] - self.bodies.pos[body]
-        np.add.at(T, body, np.cross(r, f))
-        if self.consts["is2d"]:
-            F[:, 1] = 0.0
-            T[:, 0] = T[:, 2] = 0.0
-        ftpause = float(self.params.get("FtPause", 0.0))
-        if solver.time <= ftpause:
-            self.bodies.time = solver.time     # frozen bodies (FtPause): the clock still runs
-            return
-        self.bodies.step(dt, F, T)
-        pos, quat, vel, omega = self.bodies.pos, self.bodies.quat, self.bodies.vel, self.bodies.omega_world
-        for i, (_, idp, local, _) in enumerate(self.body_sel):
-            rows = sel[body == i]
-            if rows.size == 0:
-                continue
-            R = _quat_matrix(quat[i])
-            loc = local[np.searchsorted(idp, s.idp[rows])]
-            x = pos[i] + loc @ R.T
-            s.pos[rows] = x
-            s.vel[rows] = vel[i] + np.cross(omega[i], x - pos[i])
-            if self.normals0 is not None:
-                solver.normals[rows] = self.normals0[s.idp[rows]] @ (R @ self.body_R0[i].T).T
+            zone.apply(solver.state, dt)
 
     # -- checks --------------------------------------------------------------------------
     def check(self, nexcl_before: int) -> None:
@@ -672,96 +495,16 @@ class SPHRun:
         return s.pos, {"Idp": s.idp, "Vel": s.vel, "Rhop": s.rhop, "Press": press, "Type": s.ptype,
                        "Mk": s.mk}
 
-    SCALARS = ("time", "nstep", "n_dtmin", "_verlet_count", "dt_pre", "last_dt")
-
     def save_checkpoint(self, path: str, extra: dict) -> None:
-        import h5py
-        sol = self.solver
-        with atomic_path(path) as tmp:
-            with h5py.File(tmp, "w") as f:
-                g = f.create_group("state")
-                for name in sol.state.FIELDS:
-                    g.create_dataset(name, data=getattr(sol.state, name))
-                a = f.create_group("aux")
-                for name in sol._aux_names():
-                    a.create_dataset(name, data=getattr(sol, name))
-                sc = f.create_group("scalars")
-                for name in self.SCALARS:
-                    sc.attrs[name] = getattr(sol, name)
-                sc.attrs["n_excluded"] = json.dumps(sol.n_excluded)
-                sc.attrs["dtmin_run"] = self.dtmin_run
-                sc.attrs["dtmin_seen"] = self.dtmin_seen
-                for k, v in extra.items():
-                    sc.attrs[k] = v
-                if self.bodies is not None:
-                    write_body_state(f.create_group("bodies"), self.bodies.get_state())
+        save_sph_checkpoint(path, self.solver.get_checkpoint(),
+                            dict(extra, dtmin_run=self.dtmin_run, dtmin_seen=self.dtmin_seen),
+                            self.bodies.get_state() if self.bodies is not None else None)
 
     def load_checkpoint(self, path: str) -> dict:
-        import h5py
-        sol = self.solver
-        with h5py.File(path, "r") as f:
-            for name in sol.state.FIELDS:
-                setattr(sol.state, name, np.ascontiguousarray(f["state"][name][...]))
-            sol._alloc()
-            n = sol.state.n
-            for name in sol._aux_names():
-                if name in f["aux"]:
-                    setattr(sol, name, np.ascontiguousarray(f["aux"][name][...]))
-                    continue
-                # written by an older sphdvi without this array (e.g. wall_ace of the
-                # mDBC2 slip modes): start it from zero; the run goes on, not bitwise
-                cur = getattr(sol, name)
-                setattr(sol, name, np.zeros((n,) + cur.shape[1:], cur.dtype))
-                warnings.warn(f"checkpoint {path} has no '{name}' (older sphdvi); it restarts from zero")
-            sc = f["scalars"].attrs
-            for name in self.SCALARS:
-                value = sc[name]
-                setattr(sol, name, value.item() if isinstance(value, np.generic) else value)
-            sol.n_excluded = json.loads(sc["n_excluded"])
-            self.dtmin_run = int(sc["dtmin_run"])
-            self.dtmin_seen = int(sc["dtmin_seen"])
-            extra = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in sc.items()}
-            if self.bodies is not None and "bodies" in f:
-                read_body_state(f["bodies"], self.bodies)
+        extra = load_sph_checkpoint(path, self.solver, self.bodies)
+        self.dtmin_run = int(extra["dtmin_run"])
+        self.dtmin_seen = int(extra["dtmin_seen"])
         return extra
-
-
-class DampingZone:
-    """``<special><damping><dampingzone>``: fluid velocities are reduced progressively
-    from ``limitmin`` (no reduction) to ``limitmax`` (full) along the line between them,
-    and fully over ``overlimit`` beyond it: v ← v (1 − min(1, dt·redumax·f²)·factorxyz),
-    f ∈ [0, 1] the normalised distance (DualSPHysics JDamping)."""
-
-    def __init__(self, spec: dict):
-        self.p0 = np.asarray(spec["limitmin"], float)
-        p1 = np.asarray(spec["limitmax"], float)
-        self.length = float(np.linalg.norm(p1 - self.p0))
-        self.dir = (p1 - self.p0) / self.length
-        self.overlimit = float(spec.get("overlimit", 0.0))
-        self.redumax = float(spec.get("redumax", 10.0))
-        self.factor = np.asarray(spec.get("factorxyz", [1.0, 1.0, 1.0]), float)
-
-    def apply(self, state, dt: float) -> None:
-        fluid = np.flatnonzero(state.ptype == 3)
-        d = (state.pos[fluid] - self.p0) @ self.dir
-        inside = (d > 0) & (d < self.length + self.overlimit)
-        if not inside.any():
-            return
-        rows = fluid[inside]
-        f = np.minimum(d[inside] / self.length, 1.0)
-        redu = np.minimum(1.0, dt * self.redumax * f * f)
-        state.vel[rows] *= 1.0 - redu[:, None] * self.factor[None, :]
-
-
-def damping_zones(specs) -> list:
-    return [DampingZone(z) for z in specs or []]
-
-
-def _quat_matrix(q):
-    w, x, y, z = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def _fmt(v) -> str:
@@ -936,38 +679,6 @@ def _next_multiple(t: float, step: float) -> float:
     """The first multiple of ``step`` after ``t`` (DualSPHysics's TimeOutExtraUpdate)."""
     k = math.floor(t / step * (1 + 1e-12)) + 1
     return k * step
-
-
-class BodyLog:
-    """``bodies.csv`` and ``links.csv`` of a run with bodies (one row per body
-    and per link at every output time, and at TimeOutExtra between outputs): the rows are
-    appended at each output; a resume cuts the files back to the restart time, atomically."""
-
-    def __init__(self, outdir: str, system, names, resume_time: float | None = None):
-        from .dvi.runner import BODIES_HEADER, LINKS_HEADER
-        self.system, self.names = system, names
-        self.paths = (os.path.join(outdir, "bodies.csv"), os.path.join(outdir, "links.csv"))
-        self.headers = (BODIES_HEADER, LINKS_HEADER)
-        self.rows: tuple[list, list] = ([], [])        # rows not yet written
-        for path, header in zip(self.paths, self.headers):
-            kept = []
-            if resume_time is not None:
-                kept = [line + "\n" for line in complete_lines(path)[1:]
-                        if line and float(line.split(",", 1)[0]) <= resume_time * (1 + 1e-12)]
-            write_text_atomic(path, header + "\n" + "".join(kept))
-
-    def record(self, flush: bool = True) -> None:
-        """Add a row per body and link at the current time; append the pending rows to the
-        files when ``flush`` (at every TimeOut output; TimeOutExtra rows wait in memory)."""
-        from .dvi.runner import csv_rows
-        bodies, links = csv_rows(self.system, self.names)
-        self.rows[0].extend(bodies)
-        self.rows[1].extend(links)
-        if flush:
-            for path, rows in zip(self.paths, self.rows):
-                if rows:
-                    append_text(path, "".join(rows))
-                    rows.clear()
 
 
 def _make_gauges(data, params, outdir, resume, t):

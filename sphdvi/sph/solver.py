@@ -873,6 +873,39 @@ class SPHSolver:
                 setattr(self, name, np.ascontiguousarray(a[keep]))
         self._alloc()
 
+    # ------------------------------------------------------------------ checkpoints
+    CHECKPOINT_SCALARS = ("time", "nstep", "n_dtmin", "_verlet_count", "dt_pre", "last_dt")
+
+    def get_checkpoint(self) -> dict:
+        """What a resumed run needs to go on bitwise: the particle state, the integrator's
+        work arrays (previous-step values, SPS stresses, mDBC normals…), the clock and
+        step counters, and the exclusion counts.  The arrays are the solver's own, not copies."""
+        return {"state": {name: getattr(self.state, name) for name in self.state.FIELDS},
+                "aux": {name: getattr(self, name) for name in self._aux_names()},
+                "scalars": {name: getattr(self, name) for name in self.CHECKPOINT_SCALARS},
+                "n_excluded": dict(self.n_excluded)}
+
+    def set_checkpoint(self, ck: dict) -> list:
+        """Restore what :meth:`get_checkpoint` returned; a work array missing from ``ck``
+        (written by an older sphdvi) starts from zero.  Returns the names of those."""
+        for name in self.state.FIELDS:
+            setattr(self.state, name, np.ascontiguousarray(ck["state"][name]))
+        self._alloc()
+        n = self.state.n
+        missing = []
+        for name in self._aux_names():
+            if name in ck["aux"]:
+                setattr(self, name, np.ascontiguousarray(ck["aux"][name]))
+                continue
+            cur = getattr(self, name)
+            setattr(self, name, np.zeros((n,) + cur.shape[1:], cur.dtype))
+            missing.append(name)
+        for name in self.CHECKPOINT_SCALARS:
+            value = ck["scalars"][name]
+            setattr(self, name, value.item() if isinstance(value, np.generic) else value)
+        self.n_excluded = dict(ck["n_excluded"])
+        return missing
+
     # ------------------------------------------------------------------ outputs
     @property
     def press(self):

@@ -14,6 +14,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+import sphdvi.io.checkpoint as checkpoint
+import sphdvi.io.runfiles as runfiles
 import sphdvi.simulation as simulation
 from sphdvi.cli import main
 from sphdvi.errors import InputError
@@ -43,7 +45,7 @@ def test_rows_appended_at_each_output(tmp_path, monkeypatch):
     TimeOutExtra row before it and the output row), in one append; never rewritten."""
     out = tmp_path / "out"
     seen = {}                       # file name -> [(text appended, content after, inode)]
-    real_append = simulation.append_text
+    real_append = runfiles.append_text
 
     def append(path, text):
         name = os.path.basename(path)
@@ -53,7 +55,7 @@ def test_rows_appended_at_each_output(tmp_path, monkeypatch):
         assert after == before + text       # grown by exactly the text, nothing else moved
         seen.setdefault(name, []).append((text, os.stat(path).st_ino))
 
-    monkeypatch.setattr(simulation, "append_text", append)
+    monkeypatch.setattr(runfiles, "append_text", append)
     r = invoke(["run", case_file(tmp_path), "-o", out, "-q", "--tmax", "0.05", "--tout", "0.01",
                 "--set", "TimeOutExtra=0.005"])
     assert r.exit_code == 0, r.output
@@ -256,9 +258,9 @@ def test_checkpoint_round_trip_is_exact(tmp_path):
     for _ in range(300):
         a.step(1e-3)
     path = str(tmp_path / "restart.h5")
-    simulation.save_bodies_checkpoint(path, a.get_state(), part=3, step=300, names=["arm", "driver", "bob"])
+    checkpoint.save_bodies_checkpoint(path, a.get_state(), part=3, step=300, names=["arm", "driver", "bob"])
     b, _ = build_system(*_mechanism(), gravity=(0, 0, -9.81))
-    saved = simulation.load_bodies_checkpoint(path, b)
+    saved = checkpoint.load_bodies_checkpoint(path, b)
     assert saved == {"part": 3, "step": 300, "names": ["arm", "driver", "bob"]} and b.time == a.time
     for _ in range(300):
         a.step(1e-3)
@@ -269,7 +271,7 @@ def test_checkpoint_round_trip_is_exact(tmp_path):
     # a case with other bodies: a clear input error
     other, _ = build_system(_mechanism()[0][:2], [], gravity=(0, 0, -9.81))
     with pytest.raises(InputError, match="body-only checkpoint"):
-        simulation.load_bodies_checkpoint(path, other)
+        checkpoint.load_bodies_checkpoint(path, other)
 
 
 def test_checkpoint_throttled_to_wall_time(tmp_path, monkeypatch):

@@ -109,7 +109,7 @@ def test_piston_wave_paddle_follows_stroke(tmp_path):
 
 
 def test_damping_zone_reduces_velocity():
-    from sphdvi.simulation import DampingZone
+    from sphdvi.sph.damping import DampingZone
     from sphdvi.sph.state import FluidState
     pos = np.array([[0.0, 0, 0], [0.5, 0, 0], [1.0, 0, 0], [1.5, 0, 0], [3.0, 0, 0]])
     st = FluidState(pos, np.ones((5, 3)), None, 1.0, np.array([3, 3, 3, 3, 0]))

@@ -1,0 +1,143 @@
+"""The text outputs of a run, and its progress display.
+
+* ``run.json``: provenance and status, rewritten atomically;
+* ``run.log`` / ``run.csv``: one line per output time (DualSPHysics's Run.out and
+  RunPARTs.csv), appended;
+* ``bodies.csv`` / ``links.csv``: one row per body and per link at every output (and
+  TimeOutExtra) time, appended; a resume cuts them back to the restart time;
+* a progress line on a terminal, a log line every so often otherwise.
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time as _time
+
+import numpy as np
+
+from .atomic import append_text, complete_lines, write_text_atomic
+
+RUN_CSV_HEADER = "part,time,steps,particles,excluded,dtmin,dtmax,walltime"
+
+
+class RunFiles:
+    """The small text outputs of a run: run.json rewritten atomically; run.log and run.csv
+    appended a line at a time (a resume cuts run.csv back to its restart output)."""
+
+    def __init__(self, outdir: str):
+        self.outdir = outdir
+        self.json_path = os.path.join(outdir, "run.json")
+        self.log_path = os.path.join(outdir, "run.log")
+        self.csv_path = os.path.join(outdir, "run.csv")
+        self.meta: dict = {}
+
+    def write_json(self, **updates) -> None:
+        self.meta.update(updates)
+        write_text_atomic(self.json_path, json.dumps(self.meta, indent=2, default=_jsonable) + "\n")
+
+    def log(self, line: str) -> None:
+        append_text(self.log_path, line + "\n")
+
+    def csv(self, row: str) -> None:
+        if not os.path.exists(self.csv_path):
+            write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
+        append_text(self.csv_path, row + "\n")
+
+    def start(self) -> None:
+        """A new run: empty run.log and run.csv (header only)."""
+        write_text_atomic(self.log_path, "")
+        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
+
+    def load_existing(self, nparts: int) -> None:
+        """On resume: keep the log (without a torn last line), and the CSV rows of the first
+        ``nparts`` outputs."""
+        write_text_atomic(self.log_path, "".join(line + "\n" for line in complete_lines(self.log_path)))
+        rows = complete_lines(self.csv_path)[1:nparts + 1]
+        write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n" + "".join(r + "\n" for r in rows))
+        if os.path.exists(self.json_path):
+            with open(self.json_path) as fh:
+                try:
+                    self.meta = json.load(fh)
+                except json.JSONDecodeError:
+                    self.meta = {}
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return str(obj)
+
+
+class Progress:
+    """A progress line on a terminal; a log line every ``interval`` seconds otherwise."""
+
+    def __init__(self, tmax: float, quiet: bool, stream=None, interval: float = 30.0, counts: str = "particles"):
+        self.tmax = tmax
+        self.counts = counts            # what the count ``n`` of update() counts
+        self.quiet = quiet
+        self.stream = stream or sys.stderr
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.interval = interval
+        self.last = 0.0
+        self.t0 = _time.perf_counter()
+
+    def update(self, t: float, steps: int, n: int, force: bool = False) -> None:
+        if self.quiet:
+            return
+        now = _time.perf_counter()
+        if not force and now - self.last < (0.2 if self.tty else self.interval):
+            return
+        self.last = now
+        frac = min(1.0, t / self.tmax) if self.tmax > 0 else 1.0
+        wall = now - self.t0
+        eta = wall * (1 - frac) / frac if frac > 0 else float("nan")
+        if self.tty:
+            bar = "#" * int(30 * frac)
+            self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t={t:.4f} s  steps={steps}  "
+                              f"{self.counts}={n}  eta={eta:6.0f} s ")
+            self.stream.flush()
+        else:
+            self.stream.write(f"progress: t={t:.5g} s ({100 * frac:.1f}%) steps={steps} {self.counts}={n} "
+                              f"wall={wall:.1f} s eta={eta:.0f} s\n")
+            self.stream.flush()
+
+    def close(self):
+        if self.tty and not self.quiet:
+            self.stream.write("\n")
+
+
+
+
+class BodyLog:
+    """``bodies.csv`` and ``links.csv`` of a run with bodies (one row per body
+    and per link at every output time, and at TimeOutExtra between outputs): the rows are
+    appended at each output; a resume cuts the files back to the restart time, atomically."""
+
+    def __init__(self, outdir: str, system, names, resume_time: float | None = None):
+        from ..dvi.runner import BODIES_HEADER, LINKS_HEADER
+        self.system, self.names = system, names
+        self.paths = (os.path.join(outdir, "bodies.csv"), os.path.join(outdir, "links.csv"))
+        self.headers = (BODIES_HEADER, LINKS_HEADER)
+        self.rows: tuple[list, list] = ([], [])        # rows not yet written
+        for path, header in zip(self.paths, self.headers):
+            kept = []
+            if resume_time is not None:
+                kept = [line + "\n" for line in complete_lines(path)[1:]
+                        if line and float(line.split(",", 1)[0]) <= resume_time * (1 + 1e-12)]
+            write_text_atomic(path, header + "\n" + "".join(kept))
+
+    def record(self, flush: bool = True) -> None:
+        """Add a row per body and link at the current time; append the pending rows to the
+        files when ``flush`` (at every TimeOut output; TimeOutExtra rows wait in memory)."""
+        from ..dvi.runner import csv_rows
+        bodies, links = csv_rows(self.system, self.names)
+        self.rows[0].extend(bodies)
+        self.rows[1].extend(links)
+        if flush:
+            for path, rows in zip(self.paths, self.rows):
+                if rows:
+                    append_text(path, "".join(rows))
+                    rows.clear()
