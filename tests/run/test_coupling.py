@@ -1,0 +1,131 @@
+"""sphdvi.coupling on its own: the loads the fluid puts on a floating body (sum of m a and
+of (r - R) x m a over its particles, eqs. 15-16 of Canelas et al. 2018) and the rigid-body
+motion the body gives its particles back (eq. 17), checked against closed forms."""
+import math
+import shutil
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+from sphdvi.coupling import FloatingBodies, ImposedMotions, quat_matrix
+from sphdvi.io.casefile import read_case_h5
+from sphdvi.motion import MotionSet
+from sphdvi.sph.state import FluidState
+
+CASE = Path(__file__).resolve().parents[2] / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
+
+
+@pytest.fixture(scope="module")
+def case_data(tmp_path_factory):
+    d = tmp_path_factory.mktemp("fb")
+    shutil.copy(CASE, d / CASE.name)
+    r = CliRunner().invoke(main, ["gencase", str(d / CASE.name), "-o", str(d / "out")])
+    assert r.exit_code == 0, r.output
+    return read_case_h5(str(next((d / "out").glob("*.h5"))))
+
+
+def _coupling(data):
+    fluidcount = int(data["json"]["mkconfig"]["fluidcount"])
+    motions = MotionSet(data["json"].get("motions", []), [])
+    return FloatingBodies(data, motions, fluidcount)
+
+
+def _solver(data):
+    p = data["particles"]
+    state = FluidState(p["pos"].copy(), p["vel"].copy(), p["rhop"].copy(), p["mass"].copy(), p["type"],
+                       p["idp"], p["mk"])
+    return SimpleNamespace(state=state, ace=np.zeros_like(state.pos), time=0.0, normals=None)
+
+
+def test_loads_of_a_rigid_acceleration_field(case_data):
+    """Particles accelerated as a rigid body turning about the body's centre with angular
+    acceleration alpha (a = alpha x (r - R)) plus a uniform a0: the force is M_p a0 +
+    alpha x M_p (rbar - R) and the moment about R is I_p alpha + M_p (rbar - R) x a0, with M_p,
+    rbar, I_p the particles' mass, centroid and polar moment of inertia about R."""
+    fb = _coupling(case_data)
+    sol = _solver(case_data)
+    s = sol.state
+    sel = np.flatnonzero(s.ptype == 2)
+    assert sel.size > 50 and fb.system.nb == 1
+    body = fb.body_of_idp[s.idp[sel]]
+    R = fb.system.pos[0]
+    alpha = np.array([0.0, 3.7, 0.0])            # about y: the 2D plane is x-z
+    a0 = np.array([0.4, 0.0, -1.3])
+    r = s.pos[sel] - R
+    sol.ace[sel] = np.cross(alpha, r) + a0
+    F, T = fb.loads(sol, sel, body)
+    m = s.mass[sel]
+    mp = m.sum()
+    rbar = (m[:, None] * r).sum(0) / mp
+    ip = (m * (r[:, 0] ** 2 + r[:, 2] ** 2)).sum()
+    assert np.allclose(F[0], mp * a0 + np.cross(alpha, mp * rbar), rtol=1e-12, atol=1e-9 * mp)
+    assert T[0, 1] == pytest.approx(ip * alpha[1] + mp * np.cross(rbar, a0)[1], rel=1e-12)
+    # 2D: no force out of the plane, no moment about in-plane axes
+    sol.ace[sel, 1] = 5.0
+    F, T = fb.loads(sol, sel, body)
+    assert F[0, 1] == 0.0 and T[0, 0] == 0.0 and T[0, 2] == 0.0
+
+
+def test_particles_follow_the_body(case_data):
+    """After the body is moved to R' and turned by theta about y, with velocity V and spin
+    omega, each particle sits at R' + Rot(theta) (r0 - R0) and moves at V + omega x (r - R')."""
+    fb = _coupling(case_data)
+    sol = _solver(case_data)
+    s = sol.state
+    sel = np.flatnonzero(s.ptype == 2)
+    body = fb.body_of_idp[s.idp[sel]]
+    r0 = s.pos[sel] - fb.system.pos[0]
+    theta = 0.3
+    q = np.array([math.cos(theta / 2), 0.0, math.sin(theta / 2), 0.0])     # about +y
+    sysb = fb.system
+    sysb.pos[0] = sysb.pos[0] + np.array([0.05, 0.0, -0.02])
+    sysb.quat[0] = q
+    sysb.vel[0] = np.array([0.2, 0.0, -0.1])
+    omega = np.array([0.0, 1.5, 0.0])
+    sysb.omega_b[0] = omega                   # about y, the same in body and world frames
+    fb.carry_particles(sol, sel, body)
+    R = quat_matrix(q)
+    assert np.allclose(s.pos[sel], sysb.pos[0] + r0 @ R.T, atol=1e-12)
+    assert np.allclose(s.vel[sel], sysb.vel[0] + np.cross(omega, s.pos[sel] - sysb.pos[0]), atol=1e-12)
+    # a rigid motion: every distance between particles is kept
+    d0 = np.linalg.norm(r0[:, None] - r0[None], axis=-1)
+    d1 = np.linalg.norm(s.pos[sel][:, None] - s.pos[sel][None], axis=-1)
+    assert np.allclose(d0, d1, atol=1e-12)
+
+
+def test_frozen_bodies_during_ftpause(case_data):
+    """FtPause: the body does not move and its particles stay, but the clock goes on."""
+    fluidcount = int(case_data["json"]["mkconfig"]["fluidcount"])
+    fb = FloatingBodies(case_data, MotionSet([], []), fluidcount, ftpause=0.1)
+    sol = _solver(case_data)
+    sel = sol.state.ptype == 2
+    sol.ace[sel] = [0.0, 0.0, -9.81]
+    before = sol.state.pos.copy()
+    sol.time = 0.05
+    fb.step(sol, 1e-3)
+    assert np.array_equal(sol.state.pos, before) and fb.system.time == 0.05
+    sol.time = 0.2
+    fb.step(sol, 1e-3)
+    assert sol.state.pos[sel, 2].max() < before[sel, 2].max()     # free fall once released
+
+
+def test_imposed_motion_moves_its_mk_only():
+    """A constant-velocity motion (mvrect) of mkbound 1 moves the type-1 particles of that mk to
+    pos0 + v t with velocity v; fluid and fixed particles stay."""
+    motions = MotionSet([{"ref": 1, "begin": {"mov": 1, "start": 0.0},
+                          "movements": [{"id": 1, "type": "mvrect", "duration": 10.0, "vel": [0.3, 0.0, -0.2]}]}])
+    pos0 = np.array([[0.0, 0, 0], [1.0, 0, 0], [2.0, 0, 1], [3.0, 0, 1]])
+    fluidcount = 1
+    mk = np.array([fluidcount + 1 + 1, fluidcount + 1 + 1, fluidcount + 1 + 0, 0], np.int32)
+    ptype = np.array([1, 1, 0, 3], np.int8)
+    state = FluidState(pos0.copy(), np.zeros((4, 3)), np.full(4, 1000.0), np.ones(4), ptype, np.arange(4), mk)
+    sol = SimpleNamespace(state=state, normals=None)
+    ImposedMotions(motions, pos0, fluidcount).apply(sol, 0.5)
+    v = np.array([0.3, 0.0, -0.2])
+    assert np.allclose(state.pos[:2], pos0[:2] + 0.5 * v, atol=1e-12)
+    assert np.allclose(state.vel[:2], v)
+    assert np.array_equal(state.pos[2:], pos0[2:]) and not state.vel[2:].any()
