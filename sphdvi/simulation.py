@@ -37,7 +37,6 @@ from .sph.damping import damping_zones
 
 POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
                 "Press": (np.float32, 1), "Type": (np.uint8, 1), "Mk": (np.int32, 1)}
-
 DTMIN_STUCK_STEPS = 200
 DEFAULT_MAX_EXCLUDED_FRACTION = 0.5
 
@@ -100,9 +99,6 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
     return out
 
 
-# ---------------------------------------------------------------------------------
-# run.json, run.log, run.csv
-# ---------------------------------------------------------------------------------
 # ---------------------------------------------------------------------------------
 # entry point
 # ---------------------------------------------------------------------------------
