@@ -7,10 +7,12 @@ Two kinds, as in DualSPHysics:
   ``CalcMotion`` / ``MoveLinBound`` / ``MoveMatBound``);
 * :class:`FloatingBodies`: floating particles (type 2) move with rigid bodies that
   the multibody engine (``sphdvi.dvi``, the Chrono NSC DVI) integrates, driven by
-  the force and moment the fluid and gravity exert on the bodies' particles
-  (Canelas et al. 2018, eqs. 15-16: F = sum m_k a_k, T = sum (r_k - R) x m_k a_k),
-  after which the particles take the body's rigid-body position and velocity
-  (eq. 17: v_k = V + Omega x (r_k - R)).
+  the force and moment the fluid and gravity exert on the bodies' particles,
+  F = sum m_k a_k and T = sum (r_k - R) x m_k a_k (DualSPHysics's ``FtPartsSumAce``
+  and ``FtComputeAceVel``, Canelas et al. 2018); the particles then take the
+  body's rigid-body motion, v_k = V + Omega x (r_k - R) (``FtPartsUpdate``), their
+  positions by the exact rigid transform of their body-frame offsets rather than by
+  dt times their old velocity.
 
 The fluid side is the solver's arrays; nothing here writes files.
 """
@@ -104,7 +106,8 @@ class FloatingBodies:
         return F, T
 
     def step(self, solver, dt: float) -> None:
-        """Advance the bodies by ``dt`` under this step's loads and carry their particles."""
+        """Advance the bodies by ``dt`` under this step's loads and carry their particles
+        (``solver.ace`` holds this step's accelerations, gravity included)."""
         s = solver.state
         sel = np.flatnonzero(s.ptype == 2)
         body = self.body_of_idp[s.idp[sel]]

@@ -1,6 +1,6 @@
-"""sphdvi.coupling on its own: the loads the fluid puts on a floating body (sum of m a and
-of (r - R) x m a over its particles, eqs. 15-16 of Canelas et al. 2018) and the rigid-body
-motion the body gives its particles back (eq. 17), checked against closed forms."""
+"""sphdvi.coupling on its own: the loads the fluid puts on a floating body (sums of m a and
+of (r - R) x m a over its particles, DualSPHysics's FtPartsSumAce) and the rigid-body motion
+the body gives its particles back (FtPartsUpdate), checked against closed forms."""
 import math
 import shutil
 from pathlib import Path
