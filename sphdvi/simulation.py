@@ -30,7 +30,7 @@ import numpy as np
 
 from ._version import __version__
 from .errors import DivergenceError, InputError
-from .io.checkpoint import (load_bodies_checkpoint, load_sph_checkpoint, save_bodies_checkpoint,
+from .io.checkpoint import (RESTART_FILE, load_bodies_checkpoint, load_sph_checkpoint, save_bodies_checkpoint,
                             save_sph_checkpoint)
 from .io.runfiles import BodyLog, Progress, RunFiles
 from .sph.damping import damping_zones
@@ -109,7 +109,7 @@ def find_case_file(folder: str) -> str:
         raise InputError(f"{folder}: not a folder or case file")
     found = []
     for name in sorted(os.listdir(folder)):
-        if name.endswith(".h5") and name != "restart.h5":
+        if name.endswith(".h5") and name != RESTART_FILE:
             path = os.path.join(folder, name)
             try:
                 with h5py.File(path, "r") as f:
@@ -200,7 +200,6 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=F
     return run.run(float(params["TimeMax"]), quiet)
 
 
-BODIES_RESTART = "restart.h5"
 # wall time between two checkpoints of a body-only run: its outputs are often a few steps of
 # microseconds apart, and an HDF5 checkpoint costs ~0.85 ms (the pendulum case, 901 outputs:
 # 1.3 s with one at every output against 0.26 s without)
@@ -217,7 +216,7 @@ class BodiesOnlyRun:
     def __init__(self, system, names, schedule, outdir: str, files: RunFiles):
         self.system, self.names, self.schedule = system, list(names), schedule
         self.outdir, self.files = outdir, files
-        self.ckpt = os.path.join(outdir, BODIES_RESTART)
+        self.ckpt = os.path.join(outdir, RESTART_FILE)
         self.part = 0            # outputs written (TimeOut), t = 0 being part 0
         self.step = 0
         self.runtime = 0.0       # wall time of the time stepping, over all the resumed pieces
@@ -426,6 +425,7 @@ class SPHRun:
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table)
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
+        self.excluded_limit = self.max_excluded()      # the parameters do not change in a run
         self.dtmin_run = 0
         self.dtmin_seen = 0
 
@@ -463,7 +463,7 @@ class SPHRun:
         else:
             self.dtmin_run = 0
         excluded = sum(sol.n_excluded.values())
-        limit = self.max_excluded()
+        limit = self.excluded_limit
         if excluded > limit:
             ev = sol.excluded[-1]
             raise DivergenceError(
@@ -476,6 +476,8 @@ class SPHRun:
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: a floating body state is not finite")
 
     def max_excluded(self) -> int:
+        """Excluded fluid particles beyond which the run stops: PartsOutMax (when the case
+        sets it below 1, else half the fluid), at most 1 - MinFluidStop of the fluid."""
         p = self.params
         frac = DEFAULT_MAX_EXCLUDED_FRACTION
         if "PartsOutMax" in self.data["json"].get("parameters_set", []) and p.get("PartsOutMax", 1.0) < 1.0:
@@ -560,7 +562,7 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
     sol = sph.solver
     tmax, tout = float(params["TimeMax"]), float(params["TimeOut"])
     vtk_path = os.path.join(outdir, "particles.vtkhdf")
-    ckpt = os.path.join(outdir, "restart.h5")
+    ckpt = os.path.join(outdir, RESTART_FILE)
     part = 0
     wall_prev = 0.0
     if resume:

@@ -22,6 +22,7 @@ from ..errors import InputError
 from .atomic import atomic_path
 from .bodystate import read_body_state, write_body_state
 
+RESTART_FILE = "restart.h5"            # in a run's output folder
 BODIES_RESTART_FORMAT = "sphdvi-bodies-restart"
 
 

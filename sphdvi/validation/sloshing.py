@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 
+from ..io.checkpoint import RESTART_FILE
+
 
 def linear_period(length: float, depth: float, g: float = 9.81, mode: int = 1) -> float:
     k = mode * math.pi / length
@@ -62,7 +64,7 @@ def case_periods(outdir: str, length: float = 1.0, gauge: str = "Left") -> dict:
 
     from ..io.vtkhdf import read_step, step_times
 
-    case_h5 = [f for f in glob.glob(os.path.join(outdir, "*.h5")) if not f.endswith("restart.h5")]
+    case_h5 = [f for f in glob.glob(os.path.join(outdir, "*.h5")) if not f.endswith(RESTART_FILE)]
     with h5py.File(case_h5[0], "r") as f:
         dp = float(f["constants"].attrs["dp"])
         g = -float(f["constants"].attrs["gravity"][2])

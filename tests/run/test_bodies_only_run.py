@@ -98,7 +98,7 @@ def test_run_log_and_csv_rows(tmp_path):
     assert meta["mode"] == "bodies" and meta["status"] == "completed" and meta["message"] == ""
     assert meta["steps"] == 100 and meta["physical_time"] == pytest.approx(0.1) and meta["outputs"] == 6
     assert len(lines(out / "bodies.csv")) == 1 + 6 and len(lines(out / "links.csv")) == 1 + 6
-    assert (out / simulation.BODIES_RESTART).exists()
+    assert (out / simulation.RESTART_FILE).exists()
     # progress (not quiet) counts the bodies
     r = invoke(["run", case_file(tmp_path), "-o", tmp_path / "out2", "--tmax", "0.02", "--tout", "0.02"])
     assert r.exit_code == 0 and "steps=20 bodies=1 " in r.output
@@ -230,7 +230,7 @@ def test_sigterm_stops_cleanly_and_resumes(tmp_path):
 def test_resume_without_checkpoint_is_input_error(tmp_path):
     out = tmp_path / "out"
     assert invoke(["run", case_file(tmp_path), "-o", out, "-q", "--tmax", "0.01"]).exit_code == 0
-    os.unlink(out / simulation.BODIES_RESTART)
+    os.unlink(out / simulation.RESTART_FILE)
     r = invoke(["run", out, "--resume"])
     assert r.exit_code == 2 and "no checkpoint" in r.output
 
