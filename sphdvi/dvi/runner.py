@@ -104,8 +104,13 @@ def body_record(s):
             "link_torque": s.link_torque.copy()}
 
 
+def csv_time(t: float) -> str:
+    """The time column of bodies.csv and links.csv (9 significant digits)."""
+    return f"{t:.9g}"
+
+
 def _csv_lines(t, names, record, fields):
-    return [f"{t:.9g},{nm}," + ",".join(f"{v:.9g}" for v in np.concatenate([record[f][i] for f in fields]))
+    return [f"{csv_time(t)},{nm}," + ",".join(f"{v:.9g}" for v in np.concatenate([record[f][i] for f in fields]))
             + "\n" for i, nm in enumerate(names)]
 
 

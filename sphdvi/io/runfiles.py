@@ -117,7 +117,7 @@ class BodyLog:
     appended at each output; a resume cuts the files back to the restart time, atomically."""
 
     def __init__(self, outdir: str, system, names, resume_time: float | None = None):
-        from ..dvi.runner import BODIES_HEADER, LINKS_HEADER
+        from ..dvi.runner import BODIES_HEADER, LINKS_HEADER, csv_time
         self.system, self.names = system, names
         self.paths = (os.path.join(outdir, "bodies.csv"), os.path.join(outdir, "links.csv"))
         self.headers = (BODIES_HEADER, LINKS_HEADER)
@@ -125,8 +125,11 @@ class BodyLog:
         for path, header in zip(self.paths, self.headers):
             kept = []
             if resume_time is not None:
+                # compare as printed: the row written at the restart time may have been
+                # rounded up in its 9 digits, and must stay
+                limit = float(csv_time(resume_time))
                 kept = [line + "\n" for line in complete_lines(path)[1:]
-                        if line and float(line.split(",", 1)[0]) <= resume_time * (1 + 1e-12)]
+                        if line and float(line.split(",", 1)[0]) <= limit]
             write_text_atomic(path, header + "\n" + "".join(kept))
 
     def record(self, flush: bool = True) -> None:
