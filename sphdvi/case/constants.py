@@ -6,7 +6,8 @@ From GenCase (``../shared/design/case-format.md`` §2.1):
 * speedsystem (auto) = sqrt(|g| · hswl) (dam-break front speed);
 * speedsound (auto)  = coefsound · speedsystem  (c0);
 * h                  = coefh · sqrt(3 dp²) in 3D, coefh · sqrt(2 dp²) in 2D, or hdp · dp;
-* B                  = c0² ρ0 / γ (Tait);
+* B                  = c0² ρ0 / γ (Tait); an explicit B sets c0 = sqrt(γ B / ρ0) instead,
+  as the DualSPHysics solver derives c0 from B (whatever speedsound says);
 * massfluid = massbound = ρ0 dp³ (ρ0 dp² in 2D, per metre of width).
 """
 from __future__ import annotations
@@ -40,7 +41,11 @@ def resolve_constants(cdef: ConstantsDef, dp: float, is2d: bool, posy2d: float,
         h = coefh * math.sqrt((2.0 if is2d else 3.0) * dp * dp)
     if cdef.h is not None:
         h = cdef.h
-    b = cdef.b if cdef.b is not None else cs0 * cs0 * cdef.rhop0 / cdef.gamma
+    if cdef.b is not None:
+        b = cdef.b
+        cs0 = math.sqrt(cdef.gamma * b / cdef.rhop0)      # DualSPHysics's JSph::ConfigConstants
+    else:
+        b = cs0 * cs0 * cdef.rhop0 / cdef.gamma
     vol = dp * dp if is2d else dp ** 3
     massfluid = cdef.massfluid if cdef.massfluid is not None else cdef.rhop0 * vol
     massbound = cdef.massbound if cdef.massbound is not None else cdef.rhop0 * vol

@@ -43,7 +43,9 @@ def test_resolve_constants_rules():
     assert c.massfluid == pytest.approx(1000 * 0.05 ** 3)
     cdef = ConstantsDef(hdp=2.0, speedsound=50.0, b=1e5, hswl=3.0)
     c = resolve_constants(cdef, 0.1, True, 0.0, np.array([0.0]))
-    assert c.h == pytest.approx(0.2) and c.cs0 == 50.0 and c.b == 1e5 and c.hswl == 3.0
+    # an explicit B decides c0 (DualSPHysics: Cs0 = sqrt(γ B / ρ0)), whatever speedsound says
+    assert c.h == pytest.approx(0.2) and c.b == 1e5 and c.hswl == 3.0
+    assert c.cs0 == pytest.approx(math.sqrt(7 * 1e5 / 1000))
     assert c.massbound == pytest.approx(1000 * 0.01)
 
 
