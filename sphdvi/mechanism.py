@@ -36,24 +36,30 @@ def _table(v):
 
 
 def _material_for(mkbound, case_json, body_property=None):
+    """(name, contact spec) of an mkbound's property: the floating's own ``property`` or
+    the ``<link>`` naming the mkbound.  A combination ``"steel + userdef01"`` merges the
+    named properties in order, each value of a later one replacing the earlier one's
+    (DualSPHysics's combined properties)."""
     mats = case_json.get("materials", {})
-    name = body_property
-    if name is None:
+    combo = body_property
+    if combo is None:
         for link in case_json.get("material_links", []):
             if mkbound in link.get("mkbound", []):
-                name = link["property"].split("+")[-1].strip()
-    if name is None or name not in mats:
+                combo = link["property"]
+    if combo is None:
         return None, None
-    m = mats[name]
+    names = [n.strip() for n in combo.split("+") if n.strip()]
+    if not names or any(n not in mats for n in names):
+        return None, None
+    merged = {}
+    for n in names:
+        merged.update({k: v for k, v in mats[n].items() if v is not None})
+    name = " + ".join(names)
     spec = {"name": name}
-    if m.get("kfric") is not None:
-        spec["friction"] = m["kfric"]
-    if m.get("restitution") is not None:
-        spec["restitution"] = m["restitution"]
-    if m.get("young") is not None:
-        spec["young"] = m["young"]
-    if m.get("poisson") is not None:
-        spec["poisson"] = m["poisson"]
+    for key, out in (("kfric", "friction"), ("restitution", "restitution"), ("young", "young"),
+                     ("poisson", "poisson")):
+        if merged.get(key) is not None:
+            spec[out] = merged[key]
     return name, spec
 
 

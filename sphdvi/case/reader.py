@@ -434,21 +434,29 @@ MATERIAL_KEYS = {"Young_Modulus": "young", "PoissonRatio": "poisson",
 
 
 def _read_material(reader, el) -> Material:
+    """A ``<property>``: values as child elements (``<Kfric value="0.3"/>``) or attributes
+    (``Restitution_Coefficient_User="0.65"``); as in DualSPHysics, a ``*_User`` value
+    overrides the plain one, wherever each is written."""
     mat = Material(name=reader.text_attr(el, "name"))
+    plain, user = {}, {}
     for c in reader.children(el):
-        key = c.tag
-        if key.endswith("_User"):
-            key = key[:-5]
+        key = c.tag.removesuffix("_User")
         if key in MATERIAL_KEYS:
-            value = reader.num(c, "value", nonnegative=True)
-            setattr(mat, MATERIAL_KEYS[key], value)
+            (user if c.tag.endswith("_User") else plain)[MATERIAL_KEYS[key]] = reader.num(c, "value", nonnegative=True)
         else:
             mat.extra[c.tag] = {k: c.get(k) for k in c.keys()}
             reader.mark(c, *c.keys())
     for k in el.keys():
-        if k != "name":
+        if k == "name":
+            continue
+        key = k.removesuffix("_User")
+        if key in MATERIAL_KEYS:
+            (user if k.endswith("_User") else plain)[MATERIAL_KEYS[key]] = reader.num(el, k, nonnegative=True)
+        else:
             mat.extra[k] = el.get(k)
             reader.mark(el, k)
+    for attr, value in {**plain, **user}.items():
+        setattr(mat, attr, value)
     if mat.poisson is not None and not (0.0 <= mat.poisson < 0.5):
         raise reader.error(el, f"PoissonRatio {mat.poisson} out of range", "0 <= nu < 0.5")
     if mat.restitution is not None and mat.restitution > 1.0:

@@ -352,6 +352,26 @@ def test_property_file_and_user_overrides(tmp_path):
     assert r.case.material_links[0]["mkbound"] == [0]
 
 
+def test_property_attributes_and_combined_properties(tmp_path):
+    """DualSPHysics's CaseSolids: a property whose value is an attribute
+    (``Restitution_Coefficient_User="0.65"``) combined with a file property by
+    ``property="steel + userdef01"``: the link gets steel's values with the restitution replaced."""
+    from sphdvi.mechanism import _material_for
+    props = ('<properties><property name="steel"><Young_Modulus value="2.1e11"/><PoissonRatio value="0.3"/>'
+             '<Restitution_Coefficient value="0.8"/><Kfric value="0.45"/></property>'
+             '<property name="userdef01" Restitution_Coefficient_User="0.65" comment="user value"/>'
+             '<links><link mkbound="0" property="steel + userdef01"/></links></properties>')
+    r = build(tmp_path, casedef_extra=props)
+    assert r.case.materials["userdef01"].restitution == 0.65
+    case_json = {"materials": {k: vars(v) for k, v in r.case.materials.items()},
+                 "material_links": r.case.material_links}
+    name, spec = _material_for(0, case_json)
+    assert name == "steel + userdef01"
+    assert spec == {"name": name, "friction": 0.45, "restitution": 0.65, "young": 2.1e11, "poisson": 0.3}
+    assert _material_for(0, case_json, "steel")[1]["restitution"] == 0.8
+    assert _material_for(7, case_json) == (None, None)
+
+
 def test_bad_material_values(tmp_path):
     props = ('<properties><property name="x"><PoissonRatio value="0.7"/></property></properties>')
     with pytest.raises(CaseError, match="PoissonRatio 0.7 out of range"):
