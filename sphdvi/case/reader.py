@@ -244,6 +244,8 @@ def read_floatings(reader, casedef) -> list:
                 raise reader.error(inf, f"{len(rows)} <values> rows", "3 rows v11 v12 v13 / v21.. / v31..")
             mat = [[reader.num(r, f"v{i + 1}{j + 1}") for j in range(3)] for i, r in enumerate(rows)]
             fd.inertia = mat
+        if fd.inertia is not None:
+            _check_inertia(reader, ine if ine is not None else inf, np.asarray(fd.inertia, float))
         for tag, attr in (("translationDOF", "translation_dof"), ("rotationDOF", "rotation_dof")):
             d = reader.child(f, tag)
             if d is not None:
@@ -262,6 +264,18 @@ def read_floatings(reader, casedef) -> list:
         fd.angularforce = _series(reader, reader.child(f, "angularforce"), "force")
         out.append(fd)
     return out
+
+
+def _check_inertia(reader, el, tensor):
+    """A body's inertia tensor must be symmetric with no negative principal moment (zeros
+    are allowed: a 2D case uses only I_yy)."""
+    scale = max(float(np.abs(tensor).max()), 1e-300)
+    if np.abs(tensor - tensor.T).max() > 1e-9 * scale:
+        raise reader.error(el, "inertia tensor is not symmetric", "v12 = v21, v13 = v31, v23 = v32")
+    lowest = float(np.linalg.eigvalsh(tensor).min())
+    if lowest < -1e-12 * scale:
+        raise reader.error(el, f"inertia tensor has a negative principal moment ({lowest:g} kg m²)",
+                           "moments of inertia >= 0")
 
 
 def read_initials(reader, casedef) -> list:
@@ -812,6 +826,8 @@ def _read_link(reader, ln, ids) -> dict:
             raise reader.error(ln, f"{which}='{v}' names no body",
                                "one of " + (", ".join(sorted(ids)) if ids else "(no bodies defined)"))
         d[which] = v
+    if d.get("idbody2") is not None and d["idbody2"] == d["idbody1"]:
+        raise reader.error(ln, f"idbody1 and idbody2 are both '{d['idbody1']}'", "two different bodies")
     for c in reader.children(ln):
         if c.tag not in spec:
             raise reader.error(c, f"unknown element <{c.tag}> in <{ln.tag}>", "one of " + ", ".join(f"<{k}>" for k in sorted(spec)))

@@ -372,6 +372,26 @@ def test_property_attributes_and_combined_properties(tmp_path):
     assert _material_for(7, case_json) == (None, None)
 
 
+@pytest.mark.parametrize("inertia, message", [
+    ('<inertia x="1" y="-2" z="1"/>', "negative principal moment"),
+    ('<inertiafull><values v11="1" v12="0.5" v13="0"/><values v21="0" v22="1" v23="0"/>'
+     '<values v31="0" v32="0" v33="1"/></inertiafull>', "not symmetric"),
+    ('<inertiafull><values v11="1" v12="2" v13="0"/><values v21="2" v22="1" v23="0"/>'
+     '<values v31="0" v32="0" v33="1"/></inertiafull>', "negative principal moment")])
+def test_bad_floating_inertia(tmp_path, inertia, message):
+    floatings = f'<floatings><floating mkbound="50" rhopbody="500">{inertia}</floating></floatings>'
+    with pytest.raises(CaseError, match=message):
+        build(tmp_path, commands=TANK_2D + CHRONO_BODIES, casedef_extra=floatings)
+
+
+def test_link_of_a_body_to_itself(tmp_path):
+    links = ('<link_hinge idbody1="box" idbody2="box"><rotpoint x="2" y="0" z="0.6"/>'
+             '<rotvector x="0" y="1" z="0"/></link_hinge>')
+    with pytest.raises(CaseError, match="idbody1 and idbody2 are both 'box'"):
+        build(tmp_path, commands=TANK_2D + CHRONO_BODIES, casedef_extra=FLOATINGS + PROPS,
+              special=chrono(links), parameters='<parameter key="RigidAlgorithm" value="3"/>')
+
+
 def test_bad_material_values(tmp_path):
     props = ('<properties><property name="x"><PoissonRatio value="0.7"/></property></properties>')
     with pytest.raises(CaseError, match="PoissonRatio 0.7 out of range"):
