@@ -225,7 +225,9 @@ def read_floatings(reader, casedef) -> list:
         sources = [s for s, v in (("rhopbody", fd.rhopbody), ("relativeweight", fd.relativeweight),
                                   ("massbody", fd.massbody)) if v is not None]
         if not sources:
-            raise reader.error(f, "no mass given", 'one of rhopbody="..", relativeweight="..", or <massbody value=".."/>')
+            zero = " (rhopbody=\"0\" counts as not given, as in DualSPHysics)" if f.get("rhopbody") is not None else ""
+            raise reader.error(f, "no mass given" + zero,
+                               'one of rhopbody="..", relativeweight="..", or <massbody value=".."/>')
         if len(sources) > 1 and not (sources == ["rhopbody", "massbody"]):
             raise reader.error(f, "mass given more than once (" + ", ".join(sources) + ")",
                                "exactly one of rhopbody, relativeweight, massbody")
@@ -380,7 +382,7 @@ def read_motion(reader, casedef) -> list:
                     refs[ref] = child.sourceline
                     out.append({"ref": ref, "line": child.sourceline, "parents": parents, **chain})
                 walk(child, parents + [chain])
-            elif child.tag in MOVEMENTS or child.tag == "begin":
+            elif child.tag in MOVEMENTS or child.tag in _file_aliases() or child.tag == "begin":
                 continue
             else:
                 raise reader.error(child, f"unknown motion element <{child.tag}>",
@@ -389,30 +391,37 @@ def read_motion(reader, casedef) -> list:
     return out
 
 
+def _file_aliases() -> dict:
+    """DualSPHysics's other names of ``mvrectfile`` (JMotion::ReadXml)."""
+    return {"mvfile": "mvrectfile", "mvpredef": "mvrectfile"}
+
+
 def _read_movement_chain(reader, obj):
     begin = reader.child(obj, "begin")
-    movs = {}
+    aliases = _file_aliases()
+    movs, elements = {}, {}
     order = []
     for m in reader.children(obj):
-        if m.tag not in MOVEMENTS:
-            continue
+        tag = aliases.get(m.tag, m.tag)
+        if tag not in MOVEMENTS:
+            if m.tag in ("begin", "obj", "objreal"):
+                continue
+            raise reader.error(m, f"unknown motion element <{m.tag}>",
+                               "objreal, obj, begin, " + ", ".join(sorted([*MOVEMENTS, *aliases])))
         mid = reader.integer(m, "id", lo=0)
         if mid in movs:
             raise reader.error(m, f"movement id {mid} is used twice", "unique ids")
-        d = {"type": m.tag, "id": mid, "duration": reader.num(m, "duration", -1.0),
+        d = {"type": tag, "id": mid, "duration": reader.num(m, "duration", -1.0),
              "next": reader.integer(m, "next", None, lo=0) if m.get("next") is not None else None}
         if d["duration"] < 0 and d["duration"] != -1:
             raise reader.error(m, "negative duration", "duration >= 0 or -1 (forever)")
         units = "degrees"
-        if m.tag in _ANGULAR or m.tag in ("mvrectsinu",):
+        if tag in _ANGULAR or tag in ("mvrectsinu",):
             units = reader.text_attr(m, "anglesunits", "degrees", choices={"degrees", "radians"}).lower()
         d["anglesunits"] = units
-        for part in MOVEMENTS[m.tag]:
+        for part in MOVEMENTS[tag]:
             if part == "file":
-                f = reader.child(m, "file", True)
-                d["file"] = reader.resolve_path(f, "name")
-                d["fields"] = {k: reader.integer(f, k, lo=0) for k in f.keys()
-                               if k.startswith("field")}
+                d.update(_read_motion_file(reader, m, tag))
                 continue
             c = reader.child(m, part)
             if c is None:
@@ -425,7 +434,14 @@ def _read_movement_chain(reader, obj):
                 d[part] = reader.num(c, "v")
             else:
                 d[part] = reader.vec3(c).tolist()
+        if "axisp1" in d and "axisp2" in d:
+            p1, p2 = np.asarray(d["axisp1"]), np.asarray(d["axisp2"])
+            if not np.linalg.norm(p2 - p1) > 1e-12 * max(1.0, np.abs(p1).max(), np.abs(p2).max()):
+                raise reader.error(reader.child(m, "axisp2"), f"<{m.tag}> id={mid}: axisp1 and axisp2 are the same "
+                                   f"point {p1.tolist()}, so they define no rotation axis",
+                                   "two distinct points on the axis")
         movs[mid] = d
+        elements[mid] = m
         order.append(mid)
     for d in movs.values():
         if d["next"] is not None and d["next"] not in movs:
@@ -436,11 +452,62 @@ def _read_movement_chain(reader, obj):
         mov = reader.integer(begin, "mov", lo=0)
         if mov not in movs:
             raise reader.error(begin, f"mov={mov} names no movement", "an id of a movement of this object")
-        chain["begin"] = {"mov": mov, "start": reader.num(begin, "start", 0.0, nonnegative=True),
-                          "finish": reader.num(begin, "finish", None) if begin.get("finish") is not None else None}
+        start = reader.num(begin, "start", 0.0, nonnegative=True)
+        finish = reader.num(begin, "finish", None) if begin.get("finish") is not None else None
+        if finish is not None and finish < 0:
+            finish = None            # DualSPHysics's finish="-1": no end
+        if finish is not None and finish < start:
+            raise reader.error(begin, f"finish={finish:g} comes before start={start:g}",
+                               "finish >= start, or -1 (no end)")
+        chain["begin"] = {"mov": mov, "start": start, "finish": finish}
     elif order:
         chain["begin"] = {"mov": order[0], "start": 0.0, "finish": None}
+    if "begin" in chain:
+        # a loop of movements (next=) whose durations add up to 0 would never advance time
+        path, cur = [], chain["begin"]["mov"]
+        while cur is not None and cur not in path and movs[cur]["duration"] >= 0:
+            path.append(cur)
+            cur = movs[cur]["next"]
+        if cur is not None and cur in path:
+            loop = path[path.index(cur):]
+            if sum(movs[i]["duration"] for i in loop) <= 0:
+                ids = " -> ".join(str(i) for i in loop + [cur])
+                raise reader.error(elements[loop[-1]], f"the movements {ids} loop forever without advancing time "
+                                   "(their durations add up to 0)",
+                                   "a positive duration in the loop, or a movement without next")
     return chain
+
+
+def _read_motion_file(reader, m, tag) -> dict:
+    """The ``<file>`` of ``mvrectfile``/``mvrotfile``: ``fields`` is the number of columns of
+    the file, ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``) 0-based column
+    indices, as DualSPHysics's JMotion reads them. The file is read and checked now."""
+    from .datafiles import read_motion_table
+    f = reader.child(m, "file", True)
+    path = reader.resolve_path(f, "name")
+    names = ("fieldtime", "fieldx", "fieldy", "fieldz") if tag == "mvrectfile" else ("fieldtime", "fieldang")
+    cols = {k: reader.integer(f, k, lo=0) for k in names if f.get(k) is not None}
+    cols.setdefault("fieldtime", 0)
+    if tag == "mvrotfile":
+        cols.setdefault("fieldang", 1)       # DualSPHysics's mvrotfile: time; angle
+    if f.get("fields") is not None:
+        ncols = reader.integer(f, "fields", lo=2)
+    else:
+        ncols = max(2, 1 + max(cols.values()))
+    for k, v in cols.items():
+        if v >= ncols:
+            raise reader.error(f, f"{k}={v} is not a column of a file of fields={ncols} columns "
+                               "(columns are numbered from 0)", f"0 <= {k} < {ncols}")
+        if k != "fieldtime" and v == cols["fieldtime"]:
+            raise reader.error(f, f"{k}={v} is the time column (fieldtime={v})", f"{k} another column than fieldtime")
+    if tag == "mvrectfile" and len(cols) == 1:
+        reader.warn(f, "none of fieldx, fieldy, fieldz is given: the movement does not move the object")
+    try:
+        read_motion_table(path, ncols, cols, f"<{m.tag}> file")
+    except CaseError as exc:
+        raise reader.error(f, f"{exc.message} ({path}" + (f", line {exc.line}" if exc.line else "") + ")",
+                           exc.expected) from None
+    return {"file": path, "fields": cols, "ncols": ncols}
 
 
 MATERIAL_KEYS = {"Young_Modulus": "young", "PoissonRatio": "poisson",
@@ -945,6 +1012,11 @@ def read_damping(reader, el) -> list:
         d.setdefault("factorxyz", [1.0, 1.0, 1.0])
         if np.allclose(d["limitmin"], d["limitmax"]):
             raise reader.error(c, "limitmin equals limitmax", "two different points")
+        for k in ("overlimit", "redumax"):
+            if not d[k] >= 0:
+                raise reader.error(c, f"<{k}> is {d[k]:g}", f"{k} >= 0")
+        if not all(v >= 0.0 for v in d["factorxyz"]):
+            raise reader.error(c, f"<factorxyz> is {d['factorxyz']}", "factors >= 0")
         out.append(d)
     return out
 

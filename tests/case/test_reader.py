@@ -246,6 +246,16 @@ def test_floating_without_particles(tmp_path):
         build(tmp_path, casedef_extra=FLOATINGS + PROPS)
 
 
+@pytest.mark.parametrize("extra, message", [
+    ('<redumax value="-1"/>', "<redumax> is -1"), ('<overlimit value="-0.5"/>', "<overlimit> is -0.5"),
+    ('<factorxyz x="1" y="-1" z="1"/>', "factors >= 0")])
+def test_bad_damping_zone(tmp_path, extra, message):
+    special = ('<damping><dampingzone><limitmin x="3" y="0" z="0"/><limitmax x="3.9" y="0" z="0"/>'
+               f'{extra}</dampingzone></damping>')
+    with pytest.raises(CaseError, match=re.escape(message)):
+        build(tmp_path, special=special)
+
+
 def test_unknown_material(tmp_path):
     props = '<properties><links><link mkbound="0" property="wood"/></links></properties>'
     with pytest.raises(CaseError, match="property 'wood' is not defined"):
