@@ -12,7 +12,9 @@ Movements (DualSPHysics ``JMotion``; times τ measured from the start of the mov
 * ``mvcir``: the object translates along the circle that ``ref`` describes when rotated about the axis;
 * ``mvrectsinu``: d = A [sin(2π f τ + φ) − sin φ] per component;
   ``mvrotsinu``: angle A [sin(2π f τ + φ) − sin φ]; ``mvcirsinu`` likewise on a circle;
-* ``mvrectfile``/``mvrotfile``: positions or angles interpolated linearly from a file.
+* ``mvrectfile`` (alias ``mvfile``, ``mvpredef``)/``mvrotfile``: positions or angles
+  interpolated linearly from a file of ``fields`` columns; ``fieldtime``, ``fieldx``...
+  are 0-based column indices (DualSPHysics's JMotionDataFile).
 
 A movement ends after ``duration`` (−1: never) and continues with ``next``; the
 chain starts at ``begin start`` and stops at ``finish``. Movements of enclosing
@@ -120,7 +122,7 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
 
 def _rotational(m, angle, w, circular) -> Rigid:
     p1, p2 = np.asarray(m["axisp1"], float), np.asarray(m["axisp2"], float)
-    axis = (p2 - p1) / np.linalg.norm(p2 - p1)
+    axis = _unit(p2 - p1, f"{m['type']} id={m.get('id')}: axisp1 and axisp2")
     R = _rotation(axis, angle)
     if not circular:
         return Rigid(R=R, d=p1 - R @ p1, W=w * axis, c=p1)
@@ -130,22 +132,43 @@ def _rotational(m, angle, w, circular) -> Rigid:
     return Rigid(d=moved - ref, V=vel)
 
 
+def _unit(v: np.ndarray, what: str) -> np.ndarray:
+    """v / |v|; a zero (or non-finite) vector is an error of the case."""
+    n = float(np.linalg.norm(v))
+    if not (n > 0 and math.isfinite(n)):
+        from .errors import CaseError
+        raise CaseError(f"{what}: no direction (zero length)",
+                        expected="two distinct points or a non-zero vector")
+    return v / n
+
+
 _FILE_CACHE: dict = {}
 
 
+def file_columns(m) -> tuple[int, dict]:
+    """(number of columns, {fieldtime/fieldx/...: 0-based column}) of a file movement;
+    the column defaults are time 0 and, for ``mvrotfile``, angle 1 (DualSPHysics's layout)."""
+    cols = {k: int(v) for k, v in m.get("fields", {}).items() if k != "fields"}
+    cols.setdefault("fieldtime", 0)
+    if m["type"] == "mvrotfile":
+        cols.setdefault("fieldang", 1)
+    ncols = int(m.get("ncols") or 1 + max(1, *cols.values()))
+    return ncols, cols
+
+
 def _load_table(m):
-    key = (m["file"], tuple(sorted(m.get("fields", {}).items())))
+    ncols, cols = file_columns(m)
+    key = (m["file"], ncols, tuple(sorted(cols.items())))
     if key not in _FILE_CACHE:
-        from .case.datafiles import read_columns
-        ncols = 1 + max([1, *m.get("fields", {}).values()])
-        _FILE_CACHE[key] = read_columns(m["file"], ncols, f"{m['type']} file")
+        from .case.datafiles import read_motion_table
+        _FILE_CACHE[key] = read_motion_table(m["file"], ncols, cols, f"<{m['type']}> file")
     return _FILE_CACHE[key]
 
 
 def _from_file(m, tau) -> Rigid:
     data = _load_table(m)
-    fields = m.get("fields", {})
-    t = data[:, fields.get("fieldtime", 0)]
+    fields = file_columns(m)[1]
+    t = data[:, fields["fieldtime"]]
     if m["type"] == "mvrectfile":
         d = np.zeros(3)
         v = np.zeros(3)
@@ -155,7 +178,7 @@ def _from_file(m, tau) -> Rigid:
                 d[k] = np.interp(tau, t, col) - col[0]
                 v[k] = np.interp(tau, t, np.gradient(col, t))
         return Rigid(d=d, V=v)
-    col = data[:, fields.get("fieldang", 1)] * _angle_units(m)
+    col = data[:, fields["fieldang"]] * _angle_units(m)
     angle = np.interp(tau, t, col) - col[0]
     w = np.interp(tau, t, np.gradient(col, t))
     return _rotational(m, angle, w, circular=False)
@@ -174,10 +197,17 @@ def chain_transform(chain: dict, t: float) -> Rigid:
     total = Rigid()
     state: dict = {}
     current, t0 = movs.get(begin["mov"]), start
+    stalled = 0          # movements in a row that took no time
     for _ in range(1_000_000):
         if current is None:
             break
         dur = current["duration"]
+        stalled = stalled + 1 if dur == 0 else 0
+        if stalled > len(movs):
+            from .errors import CaseError
+            raise CaseError(f"motion of mkbound {chain.get('ref', '?')}: the movements loop through next= "
+                            "without advancing time (their durations add up to 0)",
+                            expected="a positive duration in every loop of movements")
         t1 = math.inf if dur < 0 else t0 + dur
         if t_end < t1:
             seg = _segment(current, t_end - t0, state)
@@ -189,6 +219,11 @@ def chain_transform(chain: dict, t: float) -> Rigid:
         total = total.then(Rigid(seg.R, seg.d, c=seg.c))
         t0 = t1
         current = movs.get(current["next"]) if current.get("next") is not None else None
+    if current is not None:
+        from .errors import CaseError
+        raise CaseError(f"motion of mkbound {chain.get('ref', '?')}: more than a million movements "
+                        f"before t={t:g} s (a loop of very short durations)",
+                        expected="loops of movements lasting a reasonable time")
     return Rigid(total.R, total.d, c=total.c)   # chain over: at rest
 
 
@@ -204,7 +239,9 @@ def motion_transform(motion: dict, t: float) -> Rigid:
 # wave paddles
 # ---------------------------------------------------------------------------
 def wave_number(period: float, depth: float, g: float = 9.81) -> float:
-    """k from ω² = g k tanh(k d) (Newton iterations)."""
+    """k from ω² = g k tanh(k d) (Newton iterations; k → ω²/g in deep water, ω/√(g d) in shallow)."""
+    if not (period > 0 and depth > 0 and g > 0 and math.isfinite(period) and math.isfinite(depth)):
+        raise ValueError(f"wave period {period} s and depth {depth} m must be positive and finite")
     omega = 2 * math.pi / period
     k = max(omega * omega / g, omega / math.sqrt(g * depth))
     for _ in range(100):
@@ -218,15 +255,28 @@ def wave_number(period: float, depth: float, g: float = 9.81) -> float:
     return k
 
 
+# The transfer functions are written with q = exp(-kd) so that they hold without overflow
+# from shallow water to the deep-water limits (piston H/S -> 2, flap H/S -> 2 (1 - 1/kd)).
 def piston_height_to_stroke(k: float, d: float) -> float:
-    """Biesel transfer function of a piston: H/S."""
-    return 2 * (math.cosh(2 * k * d) - 1) / (math.sinh(2 * k * d) + 2 * k * d)
+    """Biesel transfer function of a piston: H/S = 2 (cosh 2kd − 1)/(sinh 2kd + 2kd)."""
+    x = k * d
+    e = math.exp(-2 * x)
+    return 2 * math.expm1(-2 * x) ** 2 / (-math.expm1(-4 * x) + 4 * x * e)
 
 
 def flap_height_to_stroke(k: float, d: float) -> float:
-    """Biesel transfer function of a flap hinged at the bottom: H/S (S at the free surface)."""
-    kd = k * d
-    return 4 * math.sinh(kd) / kd * (1 - math.cosh(kd) + kd * math.sinh(kd)) / (math.sinh(2 * kd) + 2 * kd)
+    """Biesel transfer function of a flap hinged at the bottom: H/S (S at the free surface),
+    4 sinh kd/kd · (1 − cosh kd + kd sinh kd)/(sinh 2kd + 2kd)."""
+    x = k * d
+    a = -math.expm1(-2 * x)          # 1 - q²
+    b = -math.expm1(-x)              # 1 - q
+    return 2 * a * (x * a - b * b) / (x * (-math.expm1(-4 * x) + 4 * x * math.exp(-2 * x)))
+
+
+def _coth_over_sinh2(x: float) -> float:
+    """cosh x / sinh³ x without overflow: 4 q² (1 + q²)/(1 − q²)³, q = exp(−x)."""
+    q2 = math.exp(-2 * x)
+    return 4 * q2 * (1 + q2) / (-math.expm1(-2 * x)) ** 3
 
 
 class WavePaddle:
@@ -249,9 +299,9 @@ class WavePaddle:
             self.second = 0.0
             if spec.get("waveorder", 1) == 2:
                 kd = self.k * d
-                self.second = (H * H / (32 * d)) * (3 * math.cosh(kd) / math.sinh(kd) ** 3 - 2 / m1) * self.gain
+                self.second = (H * H / (32 * d)) * (3 * _coth_over_sinh2(kd) - 2 / m1) * self.gain
             direction = np.asarray(spec.get("pistondir", [1, 0, 0]), float)
-            self.direction = direction / np.linalg.norm(direction)
+            self.direction = _unit(direction, f"piston mkbound={spec.get('mkbound')}: <pistondir>")
         else:
             m1 = flap_height_to_stroke(self.k, d)
             self.stroke = H / m1 * self.gain
@@ -262,7 +312,7 @@ class WavePaddle:
                               "the flap moves with first-order theory" % spec.get("mkbound"))
             self.hinge_depth = d + spec.get("variabledraft", 0.0)
             p0, p1 = np.asarray(spec["flapaxis0"], float), np.asarray(spec["flapaxis1"], float)
-            self.p0, self.axis = p0, (p1 - p0) / np.linalg.norm(p1 - p0)
+            self.p0, self.axis = p0, _unit(p1 - p0, f"flap mkbound={spec.get('mkbound')}: <flapaxis0> and <flapaxis1>")
 
     def _ramp(self, tau):
         if self.ramp_time <= 0 or tau >= self.ramp_time:

@@ -5,12 +5,15 @@ import numpy as np
 from ..errors import CaseError
 
 
-def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
-    """Numeric rows of ``path``, each with at least ``ncols`` columns -> (n, k):
-    k is the smallest column count over the rows; leading non-numeric lines
-    are headers, a non-numeric line after the data is an error."""
-    rows = []
+def _read_rows(path: str, ncols: int, what: str) -> tuple[np.ndarray, list]:
+    """Numeric rows of ``path`` and the line number of each (see :func:`read_columns`)."""
+    rows, lines = [], []
     try:
+        with open(path, "rb") as fb:
+            head = fb.read(4096)
+        if b"\x00" in head:
+            raise CaseError(f"{what}: not a text file (it holds NUL bytes)", file=path,
+                            expected="a text file of numbers in columns")
         with open(path, encoding="utf-8", errors="replace") as f:
             for lineno, line in enumerate(f, 1):
                 text = line.split("#", 1)[0].replace(";", " ").replace(",", " ").split()
@@ -21,17 +24,86 @@ def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
                 except ValueError:
                     if not rows:      # a header line
                         continue
-                    raise CaseError(f"{what}: '{line.strip()}' is not numeric", file=path,
+                    raise CaseError(f"{what}: '{line.strip()[:80]}' is not numeric", file=path,
                                     line=lineno, expected=f"{ncols} numbers per line") from None
                 if len(vals) < ncols:
                     raise CaseError(f"{what}: {len(vals)} column(s)", file=path, line=lineno,
                                     expected=f"{ncols} numbers per line")
                 rows.append(vals)
+                lines.append(lineno)
     except OSError as exc:
         raise CaseError(f"{what}: cannot read the file ({exc.strerror})", file=path,
                         expected="a readable file") from None
     k = min((len(r) for r in rows), default=ncols)
-    return np.asarray([r[:k] for r in rows], float).reshape(-1, k)
+    return np.asarray([r[:k] for r in rows], float).reshape(-1, k), lines
+
+
+def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
+    """Numeric rows of ``path``, each with at least ``ncols`` columns -> (n, k):
+    k is the smallest column count over the rows; leading non-numeric lines
+    are headers, a non-numeric line after the data is an error."""
+    return _read_rows(path, ncols, what)[0]
+
+
+def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.ndarray:
+    """A DualSPHysics motion file (``mvrectfile``/``mvrotfile``, JMotionDataFile): rows of
+    ``ncols`` numbers (the ``fields`` attribute), of which ``columns`` (name -> 0-based
+    column, ``fieldtime`` among them) are used. Checked as DualSPHysics needs them: at
+    least two rows, the used values finite, the times strictly rising. -> (n, ncols)."""
+    a, lines = _read_rows(path, ncols, what)
+    if a.shape[0] < 2:
+        found = "no data rows" if a.shape[0] == 0 else f"one data row (line {lines[0]})"
+        raise CaseError(f"{what}: {found}", file=path,
+                        expected=f"at least two lines of {ncols} numbers (time and position)")
+    a = a[:, :ncols]
+    for name, col in sorted(columns.items(), key=lambda kv: kv[1]):
+        bad = np.flatnonzero(~np.isfinite(a[:, col]))
+        if bad.size:
+            raise CaseError(f"{what}: column {col} ({name}) is {a[bad[0], col]}", file=path,
+                            line=lines[bad[0]], expected="finite numbers")
+    t = a[:, columns.get("fieldtime", 0)]
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        i = bad[0] + 1
+        raise CaseError(f"{what}: time {t[i]:g} does not come after {t[i - 1]:g} (line {lines[i - 1]})",
+                        file=path, line=lines[i], expected="strictly rising times")
+    return a
+
+
+# DualSPHysics's other names of ``mvrectfile`` (JMotion::ReadXml)
+MOTION_FILE_ALIASES = {"mvfile": "mvrectfile", "mvpredef": "mvrectfile"}
+
+
+def read_motion_file(reader, m, tag: str) -> dict:
+    """Read and check the ``<file>`` element of movement element ``m`` (``tag``: ``mvrectfile``,
+    its aliases included, or ``mvrotfile``) of ``mvrectfile``/``mvrotfile``: ``fields`` is the number of columns of
+    the file, ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``) 0-based column
+    indices, as DualSPHysics's JMotion reads them. The file is read and checked now."""
+    f = reader.child(m, "file", True)
+    path = reader.resolve_path(f, "name")
+    names = ("fieldtime", "fieldx", "fieldy", "fieldz") if tag == "mvrectfile" else ("fieldtime", "fieldang")
+    cols = {k: reader.integer(f, k, lo=0) for k in names if f.get(k) is not None}
+    cols.setdefault("fieldtime", 0)
+    if tag == "mvrotfile":
+        cols.setdefault("fieldang", 1)       # DualSPHysics's mvrotfile: time; angle
+    if f.get("fields") is not None:
+        ncols = reader.integer(f, "fields", lo=2)
+    else:
+        ncols = max(2, 1 + max(cols.values()))
+    for k, v in cols.items():
+        if v >= ncols:
+            raise reader.error(f, f"{k}={v} is not a column of a file of fields={ncols} columns "
+                               "(columns are numbered from 0)", f"0 <= {k} < {ncols}")
+        if k != "fieldtime" and v == cols["fieldtime"]:
+            raise reader.error(f, f"{k}={v} is the time column (fieldtime={v})", f"{k} another column than fieldtime")
+    if tag == "mvrectfile" and len(cols) == 1:
+        reader.warn(f, "none of fieldx, fieldy, fieldz is given: the movement does not move the object")
+    try:
+        read_motion_table(path, ncols, cols, "motion data")
+    except CaseError as exc:
+        where = path + (f":{exc.line}" if exc.line else "")
+        raise reader.error(f, f"{where}: {exc.message}", exc.expected) from None
+    return {"file": path, "fields": cols, "ncols": ncols}
 
 
 def _time_table(path: str, what: str, name: str, unit: str, positive: bool) -> np.ndarray:

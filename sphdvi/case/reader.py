@@ -382,7 +382,7 @@ def read_motion(reader, casedef) -> list:
                     refs[ref] = child.sourceline
                     out.append({"ref": ref, "line": child.sourceline, "parents": parents, **chain})
                 walk(child, parents + [chain])
-            elif child.tag in MOVEMENTS or child.tag in _file_aliases() or child.tag == "begin":
+            elif child.tag in MOVEMENTS or child.tag in ("mvfile", "mvpredef", "begin"):
                 continue
             else:
                 raise reader.error(child, f"unknown motion element <{child.tag}>",
@@ -391,14 +391,9 @@ def read_motion(reader, casedef) -> list:
     return out
 
 
-def _file_aliases() -> dict:
-    """DualSPHysics's other names of ``mvrectfile`` (JMotion::ReadXml)."""
-    return {"mvfile": "mvrectfile", "mvpredef": "mvrectfile"}
-
-
 def _read_movement_chain(reader, obj):
+    from .datafiles import MOTION_FILE_ALIASES as aliases, read_motion_file
     begin = reader.child(obj, "begin")
-    aliases = _file_aliases()
     movs, elements = {}, {}
     order = []
     for m in reader.children(obj):
@@ -421,7 +416,7 @@ def _read_movement_chain(reader, obj):
         d["anglesunits"] = units
         for part in MOVEMENTS[tag]:
             if part == "file":
-                d.update(_read_motion_file(reader, m, tag))
+                d.update(read_motion_file(reader, m, tag))
                 continue
             c = reader.child(m, part)
             if c is None:
@@ -476,38 +471,6 @@ def _read_movement_chain(reader, obj):
                                    "(their durations add up to 0)",
                                    "a positive duration in the loop, or a movement without next")
     return chain
-
-
-def _read_motion_file(reader, m, tag) -> dict:
-    """The ``<file>`` of ``mvrectfile``/``mvrotfile``: ``fields`` is the number of columns of
-    the file, ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``) 0-based column
-    indices, as DualSPHysics's JMotion reads them. The file is read and checked now."""
-    from .datafiles import read_motion_table
-    f = reader.child(m, "file", True)
-    path = reader.resolve_path(f, "name")
-    names = ("fieldtime", "fieldx", "fieldy", "fieldz") if tag == "mvrectfile" else ("fieldtime", "fieldang")
-    cols = {k: reader.integer(f, k, lo=0) for k in names if f.get(k) is not None}
-    cols.setdefault("fieldtime", 0)
-    if tag == "mvrotfile":
-        cols.setdefault("fieldang", 1)       # DualSPHysics's mvrotfile: time; angle
-    if f.get("fields") is not None:
-        ncols = reader.integer(f, "fields", lo=2)
-    else:
-        ncols = max(2, 1 + max(cols.values()))
-    for k, v in cols.items():
-        if v >= ncols:
-            raise reader.error(f, f"{k}={v} is not a column of a file of fields={ncols} columns "
-                               "(columns are numbered from 0)", f"0 <= {k} < {ncols}")
-        if k != "fieldtime" and v == cols["fieldtime"]:
-            raise reader.error(f, f"{k}={v} is the time column (fieldtime={v})", f"{k} another column than fieldtime")
-    if tag == "mvrectfile" and len(cols) == 1:
-        reader.warn(f, "none of fieldx, fieldy, fieldz is given: the movement does not move the object")
-    try:
-        read_motion_table(path, ncols, cols, f"<{m.tag}> file")
-    except CaseError as exc:
-        raise reader.error(f, f"{exc.message} ({path}" + (f", line {exc.line}" if exc.line else "") + ")",
-                           exc.expected) from None
-    return {"file": path, "fields": cols, "ncols": ncols}
 
 
 MATERIAL_KEYS = {"Young_Modulus": "young", "PoissonRatio": "poisson",
