@@ -945,12 +945,29 @@ def read_wavepaddles(reader, el) -> list:
             raise reader.error(c, f"waveorder {d['waveorder']}", "1 or 2")
         for k in ("depth", "waveheight", "waveperiod"):
             if d[k] <= 0:
-                raise reader.error(c, f"<{k}> must be positive", f"{k} > 0")
+                raise reader.error(reader.child(c, k), f"<{k}> must be positive", f"{k} > 0")
+        for k, what in (("start", "seconds"), ("duration", "seconds, 0: until the end"), ("ramp", "wave periods")):
+            if d.get(k, 0.0) < 0:
+                raise reader.error(reader.child(c, k), f"<{k}> value={d[k]:g} is negative", f"{k} >= 0 ({what})")
         if c.tag == "flap" and d["waveorder"] == 2:
             raise reader.error(c, "second-order generation is not supported for flaps by sphdvi",
                                "waveorder 1 for a <flap> (a <piston> supports 2)")
         if c.tag == "flap" and ("flapaxis0" not in d or "flapaxis1" not in d):
             raise reader.error(c, "missing <flapaxis0>/<flapaxis1>", "the two points of the hinge axis")
+        if c.tag == "flap" and d["flapaxis0"] == d["flapaxis1"]:
+            raise reader.error(reader.child(c, "flapaxis1"), f"<flapaxis0> and <flapaxis1> are the same point "
+                               f"{d['flapaxis0']}, so they define no hinge axis", "two distinct points on the hinge axis")
+        if c.tag == "piston" and "pistondir" in d and not any(d["pistondir"]):
+            raise reader.error(reader.child(c, "pistondir"), "<pistondir> is the zero vector",
+                               "the direction of the piston's stroke, e.g. x=1 y=0 z=0")
+        for k, what in (("awas_zsurf", "active wave absorption (AWAS) is not implemented by sphdvi: the paddle "
+                                       "follows the theoretical stroke and absorbs no reflected waves"),
+                        ("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
+                                        "regular-wave theory"),
+                        ("savemotion", "<savemotion> (the paddle motion written to a file) is not implemented "
+                                       "by sphdvi: no file is written")):
+            if k in d:
+                reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
         d.setdefault("start", 0.0)
         d.setdefault("duration", 0.0)
         d.setdefault("gainstroke", 1.0)
@@ -958,6 +975,12 @@ def read_wavepaddles(reader, el) -> list:
         d.setdefault("ramp", 0.0)
         if c.tag == "piston":
             d.setdefault("pistondir", [1.0, 0.0, 0.0])
+        try:       # the stroke from the wave theory: fails here, not at the first step of the run
+            from ..motion import WavePaddle
+            WavePaddle(d)
+        except (ArithmeticError, ValueError, CaseError) as exc:
+            raise reader.error(c, f"cannot compute the paddle's stroke: {exc}",
+                               "a wave period and depth of a real wave") from None
         out.append(d)
     return out
 
