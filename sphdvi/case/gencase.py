@@ -74,6 +74,7 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     if drawing.pos.shape[0] == 0:
         raise reader.error(geometry, "the geometry commands created no particles",
                            "drawing commands inside <mainlist> that create particles inside pointmin..pointmax")
+    warn_no_fluid(drawing, reader)
     fluid_z = drawing.pos[drawing.is_fluid, 2]
     consts = resolve_constants(cdef, drawing.dp, drawing.is2d, drawing.posy2d, fluid_z)
     if fluid_z.size and not consts.cs0 > 0:
@@ -94,6 +95,25 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
                          mkinfo=mkinfo, warnings=warnings, primitives=list(drawing.primitives),
                          files=list(drawing.shape_files))
+
+
+def warn_no_fluid(drawing, reader) -> None:
+    """Warn when fluid was drawn or filled (``setmkfluid`` + a drawing or fill command) but no
+    fluid particle is left; cases without any fluid command stay silent."""
+    fluid_cmds = [p for p in drawing.primitives if p.get("fluid")]
+    if not fluid_cmds or drawing.count_fluid:
+        return
+    lines = sorted({p["line"] for p in fluid_cmds if p.get("line")})
+    where = (f" (line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines[:10]))}"
+             f"{', ...' if len(lines) > 10 else ''})") if lines else ""
+    made = sum(int(p.get("nodes") or 0) for p in fluid_cmds)
+    why = ("later drawing commands replaced all of them" if made else
+           "they created none (a fill seed on a boundary or outside its box, a shape outside "
+           "pointmin..pointmax, or drawpoints disabled)")
+    reader.warnings.add(f"no fluid particles were created: the {len(fluid_cmds)} fluid "
+                        f"command{'s' if len(fluid_cmds) > 1 else ''}{where} drew or filled "
+                        f"fluid, but {why}; the case has no fluid",
+                        file=reader.file, line=lines[0] if lines else None, element="geometry")
 
 
 # ---------------------------------------------------------------------------

@@ -23,6 +23,8 @@ from .expressions import ExpressionError, Variables
 
 MAX_CASE_BYTES = 64 * 1024 * 1024
 IGNORED_ATTRIBUTES = {"comment", "units_comment", "comment2", "rem"}
+#: attributes GenCase writes itself (its output case files are valid input), per element
+GENERATED_ATTRIBUTES = {"case": {"app", "date"}}
 REQUIRED = object()
 _TRUE = {"true", "1", "yes"}
 _FALSE = {"false", "0", "no"}
@@ -344,6 +346,7 @@ class CaseReader:
         for el, names in list(self._read.items()):
             for attr in el.keys():
                 if attr in names or attr in IGNORED_ATTRIBUTES or attr.startswith("_") \
-                        or attr == "active" or attr.endswith("_comment"):
+                        or attr == "active" or attr.endswith("_comment") \
+                        or attr in GENERATED_ATTRIBUTES.get(el.tag, ()):
                     continue
                 self.warn(el, f"unknown attribute '{attr}' ignored")

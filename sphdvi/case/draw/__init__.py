@@ -44,12 +44,23 @@ Surfaces (see :mod:`.raster`)
     nearest nodes). Curved surfaces: the inner shell (inside nodes with an
     outside face-neighbour). Both are closed against face-connected leaks.
 
-Masks
-    ``mask`` is a bit set (values joined by ``|`` are OR-ed): bit ``2**i``
-    hides face ``i``. Cylinder: 1 = cover at the first point, 2 = cover at
-    the second point, 4 = side. Prism (base points, then top points): 1 = base,
-    2 = top, 4, 8, ... = sides (side i joins base points i and i+1). Pyramid
-    (apex, then base points): 1 = base, 2, 4, ... = sides.
+Masks (``drawprism``, ``drawpyramid``, ``drawcylinder``)
+    ``mask`` lists the numbers (from 1) of the faces left out, joined by ``|``
+    (``mask="1 | 2 | 6 | 7"`` leaves out faces 1, 2, 6 and 7; ``0`` none;
+    numbers beyond the shape's faces are ignored). Prism (first polygon, then
+    second polygon): 1 = first polygon, 2 = second polygon, 3, 4, ... = sides
+    (side k joins points k-2 and k-1 of each polygon, the last one closes it).
+    Pyramid (apex, then base points): 1 = base, 2, 3, ... = sides apex-P1P2,
+    apex-P2P3, ... Cylinder: 1 = cover at the first point, 2 = cover at the
+    second point, 3 = tube. A shape with a face left out is open and has no
+    inside: ``full`` draws its remaining faces only, ``solid`` draws nothing
+    (warning), ``wire`` the edges of the remaining faces.
+    Evidence: the DualSPHysics v5.4 examples CaseWavemaker, CasePointAbsorber
+    and CaseFloatingWavesVal only make sense with faces listed (as bits their
+    masks would draw a lid, a diagonal through the water or a wall over the
+    piston), and their fillbox seeds (or the fluid drawn before) lie inside
+    the masked prism drawn in full mode, so GenCase leaves it hollow. The
+    cylinder and pyramid numbering is inferred (caps first, like prisms).
 
 Ellipsoid
     ``<point>`` (or ``<center>``) + ``<radius x y z>`` (or ``<size>``):
@@ -77,6 +88,17 @@ Layers (``<layers vdp="0,1,-0.5*">`` in drawbox, drawsphere, drawcylinder)
     The shape is drawn once per offset, widened by offset*dp on every side
     (box), on the radius (sphere), on the radius and at both covers
     (cylinder); negative offsets shrink it. A trailing ``*`` is ignored.
+
+``resetdraw``
+    Back to the initial drawing configuration: no mk selected, ``full`` mode,
+    identity matrix, points and shapes active (``setactive``), ``full`` box
+    limits, no line start. Variables, lists, saved stacks (``matrixsave``,
+    ``statesave``, ``mksave``) and the particles drawn so far are kept (a
+    warning when there are some: GenCase's treatment is not documented).
+
+``setboxlimitmode``
+    ``full`` (GenCase's default, the box rules above) is accepted; ``inner``
+    is refused (its node rule is not documented).
 
 Not supported (CaseError "not supported by sphdvi"): see ``UNSUPPORTED``
 (bathymetry, waves, beaches, extrusions, redraw, clipping, patterns, ...)

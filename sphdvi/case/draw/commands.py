@@ -30,10 +30,11 @@ SKIPPED_ATTRS = {"comment", "units_comment", "comment2", "rem", "active"}
 UNSUPPORTED = {
     "drawbathymetry", "drawwave", "drawbeach", "drawextrude", "drawfilevtm", "drawfilecsv",
     "redraw", "redrawbox", "redrawnear", "redrawnearbox", "clipdomain", "clipplane", "clipbox",
-    "clipreset", "setpattern", "patterns", "fillfigure", "fillprism", "setboxlimitmode",
+    "clipreset", "setpattern", "patterns", "fillfigure", "fillprism",
     "setmknextfluid", "setmknextbound", "setmknextauto", "setmkbackvoid", "setmkbackfluid",
-    "setmkbackbound", "setmkbackclear", "setfrdrawmode", "resetdraw", "rotateadv",
+    "setmkbackbound", "setmkbackclear", "setfrdrawmode", "rotateadv",
 }
+BOX_LIMIT_MODES = {"full", "inner"}
 #: commands accepted without effect (they tune GenCase's own output or sampling)
 NO_EFFECT = {"setdpctes", "dpctessave", "dpctesload", "dpctesreset", "setshapemode",
              "setnormalinvert", "exportvar", "debugout", "cellsout", "pointsmkout"}
@@ -76,10 +77,11 @@ class DrawState:
     matrix: np.ndarray = field(default_factory=tf.identity)
     draw_points: bool = True
     draw_shapes: bool = True
+    box_limit: str = "full"      # setboxlimitmode (only "full" is supported)
 
     def copy(self) -> "DrawState":
         return DrawState(self.kind, self.mk, self.mode, self.matrix.copy(), self.draw_points,
-                         self.draw_shapes)
+                         self.draw_shapes, self.box_limit)
 
 
 def _point_summary(pts: np.ndarray, keep: int = 100) -> dict:
@@ -128,7 +130,7 @@ class GeometryRunner:
         names = ["newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",
                  "delvar", "varssave", "varsload", "printf", "abort", "runlist",
                  "setmkfluid", "setmkbound", "setmkvoid", "mksave", "mkload", "setdrawmode",
-                 "setactive", "move", "scale", "rotate", "rotateline", "matrixreset",
+                 "setactive", "resetdraw", "setboxlimitmode", "move", "scale", "rotate", "rotateline", "matrixreset",
                  "matrixsave", "matrixload", "statesave", "stateload",
                  "drawpoint", "drawpoints", "drawline", "drawlines", "setlinebegin", "drawlineto",
                  "drawtriangle", "drawquadri", "drawtrianglesstrip", "drawtrianglesfan",
@@ -222,10 +224,13 @@ class GeometryRunner:
             self.shape_triangles += len(tris)
             self.shapes.append({"triangles": tris, "mk": prim["mk"], "fluid": prim["fluid"]})
 
-    def _mask(self, el) -> int:
-        """The ``mask`` attribute: integers combined with ``|`` (bitwise OR)."""
+    def _mask(self, el) -> frozenset:
+        """The ``mask`` attribute: the numbers (from 1) of the faces left out, joined by ``|``.
+
+        ``mask="1 | 2 | 6 | 7"`` hides faces 1, 2, 6 and 7 (a list, not a bit set); 0 hides none.
+        """
         text = self.reader.text_attr(el, "mask", "0")
-        value = 0
+        hidden = set()
         for tok in str(text).split("|"):
             tok = tok.strip()
             if not tok:
@@ -234,12 +239,27 @@ class GeometryRunner:
                 v = float(self.vars.number(tok[1:] if tok.startswith("#") else tok))
             except ExpressionError:
                 raise self.reader.error(el, f"mask={text!r} is not valid",
-                                        "integers joined by |, e.g. mask=\"1 | 2\"") from None
+                                        "face numbers joined by |, e.g. mask=\"1 | 2\"") from None
             if v != int(v) or v < 0 or v > 2**31:
                 raise self.reader.error(el, f"mask={text!r} is not valid",
-                                        "non-negative integers joined by |")
-            value |= int(v)
-        return value
+                                        "non-negative integer face numbers joined by |")
+            if v > 0:
+                hidden.add(int(v))
+        return frozenset(hidden)
+
+    def _open_shape_flags(self, el, hidden: frozenset, nfaces: int):
+        """(solid, faces, wire) of a shape with ``nfaces`` faces of which ``hidden`` are left out.
+
+        Only a closed shape has an inside: with a face left out, ``full`` draws the remaining
+        faces alone and ``solid`` draws nothing (warning).
+        """
+        solid, surface, wire = self._mode_flags()
+        if any(1 <= f <= nfaces for f in hidden):
+            if self.state.mode == "solid":
+                self.reader.warn(el, f"mask leaves faces {sorted(f for f in hidden if f <= nfaces)} "
+                                     "out: an open shape has no inside, nothing drawn in solid mode")
+            solid = False
+        return solid, surface, wire
 
     def _mode_flags(self):
         """(solid, surface, wire) for the current draw mode."""
@@ -365,6 +385,24 @@ class GeometryRunner:
         self.state.draw_points = self.reader.boolean(el, "drawpoints", self.state.draw_points)
         self.state.draw_shapes = self.reader.boolean(el, "drawshapes", self.state.draw_shapes)
         self.reader.boolean(el, "vtkout", True)
+
+    def cmd_resetdraw(self, el):
+        """Back to the initial drawing configuration: no mk selected, ``full`` mode, identity
+        matrix, points and shapes active, ``full`` box limits, no line start. Variables, lists,
+        the saved stacks and everything drawn so far are kept."""
+        if self.state.draw_points and self.canvas is not None and self.canvas.codes.any():
+            self.reader.warn(el, "particles were drawn before <resetdraw>; sphdvi keeps them "
+                                 "(GenCase's treatment of them is not documented)")
+        self.state = DrawState()
+        self.line_begin = None
+
+    def cmd_setboxlimitmode(self, el):
+        mode = self.reader.text_attr(el, "mode", choices=BOX_LIMIT_MODES).lower()
+        if mode == "inner":
+            raise self.reader.error(el, "setboxlimitmode mode=\"inner\" is not supported by sphdvi",
+                                    "mode=\"full\" (GenCase's default box limits, the only ones "
+                                    "sphdvi draws)")
+        self.state.box_limit = mode
 
     # ------------------------------------------------------------ transforms
     def _compose(self, el, m) -> None:
@@ -680,6 +718,10 @@ class GeometryRunner:
         p = self._points(el, exact=2)
         mask = self._mask(el)
         solid, shell = self._curved_flags()
+        if any(1 <= f <= 3 for f in mask):
+            # an open cylinder (a cover or the tube left out) has no inside: its faces only
+            solid = self._open_shape_flags(el, mask, 3)[0]
+            shell = self.state.mode != "solid"
         length = float(np.linalg.norm(p[1] - p[0]))
         if not length > 0:
             raise self.reader.error(el, "the two points of the cylinder axis coincide",
@@ -695,7 +737,7 @@ class GeometryRunner:
             pieces, params, tris = shapes.draw_cylinder(
                 self.lat, self.state.matrix, p[0] - grow * u, p[1] + grow * u, r,
                 solid=solid, shell=shell, mask=mask)
-            params["mask"] = mask
+            params["mask"] = sorted(mask)
             params["layer"] = layer
             n = self._paint(el, pieces)
             self._record(el, "cylinder", params, tris, solid, n)
@@ -703,11 +745,11 @@ class GeometryRunner:
     # ------------------------------------------------------------ polyhedra
     def _draw_polyhedron(self, el, verts, faces, shape):
         mask = self._mask(el)
-        solid, surface, wire = self._mode_flags()
+        solid, surface, wire = self._open_shape_flags(el, mask, len(faces))
         pieces, params, tris = shapes.draw_polyhedron(self.lat, self.state.matrix, verts, faces,
                                                       solid=solid, surface=surface, wire=wire,
                                                       mask=mask)
-        params["mask"] = mask
+        params["mask"] = sorted(mask)
         n = self._paint(el, pieces)
         self._record(el, shape, params, tris, solid, n)
 

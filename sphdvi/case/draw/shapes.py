@@ -95,9 +95,10 @@ def local_tol(m: np.ndarray, dp: float) -> float:
     return EPS * dp / max(float(sv.min()), 1e-300)
 
 
-def mask_bits(mask: int, count: int) -> list[bool]:
-    """Which of ``count`` faces are drawn: face i is hidden when bit 2**i is set in mask."""
-    return [not (mask >> i) & 1 for i in range(count)]
+def drawn_faces(hidden, count: int) -> list[bool]:
+    """Which of ``count`` faces are drawn: face i (0-based) is hidden when its GenCase number
+    i + 1 is listed in ``hidden`` (the ``mask`` attribute; numbers beyond ``count`` hide nothing)."""
+    return [(i + 1) not in hidden for i in range(count)]
 
 
 # ---------------------------------------------------------------- box
@@ -245,8 +246,9 @@ def foci_ellipsoid(f1, f2, radius):
 
 
 # ---------------------------------------------------------------- cylinder
-def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, mask: int):
-    """Cylinder of axis p1->p2. Faces (mask bits): 1 = cover at p1, 2 = cover at p2, 4 = side."""
+def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, mask=frozenset()):
+    """Cylinder of axis p1->p2. Faces (numbers listed in mask are hidden): 1 = cover at p1,
+    2 = cover at p2, 3 = side (tube). ``shell`` draws the inner shell of the faces not hidden."""
     p1, p2 = np.asarray(p1, dtype=np.float64), np.asarray(p2, dtype=np.float64)
     L = float(np.linalg.norm(p2 - p1))
     if not L > 0:
@@ -257,7 +259,7 @@ def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, 
 
     def cons(qx, qy, qz):
         return [qx >= -tol, qx <= L + tol, qy * qy + qz * qz <= (radius + tol) ** 2]
-    drawn = mask_bits(mask, 3)
+    drawn = drawn_faces(mask, 3)
     shell_faces = tuple(i for i in range(3) if drawn[i]) if shell else ()
     pieces = raster.analytic_pieces(lat, full, np.array([0.0, -radius, -radius]),
                                     np.array([L, radius, radius]), cons, solid=solid,
@@ -299,10 +301,14 @@ def pyramid_faces(n: int):
 
 
 def draw_polyhedron(lat: Lattice, m, verts, faces, *, solid: bool, surface: bool, wire: bool,
-                    mask: int):
-    """A closed polyhedron: inside by parity, faces (mask bits 2**i hide face i) by triangles."""
+                    mask=frozenset()):
+    """A polyhedron: inside by parity, faces by triangles, edges by segments.
+
+    Face ``i`` (0-based) is hidden when ``i + 1`` is listed in ``mask``; the wire edges are those
+    of the faces drawn. The caller decides whether the inside is drawn (only closed shapes have one).
+    """
     w = tf.apply(m, verts)
-    drawn = mask_bits(mask, len(faces))
+    drawn = drawn_faces(mask, len(faces))
     all_tris = faces_to_triangles(w, faces)
     pieces = []
     if solid:
@@ -312,6 +318,7 @@ def draw_polyhedron(lat: Lattice, m, verts, faces, *, solid: bool, surface: bool
         if shown:
             pieces += raster.triangle_pieces(lat, faces_to_triangles(w, shown))
     if wire:
-        pieces += raster.segment_pieces(lat, [w[[a, b]] for a, b in face_edges(faces)])
+        shown = [f for f, d in zip(faces, drawn) if d]
+        pieces += raster.segment_pieces(lat, [w[[a, b]] for a, b in face_edges(shown)])
     params = {"vertices": w.tolist(), "faces": [list(f) for f in faces]}
     return pieces, params, all_tris

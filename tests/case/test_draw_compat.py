@@ -1,0 +1,250 @@
+"""GenCase compatibility of the drawing commands found in the DualSPHysics v5.4 examples:
+``mask`` lists the faces left out (and an open shape has no inside), ``<resetdraw>``,
+``<setboxlimitmode>``, GenCase's own ``<case app date>`` attributes and the no-fluid warning."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from casetext import case_xml, write_case
+from test_draw import CYL, PRISM, draw, nodes
+
+from sphdvi.case.gencase import build_case
+from sphdvi.errors import CaseError
+
+
+def warnings_of(tmp_path, body, **kw):
+    from lxml import etree
+
+    from sphdvi.case.draw import run_geometry
+    from sphdvi.case.xmldoc import CaseReader
+    from test_draw import geometry_xml
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    d = run_geometry(reader, etree.fromstring(geometry_xml(body, **kw)), casename="case",
+                     outdir=None)
+    return d, list(reader.warnings)
+
+
+# ---------------------------------------------------------------- mask = faces left out
+# CaseFloatingWavesVal (v5.4 example 08) scaled to dp = 1: a flume drawn as a prism whose
+# faces are 1 = polygon at y=-1, 2 = polygon at y=1, 3 = P1P2 (end wall x=-5), 4 = P2P3
+# (bottom z=0), 5 = P3P4 (beach slope), 6 = P4P1 (lid z=6). mask="1|2|3|6" keeps the bottom
+# and the slope; the fillbox seed lies inside the prism and must find void.
+FLUME = """<setdrawmode mode="{mode}"/><setmkbound mk="0"/>
+<drawprism mask="{mask}">
+<point x="-5" y="-1" z="6"/><point x="-5" y="-1" z="0"/><point x="4" y="-1" z="0"/>
+<point x="10" y="-1" z="6"/>
+<point x="-5" y="1" z="6"/><point x="-5" y="1" z="0"/><point x="4" y="1" z="0"/>
+<point x="10" y="1" z="6"/></drawprism>
+<setmkfluid mk="0"/><fillbox x="1" y="0" z="1"><modefill>void</modefill>
+<point x="-2" y="-1" z="-0.5"/><size x="25" y="2" z="4.5"/></fillbox>"""
+FLUME_KW = dict(pmin=(-6, 0, -1), pmax=(12, 0, 8))
+
+
+@pytest.mark.parametrize("mode", ["full", "face"])
+def test_prism_mask_lists_hidden_faces(tmp_path, mode):
+    d = draw(tmp_path, FLUME.format(mode=mode, mask="1|2|3|6"), **FLUME_KW)
+    bound = nodes(d, fluid=False)
+    # bottom z=0 from x=-5 to 4 and the slope z = x - 4 up to (10, 6): nothing else
+    assert bound == {(x, 0, 0) for x in range(-5, 5)} | {(x, 0, x - 4) for x in range(5, 11)}
+    assert not any(z == 6 and x < 10 for x, _, z in bound)          # no lid (face 6)
+    assert not any(x == -5 and z > 0 for x, _, z in bound)          # no end wall (face 3)
+    # the fluid fills the flume above the bottom, left of the slope, up to the fillbox top
+    assert nodes(d, fluid=True) == {(x, 0, z) for z in range(1, 5) for x in range(-2, z + 4)}
+    assert d.count_fluid == 34
+    assert d.primitives[0]["params"]["mask"] == [1, 2, 3, 6] and not d.primitives[0]["solid"]
+
+
+def test_prism_mask_is_not_a_bit_set(tmp_path):
+    # as bits, 1|2|3|6 = 7 would hide the first three faces (1, 2, 3) and draw the lid
+    d = draw(tmp_path, FLUME.format(mode="full", mask="1|2|3"), **FLUME_KW)
+    bound = nodes(d, fluid=False)
+    assert (0, 0, 6) in bound and (-5, 0, 3) not in bound and d.count_fluid == 34
+    d = draw(tmp_path, FLUME.format(mode="full", mask="1|2|6"), **FLUME_KW)
+    assert (0, 0, 6) not in nodes(d, fluid=False) and (-5, 0, 3) in nodes(d, fluid=False)
+    d = draw(tmp_path, FLUME.format(mode="full", mask="0"), **FLUME_KW)
+    assert d.count_fluid == 0          # closed: the inside is boundary, the seed finds no void
+
+
+def test_wavemaker_pattern_keeps_fluid_drawn_before(tmp_path):
+    # CaseWavemaker: fluid prism (mask 0), then the same prism as boundary with faces left out
+    # in full mode; GenCase leaves the fluid inside (the face-mode variant gives the same)
+    pts = ('<point x="5" y="{y}" z="1.5"/><point x="5" y="{y}" z="1.1"/><point x="1" y="{y}" z="0"/>'
+           '<point x="0" y="{y}" z="0"/><point x="0" y="{y}" z="1.5"/>')
+    prism = "<drawprism mask=\"{m}\">" + pts.format(y=0) + pts.format(y=2) + "</drawprism>"
+    body = ('<setdrawmode mode="full"/><setmkfluid mk="0"/>' + prism.format(m="0")
+            + '<setmkvoid/><drawbox><boxfill>solid</boxfill><point x="0" y="0" z="0.75"/>'
+            '<size x="5" y="2" z="1"/></drawbox>'
+            + '<setdrawmode mode="{mode}"/><setmkbound mk="0"/>' + prism.format(m="1 | 2 | 6 | 7"))
+    kw = dict(dp=0.1, pmin=(-0.1, -0.05, -0.05), pmax=(5.1, 2.1, 2))
+    full = draw(tmp_path, body.replace("{mode}", "full"), **kw)
+    face = draw(tmp_path, body.replace("{mode}", "face"), **kw)
+    assert full.count_fluid == face.count_fluid > 1500
+    assert np.array_equal(full.pos, face.pos) and np.array_equal(full.is_fluid, face.is_fluid)
+    b = full.pos[~full.is_fluid]
+    assert not np.any((b[:, 0] < 0.05) & (b[:, 2] > 0.05))   # no face 6 (x = 0, the piston)
+    assert not np.any(np.isclose(b[:, 2], 1.5) & (b[:, 0] < 4.9))   # no face 7 (the top)
+    fluid_y = full.pos[full.is_fluid, 1]
+    assert fluid_y.min() < 0.1 and fluid_y.max() > 1.9     # no y caps (faces 1, 2) over it
+
+
+def test_mask_numbers_beyond_the_faces_are_ignored(tmp_path):
+    # a 6-face prism with mask="7" (CasePointAbsorber copies the 7 of a 7-face prism) is closed
+    assert len(draw(tmp_path, PRISM.format(mode="full", mask="7")).pos) == 45
+    assert len(draw(tmp_path, CYL.format(mode="full", mask="4")).pos) == 45
+
+
+@pytest.mark.parametrize("mode,mask,count", [
+    ("face", "1 | 2", 5 * 8), ("face", "3", 9 + 9), ("face", "1 | 3", 9), ("face", "2", 9 + 4 * 8),
+    ("full", "2", 9 + 4 * 8), ("full", "3", 9 + 9), ("full", "0", 45), ("full", "1|2|3", 0)])
+def test_cylinder_mask_faces(tmp_path, mode, mask, count):
+    # faces 1 = cover at the first point (z=2), 2 = cover at the second point (z=6), 3 = tube
+    d = draw(tmp_path, CYL.format(mode=mode, mask=mask))
+    assert len(d.pos) == count
+
+
+def test_open_cylinder_in_full_mode_is_a_cup(tmp_path):
+    body = CYL.format(mode="full", mask="2") + (
+        '<setmkfluid mk="0"/><fillbox x="5" y="5" z="4"><modefill>void</modefill>'
+        '<point x="0" y="0" z="0"/><size x="10" y="10" z="6"/></fillbox>')
+    d = draw(tmp_path, body)
+    assert nodes(d, fluid=True) == {(5, 5, z) for z in (3, 4, 5, 6)}
+    assert (5, 5, 2) in nodes(d, fluid=False) and d.count_bound == 41
+
+
+def test_pyramid_mask_faces(tmp_path):
+    # faces 1 = base, 2, 3, 4 = sides apex-P1P2, apex-P2P3, apex-P3P1
+    body = ('<setdrawmode mode="{mode}"/><setmkbound mk="0"/><drawpyramid mask="{mask}">'
+            '<point x="0" y="0" z="3"/><point x="0" y="0" z="0"/><point x="3" y="0" z="0"/>'
+            '<point x="0" y="3" z="0"/></drawpyramid>')
+    closed = nodes(draw(tmp_path, body.format(mode="face", mask="0")))
+    no_y0 = nodes(draw(tmp_path, body.format(mode="face", mask="2")))
+    assert {(1, 0, 1), (2, 0, 0)} <= closed and (1, 0, 1) not in no_y0 and (1, 1, 0) in no_y0
+    # the template's mask="1 | 3 | 5" (5 does not exist) opens the shape: faces only in full mode
+    assert nodes(draw(tmp_path, body.format(mode="full", mask="1 | 3 | 5"))) == \
+        nodes(draw(tmp_path, body.format(mode="face", mask="1 | 3")))
+
+
+def test_open_shape_in_solid_mode_draws_nothing_and_warns(tmp_path):
+    d, w = warnings_of(tmp_path, PRISM.format(mode="solid", mask="2"))
+    assert len(d.pos) == 0 and any("open shape has no inside" in m for m in w)
+    d, w = warnings_of(tmp_path, CYL.format(mode="solid", mask="3"))
+    assert len(d.pos) == 0 and any("faces [3]" in m for m in w)
+
+
+@pytest.mark.parametrize("mask", ["top", "-1", "1.5", "1 | x"])
+def test_bad_mask(tmp_path, mask):
+    with pytest.raises(CaseError, match="mask") as e:
+        draw(tmp_path, PRISM.format(mode="full", mask=mask))
+    assert e.value.element == "drawprism" and e.value.line
+
+
+# ---------------------------------------------------------------- resetdraw
+NORMALS_LIST = """<list name="GeometryForNormals">
+<setactive drawpoints="0" drawshapes="1"/><setshapemode>actual | bound</setshapemode>
+<setnormalinvert invert="true"/><setdrawmode mode="face"/><move x="3" y="0" z="0"/>
+<setmkbound mk="0"/>
+<drawbox><boxfill>all</boxfill><point x="1" y="1" z="1"/><size x="4" y="4" z="4"/>
+<layers vdp="-0.5"/></drawbox>
+<shapeout file="hdp"/><resetdraw/></list>"""
+
+
+def test_resetdraw_after_normals_geometry(tmp_path):
+    # the v5.x mDBC pattern: shapes only, then <resetdraw/> re-enables drawing points
+    body = ('<runlist name="GeometryForNormals"/><setmkfluid mk="0"/>'
+            '<drawbox><boxfill>solid</boxfill><point x="1" y="1" z="1"/><size x="2" y="2" z="2"/>'
+            '</drawbox>')
+    d, w = warnings_of(tmp_path, body, lists=NORMALS_LIST)
+    assert w == []
+    # full mode and identity matrix again: the solid 3x3x3 box at 1..3, not moved by x=3
+    assert nodes(d, fluid=True) == {(x, y, z) for x in (1, 2, 3) for y in (1, 2, 3)
+                                    for z in (1, 2, 3)}
+
+
+def test_resetdraw_clears_the_pen(tmp_path):
+    body = ('<runlist name="GeometryForNormals"/>'
+            '<drawbox><boxfill>solid</boxfill><point x="1" y="1" z="1"/><size x="2" y="2" z="2"/>'
+            '</drawbox>')
+    with pytest.raises(CaseError, match="no mk selected") as e:
+        draw(tmp_path, body, lists=NORMALS_LIST)
+    assert e.value.element == "drawbox"
+
+
+def test_resetdraw_keeps_what_was_drawn_and_warns(tmp_path):
+    body = ('<setmkbound mk="2"/><drawpoint x="1" y="1" z="1"/><matrixsave/><resetdraw/>'
+            '<matrixload/><setmkfluid mk="0"/><drawpoint x="2" y="2" z="2"/>')
+    d, w = warnings_of(tmp_path, body)
+    assert nodes(d) == {(1, 1, 1), (2, 2, 2)}
+    assert any("particles were drawn before <resetdraw>" in m for m in w)
+
+
+# ---------------------------------------------------------------- setboxlimitmode
+def test_setboxlimitmode_full_is_the_default(tmp_path):
+    box = ('<setmkfluid mk="0"/><drawbox><boxfill>solid</boxfill><point x="0.5" y="0.5" '
+           'z="0.5"/><size x="2.2" y="2" z="2.5"/></drawbox>')
+    plain = draw(tmp_path, box)
+    full = draw(tmp_path, '<setboxlimitmode mode="full"/>' + box)
+    assert np.array_equal(plain.pos, full.pos) and len(full.pos) > 0
+
+
+@pytest.mark.parametrize("mode,fragment", [("inner", "not supported"), ("half", "not recognised")])
+def test_setboxlimitmode_refused(tmp_path, mode, fragment):
+    with pytest.raises(CaseError, match=fragment) as e:
+        draw(tmp_path, f'<setboxlimitmode mode="{mode}"/>')
+    assert e.value.element == "setboxlimitmode" and e.value.line
+
+
+def test_setboxlimitmode_inner_exits_2_from_the_cli(tmp_path):
+    from click.testing import CliRunner
+
+    from sphdvi.cli import main
+    path = write_case(tmp_path, case_xml(commands='<setboxlimitmode mode="inner"/>'))
+    res = CliRunner().invoke(main, ["gencase", path, "-o", str(tmp_path / "out")])
+    assert res.exit_code == 2
+    out = res.output
+    assert "Case_Def.xml:" in out and "<setboxlimitmode>" in out and "inner" in out
+    assert "expected" in out and "Traceback" not in out
+
+
+# ---------------------------------------------------------------- whole cases
+def test_gencase_app_and_date_attributes_are_accepted(tmp_path):
+    text = case_xml().replace("<case>", '<case app="GenCase v5.4.354.01 (12-11-2024)" '
+                                         'date="12-11-2024 10:00:00">')
+    res = build_case(write_case(tmp_path, text), str(tmp_path / "out"))
+    assert not [w for w in res.warnings if "unknown attribute" in w]
+    text = case_xml().replace("<case>", '<case app="x" colour="red">')
+    res = build_case(write_case(tmp_path, text), str(tmp_path / "out"))
+    assert [w for w in res.warnings if "unknown attribute 'colour'" in w]
+
+
+BODY_ONLY = """
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>bottom | left | right</boxfill>
+                        <point x="0" y="-1" z="0" /><size x="4" y="2" z="3" /></drawbox>"""
+
+
+def test_no_fluid_created_is_warned(tmp_path):
+    # the seed lies in the wall: the fill finds no void and the case ends without fluid
+    commands = BODY_ONLY + """
+                    <setmkfluid mk="0" />
+                    <fillbox x="0" y="0" z="1"><modefill>void</modefill>
+                        <point x="0" y="-1" z="0" /><size x="4" y="2" z="2" /></fillbox>"""
+    res = build_case(write_case(tmp_path, case_xml(commands=commands)), str(tmp_path / "out"))
+    msgs = [w for w in res.warnings if "no fluid particles were created" in w]
+    assert len(msgs) == 1 and "the case has no fluid" in msgs[0] and "fill" in msgs[0]
+    assert "Case_Def.xml:" in msgs[0]
+
+
+def test_fluid_replaced_later_is_warned(tmp_path):
+    commands = """
+                    <setmkfluid mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="1" y="-1" z="1" /><size x="1" y="2" z="1" /></drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="4" y="2" z="3" /></drawbox>"""
+    res = build_case(write_case(tmp_path, case_xml(commands=commands)), str(tmp_path / "out"))
+    assert [w for w in res.warnings if "later drawing commands replaced all of them" in w]
+
+
+def test_body_only_case_is_silent(tmp_path):
+    res = build_case(write_case(tmp_path, case_xml(commands=BODY_ONLY)), str(tmp_path / "out"))
+    assert not [w for w in res.warnings if "fluid" in w]
+    assert res.particles["pos"].shape[0] > 0
