@@ -894,37 +894,24 @@ def _read_link(reader, ln, ids) -> dict:
     return d
 
 
-GAUGE_COMMON = {"savevtkpart": "bool", "computedt": "num", "computetime": "raw", "output": "bool",
-                "outputdt": "num", "outputtime": "raw"}
+# the children of a gauge and their kinds (read and checked by case.gauge_spec.read_field)
+GAUGE_COMMON = {"savevtkpart": "bool", "computedt": "dt", "computetime": "window", "output": "bool",
+                "outputdt": "dt", "outputtime": "window"}
 GAUGE_SPECS = {
     "velocity": {"point": "vec"},
-    "swl": {"point0": "vec", "point2": "vec", "pointdp": "raw", "masslimit": "raw"},
-    "maxz": {"point0": "vec", "height": "num", "distlimit": "raw"},
-    "force": {"target": "raw"},
-    "mesh": {"point": "vec", "vec1": "vec", "vec2": "vec", "vec3": "vec", "size1": "num", "size2": "num",
-             "size3": "num", "dirdat": "vec", "masslimit": "raw", "kclimit": "raw", "outputdata": "raw",
-             "outputfmt": "raw", "buffersize": "num"},
+    "swl": {"point0": "vec", "point2": "vec", "pointdp": "oneof:value,coefdp", "masslimit": "oneof:value,coef"},
+    "maxz": {"point0": "vec", "height": "positive", "distlimit": "oneof:value,coefdp,coefh"},
+    "force": {"target": "mkbound"},
+    "mesh": {"point": "vec", "vec1": "vec", "vec2": "vec", "vec3": "vec", "size1": "size", "size2": "size",
+             "size3": "size", "dirdat": "vec", "masslimit": "oneof:value,coef", "kclimit": "kclimit",
+             "outputdata": "outputdata", "outputfmt": "outputfmt", "buffersize": "count"},
 }
 
 
 def read_gauges(reader, el) -> dict:
-    out = {"default": {}, "items": []}
-    names = set()
-    for c in reader.children(el):
-        if c.tag == "default":
-            out["default"] = _value_children(reader, c, GAUGE_COMMON)
-            continue
-        if c.tag not in GAUGE_SPECS:
-            raise reader.error(c, f"unknown gauge <{c.tag}>", "velocity, swl, maxz, force or mesh")
-        name = reader.text_attr(c, "name")
-        if name in names:
-            raise reader.error(c, f"gauge name '{name}' used twice", "unique gauge names")
-        names.add(name)
-        spec = {**GAUGE_COMMON, **GAUGE_SPECS[c.tag]}
-        d = {"type": c.tag, "name": name, "line": c.sourceline}
-        d.update(_value_children(reader, c, spec))
-        out["items"].append(d)
-    return out
+    """``<special><gauges>``: every field typed and range-checked at gencase (see case.gauge_spec)."""
+    from .gauge_spec import read_gauges as read_checked
+    return read_checked(reader, el, GAUGE_COMMON, GAUGE_SPECS)
 
 
 def read_wavepaddles(reader, el) -> list:

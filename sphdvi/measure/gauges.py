@@ -16,8 +16,12 @@ Types and outputs (``;``-separated, first column ``time [s]``, in OUT):
 * ``mesh`` -> ``GaugesMesh_<name>.csv``: nodes ``point + i dp e1 + j dp e2 + k dp e3``
   (e = unit ``vec1..3``, ``size1..3`` lengths, spacing dp), ``outputdata`` among
   ``vel,veldir,rhop,zsurf`` (veldir: velocity along ``dirdat``; zsurf: free surface
-  along ``vec3`` over ``size3`` for each (i, j) column), ``kclimit`` (default 0.5,
-  ``NONE`` disables).
+  along ``vec3`` over ``size3`` for each (i, j) column), ``dirdat`` (default 1,0,0
+  as in DualSPHysics), ``kclimit`` (default 0.5, ``NONE`` disables).
+
+Gauge input is checked at gencase (:mod:`sphdvi.case.gauge_spec`), so the items
+read here are valid; a case file written before those checks that still holds
+an invalid gauge stops the run at start-up with exit code 2.
 
 Each gauge is computed at ``t = 0`` and then at the first step reaching each
 multiple of ``computedt`` (default TimeOut; 0 = every step) inside
@@ -35,6 +39,8 @@ import os
 
 import numpy as np
 
+from ..case.gauge_spec import mesh_count, name_problem
+from ..errors import InputError
 from ..io.atomic import append_text, complete_lines, write_text_atomic
 from . import core
 
@@ -205,7 +211,7 @@ class MeshGauge(Gauge):
             nv = np.linalg.norm(v)
             axes.append(v / nv if nv > 0 else np.zeros(3))
             size = float(item.get(f"size{k}", 0.0) or 0.0)
-            counts.append(int(math.floor(size / dp + 1e-9)) + 1 if nv > 0 else 1)
+            counts.append(int(mesh_count(size, dp)) if nv > 0 else 1)
         self.axes, self.counts = axes, counts
         ii, jj, kk = np.meshgrid(*(np.arange(c) for c in counts), indexing="ij")
         self.nodes = (self.origin + dp * (ii[..., None] * axes[0] + jj[..., None] * axes[1]
@@ -219,9 +225,12 @@ class MeshGauge(Gauge):
         kc = (item.get("kclimit") or {}).get("value")
         self.kclimit = None if (kc is not None and str(kc).strip().upper() == "NONE") else _num(
             item.get("kclimit") or {}, "value", core.DEFAULT_KCLIMIT)
-        self.dirdat = np.asarray(item.get("dirdat", [0, 0, 0]), float)
+        self.dirdat = np.asarray(item.get("dirdat", [1, 0, 0]), float)
         ml = item.get("masslimit") or {}
-        self.limit = _num(ml, "coef", spec.surface_threshold)
+        if _num(ml, "value") is not None and spec.massfluid > 0:
+            self.limit = _num(ml, "value") / spec.massfluid
+        else:
+            self.limit = _num(ml, "coef", spec.surface_threshold)
         base = self.origin + dp * (np.arange(counts[0])[:, None, None] * axes[0]
                                    + np.arange(counts[1])[None, :, None] * axes[1])
         self.col0 = base.reshape(-1, 3)
@@ -304,15 +313,24 @@ class RunGauges:
         self.slots = []
         for raw in gauges.get("items") or []:
             item = {**default, **raw}
-            gauge = GAUGE_TYPES[item["type"]](item, self.spec, data)
-            cdt = item.get("computedt")
-            ct = item.get("computetime") or {}
-            compute = Schedule(self.tout if cdt is None else float(cdt), _num(ct, "start", 0.0),
-                               _num(ct, "end", math.inf))
-            ot = item.get("outputtime") or {}
-            odt = item.get("outputdt")
-            output = Schedule(compute.dt if odt is None else float(odt), _num(ot, "start", 0.0),
-                              _num(ot, "end", math.inf))
+            try:
+                problem = name_problem(str(item["name"]))
+                if problem:
+                    raise ValueError(problem)
+                gauge = GAUGE_TYPES[item["type"]](item, self.spec, data)
+                cdt = item.get("computedt")
+                ct = item.get("computetime") or {}
+                compute = Schedule(self.tout if cdt is None else float(cdt), _num(ct, "start", 0.0),
+                                   _num(ct, "end", math.inf))
+                ot = item.get("outputtime") or {}
+                odt = item.get("outputdt")
+                output = Schedule(compute.dt if odt is None else float(odt), _num(ot, "start", 0.0),
+                                  _num(ot, "end", math.inf))
+            except (KeyError, ValueError, TypeError, ZeroDivisionError, OverflowError) as exc:
+                # only a case file written before gencase checked the gauges gets here
+                raise InputError(f"gauge '{item.get('name')}' (case file line {item.get('line')}) is invalid: "
+                                 f"{type(exc).__name__}: {exc}; run 'sphdvi gencase' again to see what is "
+                                 "wrong with it") from None
             write = item.get("output", True) is not False
             self.slots.append(_Slot(gauge, compute, output, write, os.path.join(outdir, gauge.filename())))
         self.next_flush = 1

@@ -1,0 +1,302 @@
+"""Reading and checking ``<special><gauges>`` (DualSPHysics ``JGaugeSystem::ReadXml``).
+
+Every field of every gauge is typed and range-checked here, at gencase, so the
+run (:mod:`sphdvi.measure.gauges`) never meets an invalid gauge: a bad value is
+a :class:`~sphdvi.errors.CaseError` (``file:line: <element>: ...; expected ...``,
+exit code 2), not a failure minutes into a run.
+
+The item dicts keep the layout :mod:`sphdvi.measure.gauges` consumes: points
+and vectors as ``[x, y, z]``, ``computedt``/``outputdt``/``height``/``size*``
+as floats, the multi-form elements as ``{attribute: number}`` (``pointdp``
+``{"value"|"coefdp": v}``, ``masslimit`` ``{"value"|"coef": v}``, ``distlimit``
+``{"value"|"coefdp"|"coefh": v}``), ``computetime``/``outputtime`` as
+``{"start": t0, "end": t1}`` (a gauge's window inherits the attributes it
+does not give from ``<default>``, as in DualSPHysics), ``target``
+``{"mkbound": n}``, mesh ``outputdata``/``outputfmt`` ``{"value": "a,b"}``
+(lower case, checked) and ``kclimit`` ``{"value": v | "none"}``.
+
+What DualSPHysics means, and what is therefore checked:
+
+* ``computedt``, ``outputdt`` >= 0 (0: every step); ``computetime`` /
+  ``outputtime`` ``start <= end``;
+* ``velocity`` needs ``<point>``; ``swl`` ``<point0>`` and ``<point2>`` (two
+  distinct points); ``maxz`` ``<point0>``; ``force`` ``<target mkbound>``;
+  ``mesh`` ``<point>``;
+* ``pointdp``, ``masslimit``, ``distlimit``: exactly one of their attributes,
+  > 0 (``JGaugeSystem`` rejects a non-positive pointdp, masslimit or distlimit);
+  ``height`` > 0;
+* mesh: a zero ``vec<k>`` means "no extent along k" (DualSPHysics then reads
+  no ``size<k>``), so it is accepted with a zero or absent ``size<k>`` and
+  rejected with a positive one; ``size<k>`` >= 0 (``size 0``: one node along
+  that axis, the single-point pressure probes of the Lobovsky case);
+  ``outputdata`` among vel, veldir, rhop, zsurf (zsurf needs a column:
+  ``size3`` > 0 along a non-zero ``vec3``; veldir a non-zero ``dirdat``);
+  ``outputfmt`` among csv, bin; ``kclimit`` a number >= 0 or ``none``;
+* the number of sample points of a gauge (swl line samples, mesh nodes, mesh
+  zsurf samples) is at most :data:`MAX_GAUGE_POINTS`;
+* names become file names (``Gauges<Type>_<name>.csv``): not empty, at most
+  :data:`MAX_NAME_BYTES` bytes, no path separators, ``..``, control characters
+  or the characters Windows forbids in file names; unique.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+MAX_GAUGE_POINTS = 1_000_000
+MAX_NAME_BYTES = 100
+NAME_FORBIDDEN = set('/\\:*?"<>|')
+MESH_OUTPUTS = ("vel", "veldir", "rhop", "zsurf")
+MESH_FORMATS = ("csv", "bin")
+ZSURF_STEP = 0.25          # zsurf samples every ZSURF_STEP * dp along vec3 (measure.gauges.MeshGauge)
+SWL_DEFAULT_COEFDP = 0.5   # pointdp when <pointdp> is absent: 0.5 dp
+
+REQUIRED_CHILDREN = {"velocity": ("point",), "swl": ("point0", "point2"), "maxz": ("point0",),
+                     "force": ("target",), "mesh": ("point",)}
+
+
+def line_samples(length: float, step: float) -> float:
+    """Samples of a line of ``length`` every ``step`` (as ``measure.core.surface_along_lines``).
+
+    A float, so an absurd count is compared before it is turned into an int."""
+    q = length / step
+    return max(2.0, math.floor(q + 1e-9) + 1.0) if math.isfinite(q) else math.inf
+
+
+def mesh_count(size: float, dp: float) -> float:
+    """Nodes along one mesh axis of length ``size`` spaced ``dp`` (as ``measure.gauges.MeshGauge``)."""
+    q = size / dp
+    return math.floor(q + 1e-9) + 1.0 if math.isfinite(q) else math.inf
+
+
+# ---------------------------------------------------------------------------------
+# one field
+# ---------------------------------------------------------------------------------
+def _one_of(reader, c, attrs):
+    """``{attr: v}`` for exactly one of ``attrs`` given on ``c``, v > 0."""
+    given = [a for a in attrs if c.get(a) is not None]
+    reader.mark(c, *attrs)
+    choices = " or ".join(f'{a}=".."' for a in attrs)
+    if len(given) != 1:
+        what = "none of" if not given else "more than one of"
+        raise reader.error(c, f"gives {what} " + ", ".join(attrs), f"exactly one of {choices}, > 0")
+    a = given[0]
+    return {a: reader.num(c, a, positive=True)}
+
+
+def _window(reader, c, inherited):
+    """``computetime``/``outputtime``: ``{"start", "end"}``, missing ones from ``<default>``."""
+    if c.get("start") is None and c.get("end") is None:
+        reader.mark(c, "start", "end")
+        raise reader.error(c, "neither start nor end is given", 'start=".." and/or end=".." [s]')
+    out = dict(inherited or {})
+    for a in ("start", "end"):
+        if c.get(a) is not None:
+            out[a] = reader.num(c, a)
+        else:
+            reader.mark(c, a)
+    if out.get("start", 0.0) > out.get("end", math.inf):
+        raise reader.error(c, f"start={out.get('start', 0.0):g} is after end={out['end']:g}"
+                           + ("" if c.get("start") is not None and c.get("end") is not None
+                              else " (the other one from <default>)"), "start <= end")
+    return out
+
+
+def _outputdata(reader, c):
+    raw = reader.text_attr(c, "value")
+    items = [s.strip().lower() for s in raw.split(",") if s.strip()]
+    bad = [s for s in items if s not in MESH_OUTPUTS]
+    if bad or not items:
+        what = "no output data" if not items else "unknown output data " + ", ".join(repr(b) for b in bad)
+        raise reader.error(c, f"value={raw!r}: {what}",
+                           "a comma-separated list of " + ", ".join(MESH_OUTPUTS))
+    return {"value": ",".join(dict.fromkeys(items))}
+
+
+def _outputfmt(reader, c):
+    raw = reader.text_attr(c, "value")
+    items = [s.strip().lower() for s in raw.split(",") if s.strip()]
+    bad = [s for s in items if s not in MESH_FORMATS]
+    if bad or not items:
+        raise reader.error(c, f"value={raw!r} is not an output format", "csv and/or bin, comma-separated")
+    if "bin" in items:
+        reader.warn(c, "outputfmt bin: sphdvi writes the mesh gauge as CSV only")
+    return {"value": ",".join(dict.fromkeys(items))}
+
+
+def _kclimit(reader, c):
+    raw = c.get("value")
+    if raw is not None and raw.strip().lower() == "none":
+        reader.mark(c, "value")
+        return {"value": "none"}
+    return {"value": reader.num(c, "value", nonnegative=True)}
+
+
+def read_field(reader, c, kind, inherited=None):
+    """The value of gauge child ``c`` of ``kind`` (the kinds of ``reader.GAUGE_COMMON/GAUGE_SPECS``)."""
+    if kind == "bool":
+        return reader.boolean(c, "value")
+    if kind == "dt":
+        return reader.num(c, "value", nonnegative=True)
+    if kind == "window":
+        return _window(reader, c, inherited)
+    if kind == "vec":
+        return reader.vec3(c).tolist()
+    if kind == "positive":
+        return reader.num(c, "value", positive=True)
+    if kind == "size":
+        return reader.num(c, "value", nonnegative=True)
+    if kind == "count":
+        return reader.integer(c, "value", lo=0, hi=2**31 - 1)
+    if kind == "mkbound":
+        return {"mkbound": reader.integer(c, "mkbound", lo=0, hi=65535)}
+    if kind.startswith("oneof:"):
+        return _one_of(reader, c, kind[6:].split(","))
+    if kind == "outputdata":
+        return _outputdata(reader, c)
+    if kind == "outputfmt":
+        return _outputfmt(reader, c)
+    if kind == "kclimit":
+        return _kclimit(reader, c)
+    raise AssertionError(f"unknown gauge field kind {kind!r}")
+
+
+def read_fields(reader, el, spec: dict, inherited: dict) -> tuple[dict, dict]:
+    """All children of ``el`` by ``spec`` (tag -> kind); returns (values, tag -> element)."""
+    out, elements = {}, {}
+    for c in reader.children(el):
+        if c.tag not in spec:
+            raise reader.error(c, f"unknown element <{c.tag}> in <{el.tag}>",
+                               "one of " + ", ".join(f"<{k}>" for k in sorted(spec)))
+        if c.tag in elements:
+            raise reader.error(c, f"<{c.tag}> given twice in <{el.tag}>", f"one <{c.tag}>")
+        elements[c.tag] = c
+        out[c.tag] = read_field(reader, c, spec[c.tag], inherited.get(c.tag))
+    return out, elements
+
+
+# ---------------------------------------------------------------------------------
+# names and whole gauges
+# ---------------------------------------------------------------------------------
+NAME_EXPECTED = (f"a name of 1 to {MAX_NAME_BYTES} bytes without / \\ : * ? \" < > |, '..' or control "
+                 "characters (it becomes part of the file name Gauges<Type>_<name>.csv)")
+
+
+def name_problem(name: str) -> str | None:
+    """What is wrong with a gauge name as part of a file name, or None."""
+    shown = name if len(name) <= 40 else name[:37] + "..."
+    if not name:
+        return "empty gauge name"
+    if len(name.encode("utf-8")) > MAX_NAME_BYTES:
+        return f"gauge name '{shown}' is {len(name.encode('utf-8'))} bytes long"
+    bad = sorted({ch for ch in name if ch in NAME_FORBIDDEN or ord(ch) < 32 or ord(ch) == 127})
+    if bad:
+        return f"gauge name {shown!r} contains {', '.join(repr(b) for b in bad)}"
+    if ".." in name:
+        return f"gauge name '{shown}' contains '..'"
+    if name != name.strip():
+        return f"gauge name {shown!r} starts or ends with a space"
+    return None
+
+
+def check_name(reader, c, name: str) -> None:
+    problem = name_problem(name)
+    if problem:
+        raise reader.error(c, problem, NAME_EXPECTED)
+
+
+def case_dp(reader, el):
+    """dp of the case (``<casedef><geometry><definition dp>``), None when it cannot be read."""
+    from ..errors import CaseError
+    root = el.getroottree().getroot()
+    d = root.find("casedef/geometry/definition")
+    if d is None or d.get("dp") is None:
+        return None
+    try:
+        return reader.num(d, "dp", positive=True)
+    except CaseError:
+        return None
+
+
+def _too_many(reader, el, what, n, expected):
+    if n > MAX_GAUGE_POINTS:
+        count = f"{n:.3g}" if n < 1e15 else "more than 1e15"
+        raise reader.error(el, f"{what}: {count} sample points, more than {MAX_GAUGE_POINTS:,}",
+                           expected)
+
+
+def check_gauge(reader, c, d: dict, elements: dict, dp) -> None:
+    """The checks that need several fields of one gauge (and dp for the sample counts)."""
+    kind, name = c.tag, d["name"]
+    for tag in REQUIRED_CHILDREN[kind]:
+        if tag not in d:
+            attrs = 'mkbound="N"' if tag == "target" else 'x=".." y=".." z=".."'
+            raise reader.error(c, f"{kind} gauge '{name}' has no <{tag}>", f"<{tag} {attrs}/> in <{kind}>")
+    if kind == "swl":
+        length = float(np.linalg.norm(np.subtract(d["point2"], d["point0"])))
+        if length == 0:
+            raise reader.error(elements["point2"], f"swl gauge '{name}': <point2> equals <point0>",
+                               "a line of positive length from <point0> to <point2>")
+        pdp = d.get("pointdp", {})
+        step = pdp["value"] if "value" in pdp else (dp * pdp.get("coefdp", SWL_DEFAULT_COEFDP) if dp else None)
+        if step:
+            _too_many(reader, elements.get("pointdp", c), f"swl gauge '{name}'", line_samples(length, step),
+                      f"a larger <pointdp> (the line is {length:g} m long; at most {MAX_GAUGE_POINTS:,} "
+                      "points along it)")
+    elif kind == "mesh":
+        outputs = d.get("outputdata", {}).get("value", "vel,rhop").split(",")
+        vecs = {}
+        for k in (1, 2, 3):
+            default = [1.0 * (k == 1), 1.0 * (k == 2), 1.0 * (k == 3)]
+            vecs[k] = np.linalg.norm(d.get(f"vec{k}", default))
+            if vecs[k] == 0 and d.get(f"size{k}", 0.0) > 0:
+                raise reader.error(elements[f"vec{k}"], f"mesh gauge '{name}': <vec{k}> is the zero vector but "
+                                   f"<size{k}> is {d[f'size{k}']:g}",
+                                   f"a non-zero <vec{k}>, or <size{k} value=\"0\"/> (no extent along it)")
+        if "zsurf" in outputs and (vecs[3] == 0 or d.get("size3", 0.0) <= 0):
+            raise reader.error(elements.get("outputdata", c),
+                               f"mesh gauge '{name}': zsurf needs a column to search the surface along",
+                               "<size3 value> > 0 along a non-zero <vec3>")
+        if "veldir" in outputs and "dirdat" in d and np.linalg.norm(d["dirdat"]) == 0:
+            raise reader.error(elements["dirdat"], f"mesh gauge '{name}': <dirdat> is the zero vector",
+                               "a non-zero direction for veldir (default 1,0,0)")
+        if dp:
+            counts = [mesh_count(d.get(f"size{k}", 0.0), dp) if vecs[k] > 0 else 1.0 for k in (1, 2, 3)]
+            nodes = counts[0] * counts[1] * counts[2]
+            _too_many(reader, c, f"mesh gauge '{name}'", nodes,
+                      f"smaller <size1..3> (nodes are dp = {dp:g} m apart; at most {MAX_GAUGE_POINTS:,} nodes)")
+            if "zsurf" in outputs:
+                samples = counts[0] * counts[1] * line_samples(d["size3"], ZSURF_STEP * dp)
+                _too_many(reader, c, f"mesh gauge '{name}' (zsurf)", samples,
+                          f"a smaller mesh or <size3> (zsurf samples every {ZSURF_STEP:g} dp along vec3)")
+
+
+def read_gauges(reader, el, common: dict, specs: dict) -> dict:
+    """``<special><gauges>`` -> ``{"default": {...}, "items": [{"type", "name", "line", ...}]}``."""
+    out = {"default": {}, "items": []}
+    defaults = reader.children(el, "default")
+    if len(defaults) > 1:
+        raise reader.error(defaults[1], "<default> given twice in <gauges>", "one <default>")
+    if defaults:
+        out["default"], _ = read_fields(reader, defaults[0], common, {})
+    dp = None
+    names = set()
+    for c in reader.children(el):
+        if c.tag == "default":
+            continue
+        if c.tag not in specs:
+            raise reader.error(c, f"unknown gauge <{c.tag}>", "velocity, swl, maxz, force or mesh")
+        name = reader.text_attr(c, "name")
+        check_name(reader, c, name)
+        if name in names:
+            raise reader.error(c, f"gauge name '{name}' used twice", "unique gauge names")
+        names.add(name)
+        d = {"type": c.tag, "name": name, "line": c.sourceline}
+        values, elements = read_fields(reader, c, {**common, **specs[c.tag]}, out["default"])
+        d.update(values)
+        if dp is None:
+            dp = case_dp(reader, el) or 0.0
+        check_gauge(reader, c, d, elements, dp or None)
+        out["items"].append(d)
+    return out
