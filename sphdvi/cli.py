@@ -12,7 +12,7 @@ import sys
 import click
 
 from ._version import __version__
-from .cli_errors import report_errors
+from .cli_errors import FiniteFloat, report_errors
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
@@ -84,14 +84,17 @@ def gencase(case_xml, outdir, max_nodes, dp, quiet):
 @click.argument("source", type=click.Path())
 @click.option("-o", "--out", "outdir", type=click.Path(file_okay=False), default=None,
               help="Output folder (default: SOURCE when it is a gencase output, else ./<casename>_out).")
-@click.option("--tmax", type=float, default=None, help="Simulated time [s] (overrides TimeMax).")
-@click.option("--tout", type=float, default=None, help="Output interval [s] (overrides TimeOut).")
+@click.option("--tmax", type=FiniteFloat(min=0), default=None, help="Simulated time [s] (overrides TimeMax).")
+@click.option("--tout", type=FiniteFloat(min=0, min_open=True), default=None,
+              help="Output interval [s] (overrides TimeOut).")
 @click.option("--threads", type=click.IntRange(min=1), default=None,
               help="Threads (default: SLURM_CPUS_PER_TASK or the CPU affinity).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
               help="Override any <parameters> key, e.g. --set Visco=0.05 (repeatable).")
 @click.option("--resume", is_flag=True, help="Continue an interrupted run from its last output.")
-@click.option("--dp", type=float, default=None, help="With a case XML: override <definition dp>.")
+@click.option("--dp", type=FiniteFloat(min=0, min_open=True), default=None,
+              help="With a case XML: override <definition dp> (gencase runs with it). With a gencase folder "
+                   "or --resume, where gencase does not run, only the case's own dp is accepted.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress output.")
 @report_errors
 def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
@@ -104,12 +107,14 @@ def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
     """
     from .errors import InputError
     from .simulation import find_case_file, run as run_case
+    drawn_dp = None      # --dp where no gencase runs: it must be the case's dp
     if os.path.isfile(source) and source.lower().endswith(".xml"):
         from .case.gencase import build_case, write_outputs
         from .case.reader import case_name_from_path
         outdir = outdir or f"{case_name_from_path(source)}_out"
         if resume:
             case_h5 = find_case_file(outdir)
+            drawn_dp = dp
         else:
             result = build_case(source, outdir, dp=dp)
             print_warnings(result.warnings)
@@ -117,10 +122,11 @@ def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
     elif os.path.isdir(source):
         case_h5 = find_case_file(source)
         outdir = outdir or source
+        drawn_dp = dp
     else:
         raise InputError(f"{source}: not a case XML file or a gencase output folder")
     result = run_case(case_h5, outdir, tmax=tmax, tout=tout, threads=threads, sets=sets, resume=resume,
-                      quiet=quiet)
+                      quiet=quiet, expect_dp=drawn_dp)
     if result.status != "completed":
         click.echo(f"{result.status}: {result.message}", err=True)
     elif not quiet:
@@ -133,22 +139,33 @@ def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
 @click.option("--format", "fmt", type=click.Choice(["vtp"]), default="vtp", show_default=True,
               help="Output format.")
-@click.option("--dir", "subdir", default=None, help="Sub-folder of OUTDIR to write to (default vtp, or iso).")
+@click.option("--dir", "subdir", default=None,
+              help="Folder to write to: relative paths are taken inside OUTDIR, absolute ones as given; "
+                   "created when missing (default OUTDIR/vtp, or OUTDIR/iso).")
 @click.option("--isosurface", is_flag=True,
               help="Write the free surface (kernel-sum isosurface) of every output time instead: "
                    "Iso_XXXX.vtp + isosurface.pvd (needs vtk).")
-@click.option("--iso-spacing", type=float, default=None, help="Isosurface grid spacing (default dp/2).")
-@click.option("--iso-threshold", type=float, default=None,
+@click.option("--iso-spacing", type=FiniteFloat(min=0, min_open=True), default=None,
+              help="Isosurface grid spacing (default dp/2).")
+@click.option("--iso-threshold", type=FiniteFloat(min=0, min_open=True), default=None,
               help="Kernel-sum level of the surface (default 0.5 in 3D, 0.4 in 2D).")
 @report_errors
 def export(outdir, fmt, subdir, isosurface, iso_spacing, iso_threshold):
     """Export particles.vtkhdf as Part_XXXX.vtp files and a .pvd for older ParaView."""
+    from .errors import InputError
+    from .io.export import export_dir, export_vtp
     if isosurface:
         from .measure.isosurface import export_isosurface
-        files = export_isosurface(outdir, subdir or "iso", spacing=iso_spacing, threshold=iso_threshold)
+        name = subdir or "iso"
+        if os.path.isabs(name) or os.path.basename(os.path.normpath(name)) != os.path.normpath(name) \
+                or name in (".", ".."):
+            # export_isosurface writes into OUTDIR/<the last part of the name> only
+            raise InputError(f"--dir {name}: with --isosurface, --dir is a folder name inside OUTDIR "
+                             "(no path); expected e.g. --dir iso")
+        export_dir(outdir, name)
+        files = export_isosurface(outdir, name, spacing=iso_spacing, threshold=iso_threshold)
         click.echo(f"wrote {len(files) - 1} isosurface .vtp files and {files[-1]}")
         return
-    from .io.export import export_vtp
     files = export_vtp(outdir, subdir or "vtp")
     click.echo(f"wrote {len(files) - 1} .vtp files and {files[-1]}")
 

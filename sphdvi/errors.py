@@ -59,6 +59,15 @@ class DivergenceError(SphdviError):
     exit_code = EXIT_DIVERGED
 
 
+def h5_reason(exc: BaseException) -> str:
+    """What an HDF5 (h5py) exception says, without its boilerplate: 'file signature not
+    found', 'object 'pos' doesn't exist', ... (for messages that name the file themselves)."""
+    text = str(exc.args[0]) if exc.args else type(exc).__name__
+    if "(" in text and text.rstrip().endswith(")"):
+        text = text[text.index("(") + 1:text.rstrip().rindex(")")]
+    return text.replace("Unable to synchronously open file ", "").strip() or type(exc).__name__
+
+
 class Warnings:
     """Collects warnings (``file:line: element: text``) so the CLI can print them once."""
 

@@ -30,8 +30,8 @@ import numpy as np
 
 from ._version import __version__
 from .errors import DivergenceError, InputError
-from .io.checkpoint import (RESTART_FILE, load_bodies_checkpoint, load_sph_checkpoint, save_bodies_checkpoint,
-                            save_sph_checkpoint)
+from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint, load_sph_checkpoint,
+                            save_bodies_checkpoint, save_sph_checkpoint)
 from .io.runfiles import BodyLog, Progress, RunFiles
 from .sph.damping import damping_zones
 
@@ -39,6 +39,12 @@ POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float3
                 "Press": (np.float32, 1), "Type": (np.uint8, 1), "Mk": (np.int32, 1)}
 DTMIN_STUCK_STEPS = 200
 DEFAULT_MAX_EXCLUDED_FRACTION = 0.5
+# fluid excluded in one time step beyond which the run stops: a step limited by the CFL
+# condition moves a particle a fraction of h, so no flow loses a quarter of its fluid through
+# the domain's limits or the density bounds at once; a far too large DtFixed does (at least
+# MIN_EXCLUDED_PER_STEP particles, so that a case of a few particles does not stop for one)
+MAX_EXCLUDED_PER_STEP = 0.25
+MIN_EXCLUDED_PER_STEP = 10
 
 
 @dataclass
@@ -66,8 +72,13 @@ def default_threads() -> int:
 # parameters from the case file and the command line
 # ---------------------------------------------------------------------------------
 def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
-    """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError."""
-    from .case.parameters import DOMAIN_KEYS, PARAMETERS, apply_delta_sph, check_supported, closest_key, coerce
+    """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError.
+
+    The checks and warnings are the case reader's: each value as in the XML, then the
+    checks across parameters (RhopOutMin < RhopOutMax) on the result; deprecated keys and
+    keys without effect in sphdvi are warned about (``warnings.warn``)."""
+    from .case.parameters import (DOMAIN_KEYS, PARAMETERS, apply_delta_sph, check_consistency, check_supported,
+                                  closest_key, coerce, constant_hint, parameter_warnings)
     out = dict(params)
     given = []
     for item in sets or ():
@@ -75,6 +86,9 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
             raise InputError(f"--set {item!r}: expected KEY=VALUE")
         key, value = (s.strip() for s in item.split("=", 1))
         if key not in PARAMETERS:
+            const = constant_hint(key)
+            if const:
+                raise InputError(f"--set {key}: {const}")
             hint = closest_key(key)
             raise InputError(f"--set: unknown parameter '{key}'" + (f"; did you mean '{hint}'?" if hint else ""))
         if key in DOMAIN_KEYS:
@@ -85,17 +99,26 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
             check_supported(key, out[key])
         except ValueError as exc:
             raise InputError(f"--set {key}: {exc}") from None
+        for text in parameter_warnings(key, out[key]):
+            warnings.warn(f"--set {key}: {text}")
         given.append(key)
     try:
         apply_delta_sph(out, given)
     except ValueError as exc:
         raise InputError(f"--set: {exc}") from None
-    if tmax is not None:
-        out["TimeMax"] = coerce("TimeMax", tmax)
-    if tout is not None:
-        out["TimeOut"] = coerce("TimeOut", tout)
+    for option, key, value in (("--tmax", "TimeMax", tmax), ("--tout", "TimeOut", tout)):
+        if value is not None:
+            try:
+                out[key] = coerce(key, value)
+            except ValueError as exc:
+                raise InputError(f"{option} {value}: {exc}") from None
     if not out["TimeOut"] > 0:
-        raise InputError("TimeOut must be positive")
+        raise InputError(f"TimeOut is {out['TimeOut']}: it must be positive; give --tout or correct the case "
+                         "file and run gencase again")
+    try:
+        check_consistency(out)
+    except ValueError as exc:
+        raise InputError(("--set: " if given else "case parameters: ") + str(exc)) from None
     return out
 
 
@@ -103,11 +126,13 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
 # entry point
 # ---------------------------------------------------------------------------------
 def find_case_file(folder: str) -> str:
-    """The gencase HDF5 file in a run folder."""
+    """The gencase HDF5 file in a run folder (``format="sphdvi-case"``).  With none, an
+    .h5 file that cannot be read (truncated, corrupt) is named in the error."""
     import h5py
+    from .errors import h5_reason
     if not os.path.isdir(folder):
         raise InputError(f"{folder}: not a folder or case file")
-    found = []
+    found, unreadable = [], []
     for name in sorted(os.listdir(folder)):
         if name.endswith(".h5") and name != RESTART_FILE:
             path = os.path.join(folder, name)
@@ -115,8 +140,11 @@ def find_case_file(folder: str) -> str:
                 with h5py.File(path, "r") as f:
                     if f.attrs.get("format") == "sphdvi-case":
                         found.append(path)
-            except OSError:
-                continue
+            except OSError as exc:
+                unreadable.append(f"{path} ({h5_reason(exc)})")
+    if not found and unreadable:
+        raise InputError(f"{folder}: no readable gencase output: {'; '.join(unreadable)} cannot be read as HDF5 "
+                         "(truncated or corrupt?); run 'sphdvi gencase' again")
     if not found:
         raise InputError(f"{folder}: no gencase output (<casename>.h5) found; run 'sphdvi gencase' first "
                          "or give the case XML")
@@ -150,13 +178,18 @@ def special_parameters(data: dict) -> dict:
 
 
 def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(), resume=False,
-        quiet=False) -> RunResult:
-    """Run a gencase output: body-only cases go to the multibody engine, the rest to SPH."""
+        quiet=False, expect_dp=None) -> RunResult:
+    """Run a gencase output: body-only cases go to the multibody engine, the rest to SPH.
+
+    ``expect_dp``: a dp the user gave where no gencase runs (a gencase folder, --resume);
+    it must be the case's, else InputError."""
     from .io.casefile import read_case_h5
     t_start = _time.perf_counter()
     data = read_case_h5(case_h5)
+    if expect_dp is not None:
+        _check_dp(expect_dp, data, case_h5, resume)
     params = apply_overrides(special_parameters(data), sets, tmax, tout)
-    threads = int(threads) if threads else default_threads()
+    threads = _usable_threads(threads)
     os.makedirs(outdir, exist_ok=True)
     files = RunFiles(outdir)
     nfluid = int(np.count_nonzero(data["particles"]["type"] == 3))
@@ -167,7 +200,50 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
     }
     if nfluid == 0:
         return _run_bodies_only(data, params, outdir, files, base_meta, t_start, quiet, resume)
+    _check_dtfixed(float(params.get("DtFixed") or 0.0), params)
     return _run_sph(data, params, outdir, files, base_meta, threads, resume, quiet, t_start)
+
+
+def _check_dp(dp: float, data: dict, case_h5: str, resume: bool) -> None:
+    """--dp where gencase does not run: only the case's own dp (a no-op) is accepted."""
+    case_dp = float(data["constants"]["dp"])
+    if abs(float(dp) - case_dp) <= 1e-9 * case_dp:
+        return
+    where = "--resume continues the run of" if resume else "a gencase output folder holds"
+    raise InputError(f"--dp {dp:g}: {where} the case {case_h5}, drawn at dp={case_dp:g}; a new dp needs gencase: "
+                     f"run 'sphdvi run CASE.xml --dp {dp:g} -o NEWOUT' (or 'sphdvi gencase CASE.xml --dp {dp:g}')")
+
+
+def _usable_threads(threads) -> int:
+    """--threads (or the default), at most numba's thread count NUMBA_NUM_THREADS: more is
+    clamped with a warning, and run.json records the count used."""
+    if not threads:
+        wanted, given = default_threads(), False
+    else:
+        wanted, given = int(threads), True
+    from numba import config
+    limit = max(1, int(config.NUMBA_NUM_THREADS))
+    if wanted > limit:
+        if given:
+            warnings.warn(f"--threads {wanted}: numba runs at most {limit} threads here (NUMBA_NUM_THREADS); "
+                          f"using {limit}")
+        wanted = limit
+    return wanted
+
+
+def _check_dtfixed(dt: float, params: dict, what: str = "DtFixed") -> None:
+    """A fixed step longer than the whole run is refused (the run would take no step, or one
+    step far past TimeMax); one longer than TimeOut is warned about (every step is then an
+    output, DtFixed apart instead of TimeOut)."""
+    if not dt > 0:
+        return
+    tmax, tout = float(params["TimeMax"]), float(params["TimeOut"])
+    if tmax > 0 and dt > tmax * (1 + 1e-9):
+        raise InputError(f"{what} ({dt:g} s) is longer than the whole run (TimeMax {tmax:g} s): the run cannot "
+                         f"reach TimeMax in steps of {dt:g} s; expected DtFixed <= TimeMax (or a longer --tmax)")
+    if dt > tout * (1 + 1e-9):
+        warnings.warn(f"{what} ({dt:g} s) is longer than TimeOut ({tout:g} s): every step is an output, and the "
+                      f"outputs are {dt:g} s apart")
 
 
 def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=False) -> RunResult:
@@ -182,6 +258,7 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=F
     if not mech["bodies"]:
         raise InputError("the case has neither fluid nor bodies: nothing to simulate")
     dt = params["DtFixed"] if params["DtFixed"] > 0 else 1e-3
+    _check_dtfixed(dt, params, "DtFixed" if params["DtFixed"] > 0 else "the default step of a body-only run")
     tout = float(params["TimeOut"])
     extra = params.get("TimeOutExtra")
     schedule = StepSchedule(float(params["TimeMax"]), tout, dt,
@@ -189,7 +266,7 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=F
     system, names = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
     if not system._packed:
         system._pack()
-    run = BodiesOnlyRun(system, names, schedule, outdir, files)
+    run = BodiesOnlyRun(system, names, schedule, outdir, files, case_identity(data["particles"], data["constants"]))
     if resume:
         run.resume()
     else:
@@ -213,8 +290,9 @@ class BodiesOnlyRun:
     first non-finite body state stops the run (diverged, exit 3); SIGTERM/SIGINT stop it at
     the next step (interrupted, resumable)."""
 
-    def __init__(self, system, names, schedule, outdir: str, files: RunFiles):
+    def __init__(self, system, names, schedule, outdir: str, files: RunFiles, case_id: dict | None = None):
         self.system, self.names, self.schedule = system, list(names), schedule
+        self.case_id = case_id or {}     # written into restart.h5; --resume checks it
         self.outdir, self.files = outdir, files
         self.ckpt = os.path.join(outdir, RESTART_FILE)
         self.part = 0            # outputs written (TimeOut), t = 0 being part 0
@@ -230,7 +308,7 @@ class BodiesOnlyRun:
         are cut when the run starts."""
         if not os.path.exists(self.ckpt):
             raise InputError(f"--resume: no checkpoint {self.ckpt} in {self.outdir}")
-        saved = load_bodies_checkpoint(self.ckpt, self.system)
+        saved = load_bodies_checkpoint(self.ckpt, self.system, self.case_id or None, self.names)
         if saved["names"] != self.names:
             raise InputError(f"--resume: {self.ckpt} holds the bodies {saved['names']}, the case {self.names}")
         self.part, self.step, self.runtime = int(saved["part"]), int(saved["step"]), float(saved["runtime_s"])
@@ -246,7 +324,8 @@ class BodiesOnlyRun:
         self.body_log.record()
         # the state at this output, kept in memory; written out at most every
         # BODIES_CHECKPOINT_EVERY_S of wall time, at the last output and when the run stops
-        self._at_output = (s.get_state(), dict(part=self.part, step=self.step, runtime_s=wall, names=self.names))
+        self._at_output = (s.get_state(), dict(part=self.part, step=self.step, runtime_s=wall, names=self.names,
+                                                 **self.case_id))
         now = _time.perf_counter()
         if last or now - self._ckpt_wall >= BODIES_CHECKPOINT_EVERY_S:
             self._checkpoint()
@@ -426,6 +505,9 @@ class SPHRun:
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table)
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.excluded_limit = self.max_excluded()      # the parameters do not change in a run
+        self.excluded_step_limit = max(MIN_EXCLUDED_PER_STEP, int(MAX_EXCLUDED_PER_STEP * self.n0_fluid))
+        self.excluded_seen = 0
+        self.case_id = case_identity(p, c)             # written into restart.h5; --resume checks it
         self.dtmin_run = 0
         self.dtmin_seen = 0
 
@@ -463,6 +545,14 @@ class SPHRun:
         else:
             self.dtmin_run = 0
         excluded = sum(sol.n_excluded.values())
+        new, self.excluded_seen = excluded - self.excluded_seen, excluded
+        if new > self.excluded_step_limit:
+            ev = sol.excluded[-1]
+            raise DivergenceError(
+                f"t={sol.time:.6g} s, step {sol.nstep}: {new} of {self.n0_fluid} fluid particles excluded in one "
+                f"step (more than {MAX_EXCLUDED_PER_STEP:.0%} at once; dt {sol.last_dt:.3g} s); last: particle "
+                f"{int(ev['idp'][0])} at {_fmt(ev['pos'][0])}, reason {ev['reason'][0]}; cause: the time step is far "
+                f"too large for the flow (DtFixed?) or the solution blew up")
         limit = self.excluded_limit
         if excluded > limit:
             ev = sol.excluded[-1]
@@ -495,11 +585,12 @@ class SPHRun:
 
     def save_checkpoint(self, path: str, extra: dict) -> None:
         save_sph_checkpoint(path, self.solver.get_checkpoint(),
-                            dict(extra, dtmin_run=self.dtmin_run, dtmin_seen=self.dtmin_seen),
+                            dict(extra, dtmin_run=self.dtmin_run, dtmin_seen=self.dtmin_seen, **self.case_id),
                             self.bodies.get_state() if self.bodies is not None else None)
 
     def load_checkpoint(self, path: str) -> dict:
-        extra = load_sph_checkpoint(path, self.solver, self.bodies)
+        extra = load_sph_checkpoint(path, self.solver, self.bodies, self.case_id, self.data["particles"])
+        self.excluded_seen = sum(self.solver.n_excluded.values())
         self.dtmin_run = int(extra["dtmin_run"])
         self.dtmin_seen = int(extra["dtmin_seen"])
         return extra

@@ -18,12 +18,16 @@ class Param:
     choices: tuple = ()
     lo: float | None = None
     hi: float | None = None
+    positive: bool = False     # the value must be > 0 as well (``lo`` is inclusive)
 
 
 PARAMETERS: dict[str, Param] = {
-    "SavePosDouble": Param("int", 0, "save positions in double precision (sphdvi always does)", (0, 1)),
+    # DualSPHysics reads SavePosDouble as "!= 0" (JSph::LoadConfigParameters): any integer is valid
+    "SavePosDouble": Param("int", 0, "save positions in double precision (sphdvi always does)"),
     "SaveExtraParts": Param("str", "", "DualSPHysics: outputs with the extra restart data"),
     "Boundary": Param("int", 1, "boundary method 1:DBC, 2:mDBC", (1, 2)),
+    "BoundaryMethod": Param("int", None, "not a DualSPHysics key (it reads 'Boundary'), found in case files "
+                            "written by other tools; ignored, as DualSPHysics ignores it"),
     "SlipMode": Param("int", 1, "mDBC slip mode 1:DBC vel=0, 2:no-slip, 3:free slip", (1, 2, 3)),
     "MDBCCorrector": Param("int", None, "mDBC correction also in the Symplectic corrector (DualSPHysics "
                            "v5.0-5.2 key; not set: as v5.4, 0 with SlipMode 1, 1 with SlipMode 2, 3)", (0, 1)),
@@ -52,7 +56,7 @@ PARAMETERS: dict[str, Param] = {
     "ShiftAdvCoef": Param("float", -0.01, "advanced shifting coefficient", (), -1e6, 0.0),
     "ShiftAdvALE": Param("int", 0, "advanced shifting ALE correction", (0, 1)),
     "ShiftAdvNCPress": Param("int", 0, "advanced shifting non-conservative pressure", (0, 1)),
-    "RigidAlgorithm": Param("int", 1, "0:collision-free, 1:SPH, 2:DEM, 3:Chrono", (0, 1, 2, 3)),
+    "RigidAlgorithm": Param("int", 1, "0:collision-free, 1:SPH, 2:DEM (not implemented), 3:Chrono", (0, 1, 3)),
     "FtPause": Param("float", 0.0, "time to freeze floatings at the start [s]", (), 0.0, 1e9),
     "FtIgnoreRadius": Param("int", 0, "ignore floating radius with periodic conditions", (0, 1)),
     "FtSaveAce": Param("int", 0, "save floating accelerations (debug)", (0, 1)),
@@ -63,7 +67,7 @@ PARAMETERS: dict[str, Param] = {
     "DtFixedFile": Param("str", "NONE", "file of dt values [ms] (NONE: disabled)"),
     "DtAllParticles": Param("int", 0, "dt from all particles (1) or fluid/floating only (0)", (0, 1)),
     "TimeMax": Param("float", 1.0, "simulated time [s]", (), 0.0, 1e12),
-    "TimeOut": Param("float", 0.01, "output interval [s]", (), 0.0, 1e12),
+    "TimeOut": Param("float", 0.01, "output interval [s]", (), 0.0, 1e12, positive=True),
     "TimeOutExtra": Param("float", None, "interval of the extra floating-body outputs (bodies.csv, "
                           "links.csv) between TimeOut outputs [s] (0: every step; not set: none)", (), 0.0, 1e12),
     "RhopOutMin": Param("float", 700.0, "minimum valid density [kg/m3]", (), 0.0, 1e9),
@@ -107,7 +111,53 @@ NO_EFFECT = {
     "SaveExtraParts": "sphdvi's restart.h5 always holds the whole state, written at every output",
     "FtIgnoreRadius": "the floating radius of DualSPHysics's periodic distance test; sphdvi does not use it",
     "DivCleanKp": "the coefficient of divergence cleaning, which sphdvi does not implement",
+    "SavePosDouble": "sphdvi always keeps and writes positions in double precision",
+    "BoundaryMethod": "it is not a DualSPHysics key: DualSPHysics reads 'Boundary' (1 DBC, 2 mDBC) and ignores "
+                      "this one, and so does sphdvi; set 'Boundary' to choose the boundary method",
 }
+
+# values of a key that DualSPHysics accepts and sphdvi does not implement: an error that says
+# what to use instead (checked before ``choices``, which leave these values out)
+REJECTED_VALUES = {
+    ("RigidAlgorithm", 2): "RigidAlgorithm=2 (DEM contacts between bodies) is not implemented in sphdvi; use 1 "
+                           "(bodies interact through SPH forces) or 3 with <special><chrono> (contacts solved "
+                           "by sphdvi's DVI multibody engine)",
+}
+
+# <constantsdef> entries that are sometimes given as parameters (DualSPHysics's -cfl option
+# changes the constant): their place in the case file
+CONSTANTS = {"cflnumber": "cflnumber", "gamma": "gamma", "rhop0": "rhop0", "coefsound": "coefsound",
+             "speedsystem": "speedsystem", "speedsound": "speedsound", "coefh": "coefh",
+             "coefhdp": "coefhdp", "hswl": "hswl", "gravity": "gravity", "lattice": "lattice",
+             "eps": "eps", "h": "h", "b": "b", "massbound": "massbound", "massfluid": "massfluid"}
+
+
+def constant_hint(key: str) -> str | None:
+    """For a key that is a <constantsdef> constant (e.g. CFLnumber): where it belongs."""
+    name = CONSTANTS.get(key.strip().lower())
+    if name is None:
+        return None
+    return (f"'{key}' is a constant of the case, not an execution parameter: set <{name} value=\"...\" /> "
+            "in <constantsdef> and run gencase again")
+
+
+def parameter_warnings(key: str, value) -> list[str]:
+    """The warnings a key given with ``value`` deserves (deprecated in DualSPHysics, no effect
+    in sphdvi); the same texts as the case reader's."""
+    out = []
+    if key in DEPRECATED:
+        out.append(f"parameter '{key}' is deprecated in DualSPHysics")
+    if key in NO_EFFECT and value != PARAMETERS[key].default:
+        out.append(f"parameter '{key}' has no effect in sphdvi ({NO_EFFECT[key]})")
+    return out
+
+
+def check_consistency(params: dict) -> None:
+    """The checks that involve several parameters (raises ValueError); the case reader and
+    ``sphdvi run --set`` apply the same ones."""
+    lo, hi = params.get("RhopOutMin", 700.0), params.get("RhopOutMax", 1300.0)
+    if lo is not None and hi is not None and lo >= hi:
+        raise ValueError(f"RhopOutMin ({lo}) >= RhopOutMax ({hi}); expected RhopOutMin < RhopOutMax")
 
 # DualSPHysics options sphdvi does not implement: any value but the default is an error
 NOT_SUPPORTED = {
@@ -195,10 +245,14 @@ def coerce(key: str, value):
         if number != int(number):
             raise ValueError(f"'{value}' is not an integer")
         number = int(number)
+    if (key, number) in REJECTED_VALUES:
+        raise ValueError(REJECTED_VALUES[(key, number)])
     if spec.choices and number not in spec.choices:
         raise ValueError(f"{number} is not one of {', '.join(str(c) for c in spec.choices)}")
     if spec.lo is not None and number < spec.lo:
         raise ValueError(f"{number} is below {spec.lo}")
+    if spec.positive and not number > 0:
+        raise ValueError(f"{number} is not > 0 ({key} must be positive)")
     if spec.hi is not None and number > spec.hi:
         raise ValueError(f"{number} is above {spec.hi}")
     return number

@@ -26,6 +26,7 @@ import json
 
 import numpy as np
 
+from ..errors import InputError, h5_reason
 from .atomic import atomic_path
 
 FORMAT = "sphdvi-case"
@@ -105,11 +106,22 @@ def _attr_value(v):
 
 
 def read_case_h5(path: str) -> dict:
-    """Read a case file back into plain dicts and numpy arrays."""
+    """Read a case file back into plain dicts and numpy arrays.  A file that is not one
+    (corrupt, truncated, another format, a missing dataset) is an InputError naming it."""
     import h5py
+    try:
+        return _read_case_h5(h5py, path)
+    except InputError:
+        raise
+    except (OSError, KeyError, ValueError, TypeError) as exc:
+        raise InputError(f"{path} is not a readable sphdvi case file ({h5_reason(exc)}; truncated or corrupt?): "
+                         "run 'sphdvi gencase' again") from None
+
+
+def _read_case_h5(h5py, path: str) -> dict:
     with h5py.File(path, "r") as f:
         if f.attrs.get("format") != FORMAT:
-            raise ValueError(f"{path} is not a sphdvi case file")
+            raise InputError(f"{path} is not a sphdvi case file (no format=\"{FORMAT}\" attribute)")
         out = {"casename": _attr_value(f.attrs["casename"]), "version": _attr_value(f.attrs["version"]),
                "source_file": _attr_value(f.attrs["source_file"])}
         out["particles"] = {k: f["particles"][k][...] for k in PARTICLE_FIELDS}

@@ -8,13 +8,26 @@ from .vtkhdf import read_step, step_times
 from .vtkxml import write_pvd, write_vtp_points
 
 
+def export_dir(outdir: str, subdir: str) -> str:
+    """The folder ``--dir`` names: a relative path is taken inside OUTDIR (``vtp`` is
+    OUTDIR/vtp, ``../x`` is next to it), an absolute one as it is; it need not exist.
+    A path that exists and is not a folder is an InputError."""
+    dest = os.path.normpath(os.path.join(outdir, os.path.expanduser(subdir)))
+    if os.path.exists(dest) and not os.path.isdir(dest):
+        raise InputError(f"--dir {subdir}: {dest} exists and is not a folder; expected a folder to write the "
+                         ".vtp files into")
+    return dest
+
+
 def export_vtp(outdir: str, subdir: str = "vtp") -> list[str]:
+    """Write every step of OUTDIR/particles.vtkhdf as ``Part_XXXX.vtp`` and ``particles.pvd``
+    into :func:`export_dir` (``subdir``), created when missing; returns the files (.pvd last)."""
     src = os.path.join(outdir, "particles.vtkhdf")
     if not os.path.isfile(src):
         raise InputError(f"{src} not found: run 'sphdvi run' first")
-    dest = os.path.join(outdir, os.path.basename(os.path.normpath(subdir)) or "vtp")
-    os.makedirs(dest, exist_ok=True)
+    dest = export_dir(outdir, subdir)
     times = step_times(src)
+    os.makedirs(dest, exist_ok=True)
     files, entries = [], []
     for k, t in enumerate(times):
         step = read_step(src, k)

@@ -11,9 +11,44 @@ complete step are ignored and cut on the next append (see :meth:`truncate_to`).
 """
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 
+from ..errors import InputError, h5_reason
+
 TOPOLOGIES = ("Vertices", "Lines", "Polygons", "Strips")
+_LAYOUT = ("VTKHDF/Points", "VTKHDF/NumberOfPoints", "VTKHDF/PointData", "VTKHDF/Steps/Values",
+           "VTKHDF/Steps/PointOffsets", "VTKHDF/Steps/PointDataOffsets")
+
+
+def _bad_file(path: str, exc: BaseException) -> InputError:
+    return InputError(f"{path} is not a readable particle file ({h5_reason(exc)}; truncated or corrupt?)")
+
+
+def _check_layout(f, path: str) -> None:
+    missing = [name for name in _LAYOUT if name not in f]
+    if missing or "NSteps" not in f["VTKHDF/Steps"].attrs:
+        raise InputError(f"{path} is not a particle file of sphdvi run: no {(missing or ['Steps NSteps'])[0]}")
+
+
+@contextlib.contextmanager
+def open_particles(path: str):
+    """``path`` opened for reading, its layout checked: a corrupt or truncated file, or an
+    HDF5 file that is not a particle file, is an InputError naming it (exit code 2), also
+    when a read inside the ``with`` block fails."""
+    import h5py
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise _bad_file(path, exc) from None
+    try:
+        _check_layout(f, path)
+        yield f
+    except (OSError, KeyError) as exc:
+        raise _bad_file(path, exc) from None
+    finally:
+        f.close()
 
 
 class VTKHDFParticleWriter:
@@ -24,9 +59,22 @@ class VTKHDFParticleWriter:
         self.path = path
         self.arrays = dict(point_arrays)
         mode = "a" if append else "w"
-        self.f = h5py.File(path, mode)
+        try:
+            self.f = h5py.File(path, mode)
+        except OSError as exc:
+            if not append:
+                raise
+            raise InputError(f"--resume: {path} is not a readable particle file ({h5_reason(exc)}; truncated or "
+                             "corrupt?): the run cannot go on appending to it; move it away to resume into a new "
+                             "one, or run without --resume") from None
         if not append or "VTKHDF" not in self.f:
             self._create()
+        else:
+            try:
+                _check_layout(self.f, path)
+            except InputError as exc:
+                self.f.close()
+                raise InputError(f"--resume: {exc}") from None
         self.root = self.f["VTKHDF"]
 
     # -- layout -----------------------------------------------------------------------
@@ -147,8 +195,7 @@ class VTKHDFParticleWriter:
 
 def read_step(path: str, step: int) -> dict:
     """Read one step of a particle VTKHDF file: time, points and point arrays."""
-    import h5py
-    with h5py.File(path, "r") as f:
+    with open_particles(path) as f:
         root = f["VTKHDF"]
         steps = root["Steps"]
         nsteps = int(steps.attrs["NSteps"])
@@ -165,7 +212,6 @@ def read_step(path: str, step: int) -> dict:
 
 
 def step_times(path: str) -> np.ndarray:
-    import h5py
-    with h5py.File(path, "r") as f:
+    with open_particles(path) as f:
         steps = f["VTKHDF"]["Steps"]
         return steps["Values"][: int(steps.attrs["NSteps"])]

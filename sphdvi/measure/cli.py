@@ -5,15 +5,16 @@ inside the commands, so ``sphdvi --help`` stays fast.
 """
 from __future__ import annotations
 
+import os
 
 import click
 
-from ..cli_errors import report_errors
+from ..cli_errors import FiniteFloat, report_errors
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
-
-
+# the image formats matplotlib's savefig writes (told by the file's extension)
+PLOT_FORMATS = ("png", "pdf", "svg", "svgz", "jpg", "jpeg", "tif", "tiff", "webp", "eps", "ps", "pgf")
 
 
 def _output_options(fn):
@@ -29,6 +30,37 @@ def _output_options(fn):
     fn = click.option("--first", type=click.IntRange(min=0), default=0, show_default=True,
                       help="First output index.")(fn)
     return fn
+
+
+def _check_outputs(csv_path, plot):
+    """--csv and --plot are checked before any work: their folder must exist (a missing one
+    is a typo more often than a wish), and --plot needs an image extension."""
+    for path, hint in ((csv_path, "'--csv'"), (plot, "'--plot'")):
+        if path:
+            folder = os.path.dirname(os.path.abspath(path))
+            if not os.path.isdir(folder):
+                raise click.BadParameter(f"{path}: the folder {folder} does not exist; create it first",
+                                         param_hint=hint)
+    if plot:
+        ext = os.path.splitext(plot)[1].lower().lstrip(".")
+        if ext not in PLOT_FORMATS:
+            raise click.BadParameter(f"{plot}: expected an image file name ending in "
+                                     f"{', '.join('.' + e for e in PLOT_FORMATS[:4])}, ...", param_hint="'--plot'")
+
+
+def _warn_y_in_2d(run, pts, option):
+    """In a 2D case the kernel uses x and z only: a y off the case's plane is ignored
+    (as in DualSPHysics's MeasureTool on a 2D case); say so."""
+    if not run.spec.is2d:
+        return
+    import numpy as np
+    y0 = float(run.data["constants"].get("posy2d") or 0.0)
+    y = np.asarray(pts)[:, 1]          # 0 also where the point was given without y (x,z or x)
+    off = np.flatnonzero((np.abs(y - y0) > 1e-9 * max(1.0, abs(y0))) & (y != 0.0))
+    if off.size:
+        i = int(off[0])
+        click.echo(f"warning: {option}: the case is 2D (the plane y = {y0:g}); the y of {off.size} point(s) is "
+                   f"ignored (point {i}: y = {float(pts[i][1]):g})", err=True)
 
 
 def _emit(table, csv_path, sep, plot):
@@ -84,7 +116,7 @@ def measure():
                    "(MeasureTool POINTS/POINTSLIST files too).")
 @click.option("--vars", "variables", default="vel,rhop,press", show_default=True,
               help="Comma-separated: vel, rhop, press, mass, vol.")
-@click.option("--kclimit", type=float, default=0.5, show_default=True,
+@click.option("--kclimit", type=FiniteFloat(min=0), default=0.5, show_default=True,
               help="Kernel-sum threshold below which a point has no value (empty field).")
 @click.option("--correction", type=click.Choice(["shepard", "linear"]), default="shepard", show_default=True,
               help="shepard: normalised by the kernel sum (MeasureTool); linear: first-order "
@@ -97,6 +129,7 @@ def points(outdir, points, variables, kclimit, correction, first, last, every, c
     Points closer than 1.5h to a boundary (DBC) particle are named in a warning:
     DBC keeps the fluid about 1.5h away from walls, so values there are unreliable.
     """
+    _check_outputs(csv_path, plot)
     pts = _points_option(points, "'--points'")
     from .post import UNITS, measure_points
     names = [v.strip().lower() for v in variables.split(",") if v.strip()]
@@ -105,6 +138,7 @@ def points(outdir, points, variables, kclimit, correction, first, last, every, c
         raise click.BadParameter(f"unknown variable(s) {', '.join(bad) or '(none)'}; expected some of "
                                  f"{', '.join(UNITS)}", param_hint="'--vars'")
     run = _run(outdir)
+    _warn_y_in_2d(run, pts, "--points")
     table, near = measure_points(run, pts, names, kclimit=kclimit, order=1 if correction == "linear" else 0,
                                  first=first, last=last, every=every)
     for i, d, t in near:
@@ -119,9 +153,10 @@ def points(outdir, points, variables, kclimit, correction, first, last, every, c
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
 @click.option("--at", "at", required=True, metavar='"x[,y];..."',
               help="Horizontal positions: 'x;x' (2D) or 'x,y;x,y' (3D), or a file.")
-@click.option("--threshold", type=float, default=None,
+@click.option("--threshold", type=FiniteFloat(min=0, min_open=True), default=None,
               help="Kernel-sum threshold of the surface (default 0.5 in 3D, 0.4 in 2D).")
-@click.option("--dz", type=float, default=None, help="Sampling step along the vertical (default dp/4).")
+@click.option("--dz", type=FiniteFloat(min=0, min_open=True), default=None,
+              help="Sampling step along the vertical (default dp/4).")
 @_output_options
 @report_errors
 def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot):
@@ -131,11 +166,11 @@ def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot
     threshold going up. Depth: elevation minus the bottom (the top boundary
     particle below the surface, plus dp/2).
     """
+    _check_outputs(csv_path, plot)
     xy = _points_option(at, "'--at'", ncoord=2)
-    if dz is not None and not dz > 0:
-        raise click.BadParameter("must be positive", param_hint="'--dz'")
     from .post import measure_elevation
     run = _run(outdir)
+    _warn_y_in_2d(run, xy, "--at")
     _emit(measure_elevation(run, xy, threshold=threshold, dz=dz, first=first, last=last, every=every),
           csv_path, sep, plot)
 
@@ -159,6 +194,7 @@ def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_p
     cubic kernel, viscosity). Columns time,fx,fy,fz,mx,my,mz; per metre of width in 2D.
     """
     from .post import measure_forces, parse_mk_list
+    _check_outputs(csv_path, plot)
     if (mk is None) == (mkbound is None):
         raise click.UsageError("give exactly one of --mk or --mkbound")
     try:
@@ -190,4 +226,5 @@ def bodies(outdir, first, last, every, csv_path, sep, plot):
     the run's bodies.csv/links.csv at the snapshot times (empty without them).
     """
     from .post import measure_bodies
+    _check_outputs(csv_path, plot)
     _emit(measure_bodies(outdir, first=first, last=last, every=every), csv_path, sep, plot)

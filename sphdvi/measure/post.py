@@ -81,10 +81,11 @@ class RunOutput:
             raise InputError(f"{self.vtk_path} not found: run 'sphdvi run {self.outdir}' first")
 
     def snapshots(self, arrays=("Vel", "Rhop", "Press", "Mk"), first=0, last=None, every=1):
-        """Yield :class:`Snapshot` objects for steps first..last (inclusive)."""
-        import h5py
+        """Yield :class:`Snapshot` objects for steps first..last (inclusive); a range with no
+        output time in it, or an unreadable particle file, is an InputError."""
+        from ..io.vtkhdf import open_particles
         self._require_particles()
-        with h5py.File(self.vtk_path, "r") as f:
+        with open_particles(self.vtk_path) as f:
             root = f["VTKHDF"]
             steps = root["Steps"]
             nsteps = int(steps.attrs["NSteps"])
@@ -92,8 +93,7 @@ class RunOutput:
             offs = steps["PointOffsets"][:nsteps]
             counts = root["NumberOfPoints"][:nsteps]
             pd = root["PointData"]
-            last = nsteps - 1 if last is None else min(int(last), nsteps - 1)
-            for k in range(int(first), last + 1, max(1, int(every))):
+            for k in output_range(nsteps, first, last, every, self.vtk_path):
                 o, n = int(offs[k]), int(counts[k])
 
                 def read(name):
@@ -121,6 +121,20 @@ class RunOutput:
         return (float(lo[2]), float(hi[2])) if lo is not None and hi is not None else (None, None)
 
 
+def output_range(n: int, first=0, last=None, every=1, source: str = "the run") -> range:
+    """The output indices ``first..last`` (inclusive, ``last`` at most n - 1) every ``every``;
+    InputError when none is left (``--first`` past the last output, ``--last`` before it)."""
+    first = int(first or 0)
+    if n == 0:
+        raise InputError(f"{source} has no output time")
+    if first > n - 1:
+        raise InputError(f"--first {first}: {source} has {n} output times, numbered 0 to {n - 1}")
+    stop = n - 1 if last is None else min(int(last), n - 1)
+    if stop < first:
+        raise InputError(f"--last {last} is before --first {first}: no output time to measure")
+    return range(first, stop + 1, max(1, int(every)))
+
+
 # ---------------------------------------------------------------------------------
 # parsing of point lists
 # ---------------------------------------------------------------------------------
@@ -133,10 +147,27 @@ def parse_points(text: str, is2d: bool | None = None, ncoord: int = 3) -> np.nda
     if os.path.isfile(text):
         with open(text, encoding="utf-8") as fh:
             return _points_from_lines(fh.read().splitlines(), ncoord, source=text)
+    if _looks_like_a_file_name(text):
+        raise ValueError(f"{text}: file not found (and not a list of numbers)")
     items = [s for s in text.replace("\n", ";").split(";") if s.strip()]
     if not items:
         raise ValueError("no points given")
     return _points_from_lines(items, ncoord, source=None)
+
+
+def _looks_like_a_file_name(text: str) -> bool:
+    """Not numbers but a path: one word with a path separator or a letter that cannot be
+    part of a number (e, E and the words inf/nan can)."""
+    t = text.strip()
+    if not t or "," in t or ";" in t or " " in t:
+        return False
+    if "/" in t or os.sep in t:
+        return True
+    try:
+        float(t)
+        return False
+    except ValueError:
+        return any(ch.isalpha() for ch in t)
 
 
 def _numbers(line: str):
@@ -169,8 +200,11 @@ def _points_from_lines(lines, ncoord, source):
                 plist = []
             continue
         if ncoord == 2:
-            if len(vals) not in (1, 2, 3):
-                raise ValueError(f"{where}'{raw.strip()}': expected x or x,y")
+            # a MeasureTool points file has x y z lines (z unused: the whole vertical is
+            # sampled); given on the command line, a third number is a mistake
+            if len(vals) not in ((1, 2, 3) if source else (1, 2)):
+                raise ValueError(f"{where}'{raw.strip()}': expected x or x,y (the elevation is found along the "
+                                 "whole vertical at each x,y: no z)")
             pts.append([vals[0], vals[1] if len(vals) > 1 else 0.0, 0.0])
         else:
             if len(vals) == 2:                  # 2D shorthand x,z
@@ -515,24 +549,29 @@ def with_logged_contacts(table: Table, outdir: str, data: dict, is2d: bool) -> T
     return Table(table.time, cols, units, out, table.part, title=table.title)
 
 
-def bodies_from_csv(outdir: str, is2d: bool) -> Table:
+def bodies_from_csv(outdir: str, is2d: bool, first=0, last=None, every=1) -> Table:
     """The body table from bodies.csv / links.csv of a body-only run (no fluid:
-    the fluid force is zero)."""
+    the fluid force is zero); ``first``, ``last``, ``every`` index its row times."""
     rows, links = _read_body_logs(outdir)
     names = list(dict.fromkeys(r["body"] for r in rows))
     lnames = list(dict.fromkeys(r["link"] for r in links))
     times = sorted({float(r["time"]) for r in rows})
+    keep = set(times[k] for k in output_range(len(times), first, last, every,
+                                              os.path.join(outdir, "bodies.csv")))
+    times = [t for t in times if t in keep]
+    origin = {}                       # each body's first centre (t = 0): surge, sway, heave from it
+    for r in rows:
+        origin.setdefault(r["body"], np.array([float(r[k]) for k in ("x", "y", "z")]))
+    rows = [r for r in rows if float(r["time"]) in keep]
     tindex = {t: i for i, t in enumerate(times)}
     cols, units = _body_table_columns(names, is2d, lnames)
     data = np.full((len(times), len(cols)), np.nan)
-    first = {}
     nb = len(BODY_COLUMNS)
     for r in rows:
         i = tindex[float(r["time"])]
         b = names.index(r["body"])
         c = np.array([float(r[k]) for k in ("x", "y", "z")])
-        first.setdefault(r["body"], c)
-        vals = np.concatenate([c, c - first[r["body"]], [float(r[k]) for k in ("roll", "pitch", "yaw")],
+        vals = np.concatenate([c, c - origin[r["body"]], [float(r[k]) for k in ("roll", "pitch", "yaw")],
                                [float(r[k]) for k in ("vx", "vy", "vz", "wx", "wy", "wz")], np.zeros(6),
                                [float(r[k]) for k in ("cfx", "cfy", "cfz", "ctx", "cty", "ctz")]])
         data[i, b * nb:(b + 1) * nb] = vals
@@ -601,7 +640,7 @@ def measure_bodies(outdir: str, first=0, last=None, every=1) -> Table:
     logged = os.path.exists(os.path.join(outdir, "bodies.csv"))
     if logged and not os.path.exists(os.path.join(outdir, "particles.vtkhdf")):
         # a body-only run: no particle snapshots, the logs are the whole record
-        return bodies_from_csv(outdir, bool(data["constants"]["is2d"]))
+        return bodies_from_csv(outdir, bool(data["constants"]["is2d"]), first=first, last=last, every=every)
     table = bodies_from_snapshots(RunOutput(outdir), first=first, last=last, every=every)
     if logged:
         table = with_logged_contacts(table, outdir, data, bool(data["constants"]["is2d"]))

@@ -103,3 +103,40 @@ def test_solver_warnings_print_as_one_line_without_a_code_location():
     other = _user_warning_line("old", DeprecationWarning, "/x/solver.py", 12, "",
                                _default=warnings.formatwarning)
     assert "/x/solver.py:12" in other
+
+
+def test_finite_float_options():
+    """FiniteFloat: nan, inf and values below the minimum are usage errors (exit 2) naming
+    the option; click's FloatRange lets nan through."""
+    import click
+    from sphdvi.cli_errors import FiniteFloat
+
+    @click.command()
+    @click.option("--x", type=FiniteFloat(min=0, min_open=True))
+    def cmd(x):
+        click.echo(repr(x))
+
+    runner = CliRunner()
+    assert runner.invoke(cmd, ["--x", "0.5"]).output == "0.5\n"
+    for bad in ("nan", "inf", "-inf", "0", "-1", "abc"):
+        r = runner.invoke(cmd, ["--x", bad])
+        assert r.exit_code == 2 and "Invalid value for '--x'" in r.output and "> 0" in r.output, (bad, r.output)
+
+
+def test_os_error_without_a_file_name_reads_cleanly():
+    """An OSError that names no file (h5py's) prints its text, not 'text: ' with an empty name."""
+    import click
+    from sphdvi.cli_errors import report_errors
+
+    @click.command()
+    @click.option("--named", is_flag=True)
+    @report_errors
+    def cmd(named):
+        if named:
+            raise FileNotFoundError(2, "No such file or directory", "/x/y.h5")
+        raise OSError("Unable to synchronously open file (file signature not found)")
+
+    r = CliRunner().invoke(cmd, [])
+    assert r.exit_code == 1 and r.output == "error: Unable to synchronously open file (file signature not found)\n"
+    r = CliRunner().invoke(cmd, ["--named"])
+    assert r.output == "error: No such file or directory: /x/y.h5\n"

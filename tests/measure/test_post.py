@@ -114,6 +114,48 @@ def test_cli_outputs_and_exit_codes(tank2d, tmp_path):
     assert t.names == ["fx", "fy", "fz", "mx", "my", "mz"] and t.units[:3] == ["N/m"] * 3
 
 
+def test_cli_bad_options_exit_2_before_any_output(tank2d, tmp_path):
+    """Option values are checked before the table is computed or printed: --plot needs an image
+    name, --csv and --plot an existing folder (never created), --kclimit/--threshold finite and
+    in range, --first an existing output, --at no z; a missing points file is named."""
+    tank, out = tank2d
+    cases = [
+        (["points", "--points", "0.5,0,0.1", "--plot", tmp_path / "x.txt"], "expected an image file name"),
+        (["points", "--points", "0.5,0,0.1", "--csv", tmp_path / "no" / "dir" / "x.csv"], "does not exist"),
+        (["points", "--points", "0.5,0,0.1", "--kclimit", "nan"], "Invalid value for '--kclimit'"),
+        (["points", "--points", "0.5,0,0.1", "--kclimit", "-1"], "Invalid value for '--kclimit'"),
+        (["elevation", "--at", "0.3", "--threshold", "-5"], "Invalid value for '--threshold'"),
+        (["elevation", "--at", "0.3", "--dz", "inf"], "Invalid value for '--dz'"),
+        (["elevation", "--at", "0.3", "--first", "10"], "--first 10: "),
+        (["elevation", "--at", "0.3", "--first", "1", "--last", "0"], "--last 0 is before --first 1"),
+        (["elevation", "--at", "0.2,0,1"], "expected x or x,y"),
+        (["points", "--points", "nonexist.txt"], "nonexist.txt: file not found"),
+        (["points", "--points", str(tmp_path / "nope.csv")], "nope.csv: file not found"),
+    ]
+    for args, text in cases:
+        r = invoke("measure", args[0], out, *args[1:])
+        assert r.exit_code == 2, (args, r.output)
+        assert text in r.output and "Traceback" not in r.output, (args, r.output)
+        assert r.stdout == "" or "time [s]" not in r.stdout, (args, r.stdout)     # no table printed
+    assert not (tmp_path / "no").exists()
+    r = invoke("measure", "elevation", out, "--at", "0.3", "--first", "10")
+    assert "has 2 output times, numbered 0 to 1" in r.output
+    r = invoke("measure", "elevation", out, "--at", "0.3", "--first", "1")
+    assert r.exit_code == 0 and len(r.stdout.splitlines()) == 2, r.output
+
+
+def test_cli_2d_points_off_the_plane_are_warned(tank2d):
+    """In 2D the kernel uses x and z: a y off the case's plane is ignored, with a warning."""
+    tank, out = tank2d
+    r = invoke("measure", "points", out, "--points", "0.5,0.3,0.2", "--vars", "press")
+    assert r.exit_code == 0, r.output
+    assert "the case is 2D" in r.stderr and "y = 0.3" in r.stderr
+    same = invoke("measure", "points", out, "--points", "0.5,0,0.2", "--vars", "press")
+    assert "the case is 2D" not in same.stderr and same.stdout == r.stdout
+    r = invoke("measure", "elevation", out, "--at", "0.3,0.2")
+    assert r.exit_code == 0 and "the case is 2D" in r.stderr, r.output
+
+
 def test_csv_round_trip(tmp_path):
     rng = np.random.default_rng(3)
     data = rng.normal(size=(4, 3)) * 1e3
@@ -190,3 +232,21 @@ def test_viscotime_viscosity_of_the_force_at_the_snapshot_time():
     assert spec.visco_bound_at(0.25) == pytest.approx(0.025)
     assert spec.visco_bound_at(-1.0) == 0.02 and spec.visco_bound_at(5.0) == 0.04
     assert KernelSpec(kind=2, h=0.014, dp=0.01, is2d=True, visco_bound=0.01).visco_bound_at(0.5) == 0.01
+
+
+def test_bodies_of_a_body_only_run_honour_first_last_every(tmp_path):
+    """measure bodies on a body-only run (from bodies.csv): --first/--last/--every select the
+    output rows (surge/sway/heave still from t = 0); --first past the end is an error."""
+    from pathlib import Path
+    case = Path(__file__).resolve().parents[2] / "cases" / "pendulum" / "CasePendulum_Def.xml"
+    out = tmp_path / "p"
+    r = invoke("run", case, "-o", out, "--tmax", "0.03", "--tout", "0.01", "-q")
+    assert r.exit_code == 0, r.output
+    full = invoke("measure", "bodies", out, "--csv", tmp_path / "all.csv")
+    part = invoke("measure", "bodies", out, "--first", "1", "--last", "2", "--csv", tmp_path / "part.csv")
+    assert full.exit_code == 0 and part.exit_code == 0, (full.output, part.output)
+    a, b = read_table(str(tmp_path / "all.csv")), read_table(str(tmp_path / "part.csv"))
+    assert a.time.size == 4 and b.time.tolist() == a.time[1:3].tolist()
+    np.testing.assert_array_equal(b.data, a.data[1:3])
+    r = invoke("measure", "bodies", out, "--first", "10")
+    assert r.exit_code == 2 and "--first 10: " in r.output and "4 output times" in r.output

@@ -1,0 +1,292 @@
+"""sphdvi run / export on bad input: option values, --set checks shared with the case reader,
+checkpoints of another case, corrupt HDF5 files, DtFixed against the run, --threads, --dp.
+Each ends with exit code 2 (or 3 for a run that blows up) and a message naming what is wrong,
+without a traceback.  Tiny cases (dp 0.1, a few steps)."""
+import json
+import warnings
+from pathlib import Path
+
+import h5py
+import pytest
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+from sphdvi.errors import InputError
+
+REPO = Path(__file__).resolve().parents[2]
+DAMBREAK = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
+PENDULUM = REPO / "cases" / "pendulum" / "CasePendulum_Def.xml"
+CASE_H5 = "CaseDambreakVal2D.h5"
+
+
+def invoke(args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def assert_input_error(r, *fragments):
+    assert r.exit_code == 2, r.output
+    assert "Traceback" not in r.output and "internal error" not in r.output, r.output
+    for text in fragments:
+        assert text in r.output, (text, r.output)
+
+
+def case_xml(tmp_path, params="", name="CaseDambreakVal2D_Def.xml"):
+    text = DAMBREAK.read_text()
+    if params:
+        text = text.replace("<parameters>", "<parameters>" + params)
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def done(tmp_path_factory):
+    """A finished tiny run (dp 0.1, outputs at 0, 0.002, 0.004); tests copy it."""
+    base = tmp_path_factory.mktemp("done")
+    out = base / "out"
+    r = invoke(["run", case_xml(base), "-o", out, "--dp", "0.1", "--tmax", "0.004", "--tout", "0.002",
+                "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def copy_run(src, dest):
+    import shutil
+    shutil.copytree(src, dest)
+    return dest
+
+
+# -- option values ---------------------------------------------------------------------
+@pytest.mark.parametrize("option,value", [("--tmax", "-1"), ("--tmax", "nan"), ("--tmax", "inf"),
+                                          ("--tout", "-1"), ("--tout", "nan"), ("--tout", "0"),
+                                          ("--dp", "-0.1"), ("--dp", "nan")])
+def test_bad_time_options_are_usage_errors(tmp_path, option, value):
+    r = invoke(["run", tmp_path, option, value])
+    assert_input_error(r, f"Invalid value for '{option}'", "expected a finite number")
+
+
+def test_timeout_zero_is_a_case_error_at_gencase(tmp_path):
+    r = invoke(["gencase", case_xml(tmp_path, '<parameter key="TimeOut" value="0" />'), "-o", tmp_path / "g",
+                "--dp", "0.1"])
+    assert_input_error(r, "CaseDambreakVal2D_Def.xml:", "parameter TimeOut: 0.0 is not > 0")
+
+
+# -- --set: the reader's checks and warnings ---------------------------------------------
+def test_set_applies_the_cross_parameter_checks(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    r = invoke(["run", out, "--set", "RhopOutMin=1400", "--tmax", "0.002"])
+    assert_input_error(r, "RhopOutMin (1400.0) >= RhopOutMax (1300.0)")
+    r = invoke(["run", out, "--set", "RhopOutMax=600", "--tmax", "0.002"])
+    assert_input_error(r, "RhopOutMin (700.0) >= RhopOutMax (600.0)")
+
+
+def test_set_warnings_as_the_case_reader():
+    from sphdvi.simulation import apply_overrides
+    base = {"TimeOut": 0.1, "DensityDT": 0}
+    for item, text in (("DeltaSPH=0.05", "'DeltaSPH' is deprecated"),
+                       ("FtSaveAce=1", "'FtSaveAce' has no effect"),
+                       ("SavePosDouble=2", "'SavePosDouble' has no effect"),
+                       ("BoundaryMethod=2", "DualSPHysics reads 'Boundary'")):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            apply_overrides(base, [item])
+        assert any(text in str(w.message) for w in caught), (item, [str(w.message) for w in caught])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        apply_overrides(base, ["FtSaveAce=0", "Visco=0.05"])
+    assert not caught
+
+
+def test_set_of_a_constant_and_of_dem():
+    from sphdvi.simulation import apply_overrides
+    with pytest.raises(InputError, match=r"'CFLnumber' is a constant of the case.*<cflnumber value=.*<constantsdef>"):
+        apply_overrides({"TimeOut": 0.1}, ["CFLnumber=5"])
+    with pytest.raises(InputError, match=r"RigidAlgorithm=2 \(DEM.*not implemented.*use 1.*or 3"):
+        apply_overrides({"TimeOut": 0.1}, ["RigidAlgorithm=2"])
+    with pytest.raises(InputError, match="unknown parameter 'Visc'; did you mean 'Visco'"):
+        apply_overrides({"TimeOut": 0.1}, ["Visc=1"])
+
+
+def test_dualsphysics_keys_in_a_case_file(tmp_path):
+    """SavePosDouble=2 (DualSPHysics reads != 0) and BoundaryMethod (not a DualSPHysics key,
+    ignored by it) are accepted with a warning naming the line; RigidAlgorithm=2 (DEM) is an error."""
+    case = case_xml(tmp_path, '<parameter key="SavePosDouble" value="2" />'
+                              '<parameter key="BoundaryMethod" value="2" />')
+    r = invoke(["gencase", case, "-o", tmp_path / "g", "--dp", "0.1", "-q"])
+    assert r.exit_code == 0, r.output
+    assert "warning: <parameter>: parameter 'SavePosDouble' has no effect" in r.output
+    assert "'BoundaryMethod' has no effect in sphdvi (it is not a DualSPHysics key" in r.output
+    r = invoke(["gencase", case_xml(tmp_path, '<parameter key="RigidAlgorithm" value="2" />', "b_Def.xml"),
+                "-o", tmp_path / "g2", "--dp", "0.1"])
+    assert_input_error(r, "b_Def.xml:", "RigidAlgorithm=2 (DEM", "expected one of 0, 1, 3")
+
+
+# -- --resume: a checkpoint of another case ---------------------------------------------------
+def test_resume_refuses_the_checkpoint_of_another_case(done, tmp_path):
+    """Re-gencasing OUT at another dp and resuming: refused (exit 2), naming the particle
+    counts and dp; the outputs stay as they were."""
+    out = copy_run(done, tmp_path / "o")
+    before = (out / "run.csv").read_text()
+    assert invoke(["gencase", case_xml(tmp_path), "-o", out, "--dp", "0.05", "-q"]).exit_code == 0
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
+    assert_input_error(r, "restart.h5 was written by a run of another case", "particles 301 in the checkpoint, "
+                       "1001 in the case", "dp 0.1 in the checkpoint, 0.05 in the case")
+    assert (out / "run.csv").read_text() == before
+
+
+def test_resume_of_an_older_checkpoint_without_the_case_identity(done, tmp_path):
+    """A checkpoint of an older sphdvi (no case_* scalars) still resumes its own case, and is
+    refused for a re-drawn one (its particles are not the case's)."""
+    out = copy_run(done, tmp_path / "o")
+    with h5py.File(out / "restart.h5", "a") as f:
+        for key in ("case_np", "case_dp", "case_h", "case_hash"):
+            del f["scalars"].attrs[key]
+    other = copy_run(out, tmp_path / "other")
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "restart.h5") as f:
+        assert "case_hash" in f["scalars"].attrs          # written again, with it
+    assert invoke(["gencase", case_xml(tmp_path), "-o", other, "--dp", "0.05", "-q"]).exit_code == 0
+    r = invoke(["run", other, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
+    assert_input_error(r, "written by a run of another case")
+
+
+def test_body_only_checkpoint_given_to_an_sph_run(done, tmp_path):
+    from sphdvi.io.checkpoint import BODIES_RESTART_FORMAT
+    out = copy_run(done, tmp_path / "o")
+    with h5py.File(out / "restart.h5", "w") as f:
+        f.attrs["format"] = BODIES_RESTART_FORMAT
+        f.attrs["extra"] = json.dumps({"part": 1, "step": 1, "runtime_s": 0.0, "names": ["b"]})
+        f.create_group("bodies")
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "-q"])
+    assert_input_error(r, "restart.h5 is the checkpoint of a body-only run")
+
+
+def test_sph_checkpoint_given_to_a_body_only_run(done, tmp_path):
+    out = tmp_path / "p"
+    r = invoke(["run", PENDULUM, "-o", out, "--tmax", "0.02", "--tout", "0.01", "-q"])
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "restart.h5") as f:
+        assert json.loads(f.attrs["extra"])["case_hash"]
+    import shutil
+    shutil.copy(done / "restart.h5", out / "restart.h5")
+    r = invoke(["run", out, "--resume", "--tmax", "0.04", "-q"])
+    assert_input_error(r, "restart.h5 is the checkpoint of an SPH run")
+
+
+# -- corrupt HDF5 files ---------------------------------------------------------------------
+def _truncate(path, size=1000):
+    data = Path(path).read_bytes()[:size]
+    Path(path).write_bytes(data)
+
+
+def test_corrupt_checkpoint(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    good = (out / "restart.h5").read_bytes()
+    _truncate(out / "restart.h5")
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "-q"])
+    assert_input_error(r, f"{out / 'restart.h5'} is not a readable checkpoint (truncated file")
+    (out / "restart.h5").write_text("garbage\n")
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "-q"])
+    assert_input_error(r, f"{out / 'restart.h5'} is not a readable checkpoint (file signature not found")
+    (out / "restart.h5").write_bytes(good)
+    with h5py.File(out / "restart.h5", "a") as f:
+        del f["state/rhop"]
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "-q"])
+    assert_input_error(r, "restart.h5 is not a readable checkpoint (no state/rhop")
+
+
+def test_corrupt_particle_file(done, tmp_path):
+    """A truncated particles.vtkhdf: --resume, export and measure name it (exit 2)."""
+    out = copy_run(done, tmp_path / "o")
+    _truncate(out / "particles.vtkhdf", 3000)
+    name = str(out / "particles.vtkhdf")
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "-q"])
+    assert_input_error(r, f"{name} is not a readable particle file (truncated file")
+    assert_input_error(invoke(["export", out]), f"{name} is not a readable particle file")
+    assert_input_error(invoke(["measure", "points", out, "--points", "0.5,0,0.1"]),
+                       f"{name} is not a readable particle file")
+    with h5py.File(out / "particles.vtkhdf", "w") as f:      # HDF5, but not a particle file
+        f.create_group("other")
+    assert_input_error(invoke(["export", out]), f"{name} is not a particle file of sphdvi run: no VTKHDF/Points")
+
+
+def test_corrupt_case_file(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    good = (out / CASE_H5).read_bytes()
+    _truncate(out / CASE_H5, 2000)
+    r = invoke(["run", out, "--tmax", "0.002", "-q"])
+    assert_input_error(r, f"{out / CASE_H5} (truncated file", "cannot be read as HDF5")
+    assert_input_error(invoke(["measure", "points", out, "--points", "0.5,0,0.1"]), f"{out / CASE_H5}")
+    (out / CASE_H5).write_bytes(good)
+    with h5py.File(out / CASE_H5, "a") as f:
+        del f["particles/mass"]
+    r = invoke(["run", out, "--tmax", "0.002", "-q"])
+    assert_input_error(r, f"{out / CASE_H5} is not a readable sphdvi case file")
+
+
+# -- DtFixed against TimeMax and TimeOut ---------------------------------------------------------
+def test_dtfixed_longer_than_the_run(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    r = invoke(["run", out, "--set", "DtFixed=1", "--tmax", "0.002", "-q"])
+    assert_input_error(r, "DtFixed (1 s) is longer than the whole run (TimeMax 0.002 s)")
+    r = invoke(["run", PENDULUM, "-o", tmp_path / "p", "--set", "DtFixed=10", "--tmax", "0.01", "-q"])
+    assert_input_error(r, "DtFixed (10 s) is longer than the whole run (TimeMax 0.01 s)")
+
+
+def test_dtfixed_that_throws_the_fluid_out_stops_the_run(done, tmp_path):
+    """DtFixed = 1 s: warned as longer than TimeOut; its one step excludes 46 % of the fluid,
+    under the run's limit (half) but beyond the one-step limit (a quarter): exit 3."""
+    out = copy_run(done, tmp_path / "o")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = invoke(["run", out, "--set", "DtFixed=1", "--tmax", "1", "--threads", "1", "-q"])
+    assert r.exit_code == 3, r.output
+    assert any("DtFixed (1 s) is longer than TimeOut (0.01 s)" in str(w.message) for w in caught)
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "diverged" and "excluded in one step" in meta["message"]
+
+
+# -- --threads and --dp --------------------------------------------------------------------------
+def test_threads_beyond_numba_are_clamped_and_recorded(done, tmp_path):
+    import numba
+    out = copy_run(done, tmp_path / "o")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = invoke(["run", out, "--threads", "99999999999", "--tmax", "0.002", "-q"])
+    assert r.exit_code == 0, r.output
+    limit = numba.config.NUMBA_NUM_THREADS
+    assert json.loads((out / "run.json").read_text())["threads"] == limit
+    assert any(f"--threads 99999999999: numba runs at most {limit} threads" in str(w.message) for w in caught)
+
+
+def test_dp_where_gencase_does_not_run(done, tmp_path):
+    """--dp with a gencase folder or --resume: the case's own dp is accepted, another refused."""
+    out = copy_run(done, tmp_path / "o")
+    r = invoke(["run", out, "--dp", "0.05", "--tmax", "0.002", "-q"])
+    assert_input_error(r, "--dp 0.05: a gencase output folder holds the case", "drawn at dp=0.1")
+    xml = case_xml(tmp_path)
+    r = invoke(["run", xml, "-o", out, "--resume", "--dp", "0.05", "--tmax", "0.006", "-q"])
+    assert_input_error(r, "--dp 0.05: --resume continues the run of the case", "drawn at dp=0.1")
+    r = invoke(["run", xml, "-o", out, "--resume", "--dp", "0.1", "--tmax", "0.006", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+
+
+# -- export --dir ------------------------------------------------------------------------------
+def test_export_dir_is_used_as_given(done, tmp_path):
+    """--dir: relative paths inside OUTDIR (also ../x), absolute ones as given, never changed;
+    an existing file is refused."""
+    out = copy_run(done, tmp_path / "run" / "o")
+    r = invoke(["export", out, "--dir", "../escape"])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "run" / "escape" / "particles.pvd").is_file() and not (out / "escape").exists()
+    absdir = tmp_path / "abs" / "vtp"
+    r = invoke(["export", out, "--dir", absdir])
+    assert r.exit_code == 0 and (absdir / "Part_0002.vtp").is_file(), r.output
+    assert not (out / "vtp").exists()
+    r = invoke(["export", out, "--dir", "run.csv"])
+    assert_input_error(r, "run.csv exists and is not a folder")
+    r = invoke(["export", out, "--isosurface", "--dir", str(absdir)])
+    assert_input_error(r, "with --isosurface, --dir is a folder name inside OUTDIR")
+    r = invoke(["export", out, "--isosurface", "--iso-spacing", "nan"])
+    assert_input_error(r, "Invalid value for '--iso-spacing'")
