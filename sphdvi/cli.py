@@ -91,22 +91,38 @@ def gencase(case_xml, outdir, max_nodes, dp, quiet):
               help="Threads (default: SLURM_CPUS_PER_TASK or the CPU affinity).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
               help="Override any <parameters> key, e.g. --set Visco=0.05 (repeatable).")
-@click.option("--resume", is_flag=True, help="Continue an interrupted run from its last output.")
+@click.option("--resume", is_flag=True,
+              help="Continue an interrupted run from its last output, with the --tmax/--tout/--set it was "
+                   "started with (--tmax may be raised to extend it).")
+@click.option("--overwrite", is_flag=True,
+              help="Start a new run into an OUT that holds an earlier run's results: they are deleted first.")
 @click.option("--dp", type=FiniteFloat(min=0, min_open=True), default=None,
               help="With a case XML: override <definition dp> (gencase runs with it). With a gencase folder "
                    "or --resume, where gencase does not run, only the case's own dp is accepted.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress output.")
 @report_errors
-def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
+def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet):
     """Run a case: SOURCE is a case XML (gencase runs first) or a gencase output folder.
 
     \b
     Outputs in OUT: particles.vtkhdf (one temporal VTKHDF file), run.json,
     run.log, run.csv, restart.h5; body-only cases write bodies.csv and links.csv.
+    A new run into an OUT holding an earlier run's results needs --overwrite.
     Exit codes: 0 completed, 1 failed or interrupted, 2 bad input, 3 diverged.
     """
     from .errors import InputError
-    from .simulation import find_case_file, run as run_case
+    from .simulation import _Stop
+    if resume and overwrite:
+        raise InputError("--resume and --overwrite: give one (--resume continues the run in OUT, --overwrite "
+                         "deletes its results and starts again)")
+    # SIGTERM/SIGINT from here on end the run cleanly (status 'interrupted'), start-up included
+    with _Stop() as stop:
+        _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop)
+
+
+def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
+    from .errors import InputError
+    from .simulation import check_new_run_folder, find_case_file, run as run_case
     drawn_dp = None      # --dp where no gencase runs: it must be the case's dp
     if os.path.isfile(source) and source.lower().endswith(".xml"):
         from .case.gencase import build_case, write_outputs
@@ -116,6 +132,7 @@ def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
             case_h5 = find_case_file(outdir)
             drawn_dp = dp
         else:
+            check_new_run_folder(outdir, overwrite)     # before gencase writes into it
             result = build_case(source, outdir, dp=dp)
             print_warnings(result.warnings)
             case_h5 = write_outputs(result, outdir)[0]
@@ -126,7 +143,7 @@ def run(source, outdir, tmax, tout, threads, sets, resume, dp, quiet):
     else:
         raise InputError(f"{source}: not a case XML file or a gencase output folder")
     result = run_case(case_h5, outdir, tmax=tmax, tout=tout, threads=threads, sets=sets, resume=resume,
-                      quiet=quiet, expect_dp=drawn_dp)
+                      quiet=quiet, expect_dp=drawn_dp, overwrite=overwrite, stop=stop)
     if result.status != "completed":
         click.echo(f"{result.status}: {result.message}", err=True)
     elif not quiet:

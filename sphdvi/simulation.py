@@ -18,6 +18,8 @@ time, step, particle id, position and cause; what was written before stays.
 """
 from __future__ import annotations
 
+import contextlib
+import json
 import math
 import os
 import signal
@@ -32,6 +34,7 @@ from ._version import __version__
 from .errors import DivergenceError, InputError
 from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint, load_sph_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
+from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, Progress, RunFiles
 from .sph.damping import damping_zones
 
@@ -177,31 +180,155 @@ def special_parameters(data: dict) -> dict:
     return params
 
 
+# the files a run writes into OUT (Gauges<Type>_<name>.csv too); a gencase output folder
+# (<casename>.h5, <casename>_All.vtp) holds none of them
+RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "run.csv", "bodies.csv", "links.csv")
+
+
+def earlier_results(outdir: str) -> list[str]:
+    """The names of the files of an earlier run in ``outdir`` (sorted; [] when none)."""
+    if not os.path.isdir(outdir):
+        return []
+    return sorted(name for name in os.listdir(outdir)
+                  if name in RUN_OUTPUT_FILES or (name.startswith("Gauges") and "_" in name and name.endswith(".csv")))
+
+
+def check_new_run_folder(outdir: str, overwrite: bool) -> None:
+    """A new run into ``outdir``: refused (InputError) when it holds an earlier run's results,
+    unless ``overwrite``: they would be emptied or mixed with the new run's."""
+    found = earlier_results(outdir)
+    if not found or overwrite:
+        return
+    status = ""
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        with open(os.path.join(outdir, "run.json")) as fh:
+            meta = json.load(fh)
+        status = f", status '{meta['status']}' at t={float(meta['physical_time']):.6g} s"
+    raise InputError(f"{outdir} holds the results of an earlier run ({', '.join(found)}{status}); continue it with "
+                     f"'sphdvi run {outdir} --resume', or start again with --overwrite (deletes those files) "
+                     "or into another -o folder")
+
+
+def clear_earlier_results(outdir: str) -> list[str]:
+    """Delete the files of an earlier run in ``outdir`` (a new run with --overwrite), so that
+    nothing of it mixes with the new run's outputs.  Returns their names."""
+    found = earlier_results(outdir)
+    for name in found:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(os.path.join(outdir, name))
+    return found
+
+
+def _stored_overrides(outdir: str):
+    """The --tmax/--tout/--set of the run in ``outdir`` (run.json ``overrides``); None when
+    unknown (no or unreadable run.json, or one written before they were stored)."""
+    try:
+        with open(os.path.join(outdir, "run.json")) as fh:
+            meta = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    stored = meta.get("overrides") if isinstance(meta, dict) else None
+    return stored if isinstance(stored, dict) else None
+
+
+def resume_overrides(base: dict, outdir: str, tmax, tout, sets):
+    """The --tmax/--tout/--set a --resume runs with: the interrupted run's (run.json), with
+    --tmax replaced when given (a run may be extended); a --tout or --set that changes a
+    parameter of the run is refused (a gap in the outputs, other physics)."""
+    stored = _stored_overrides(outdir)
+    if stored is None:
+        warnings.warn(f"--resume: {os.path.join(outdir, 'run.json')} does not say which --tmax/--tout/--set the "
+                      "interrupted run used; the case's parameters and the options given now are used")
+        return tmax, tout, tuple(sets or ())
+    old_tmax, old_tout, old_sets = stored.get("tmax"), stored.get("tout"), tuple(stored.get("set") or ())
+    if tout is None and not sets:
+        return (old_tmax if tmax is None else tmax), old_tout, old_sets
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        before = apply_overrides(base, old_sets, None, old_tout)
+        after = apply_overrides(base, old_sets + tuple(sets or ()), None, old_tout if tout is None else tout)
+    changed = [k for k in sorted(set(before) | set(after))
+               if k != "TimeMax" and not _same_value(before.get(k), after.get(k))]
+    if changed:
+        used = " ".join([f"--tout {old_tout:g}"] if old_tout is not None else []) + \
+            "".join(f" --set {x}" for x in old_sets)
+        diffs = ", ".join(f"{k} {before.get(k)!r} -> {after.get(k)!r}" for k in changed)
+        raise InputError(f"--resume: the options given change the run ({diffs}); a resumed run goes on with the "
+                         f"parameters it started with ({used.strip() or 'the case file'}; only --tmax may change). "
+                         "Resume without them, or start a new run with --overwrite or another -o folder")
+    return (old_tmax if tmax is None else tmax), old_tout, old_sets
+
+
+def _same_value(a, b) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    try:
+        return bool(a == b)
+    except ValueError:          # arrays
+        return bool(np.array_equal(a, b))
+
+
 def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(), resume=False,
-        quiet=False, expect_dp=None) -> RunResult:
+        quiet=False, expect_dp=None, overwrite=False, stop=None) -> RunResult:
     """Run a gencase output: body-only cases go to the multibody engine, the rest to SPH.
 
     ``expect_dp``: a dp the user gave where no gencase runs (a gencase folder, --resume);
-    it must be the case's, else InputError."""
+    it must be the case's, else InputError.  A new run into a folder with an earlier run's
+    results is refused unless ``overwrite`` (they are deleted first); ``--resume`` reuses the
+    --tmax/--tout/--set of the interrupted run.  ``stop``: a :class:`_Stop` the caller
+    installed before its own start-up work (a signal then interrupts the run cleanly)."""
     from .io.casefile import read_case_h5
     t_start = _time.perf_counter()
     data = read_case_h5(case_h5)
     if expect_dp is not None:
         _check_dp(expect_dp, data, case_h5, resume)
-    params = apply_overrides(special_parameters(data), sets, tmax, tout)
+    base = special_parameters(data)
+    if resume:
+        tmax, tout, sets = resume_overrides(base, outdir, tmax, tout, sets)
+    params = apply_overrides(base, sets, tmax, tout)
     threads = _usable_threads(threads)
-    os.makedirs(outdir, exist_ok=True)
-    files = RunFiles(outdir)
     nfluid = int(np.count_nonzero(data["particles"]["type"] == 3))
+    if nfluid:
+        _check_dtfixed(float(params.get("DtFixed") or 0.0), params)
+    if not resume:
+        check_new_run_folder(outdir, overwrite)
+    os.makedirs(outdir, exist_ok=True)
+    remove_leftover_temporaries(outdir)
+    if not resume:
+        clear_earlier_results(outdir)
+    files = RunFiles(outdir)
     base_meta = {
         "version": __version__, "case": data["casename"], "case_file": os.path.abspath(case_h5),
-        "parameters": params, "threads": threads, "particles": int(data["particles"]["type"].size),
+        "parameters": params, "overrides": {"tmax": tmax, "tout": tout, "set": list(sets or ())},
+        "threads": threads, "particles": int(data["particles"]["type"].size),
         "fluid_particles": nfluid, "python": sys.version.split()[0], "numpy": np.__version__,
     }
-    if nfluid == 0:
-        return _run_bodies_only(data, params, outdir, files, base_meta, t_start, quiet, resume)
-    _check_dtfixed(float(params.get("DtFixed") or 0.0), params)
-    return _run_sph(data, params, outdir, files, base_meta, threads, resume, quiet, t_start)
+    with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
+        if nfluid == 0:
+            return _run_bodies_only(data, params, outdir, files, base_meta, t_start, quiet, resume, stop)
+        return _run_sph(data, params, outdir, files, base_meta, threads, resume, quiet, t_start, stop)
+
+
+def _stopped_at_startup(stop, files: RunFiles, meta: dict, outdir: str, resume: bool):
+    """A signal caught before the time loop: run.json says ``interrupted``; the RunResult
+    (exit 1), or None when no signal came."""
+    if stop is None or stop.signal is None:
+        return None
+    if os.path.exists(os.path.join(outdir, RESTART_FILE)) and resume:
+        message = (f"stopped by signal {stop.signal} during start-up; resume with 'sphdvi run {outdir} --resume'")
+    else:
+        message = (f"stopped by signal {stop.signal} during start-up, before the first output: nothing to resume; "
+                   f"run again with 'sphdvi run {outdir} --overwrite'")
+    if resume and not files.meta:
+        with contextlib.suppress(OSError, ValueError):
+            with open(files.json_path) as fh:
+                files.meta = dict(json.load(fh))
+    if not resume:
+        files.start()
+    files.log(f"interrupted: {message}")
+    files.write_json(**meta, status="interrupted", message=message)
+    return RunResult("interrupted", message, 1, int(files.meta.get("steps", 0) or 0),
+                     float(files.meta.get("physical_time", 0.0) or 0.0), float(files.meta.get("runtime_s", 0.0) or 0.0))
 
 
 def _check_dp(dp: float, data: dict, case_h5: str, resume: bool) -> None:
@@ -246,9 +373,12 @@ def _check_dtfixed(dt: float, params: dict, what: str = "DtFixed") -> None:
                       f"outputs are {dt:g} s apart")
 
 
-def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=False) -> RunResult:
+def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=False, stop=None) -> RunResult:
     """A case with bodies and no fluid: the multibody engine alone, DtFixed steps (default
     1e-3 s), with the outputs, logs, checks, checkpoints and resume of an SPH run."""
+    stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
+    if stopped is not None:
+        return stopped
     from .dvi.runner import StepSchedule, build_system
     from .mechanism import mechanism_from_case
     from .motion import MotionSet
@@ -274,7 +404,7 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=F
     files.write_json(**meta, mode="bodies", status="running", message="", dt=dt, steps=run.step,
                      physical_time=float(run.system.time), runtime_s=run.runtime,
                      startup_s=_time.perf_counter() - t_start, bodies=len(names), links=len(system.links))
-    return run.run(float(params["TimeMax"]), quiet)
+    return run.run(float(params["TimeMax"]), quiet, stop)
 
 
 # wall time between two checkpoints of a body-only run: its outputs are often a few steps of
@@ -338,14 +468,14 @@ class BodiesOnlyRun:
             save_bodies_checkpoint(self.ckpt, state, **extra)
             self._at_output = None
 
-    def run(self, tmax: float, quiet: bool) -> RunResult:
+    def run(self, tmax: float, quiet: bool, stop=None) -> RunResult:
         s, sch, files = self.system, self.schedule, self.files
         self.body_log = BodyLog(self.outdir, s, self.names, float(s.time) if self.resumed else None)
         progress = Progress(tmax, quiet, counts="bodies")
         wall_prev = self.runtime
         t_loop = _time.perf_counter()
         status, code, message = "completed", 0, ""
-        with _Stop() as stop:
+        with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
             try:
                 if not self.resumed:
                     self._write_part(wall_prev, stepped=False)
@@ -633,7 +763,7 @@ def _warm_up(sph: "SPHRun") -> float:
     return _time.perf_counter() - t0
 
 
-def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start) -> RunResult:
+def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start, stop=None) -> RunResult:
     """The SPH run on ``threads`` numba threads; the caller's thread count is
     restored afterwards (an in-process run must not change it for the rest of
     the process, e.g. a test session)."""
@@ -641,14 +771,17 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start)
     previous = numba.get_num_threads()
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     try:
-        return _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
+        return _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start, stop)
     finally:
         numba.set_num_threads(previous)
 
 
-def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start) -> RunResult:
+def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start, stop=None) -> RunResult:
     import numba
     from .io.vtkhdf import VTKHDFParticleWriter
+    stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
+    if stopped is not None:
+        return stopped
     sph = SPHRun(data, params, outdir)
     sol = sph.solver
     tmax, tout = float(params["TimeMax"]), float(params["TimeOut"])
@@ -662,14 +795,30 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
         extra = sph.load_checkpoint(ckpt)
         part = int(extra["part"])
         wall_prev = float(extra.get("runtime_s", 0.0))
+        had_vtk = os.path.exists(vtk_path)
         writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS, append=True)
+        held = int(writer.root["Steps"].attrs["NSteps"])
         writer.truncate_to(part + 1)
         files.load_existing(part + 1)
         files.log(f"resumed from part {part} at t={sol.time:.6g} s, step {sol.nstep}")
+        if held < part + 1:
+            lost = (f"{vtk_path} was missing: it starts anew" if not had_vtk else
+                    f"{vtk_path} holds {held} outputs")
+            line = (f"--resume: {lost}, but {ckpt} is at part {part} (t={sol.time:.6g} s): the particles of parts "
+                    f"{held}..{part} are not in it and the steps go on from part {part + 1}; restore the file to "
+                    "keep them, or run again with --overwrite for a complete one")
+            files.log("WARNING: " + line)
+            warnings.warn(line)
     else:
         writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS)
         files.start()
-    jit_s = _warm_up(sph)
+    stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
+    if stopped is None:
+        jit_s = _warm_up(sph)
+        stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
+    if stopped is not None:
+        writer.close()
+        return stopped
     startup = _time.perf_counter() - t_start
     files.write_json(**meta, mode="sph", numba=numba.__version__, threading_layer=_threading_layer(),
                      status="running", message="", steps=int(sol.nstep), physical_time=float(sol.time),
@@ -705,7 +854,7 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start)
     body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None)
                 if sph.bodies is not None else None)
     status, code, message = "completed", 0, ""
-    with _Stop() as stop:
+    with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
         try:
             if not resume:
                 write_part(0)

@@ -32,6 +32,21 @@ def atomic_path(path: str):
         raise
 
 
+def remove_leftover_temporaries(folder: str) -> list[str]:
+    """Delete the temporary files :func:`atomic_path` leaves when its process is killed
+    (SIGKILL) between creating and renaming one: ``.NAME.XXXXXXXX.tmp``.  Returns their names.
+    Call it only where no other process writes into ``folder``."""
+    removed = []
+    with contextlib.suppress(FileNotFoundError):
+        for entry in os.scandir(folder):
+            name = entry.name
+            if name.startswith(".") and name.endswith(".tmp") and name.count(".") >= 3 and entry.is_file():
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+                    removed.append(name)
+    return sorted(removed)
+
+
 def write_text_atomic(path: str, text: str) -> None:
     with atomic_path(path) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:

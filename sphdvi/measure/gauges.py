@@ -28,8 +28,8 @@ multiple of ``computedt`` (default TimeOut; 0 = every step) inside
 ``computetime start end``; rows are kept every ``outputdt`` inside
 ``outputtime``; ``output value="false"`` writes no file.  The new rows are
 appended at every TimeOut and at the end, in one write each (the cost of an
-output does not grow with the rows written before); a resume cuts a file back
-to the restart time, atomically.  The interpolation,
+output does not grow with the rows written before); a new run starts each file
+anew (header only), a resume cuts it back to the restart time, atomically.  The interpolation,
 surface and force code is that of ``sphdvi measure`` (:mod:`.core`).
 """
 from __future__ import annotations
@@ -344,6 +344,10 @@ class RunGauges:
                 s.output.skip_to(time)
             self.next_flush = int(math.floor(time / self.tout + 1e-9)) + 1
         else:
+            for s in self.slots:
+                # a new run starts its files anew (an earlier run's rows must not stay above)
+                if s.write:
+                    write_text_atomic(s.path, s.header())
             p = data["particles"]
             view = StateView(0.0, p["pos"], p["vel"], p["rhop"], p["mass"], self.spec.tait_pressure(p["rhop"]),
                              p["type"], p["mk"], self.spec)

@@ -26,3 +26,13 @@ def test_atomic_and_appended_files_follow_the_umask(tmp_path):
     assert mode(a) == 0o666 & ~umask and a.read_text() == "{\"k\": 1}\n"
     assert not [n for n in os.listdir(tmp_path) if n.endswith(".tmp")]
 
+
+
+def test_leftover_temporaries_are_removed(tmp_path):
+    """A SIGKILL between mkstemp and the rename leaves .NAME.XXXXXXXX.tmp: it goes, the rest stays."""
+    from sphdvi.io.atomic import remove_leftover_temporaries
+    (tmp_path / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
+    (tmp_path / ".notes.tmp").write_text("the user's")
+    (tmp_path / "run.csv").write_text("x")
+    assert remove_leftover_temporaries(str(tmp_path)) == [".restart.h5.k3j_x9a1.tmp"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".notes.tmp", "run.csv"]

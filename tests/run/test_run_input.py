@@ -240,7 +240,7 @@ def test_dtfixed_that_throws_the_fluid_out_stops_the_run(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        r = invoke(["run", out, "--set", "DtFixed=1", "--tmax", "1", "--threads", "1", "-q"])
+        r = invoke(["run", out, "--set", "DtFixed=1", "--tmax", "1", "--threads", "1", "-q", "--overwrite"])
     assert r.exit_code == 3, r.output
     assert any("DtFixed (1 s) is longer than TimeOut (0.01 s)" in str(w.message) for w in caught)
     meta = json.loads((out / "run.json").read_text())
@@ -253,7 +253,7 @@ def test_threads_beyond_numba_are_clamped_and_recorded(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        r = invoke(["run", out, "--threads", "99999999999", "--tmax", "0.002", "-q"])
+        r = invoke(["run", out, "--threads", "99999999999", "--tmax", "0.002", "-q", "--overwrite"])
     assert r.exit_code == 0, r.output
     limit = numba.config.NUMBA_NUM_THREADS
     assert json.loads((out / "run.json").read_text())["threads"] == limit
