@@ -1,0 +1,171 @@
+"""`sphdvi run` into a folder that already holds a run: a new run is refused unless
+--overwrite (which deletes the earlier results first), gauge files start anew, --resume
+goes on with the run's own --tmax/--tout/--set, leftover temporaries go, a signal during
+start-up ends the run as 'interrupted', and a resume without the particle file warns.
+Tiny runs (dp 0.1, a few steps)."""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import h5py
+import pytest
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+
+REPO = Path(__file__).resolve().parents[2]
+DAMBREAK = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
+CASE_H5 = "CaseDambreakVal2D.h5"
+RUN = ["--dp", "0.1", "--tmax", "0.004", "--tout", "0.002", "--threads", "1", "-q"]
+
+
+def invoke(args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def csv_rows(path):
+    return Path(path).read_text().splitlines()[1:]
+
+
+def nsteps(path):
+    with h5py.File(path, "r") as f:
+        return int(f["VTKHDF/Steps"].attrs["NSteps"])
+
+
+@pytest.fixture(scope="module")
+def done(tmp_path_factory):
+    """A finished tiny run: outputs at 0, 0.002, 0.004 (tests copy it)."""
+    base = tmp_path_factory.mktemp("done")
+    out = base / "out"
+    r = invoke(["run", DAMBREAK, "-o", out] + RUN)
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def copy_run(src, dest):
+    shutil.copytree(src, dest)
+    return dest
+
+
+def test_new_run_into_earlier_results_is_refused_and_changes_nothing(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    for source in (DAMBREAK, out):
+        r = invoke(["run", source, "-o", out] + RUN)
+        assert r.exit_code == 2, r.output
+        assert "Traceback" not in r.output
+        for text in ("holds the results of an earlier run", "status 'completed'", "--resume", "--overwrite",
+                     "particles.vtkhdf", "restart.h5"):
+            assert text in r.output, (text, r.output)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    r = invoke(["run", out, "--resume", "--overwrite"])
+    assert r.exit_code == 2 and "give one" in r.output
+
+
+def test_gencase_folder_runs_and_overwrite_starts_clean(done, tmp_path):
+    # a gencase output folder (case files only) runs without --overwrite
+    g = tmp_path / "g"
+    assert invoke(["gencase", DAMBREAK, "-o", g, "--dp", "0.1", "-q"]).exit_code == 0
+    assert invoke(["run", g, "--tmax", "0.002", "--tout", "0.002", "--threads", "1", "-q"]).exit_code == 0
+    assert nsteps(g / "particles.vtkhdf") == 2
+    # --overwrite: nothing of the earlier run stays (stale body and gauge files included)
+    out = copy_run(done, tmp_path / "o")
+    for name in ("bodies.csv", "links.csv", "GaugesVel_old.csv"):
+        (out / name).write_text("earlier run\n")
+    (out / "notes.txt").write_text("the user's")
+    r = invoke(["run", DAMBREAK, "-o", out, "--overwrite", "--dp", "0.1", "--tmax", "0.002", "--tout", "0.002",
+                "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    names = {p.name for p in out.iterdir()}
+    assert not names & {"bodies.csv", "links.csv", "GaugesVel_old.csv"}
+    assert "notes.txt" in names
+    assert nsteps(out / "particles.vtkhdf") == 2 and len(csv_rows(out / "run.csv")) == 2
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "completed" and meta["overrides"]["tmax"] == 0.002
+    with h5py.File(out / "restart.h5", "r") as f:       # the new run's checkpoint (the old one was part 2)
+        assert int(f["scalars"].attrs["part"]) == 1
+    times = [float(r.split(";")[0]) for r in csv_rows(out / "GaugesSWL_Swl_x02.csv")]
+    assert times[0] == 0.0 and times == sorted(times) and len(times) == len(set(times))
+
+
+def test_gauge_files_start_anew_in_a_new_run(done, tmp_path):
+    """RunGauges of a new run (resume=False) rewrites its files: one series, not two."""
+    from sphdvi.io.casefile import read_case_h5
+    from sphdvi.measure.gauges import RunGauges
+    from sphdvi.simulation import apply_overrides, special_parameters
+    out = copy_run(done, tmp_path / "o")
+    path = out / "GaugesSWL_Swl_x02.csv"
+    assert len(csv_rows(path)) >= 2
+    data = read_case_h5(str(out / CASE_H5))
+    RunGauges(data, apply_overrides(special_parameters(data), (), 0.004, 0.002), str(out), resume=False).close()
+    rows = csv_rows(path)
+    assert len(rows) == 1 and float(rows[0].split(";")[0]) == 0.0
+
+
+def test_resume_reuses_the_run_options(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    # a change of --tout or of a parameter is refused, nothing touched
+    before = (out / "run.csv").read_bytes()
+    for opts, what in ((["--tout", "0.001"], "TimeOut 0.002 -> 0.001"), (["--set", "Visco=0.05"], "Visco")):
+        r = invoke(["run", out, "--resume", "--tmax", "0.008"] + opts)
+        assert r.exit_code == 2 and what in r.output and "only --tmax may change" in r.output, r.output
+    assert (out / "run.csv").read_bytes() == before
+    # --tmax extends the run; its outputs stay 0.002 apart (the case's TimeOut is 0.01); the
+    # same --tout given again is accepted
+    r = invoke(["run", out, "--resume", "--tmax", "0.008", "--tout", "0.002", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    times = [float(row.split(",")[1]) for row in csv_rows(out / "run.csv")]
+    assert len(times) == 5 and all(0.0015 < b - a < 0.003 for a, b in zip(times, times[1:]))
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["overrides"] == {"tmax": 0.008, "tout": 0.002, "set": []}
+    assert meta["parameters"]["TimeOut"] == 0.002 and meta["status"] == "completed"
+    # a plain --resume keeps the stored --tmax: nothing more to do
+    r = invoke(["run", out, "--resume", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    assert len(csv_rows(out / "run.csv")) == 5
+
+
+def test_leftover_temporaries_go_at_start(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    (out / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
+    (out / ".run.json.abcd1234.tmp").write_text("{")
+    r = invoke(["run", out, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    assert not [p.name for p in out.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_resume_without_particle_file_warns(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    os.unlink(out / "particles.vtkhdf")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = invoke(["run", out, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    msgs = [str(w.message) for w in caught if "particles.vtkhdf was missing" in str(w.message)]
+    assert msgs and "parts 0..2 are not in it" in msgs[0], [str(w.message) for w in caught]
+    assert "WARNING: --resume:" in (out / "run.log").read_text()
+
+
+def test_sigterm_during_startup_ends_interrupted(tmp_path):
+    """The signal comes as soon as gencase has written the case file (start-up: loading,
+    compiling): exit 1, run.json 'interrupted', no traceback."""
+    out = tmp_path / "o"
+    env = dict(os.environ, SPHDVI_DEBUG="1")
+    proc = subprocess.Popen([sys.executable, "-m", "sphdvi", "run", str(DAMBREAK), "-o", str(out), "--dp", "0.1",
+                             "--tmax", "5", "--tout", "0.002", "--threads", "1", "-q"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=REPO)
+    deadline = time.monotonic() + 60
+    while not (out / CASE_H5).exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.005)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 1, err
+    assert "Traceback" not in err and "interrupted: stopped by signal" in err
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "interrupted" and "stopped by signal" in meta["message"]
