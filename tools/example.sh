@@ -4,5 +4,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 python -m pip install -e ".[test]"
 sphdvi gencase cases/dambreak2d/CaseDambreakVal2D_Def.xml -o out/dambreak2d
-sphdvi run out/dambreak2d --tmax 0.05 --tout 0.01
+sphdvi run out/dambreak2d --tmax 0.05 --tout 0.01 --overwrite    # out/dambreak2d may hold an earlier run
 sphdvi export out/dambreak2d
