@@ -10,7 +10,10 @@ restart.h5 in ``io.checkpoint``, the text outputs in ``io.runfiles``). Outputs i
 * ``run.log`` / ``run.csv``: one line per output time (like Run.out and RunPARTs.csv);
 * ``restart.h5``: the complete solver state at the last output, written atomically;
   ``--resume`` continues from it (on 1 thread the result is bitwise that of an
-  uninterrupted run).
+  uninterrupted run), with the run's --tmax/--tout/--set (run.json ``overrides``).
+
+A new run into an OUT holding an earlier run's results is refused unless ``--overwrite``
+(which deletes them first); SIGTERM/SIGINT, start-up included, end a run as ``interrupted``.
 
 A run that goes unstable (NaN or inf, dt held at DtMin, too many particles
 excluded) stops with status ``diverged`` (exit code 3) and a message naming the
