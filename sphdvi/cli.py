@@ -169,18 +169,10 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
 @report_errors
 def export(outdir, fmt, subdir, isosurface, iso_spacing, iso_threshold):
     """Export particles.vtkhdf as Part_XXXX.vtp files and a .pvd for older ParaView."""
-    from .errors import InputError
-    from .io.export import export_dir, export_vtp
+    from .io.export import export_vtp
     if isosurface:
         from .measure.isosurface import export_isosurface
-        name = subdir or "iso"
-        if os.path.isabs(name) or os.path.basename(os.path.normpath(name)) != os.path.normpath(name) \
-                or name in (".", ".."):
-            # export_isosurface writes into OUTDIR/<the last part of the name> only
-            raise InputError(f"--dir {name}: with --isosurface, --dir is a folder name inside OUTDIR "
-                             "(no path); expected e.g. --dir iso")
-        export_dir(outdir, name)
-        files = export_isosurface(outdir, name, spacing=iso_spacing, threshold=iso_threshold)
+        files = export_isosurface(outdir, subdir or "iso", spacing=iso_spacing, threshold=iso_threshold)
         click.echo(f"wrote {len(files) - 1} isosurface .vtp files and {files[-1]}")
         return
     files = export_vtp(outdir, subdir or "vtp")

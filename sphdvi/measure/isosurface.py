@@ -67,7 +67,8 @@ def export_isosurface(outdir: str, subdir: str = "iso", spacing: float | None = 
     if not spacing > 0:
         raise InputError("isosurface spacing must be positive")
     level = spec.surface_threshold if threshold is None else float(threshold)
-    dest = os.path.join(outdir, os.path.basename(os.path.normpath(subdir)) or "iso")
+    from ..io.export import export_dir
+    dest = export_dir(outdir, subdir or "iso")      # as `export --dir`: relative to OUTDIR, absolute as given
     os.makedirs(dest, exist_ok=True)
     files, entries = [], []
     for snap in run.snapshots(arrays=("Rhop",), first=first, last=last):

@@ -286,7 +286,10 @@ def test_export_dir_is_used_as_given(done, tmp_path):
     assert not (out / "vtp").exists()
     r = invoke(["export", out, "--dir", "run.csv"])
     assert_input_error(r, "run.csv exists and is not a folder")
-    r = invoke(["export", out, "--isosurface", "--dir", str(absdir)])
-    assert_input_error(r, "with --isosurface, --dir is a folder name inside OUTDIR")
+    isodir = tmp_path / "abs" / "iso"         # --isosurface takes --dir the same way
+    r = invoke(["export", out, "--isosurface", "--dir", str(isodir)])
+    assert r.exit_code == 0 and (isodir / "isosurface.pvd").is_file(), r.output
+    r = invoke(["export", out, "--isosurface", "--dir", "run.csv"])
+    assert_input_error(r, "run.csv exists and is not a folder")
     r = invoke(["export", out, "--isosurface", "--iso-spacing", "nan"])
     assert_input_error(r, "Invalid value for '--iso-spacing'")
