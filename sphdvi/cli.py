@@ -122,7 +122,8 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
 
 def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
     from .errors import InputError
-    from .simulation import check_new_run_folder, find_case_file, run as run_case
+    from .io.runfolder import check_new_run_folder
+    from .simulation import find_case_file, run as run_case
     drawn_dp = None      # --dp where no gencase runs: it must be the case's dp
     if os.path.isfile(source) and source.lower().endswith(".xml"):
         from .case.gencase import build_case, write_outputs

@@ -39,6 +39,7 @@ from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, Progress, RunFiles
+from .io.runfolder import check_new_run_folder, clear_earlier_results, stored_overrides
 from .sph.damping import damping_zones
 
 POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
@@ -183,62 +184,11 @@ def special_parameters(data: dict) -> dict:
     return params
 
 
-# the files a run writes into OUT (Gauges<Type>_<name>.csv too); a gencase output folder
-# (<casename>.h5, <casename>_All.vtp) holds none of them
-RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "run.csv", "bodies.csv", "links.csv")
-
-
-def earlier_results(outdir: str) -> list[str]:
-    """The names of the files of an earlier run in ``outdir`` (sorted; [] when none)."""
-    if not os.path.isdir(outdir):
-        return []
-    return sorted(name for name in os.listdir(outdir)
-                  if name in RUN_OUTPUT_FILES or (name.startswith("Gauges") and "_" in name and name.endswith(".csv")))
-
-
-def check_new_run_folder(outdir: str, overwrite: bool) -> None:
-    """A new run into ``outdir``: refused (InputError) when it holds an earlier run's results,
-    unless ``overwrite``: they would be emptied or mixed with the new run's."""
-    found = earlier_results(outdir)
-    if not found or overwrite:
-        return
-    status = ""
-    with contextlib.suppress(OSError, ValueError, AttributeError):
-        with open(os.path.join(outdir, "run.json")) as fh:
-            meta = json.load(fh)
-        status = f", status '{meta['status']}' at t={float(meta['physical_time']):.6g} s"
-    raise InputError(f"{outdir} holds the results of an earlier run ({', '.join(found)}{status}); continue it with "
-                     f"'sphdvi run {outdir} --resume', or start again with --overwrite (deletes those files) "
-                     "or into another -o folder")
-
-
-def clear_earlier_results(outdir: str) -> list[str]:
-    """Delete the files of an earlier run in ``outdir`` (a new run with --overwrite), so that
-    nothing of it mixes with the new run's outputs.  Returns their names."""
-    found = earlier_results(outdir)
-    for name in found:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(os.path.join(outdir, name))
-    return found
-
-
-def _stored_overrides(outdir: str):
-    """The --tmax/--tout/--set of the run in ``outdir`` (run.json ``overrides``); None when
-    unknown (no or unreadable run.json, or one written before they were stored)."""
-    try:
-        with open(os.path.join(outdir, "run.json")) as fh:
-            meta = json.load(fh)
-    except (OSError, ValueError):
-        return None
-    stored = meta.get("overrides") if isinstance(meta, dict) else None
-    return stored if isinstance(stored, dict) else None
-
-
 def resume_overrides(base: dict, outdir: str, tmax, tout, sets):
     """The --tmax/--tout/--set a --resume runs with: the interrupted run's (run.json), with
     --tmax replaced when given (a run may be extended); a --tout or --set that changes a
     parameter of the run is refused (a gap in the outputs, other physics)."""
-    stored = _stored_overrides(outdir)
+    stored = stored_overrides(outdir)
     if stored is None:
         warnings.warn(f"--resume: {os.path.join(outdir, 'run.json')} does not say which --tmax/--tout/--set the "
                       "interrupted run used; the case's parameters and the options given now are used")

@@ -1,0 +1,61 @@
+"""The state of a run's output folder OUT: which files of an earlier run it holds, refusing
+a new run into them (or deleting them with ``--overwrite``), and the --tmax/--tout/--set the
+run recorded in run.json for ``--resume``."""
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+
+from ..errors import InputError
+from .checkpoint import RESTART_FILE
+
+# the files a run writes into OUT (Gauges<Type>_<name>.csv too); a gencase output folder
+# (<casename>.h5, <casename>_All.vtp) holds none of them
+RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "run.csv", "bodies.csv", "links.csv")
+
+
+def earlier_results(outdir: str) -> list[str]:
+    """The names of the files of an earlier run in ``outdir`` (sorted; [] when none)."""
+    if not os.path.isdir(outdir):
+        return []
+    return sorted(name for name in os.listdir(outdir)
+                  if name in RUN_OUTPUT_FILES or (name.startswith("Gauges") and "_" in name and name.endswith(".csv")))
+
+
+def check_new_run_folder(outdir: str, overwrite: bool) -> None:
+    """A new run into ``outdir``: refused (InputError) when it holds an earlier run's results,
+    unless ``overwrite``: they would be emptied or mixed with the new run's."""
+    found = earlier_results(outdir)
+    if not found or overwrite:
+        return
+    status = ""
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        with open(os.path.join(outdir, "run.json")) as fh:
+            meta = json.load(fh)
+        status = f", status '{meta['status']}' at t={float(meta['physical_time']):.6g} s"
+    raise InputError(f"{outdir} holds the results of an earlier run ({', '.join(found)}{status}); continue it with "
+                     f"'sphdvi run {outdir} --resume', or start again with --overwrite (deletes those files) "
+                     "or into another -o folder")
+
+
+def clear_earlier_results(outdir: str) -> list[str]:
+    """Delete the files of an earlier run in ``outdir`` (a new run with --overwrite), so that
+    nothing of it mixes with the new run's outputs.  Returns their names."""
+    found = earlier_results(outdir)
+    for name in found:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(os.path.join(outdir, name))
+    return found
+
+
+def stored_overrides(outdir: str):
+    """The --tmax/--tout/--set of the run in ``outdir`` (run.json ``overrides``); None when
+    unknown (no or unreadable run.json, or one written before they were stored)."""
+    try:
+        with open(os.path.join(outdir, "run.json")) as fh:
+            meta = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    stored = meta.get("overrides") if isinstance(meta, dict) else None
+    return stored if isinstance(stored, dict) else None
