@@ -234,7 +234,7 @@ def check_gauge(reader, c, d: dict, elements: dict, dp) -> None:
             attrs = 'mkbound="N"' if tag == "target" else 'x=".." y=".." z=".."'
             raise reader.error(c, f"{kind} gauge '{name}' has no <{tag}>", f"<{tag} {attrs}/> in <{kind}>")
     if kind == "swl":
-        length = float(np.linalg.norm(np.subtract(d["point2"], d["point0"])))
+        length = math.dist(d["point2"], d["point0"])
         if length == 0:
             raise reader.error(elements["point2"], f"swl gauge '{name}': <point2> equals <point0>",
                                "a line of positive length from <point0> to <point2>")
