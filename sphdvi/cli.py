@@ -55,10 +55,13 @@ def main():
               help="Output folder (default: ./<casename>_out).")
 @click.option("--max-nodes", type=click.IntRange(min=1), default=200_000_000, show_default=True,
               help="Refuse drawing domains with more lattice nodes than this.")
-@click.option("--dp", type=float, default=None, help="Override the particle spacing of <definition dp>.")
+@click.option("--dp", type=FiniteFloat(min=0, min_open=True), default=None,
+              help="Override the particle spacing of <definition dp>.")
+@click.option("--overwrite", is_flag=True,
+              help="Write into an OUT that holds a run's results: they are deleted (a run of another case).")
 @click.option("-q", "--quiet", is_flag=True, help="Print only warnings and errors.")
 @report_errors
-def gencase(case_xml, outdir, max_nodes, dp, quiet):
+def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
     """Turn a DualSPHysics case file into particles, like GenCase.
 
     Writes OUT/<casename>.h5 (particles, constants, parameters, bodies, links,
@@ -70,9 +73,12 @@ def gencase(case_xml, outdir, max_nodes, dp, quiet):
     from .errors import CaseError
     if not os.path.isfile(case_xml):
         raise CaseError("case file not found", file=case_xml, expected="an existing XML case file")
+    from .io.runfolder import check_new_run_folder, clear_earlier_results
     if outdir is None:
         outdir = f"{case_name_from_path(case_xml)}_out"
+    check_new_run_folder(outdir, overwrite, command="gencase")
     result = build_case(case_xml, outdir, max_nodes=max_nodes, dp=dp)
+    clear_earlier_results(outdir)
     files = write_outputs(result, outdir)
     print_warnings(result.warnings)
     if not quiet:

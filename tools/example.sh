@@ -3,6 +3,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 python -m pip install -e ".[test]"
-sphdvi gencase cases/dambreak2d/CaseDambreakVal2D_Def.xml -o out/dambreak2d
-sphdvi run out/dambreak2d --tmax 0.05 --tout 0.01 --overwrite    # out/dambreak2d may hold an earlier run
+# out/dambreak2d may hold an earlier run of the example: --overwrite deletes its results
+sphdvi gencase cases/dambreak2d/CaseDambreakVal2D_Def.xml -o out/dambreak2d --overwrite
+sphdvi run out/dambreak2d --tmax 0.05 --tout 0.01
 sphdvi export out/dambreak2d

@@ -23,9 +23,10 @@ def earlier_results(outdir: str) -> list[str]:
                   if name in RUN_OUTPUT_FILES or (name.startswith("Gauges") and "_" in name and name.endswith(".csv")))
 
 
-def check_new_run_folder(outdir: str, overwrite: bool) -> None:
-    """A new run into ``outdir``: refused (InputError) when it holds an earlier run's results,
-    unless ``overwrite``: they would be emptied or mixed with the new run's."""
+def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> None:
+    """A new run (or a gencase, ``command="gencase"``) into ``outdir``: refused (InputError)
+    when it holds an earlier run's results, unless ``overwrite``: they would be emptied or
+    mixed with the new run's, or left beside a case they do not belong to."""
     found = earlier_results(outdir)
     if not found or overwrite:
         return
@@ -34,6 +35,10 @@ def check_new_run_folder(outdir: str, overwrite: bool) -> None:
         with open(os.path.join(outdir, "run.json")) as fh:
             meta = json.load(fh)
         status = f", status '{meta['status']}' at t={float(meta['physical_time']):.6g} s"
+    if command == "gencase":
+        raise InputError(f"{outdir} holds the results of a run ({', '.join(found)}{status}); a new case there would "
+                         "leave them beside a case they do not belong to: use another -o folder, or --overwrite "
+                         "(deletes those files)")
     raise InputError(f"{outdir} holds the results of an earlier run ({', '.join(found)}{status}); continue it with "
                      f"'sphdvi run {outdir} --resume', or start again with --overwrite (deletes those files) "
                      "or into another -o folder")

@@ -68,6 +68,21 @@ def test_new_run_into_earlier_results_is_refused_and_changes_nothing(done, tmp_p
     assert r.exit_code == 2 and "give one" in r.output
 
 
+def test_gencase_into_a_run_folder_is_refused_unless_overwrite(done, tmp_path):
+    """A new case drawn into a folder holding a run's results would leave them beside a case
+    they do not belong to: refused, nothing changed; with --overwrite the results go."""
+    out = copy_run(done, tmp_path / "o")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    r = invoke(["gencase", DAMBREAK, "-o", out, "--dp", "0.05", "-q"])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    for text in ("holds the results of a run", "restart.h5", "--overwrite"):
+        assert text in r.output, (text, r.output)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    r = invoke(["gencase", DAMBREAK, "-o", out, "--dp", "0.05", "--overwrite", "-q"])
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in out.iterdir()) == [CASE_H5, "CaseDambreakVal2D_All.vtp"]
+
+
 def test_gencase_folder_runs_and_overwrite_starts_clean(done, tmp_path):
     # a gencase output folder (case files only) runs without --overwrite
     g = tmp_path / "g"

@@ -56,6 +56,16 @@ def copy_run(src, dest):
     return dest
 
 
+def redraw_case_in(out, tmp_path, dp):
+    """Replace the case files of a run folder by the case drawn at another dp, as a user
+    copying files around would (gencase itself refuses a folder holding a run's results)."""
+    import shutil
+    fresh = tmp_path / f"redrawn_{dp}"
+    assert invoke(["gencase", case_xml(tmp_path), "-o", fresh, "--dp", str(dp), "-q"]).exit_code == 0
+    for f in fresh.iterdir():
+        shutil.copy(f, out / f.name)
+
+
 # -- option values ---------------------------------------------------------------------
 @pytest.mark.parametrize("option,value", [("--tmax", "-1"), ("--tmax", "nan"), ("--tmax", "inf"),
                                           ("--tout", "-1"), ("--tout", "nan"), ("--tout", "0"),
@@ -127,7 +137,7 @@ def test_resume_refuses_the_checkpoint_of_another_case(done, tmp_path):
     counts and dp; the outputs stay as they were."""
     out = copy_run(done, tmp_path / "o")
     before = (out / "run.csv").read_text()
-    assert invoke(["gencase", case_xml(tmp_path), "-o", out, "--dp", "0.05", "-q"]).exit_code == 0
+    redraw_case_in(out, tmp_path, 0.05)
     r = invoke(["run", out, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
     assert_input_error(r, "restart.h5 was written by a run of another case", "particles 301 in the checkpoint, "
                        "1001 in the case", "dp 0.1 in the checkpoint, 0.05 in the case")
@@ -146,7 +156,7 @@ def test_resume_of_an_older_checkpoint_without_the_case_identity(done, tmp_path)
     assert r.exit_code == 0, r.output
     with h5py.File(out / "restart.h5") as f:
         assert "case_hash" in f["scalars"].attrs          # written again, with it
-    assert invoke(["gencase", case_xml(tmp_path), "-o", other, "--dp", "0.05", "-q"]).exit_code == 0
+    redraw_case_in(other, tmp_path, 0.05)
     r = invoke(["run", other, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
     assert_input_error(r, "written by a run of another case")
 
