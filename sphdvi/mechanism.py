@@ -14,6 +14,9 @@ Links map one to one: ``link_hinge`` → hinge, ``link_spheric`` → spherical,
 ``link_linearspring`` → spring-damper, ``link_coulombdamping`` → Coulomb damper,
 ``link_pulley`` → pulley. Stiffness and damping tables become time tables.
 In 2D cases bodies move in the x–z plane (y translation and x, z rotations locked).
+A ``<floating>``'s ``<linearvel>``/``<angularvel>`` tables impose its velocity (a ``none``
+component stays free) and ``<linearforce>``/``<angularforce>`` add an external force and
+torque, both linearly interpolated in time and held beyond the table's ends.
 """
 from __future__ import annotations
 
@@ -22,6 +25,44 @@ import numpy as np
 from .errors import CaseError
 
 TYPE_FLOATING, TYPE_MOVING, TYPE_FLUID = 2, 1, 3
+
+
+def _vector_series(spec, what):
+    """A ``<linearvel>``-style table ({"times", "values"} with None for a free component,
+    or {"file"}: rows time;x;y;z) -> t -> [x|None, y|None, z|None], linear in time and
+    held beyond the ends; None when no table."""
+    if spec is None:
+        return None
+    if "file" in spec:
+        from .case.datafiles import read_columns
+        data = read_columns(spec["file"], 4, what)
+        if data.shape[0] == 0:
+            raise CaseError(f"{what}: no data rows", file=spec["file"], expected="rows of time;x;y;z")
+        times, values = data[:, 0], data[:, 1:4]
+    else:
+        times = np.asarray(spec["times"], float)
+        values = np.asarray([[np.nan if c is None else c for c in row] for row in spec["values"]], float)
+    free = np.isnan(values).any(axis=0)        # 'none' in any row: that component is free
+
+    def at(t):
+        return [None if free[k] else float(np.interp(t, times, values[:, k])) for k in range(3)]
+    return at
+
+
+def _floating_drivers(fb, name):
+    """(imposed_velocity, external_load) callables of a floating body's tables, or None."""
+    lin = _vector_series(fb.get("linearvel"), f"<linearvel> of '{name}'")
+    ang = _vector_series(fb.get("angularvel"), f"<angularvel> of '{name}'")
+    force = _vector_series(fb.get("linearforce"), f"<linearforce> of '{name}'")
+    torque = _vector_series(fb.get("angularforce"), f"<angularforce> of '{name}'")
+
+    def imposed(t):
+        return (lin(t) if lin else [None] * 3) + (ang(t) if ang else [None] * 3)
+
+    def load(t):
+        return (np.asarray(force(t) if force else [0.0] * 3, float),
+                np.asarray(torque(t) if torque else [0.0] * 3, float))
+    return (imposed if lin or ang else None), (load if force or torque else None)
 
 
 def _table(v):
@@ -100,6 +141,7 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
             if is2d:
                 body["translation_dof"][1] = 0
                 body["rotation_dof"][0] = body["rotation_dof"][2] = 0
+            body["imposed_velocity"], body["external_load"] = _floating_drivers(fb, entry["id"])
         else:
             centre = pts.mean(axis=0)
             body.update(mass=float(entry.get("massbody") or 1.0), inertia=(1.0, 1.0, 1.0), pos=centre.tolist())

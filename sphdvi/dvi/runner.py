@@ -28,7 +28,7 @@ BODIES_HEADER = ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
 LINKS_HEADER = "time,link,fx,fy,fz,tx,ty,tz"
 
 _BODY_KEYS = ("mass", "inertia", "pos", "quat", "vel", "omega", "kind", "translation_dof",
-              "rotation_dof", "motion", "imposed_velocity", "force", "torque")
+              "rotation_dof", "motion", "imposed_velocity", "force", "torque", "external_load")
 
 
 def build_system(bodies, links=(), materials=(), **system_kw):

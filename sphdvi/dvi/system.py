@@ -135,6 +135,7 @@ class System:
         self.imposed = np.zeros((0, 6))
         self._motion = []
         self._imposed_fn = []
+        self._load_fn = []          # (body, t -> (force, torque)) of time-dependent external loads
         # materials (index 0 = default)
         self.mat_names = ["default"]
         self.mat_mu = np.array([0.3])
@@ -191,7 +192,7 @@ class System:
     def add_body(self, mass=1.0, inertia=(1.0, 1.0, 1.0), pos=(0, 0, 0), quat=(1, 0, 0, 0),
                  vel=(0, 0, 0), omega=(0, 0, 0), kind="floating", translation_dof=(1, 1, 1),
                  rotation_dof=(1, 1, 1), motion=None, imposed_velocity=None, name=None,
-                 force=(0, 0, 0), torque=(0, 0, 0)):
+                 force=(0, 0, 0), torque=(0, 0, 0), external_load=None):
         """Add a rigid body and return its index.
 
         inertia: principal values (3,) or a full tensor (3, 3) about the centre
@@ -202,7 +203,9 @@ class System:
         translation_dof/rotation_dof: 1 = free, 0 = locked (world axes).
         imposed_velocity: 6 values (v, ω world), None/NaN = free component;
         or a callable t -> 6 values.  force/torque: constant external load
-        (world; torque about the centre)."""
+        (world; torque about the centre); external_load: a callable t -> (force,
+        torque) replacing them at each step's end time (DualSPHysics's
+        <linearforce>/<angularforce> tables)."""
         k = _BODY_KINDS[kind] if isinstance(kind, str) else int(kind)
         I = np.asarray(inertia, dtype=np.float64)
         if I.ndim == 1:
@@ -234,6 +237,8 @@ class System:
             imp = np.array([np.nan if c is None else float(c) for c in imposed_velocity])
         self.imposed = np.vstack([self.imposed, imp[None]])
         self._imposed_fn.append(fn)
+        if external_load is not None:
+            self._load_fn.append((self.nb - 1, external_load))
         self._motion.append(motion)
         self._packed = False
         self.names.append(name if name is not None else f"body{self.nb - 1}")
@@ -656,6 +661,10 @@ class System:
         self._packed = True
 
     def _update_time_dependent(self, t_next):
+        for i, load in self._load_fn:
+            force, torque = load(t_next)
+            self.f_ext[i] = force
+            self.t_ext[i] = torque
         M = self._mates
         for i, k in self._mate_timedep:
             self.m_k[i, k] = _eval(M[i]["k"][k], t_next)
