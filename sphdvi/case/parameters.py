@@ -39,7 +39,7 @@ PARAMETERS: dict[str, Param] = {
                                "corrected, 0:Shepard average (DualSPHysics v5.4)", (0, 1)),
     "NoPenetration": Param("int", 0, "mDBC no-penetration correction (SlipMode 2, 3 only)", (0, 1)),
     "StepAlgorithm": Param("int", 1, "1:Verlet, 2:Symplectic", (1, 2)),
-    "VerletSteps": Param("int", 40, "Verlet: steps between Euler steps", (), 1, 1e9),
+    "VerletSteps": Param("int", 40, "Verlet: steps between Euler steps (0: Euler every step)", (), 0, 1e9),
     "Kernel": Param("int", 2, "1:cubic spline, 2:Wendland", (1, 2)),
     "ViscoTreatment": Param("int", 1, "1:artificial, 2:laminar+SPS, 3:laminar", (1, 2, 3)),
     "Visco": Param("float", 0.01, "viscosity value (alpha or kinematic viscosity)", (), 0.0, 1e6),

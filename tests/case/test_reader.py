@@ -100,12 +100,19 @@ def test_parameters_defaults_and_values(tmp_path):
     ('<parameter key="TimeMax" value="abc"/>', "is not a number"),
     ('<parameter key="TimeOut" value="-1"/>', "below"),
     ('<parameter key="RhopOutMin" value="1400"/>', "RhopOutMin (1400.0) >= RhopOutMax"),
+    ('<parameter key="VerletSteps" value="-1"/>', "VerletSteps: -1 is below 0"),
 ])
 def test_parameter_errors(tmp_path, param, fragment):
     with pytest.raises(CaseError) as err:
         build(tmp_path, parameters=param)
     assert fragment in str(err.value)
     assert "Case_Def.xml:" in str(err.value)
+
+
+def test_verlet_steps_zero_is_accepted(tmp_path):
+    """DualSPHysics's v5.4 examples write VerletSteps 0 (Symplectic cases; under Verlet it
+    means an Euler step every step)."""
+    assert build(tmp_path, parameters='<parameter key="VerletSteps" value="0"/>').case.parameters["VerletSteps"] == 0
 
 
 def test_simulation_domain(tmp_path):
