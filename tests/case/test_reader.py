@@ -109,6 +109,15 @@ def test_parameter_errors(tmp_path, param, fragment):
     assert "Case_Def.xml:" in str(err.value)
 
 
+def test_dp_is_defined_for_the_domain_points(tmp_path):
+    """GenCase defines Dp before it reads pointmin/pointmax (DualSPHysics's CaseJet2D writes
+    x="#-int(bx/Dp)*Dp-Dp*6"); here pointmin x = -50 dp = -1 m, as the default case's."""
+    ref = build(tmp_path / "a")
+    r = build(tmp_path / "b", pointmin=("#-int(1/Dp)*Dp", "0", "#-50*Dp"))
+    assert r.particles["pos"].shape == ref.particles["pos"].shape
+    assert np.array_equal(r.particles["pos"], ref.particles["pos"])
+
+
 def test_verlet_steps_zero_is_accepted(tmp_path):
     """DualSPHysics's v5.4 examples write VerletSteps 0 (Symplectic cases; under Verlet it
     means an Euler step every step)."""

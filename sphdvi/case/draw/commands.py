@@ -932,6 +932,7 @@ def _read_definition(reader, geometry_el):
     d = reader.child(geometry_el, "definition", required=True)
     reader.check_children(d, {"pointref", "pointmin", "pointmax", "rem"}, "child element")
     dp = reader.num(d, "dp", positive=True)
+    _define_builtin(reader.vars, "Dp", dp)        # GenCase's points may use it: x="#-int(bx/Dp)*Dp"
     pmin = reader.vec3(reader.child(d, "pointmin", required=True))
     pmax_el = reader.child(d, "pointmax", required=True)
     pmax = reader.vec3(pmax_el)
