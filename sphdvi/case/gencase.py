@@ -348,11 +348,14 @@ def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody)
             else:
                 volume = float(np.prod(size))
             sx, sy, sz = size
+            if is2d:
+                sy = 0.0         # a plate in the x-z plane, as its particles: I_xx + I_zz = I_yy
             diag = np.array([sy * sy + sz * sz, sx * sx + sz * sz, sx * sx + sy * sy]) / 12.0
         elif shape == "sphere":
             r = float(par["radius"])
             volume = math.pi * r * r if is2d else 4.0 / 3.0 * math.pi * r ** 3
-            diag = np.full(3, r * r / 2.0 if is2d else 2.0 * r * r / 5.0)
+            # in 2D a disc in the x-z plane: I_yy = m r²/2, I_xx = I_zz = m r²/4
+            diag = np.array([0.25, 0.5, 0.25]) * r * r if is2d else np.full(3, 2.0 * r * r / 5.0)
         elif shape == "cylinder":
             r = float(par["radius"])
             p1, p2 = np.asarray(par["point1"], float), np.asarray(par["point2"], float)

@@ -255,6 +255,10 @@ def test_floating_mass_from_particles(tmp_path):
     assert b.inertia[1][1] == pytest.approx(iyy)
     assert b.analytic["mass"] == pytest.approx(20.0)
     assert b.analytic["inertia"][1][1] == pytest.approx(20.0 * (0.04 + 0.04) / 12)
+    # in 2D the box is a plate in the x-z plane, like its particles: I_xx + I_zz = I_yy
+    ia, ip = np.diag(b.analytic["inertia"]), np.diag(b.inertia)
+    assert ia[0] == pytest.approx(20.0 * 0.04 / 12) and ia[0] + ia[2] == pytest.approx(ia[1])
+    assert ip[0] + ip[2] == pytest.approx(ip[1])
 
 
 def test_floating_without_particles(tmp_path):
