@@ -193,7 +193,8 @@ def test_deprecated_deltasph_selects_molteni_diffusion(tmp_path):
     assert "'DeltaSPH' and 'DensityDT' cannot be combined" in str(err.value)
     from sphdvi.errors import InputError
     from sphdvi.simulation import apply_overrides
-    p = apply_overrides({"TimeOut": 0.1, "DensityDT": 0}, ["DeltaSPH=0.05"])
+    with pytest.warns(UserWarning, match="'DeltaSPH' is deprecated"):
+        p = apply_overrides({"TimeOut": 0.1, "DensityDT": 0}, ["DeltaSPH=0.05"])
     assert p["DensityDT"] == 1 and p["DensityDTvalue"] == 0.05
     with pytest.raises(InputError, match="run gencase again"):
         apply_overrides({"TimeOut": 0.1}, ["IncZ=0.5"])
