@@ -22,8 +22,13 @@ def write_body_state(group, state: dict) -> None:
     group.attrs["scalars"] = json.dumps(scalars)
 
 
-def read_body_state(group, system) -> None:
-    """Restore into ``system`` the state :func:`write_body_state` wrote to ``group``."""
+def body_state(group) -> dict:
+    """The state :func:`write_body_state` wrote to ``group`` (for ``System.set_state``)."""
     state = {name: group[name][...] for name in group}
     state.update(json.loads(group.attrs["scalars"]))
-    system.set_state(state)
+    return state
+
+
+def read_body_state(group, system) -> None:
+    """Restore into ``system`` the state :func:`write_body_state` wrote to ``group``."""
+    system.set_state(body_state(group))

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import InputError, h5_reason
 from .atomic import atomic_path
-from .bodystate import read_body_state, write_body_state
+from .bodystate import body_state, read_body_state, write_body_state
 
 RESTART_FILE = "restart.h5"            # in a run's output folder
 BODIES_RESTART_FORMAT = "sphdvi-bodies-restart"
@@ -141,9 +141,7 @@ def load_sph_checkpoint(path: str, solver, system=None, case_id: dict | None = N
             has_bodies = "bodies" in f
             bodies = None
             if system is not None and has_bodies:
-                g = f["bodies"]
-                bodies = {name: g[name][...] for name in g}
-                bodies.update(json.loads(g.attrs["scalars"]))
+                bodies = body_state(f["bodies"])
     except InputError:
         raise
     except (OSError, KeyError, ValueError, TypeError) as exc:
