@@ -126,16 +126,14 @@ REJECTED_VALUES = {
 
 # <constantsdef> entries that are sometimes given as parameters (DualSPHysics's -cfl option
 # changes the constant): their place in the case file
-CONSTANTS = {"cflnumber": "cflnumber", "gamma": "gamma", "rhop0": "rhop0", "coefsound": "coefsound",
-             "speedsystem": "speedsystem", "speedsound": "speedsound", "coefh": "coefh",
-             "coefhdp": "coefhdp", "hswl": "hswl", "gravity": "gravity", "lattice": "lattice",
-             "eps": "eps", "h": "h", "b": "b", "massbound": "massbound", "massfluid": "massfluid"}
+CONSTANTS = frozenset({"cflnumber", "gamma", "rhop0", "coefsound", "speedsystem", "speedsound", "coefh", "hdp",
+                       "coefhdp", "hswl", "gravity", "lattice", "eps", "h", "b", "massbound", "massfluid"})
 
 
 def constant_hint(key: str) -> str | None:
     """For a key that is a <constantsdef> constant (e.g. CFLnumber): where it belongs."""
-    name = CONSTANTS.get(key.strip().lower())
-    if name is None:
+    name = key.strip().lower()
+    if name not in CONSTANTS:
         return None
     return (f"'{key}' is a constant of the case, not an execution parameter: set <{name} value=\"...\" /> "
             "in <constantsdef> and run gencase again")

@@ -17,8 +17,8 @@ from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
-from .parameters import (NO_EFFECT, NOT_SUPPORTED, PARAMETERS, DEPRECATED, apply_delta_sph, check_supported, closest_key, coerce,
-                         default_parameters, domain_from_deprecated)
+from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
+                         coerce, constant_hint, default_parameters, domain_from_deprecated, parameter_warnings)
 from .schema import validate_structure
 from .xmldoc import CaseReader, load_xml, strip_disabled
 
@@ -621,6 +621,9 @@ def read_parameters(reader, execution):
             reader.mark(p, "value")
             continue
         if key not in PARAMETERS:
+            const = constant_hint(key)
+            if const:
+                raise reader.error(p, const)
             hint = closest_key(key)
             raise reader.error(p, f"unknown parameter key '{key}'",
                                f"'{hint}'" if hint else "a DualSPHysics parameter key (see sphdvi parameters list)")
@@ -636,10 +639,8 @@ def read_parameters(reader, execution):
             check_supported(key, value)
         except ValueError as exc:
             raise reader.error(p, f"parameter {key}: {exc}", _expected_for(key)) from None
-        if key in DEPRECATED:
-            reader.warn(p, f"parameter '{key}' is deprecated in DualSPHysics")
-        if key in NO_EFFECT and value != spec.default:
-            reader.warn(p, f"parameter '{key}' has no effect in sphdvi ({NO_EFFECT[key]})")
+        for text in parameter_warnings(key, value):
+            reader.warn(p, text)
         if key in DATA_FILE_KEYS and str(value).strip() and str(value).upper() != "NONE":
             value = _checked_data_file(reader, p, DATA_FILE_KEYS[key])
         params[key] = value
@@ -649,9 +650,10 @@ def read_parameters(reader, execution):
         domain = domain_from_deprecated(params, set_keys, domain)
     except ValueError as exc:
         raise reader.error(el, str(exc), "DualSPHysics v5.4's keys: DensityDT, <simulationdomain>") from None
-    if params["RhopOutMin"] >= params["RhopOutMax"]:
-        raise reader.error(el, f"RhopOutMin ({params['RhopOutMin']}) >= RhopOutMax ({params['RhopOutMax']})",
-                           "RhopOutMin < RhopOutMax")
+    try:
+        check_consistency(params)
+    except ValueError as exc:
+        raise reader.error(el, str(exc)) from None
     return params, set_keys, domain
 
 

@@ -101,6 +101,7 @@ def test_parameters_defaults_and_values(tmp_path):
     ('<parameter key="TimeOut" value="-1"/>', "below"),
     ('<parameter key="RhopOutMin" value="1400"/>', "RhopOutMin (1400.0) >= RhopOutMax"),
     ('<parameter key="VerletSteps" value="-1"/>', "VerletSteps: -1 is below 0"),
+    ('<parameter key="CFLnumber" value="0.2"/>', "'CFLnumber' is a constant of the case"),
 ])
 def test_parameter_errors(tmp_path, param, fragment):
     with pytest.raises(CaseError) as err:
