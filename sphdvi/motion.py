@@ -146,41 +146,41 @@ _FILE_CACHE: dict = {}
 
 
 def file_columns(m) -> tuple[int, dict]:
-    """(number of columns, {fieldtime/fieldx/...: 0-based column}) of a file movement;
-    the column defaults are time 0 and, for ``mvrotfile``, angle 1 (DualSPHysics's layout)."""
-    cols = {k: int(v) for k, v in m.get("fields", {}).items() if k != "fields"}
-    cols.setdefault("fieldtime", 0)
-    if m["type"] == "mvrotfile":
-        cols.setdefault("fieldang", 1)
-    ncols = int(m.get("ncols") or 1 + max(1, *cols.values()))
-    return ncols, cols
+    """(number of columns, {fieldtime/fieldx/...: 0-based column}) of a file movement."""
+    from .case.datafiles import motion_file_columns
+    given = {k: int(v) for k, v in m.get("fields", {}).items() if k != "fields"}
+    return motion_file_columns(m["type"], given, m.get("ncols"))
 
 
 def _load_table(m):
+    """(times, {field: (values, d values/dt)}) of a file movement, read once per file; the
+    rates are computed here, not at every time step."""
     ncols, cols = file_columns(m)
     key = (m["file"], ncols, tuple(sorted(cols.items())))
     if key not in _FILE_CACHE:
         from .case.datafiles import read_motion_table
-        _FILE_CACHE[key] = read_motion_table(m["file"], ncols, cols, f"<{m['type']}> file")
+        data = read_motion_table(m["file"], ncols, cols, f"<{m['type']}> file")
+        t = data[:, cols["fieldtime"]]
+        _FILE_CACHE[key] = (t, {name: (data[:, c], np.gradient(data[:, c], t))
+                                for name, c in cols.items() if name != "fieldtime"})
     return _FILE_CACHE[key]
 
 
 def _from_file(m, tau) -> Rigid:
-    data = _load_table(m)
-    fields = file_columns(m)[1]
-    t = data[:, fields["fieldtime"]]
+    t, fields = _load_table(m)
     if m["type"] == "mvrectfile":
         d = np.zeros(3)
         v = np.zeros(3)
         for k, name in enumerate(("fieldx", "fieldy", "fieldz")):
             if name in fields:
-                col = data[:, fields[name]]
+                col, rate = fields[name]
                 d[k] = np.interp(tau, t, col) - col[0]
-                v[k] = np.interp(tau, t, np.gradient(col, t))
+                v[k] = np.interp(tau, t, rate)
         return Rigid(d=d, V=v)
-    col = data[:, fields["fieldang"]] * _angle_units(m)
-    angle = np.interp(tau, t, col) - col[0]
-    w = np.interp(tau, t, np.gradient(col, t))
+    col, rate = fields["fieldang"]
+    units = _angle_units(m)
+    angle = (np.interp(tau, t, col) - col[0]) * units
+    w = np.interp(tau, t, rate) * units
     return _rotational(m, angle, w, circular=False)
 
 

@@ -74,22 +74,29 @@ def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.nda
 MOTION_FILE_ALIASES = {"mvfile": "mvrectfile", "mvpredef": "mvrectfile"}
 
 
+def motion_file_columns(tag: str, given: dict, ncols: int | None = None) -> tuple[int, dict]:
+    """(number of columns, {fieldtime/fieldx/.../fieldang: 0-based column}) of a file movement
+    (``tag`` ``mvrectfile`` or ``mvrotfile``) from the columns ``given``: time defaults to
+    column 0 and an ``mvrotfile``'s angle to 1 (DualSPHysics's layout); without ``fields``
+    (``ncols``) the file has as many columns as the last one used."""
+    cols = dict(given)
+    cols.setdefault("fieldtime", 0)
+    if tag == "mvrotfile":
+        cols.setdefault("fieldang", 1)
+    return (int(ncols) if ncols else max(2, 1 + max(cols.values()))), cols
+
+
 def read_motion_file(reader, m, tag: str) -> dict:
-    """Read and check the ``<file>`` element of movement element ``m`` (``tag``: ``mvrectfile``,
-    its aliases included, or ``mvrotfile``) of ``mvrectfile``/``mvrotfile``: ``fields`` is the number of columns of
-    the file, ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``) 0-based column
-    indices, as DualSPHysics's JMotion reads them. The file is read and checked now."""
+    """Read and check the ``<file>`` of movement element ``m`` (``tag``: ``mvrectfile``, its
+    aliases included, or ``mvrotfile``): ``fields`` is the number of columns of the file,
+    ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``) 0-based column indices,
+    as DualSPHysics's JMotion reads them. The file is read and checked now."""
     f = reader.child(m, "file", True)
     path = reader.resolve_path(f, "name")
     names = ("fieldtime", "fieldx", "fieldy", "fieldz") if tag == "mvrectfile" else ("fieldtime", "fieldang")
-    cols = {k: reader.integer(f, k, lo=0) for k in names if f.get(k) is not None}
-    cols.setdefault("fieldtime", 0)
-    if tag == "mvrotfile":
-        cols.setdefault("fieldang", 1)       # DualSPHysics's mvrotfile: time; angle
-    if f.get("fields") is not None:
-        ncols = reader.integer(f, "fields", lo=2)
-    else:
-        ncols = max(2, 1 + max(cols.values()))
+    given = {k: reader.integer(f, k, lo=0) for k in names if f.get(k) is not None}
+    ncols, cols = motion_file_columns(tag, given,
+                                      reader.integer(f, "fields", lo=2) if f.get("fields") is not None else None)
     for k, v in cols.items():
         if v >= ncols:
             raise reader.error(f, f"{k}={v} is not a column of a file of fields={ncols} columns "
