@@ -57,7 +57,7 @@ REQUIRED_CHILDREN = {"velocity": ("point",), "swl": ("point0", "point2"), "maxz"
 
 
 def line_samples(length: float, step: float) -> float:
-    """Samples of a line of ``length`` every ``step`` (as ``measure.core.surface_along_lines``).
+    """Samples of a line of ``length`` every ``step`` (``measure.core.surface_along_lines`` uses it).
 
     A float, so an absurd count is compared before it is turned into an int."""
     q = length / step
@@ -65,7 +65,7 @@ def line_samples(length: float, step: float) -> float:
 
 
 def mesh_count(size: float, dp: float) -> float:
-    """Nodes along one mesh axis of length ``size`` spaced ``dp`` (as ``measure.gauges.MeshGauge``)."""
+    """Nodes along one mesh axis of length ``size`` spaced ``dp`` (``measure.gauges.MeshGauge`` uses it)."""
     q = size / dp
     return math.floor(q + 1e-9) + 1.0 if math.isfinite(q) else math.inf
 

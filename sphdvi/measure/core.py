@@ -13,11 +13,11 @@ stores Vel, Rhop and Press in float32).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..case.gauge_spec import line_samples
 from ..sph import _env  # noqa: F401  (OMP_WAIT_POLICY before numba)
 from . import _kernels as K
 
@@ -196,7 +196,7 @@ def surface_along_lines(grid: ParticleGrid, p0, p1, step: float, threshold: floa
     p1 = as_points(p1)
     seg = p1 - p0
     length = np.sqrt((seg * seg).sum(axis=1))
-    ns = int(max(2, math.floor(float(length.max(initial=0.0)) / step + 1e-9) + 1))
+    ns = int(line_samples(float(length.max(initial=0.0)), step))
     s = np.linspace(0.0, 1.0, ns)
     samples = (p0[:, None, :] + s[None, :, None] * seg[:, None, :]).reshape(-1, 3)
     ks = kernel_sum(grid, samples)

@@ -39,7 +39,7 @@ import os
 
 import numpy as np
 
-from ..case.gauge_spec import mesh_count, name_problem
+from ..case.gauge_spec import SWL_DEFAULT_COEFDP, ZSURF_STEP, mesh_count, name_problem
 from ..errors import InputError
 from ..io.atomic import append_text, complete_lines, write_text_atomic
 from . import core
@@ -144,7 +144,7 @@ class SwlGauge(Gauge):
         self.p0 = np.asarray(item["point0"], float).reshape(1, 3)
         self.p2 = np.asarray(item["point2"], float).reshape(1, 3)
         pdp = item.get("pointdp") or {}
-        self.step = _num(pdp, "value") or (_num(pdp, "coefdp", 0.5) * spec.dp)
+        self.step = _num(pdp, "value") or (_num(pdp, "coefdp", SWL_DEFAULT_COEFDP) * spec.dp)
         ml = item.get("masslimit") or {}
         if _num(ml, "value") is not None and spec.massfluid > 0:
             self.limit = _num(ml, "value") / spec.massfluid
@@ -260,7 +260,7 @@ class MeshGauge(Gauge):
             elif o == "rhop":
                 row += list(vals[:, 3])
             else:
-                s = core.surface_along_lines(view.grid, self.col0, self.col1, 0.25 * self.spec.dp, self.limit)
+                s = core.surface_along_lines(view.grid, self.col0, self.col1, ZSURF_STEP * self.spec.dp, self.limit)
                 row += list(s @ self.axes[2])
         return row
 
