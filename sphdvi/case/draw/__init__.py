@@ -91,8 +91,7 @@ Layers (``<layers vdp="0,1,-0.5*">`` in drawbox, drawsphere, drawcylinder)
 
 ``resetdraw``
     Back to the initial drawing configuration: no mk selected, ``full`` mode,
-    identity matrix, points and shapes active (``setactive``), ``full`` box
-    limits, no line start. Variables, lists, saved stacks (``matrixsave``,
+    identity matrix, points and shapes active (``setactive``), no line start. Variables, lists, saved stacks (``matrixsave``,
     ``statesave``, ``mksave``) and the particles drawn so far are kept (a
     warning when there are some: GenCase's treatment is not documented).
 

@@ -77,11 +77,10 @@ class DrawState:
     matrix: np.ndarray = field(default_factory=tf.identity)
     draw_points: bool = True
     draw_shapes: bool = True
-    box_limit: str = "full"      # setboxlimitmode (only "full" is supported)
 
     def copy(self) -> "DrawState":
         return DrawState(self.kind, self.mk, self.mode, self.matrix.copy(), self.draw_points,
-                         self.draw_shapes, self.box_limit)
+                         self.draw_shapes)
 
 
 def _point_summary(pts: np.ndarray, keep: int = 100) -> dict:
@@ -388,7 +387,7 @@ class GeometryRunner:
 
     def cmd_resetdraw(self, el):
         """Back to the initial drawing configuration: no mk selected, ``full`` mode, identity
-        matrix, points and shapes active, ``full`` box limits, no line start. Variables, lists,
+        matrix, points and shapes active, no line start. Variables, lists,
         the saved stacks and everything drawn so far are kept."""
         if self.state.draw_points and self.canvas is not None and self.canvas.codes.any():
             self.reader.warn(el, "particles were drawn before <resetdraw>; sphdvi keeps them "
@@ -397,12 +396,12 @@ class GeometryRunner:
         self.line_begin = None
 
     def cmd_setboxlimitmode(self, el):
+        """``full`` is the only box-limit rule sphdvi draws (GenCase's default): nothing to set."""
         mode = self.reader.text_attr(el, "mode", choices=BOX_LIMIT_MODES).lower()
         if mode == "inner":
             raise self.reader.error(el, "setboxlimitmode mode=\"inner\" is not supported by sphdvi",
                                     "mode=\"full\" (GenCase's default box limits, the only ones "
                                     "sphdvi draws)")
-        self.state.box_limit = mode
 
     # ------------------------------------------------------------ transforms
     def _compose(self, el, m) -> None:
