@@ -16,78 +16,18 @@ the first impact (p/ρgH first above 0.1) within ±0.05 in T of the experiment's
 quasi-static level after it (mean p/ρgH over T = 3–5) within 20 %.  Reference: the
 paper's representative repetition (Fig. 18, 'peak event 5').
 """
-import math
 from pathlib import Path
 
-import numpy as np
 import pytest
 from click.testing import CliRunner
 
 from sphdvi.cli import main
-from sphdvi.io.casefile import read_case_h5
-from sphdvi.simulation import find_case_file
+from sphdvi.validation import lobovsky
 
 REPO = Path(__file__).resolve().parents[2]
 CASE = REPO / "cases" / "lobovsky2d" / "CaseLobovsky2D_Def.xml"
 REF = REPO.parent / "shared" / "reference" / "dambreak2d_lobovsky_2014"
 DATA = REF / "waterLevel"
-H = 0.3
-G = 9.81
-WINDOWS = {"H1": ((0.0, 8.0), ("Fig16_WaterLevels_H1_2.dat",)),
-           "H2": ((2.0, 7.0), ("Fig16_WaterLevels_H2_3.dat", "Fig16_WaterLevels_H2_4.dat")),
-           "H3": ((2.5, 6.5), ("Fig16_WaterLevels_H3_3.dat", "Fig16_WaterLevels_H3_4.dat")),
-           "H4": ((3.0, 5.5), ("Fig16_WaterLevels_H4_4.dat", "Fig16_WaterLevels_H4_5.dat"))}
-
-
-def level_errors(outdir):
-    bed = 0.5 * read_case_h5(find_case_file(str(outdir)))["constants"]["dp"]
-    out = {}
-    for name, ((t0, t1), files) in WINDOWS.items():
-        sim = np.genfromtxt(Path(outdir) / f"GaugesSWL_{name}.csv", delimiter=";", skip_header=1)
-        T = sim[:, 0] * math.sqrt(9.81 / H)
-        h = np.nan_to_num((sim[:, 3] - bed) / H, nan=0.0)     # no surface found: dry
-        errs = []
-        for f in files:
-            exp = np.loadtxt(DATA / f, comments="#")
-            sel = (exp[:, 0] >= t0) & (exp[:, 0] <= t1)
-            hs = np.interp(exp[sel, 0], T, h)
-            errs.append(np.mean(np.abs(hs - exp[sel, 1])) / np.mean(exp[sel, 1]))
-        out[name] = min(errs)
-    return out
-
-
-SENSORS = {"P1": "Fig18_peak_event_5_sensors_5.dat", "P2": "Fig18_peak_event_5_sensors_4.dat",
-           "P3": "Fig18_peak_event_5_sensors_2.dat", "P4": "Fig18_peak_event_5_sensors_1.dat"}
-IMPACT_LEVEL = 0.1          # p/ρgH that marks the first impact
-PLATEAU = (3.0, 5.0)        # T window of the quasi-static level
-
-
-def wall_pressures(outdir):
-    """{sensor: (T, p/ρgH)} from the density gauges (no fluid at the probe: p = 0)."""
-    c = read_case_h5(find_case_file(str(outdir)))["constants"]
-    out = {}
-    for name in SENSORS:
-        sim = np.genfromtxt(Path(outdir) / f"GaugesMesh_{name}.csv", delimiter=";", skip_header=1)
-        p = c["b"] * ((sim[:, 1] / c["rhop0"]) ** c["gamma"] - 1.0) / (c["rhop0"] * G * H)
-        out[name] = (sim[:, 0] * math.sqrt(G / H), np.nan_to_num(p, nan=0.0))
-    return out
-
-
-def impact_and_plateau(T, p):
-    """(T of the first p/ρgH > IMPACT_LEVEL, mean p/ρgH over the PLATEAU window)."""
-    above = np.flatnonzero(p > IMPACT_LEVEL)
-    sel = (T >= PLATEAU[0]) & (T <= PLATEAU[1])
-    return (T[above[0]] if above.size else math.inf), float(np.mean(p[sel]))
-
-
-def pressure_scores(outdir):
-    """{sensor: (impact T sph, impact T exp, plateau sph, plateau exp)}."""
-    out = {}
-    for name, (T, p) in wall_pressures(outdir).items():
-        exp = np.loadtxt(REF / "pressure" / SENSORS[name], comments="#")
-        (ti, ps), (te, pe) = impact_and_plateau(T, p), impact_and_plateau(exp[:, 0], exp[:, 1])
-        out[name] = (ti, te, ps, pe)
-    return out
 
 
 @pytest.fixture(scope="module")
@@ -113,14 +53,14 @@ def run_dir_fine(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def errors(run_dir):
-    errs = level_errors(run_dir)
+    errs = lobovsky.level_errors(str(run_dir), str(REF.parent))
     print("S4 water-level errors: " + ", ".join(f"{k} {100 * v:.1f} %" for k, v in errs.items()))
     return errs
 
 
 @pytest.fixture(scope="module")
 def pressures(run_dir):
-    scores = pressure_scores(run_dir)
+    scores = lobovsky.pressure_scores(str(run_dir), str(REF.parent))
     for k, (ti, te, ps, pe) in scores.items():
         print(f"S4 {k}: first impact T {ti:.3f} (exp {te:.3f}), level T 3-5 {ps:.3f} (exp {pe:.3f}, "
               f"{100 * (ps / pe - 1):+.1f} %)")
@@ -176,7 +116,7 @@ def test_lobovsky_levels_at_h_over_dp_120(errors, run_dir_fine):
     errors fall from dp = 5 mm: the excess water level of DBC is the wall gap (~1.5h),
     which halves with h.  Measured: H1 1.5 %, H2 5.5 %, H3 8.1 %, H4 5.8 % (dp 5 mm:
     1.0, 8.0, 12.2, 8.2 %)."""
-    fine = level_errors(run_dir_fine)
+    fine = lobovsky.level_errors(str(run_dir_fine), str(REF.parent))
     print("S4 water-level errors at dp 2.5 mm: " + ", ".join(f"{k} {100 * v:.1f} %" for k, v in fine.items()))
     for name, err in fine.items():
         assert err <= 0.10, f"{name}: {100 * err:.1f} %"

@@ -1,0 +1,42 @@
+"""S12: a 2D box floating in still water (``cases/floatingbox2d/CaseFloatingBox2D_Def.xml``).
+
+Archimedes: at equilibrium the displaced area equals m/ρ0 per metre of width, so the box's
+draft below the free surface is m / (ρ0 w), w the box width (particle columns × dp) and the
+free surface the top fluid node + dp/2. Scored after the settling time: the mean height of the
+box's lowest particle centres against that equilibrium (in dp), the horizontal drift of the
+box's centre (in dp) and the largest tilt (degrees).
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+
+def draft_errors(outdir: str, settle: float = 1.0, x0: float = 0.5) -> dict:
+    """``draft_dp`` (mean lowest-particle height − equilibrium, in dp, over outputs t ≥ settle),
+    ``drift_dp`` (largest |x_centre − x0| in dp), ``tilt_deg`` (largest |tilt|)."""
+    from ..io.casefile import read_case_h5
+    from ..io.vtkhdf import read_step, step_times
+    from ..simulation import find_case_file
+    data = read_case_h5(find_case_file(outdir))
+    dp = data["constants"]["dp"]
+    rhop0 = data["constants"]["rhop0"]
+    p = data["particles"]
+    box = p["type"] == 2
+    width = np.ptp(p["pos"][box, 0]) + dp
+    surface = p["pos"][p["type"] == 3, 2].max() + dp / 2
+    bottom_eq = surface - p["mass"][box].sum() / (rhop0 * width) + dp / 2   # lowest particle centre
+    path = os.path.join(outdir, "particles.vtkhdf")
+    zs, xs, tilt = [], [], []
+    for k, t in enumerate(step_times(path)):
+        if t < settle:
+            continue
+        s = read_step(path, k)
+        pts = s["points"][s["Type"] == 2]
+        zs.append(pts[:, 2].min())
+        xs.append(pts[:, 0].mean())
+        tilt.append(np.degrees(np.arctan(np.polyfit(pts[:, 0], pts[:, 2], 1)[0])))
+    return {"draft_dp": float((np.mean(zs) - bottom_eq) / dp),
+            "drift_dp": float(np.max(np.abs(np.array(xs) - x0)) / dp),
+            "tilt_deg": float(np.max(np.abs(tilt))), "dp": dp}

@@ -1,0 +1,285 @@
+#!/usr/bin/env python
+"""Error against run time: every SPH validation case of ``cases/`` at several resolutions.
+
+Each case file runs through ``sphdvi run`` (a fresh process per resolution, as a user runs it)
+and is scored against its analytic solution or experiment (TOLERANCES.md in
+``../shared/reference``). One line per resolution: particles, steps, the wall time of the time
+stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle-step, the errors
+and whether they meet the target; after each case the observed order of its headline error
+between successive resolutions, log(e1/e2)/log(dp1/dp2).
+
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12)
+    python tools/validate.py S3 S7 --threads 2
+    python tools/validate.py --all           # with S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads)
+    python tools/validate.py S9 --csv s9.csv --keep runs/
+
+Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+sys.path.insert(0, REPO)
+REFERENCE = os.path.join(os.path.dirname(REPO), "shared", "reference")
+
+
+def case_path(folder: str, name: str) -> str:
+    return os.path.join(REPO, "cases", folder, name)
+
+
+@dataclass
+class Resolution:
+    label: str
+    dp: float
+    args: list = field(default_factory=list)     # extra `sphdvi run` options (--tmax, --set ...)
+    scored: bool = True                          # False: coarser than the resolution TOLERANCES sets the target at
+
+
+@dataclass
+class Case:
+    """A validation case: its file, resolutions, scoring and targets.
+
+    ``score(outdir) -> dict`` returns the errors of one run; ``columns`` are (header, key,
+    format) of what is printed; ``headline`` the key whose observed order is printed;
+    ``target(errors) -> bool`` whether TOLERANCES' target is met; ``target_text`` says it."""
+    name: str
+    title: str
+    case: str
+    resolutions: list | Callable      # Resolution rows, or a function returning them
+    score: Callable
+    columns: list
+    headline: str
+    target: Callable
+    target_text: str
+    slow: bool = False
+
+
+# ---- scoring of each case (the functions live in sphdvi.validation, shared with the tests) ----
+
+def score_hydrostatic(outdir):
+    from sphdvi.validation.hydrostatic import case_errors
+    return case_errors(outdir)
+
+
+def score_front(outdir):
+    import numpy as np
+
+    from sphdvi.validation.dambreak import front_errors, front_history, load_martin_moyce
+    t, x = front_history(outdir)
+    _, rel, speed = front_errors(t, x, load_martin_moyce(REFERENCE))
+    return {"front_max": float(np.abs(rel).max()), "front_min": float(rel.min()), "speed": float(speed)}
+
+
+def score_lobovsky(outdir):
+    from sphdvi.validation import lobovsky
+    levels = lobovsky.level_errors(outdir, REFERENCE)
+    press = lobovsky.pressure_scores(outdir, REFERENCE)
+    out = {f"level_{k}": v for k, v in levels.items()}
+    out["level_max"] = max(levels.values())
+    out["impact_max"] = max(abs(ti - te) for n, (ti, te, _, _) in press.items() if n != "P4")
+    out["plateau_max"] = max(abs(ps / pe - 1) for n, (_, _, ps, pe) in press.items() if n != "P4")
+    ti, te, ps, pe = press["P4"]
+    out["plateau_P4"] = ps / pe - 1
+    return out
+
+
+def score_sloshing(outdir):
+    from sphdvi.validation.sloshing import case_periods
+    r = case_periods(outdir)
+    return {"period": r["period_com"] / r["period_theory"] - 1, "decay": r["decay"]}
+
+
+def score_poiseuille(outdir):
+    from sphdvi.validation.poiseuille import case_errors
+    return case_errors(outdir)
+
+
+def score_floating(outdir):
+    from sphdvi.validation.floating import draft_errors
+    return draft_errors(outdir)
+
+
+def _resolutions(module: str, attr: str = "RESOLUTIONS") -> Callable:
+    """A validation module's RESOLUTIONS ({"label", "dp", "set": [...]}) as Resolution rows
+    (imported when the case runs)."""
+    def rows():
+        import importlib
+        table = getattr(importlib.import_module(f"sphdvi.validation.{module}"), attr)
+        return [Resolution(r["label"], r["dp"], [a for kv in r.get("set", []) for a in ("--set", kv)]
+                           + list(r.get("args", [])), r.get("scored", True)) for r in table]
+    return rows
+
+
+def cases() -> list:
+    pct = "{:+.2f} %"
+    return [
+        Case("S1", "hydrostatic tank and still water (S1/S2)",
+             case_path("hydrostatic2d", "CaseHydrostatic2D_Def.xml"), _resolutions("hydrostatic"),
+             score_hydrostatic,
+             [("p err max %", "rel_max", pct), ("|p-p0|/ρgH %", "einf", pct), ("max|u|/√gH", "umax", "{:.1e}"),
+              ("Δz_cm/dp", "dzcm", "{:+.1e}")],
+             "einf", lambda e: e["rel_max"] <= 0.02 and e["umax"] <= 1e-3 and e.get("lost", 0) == 0,
+             "pressure within 2 %, max|u| <= 1e-3 √(gH), nothing lost"),
+        Case("S3", "dam-break front vs Martin & Moyce (1952)",
+             case_path("dambreak2d", "CaseDambreakVal2D_Def.xml"),
+             [Resolution("a/dp 25", 0.04, ["--tmax", "0.72", "--tout", "0.01"], scored=False),
+              Resolution("a/dp 50", 0.02, ["--tmax", "0.72", "--tout", "0.01"])],
+             score_front, [("Z max|err| %", "front_max", pct), ("Z min err %", "front_min", pct),
+                           ("speed err %", "speed", pct)],
+             "front_max", lambda e: e["front_max"] <= 0.05,
+             "Z(T) within ±5 % for T in [1, 3] at a/dp >= 50 (judgement: the experiment's gate delays the surge)"),
+        Case("S4", "Lobovsky et al. (2014) dam break: levels and wall pressure",
+             case_path("lobovsky2d", "CaseLobovsky2D_Def.xml"),
+             [Resolution("H/dp 60", 0.005), Resolution("H/dp 120", 0.0025)],
+             score_lobovsky, [("level max %", "level_max", pct), ("H3 %", "level_H3", pct),
+                              ("impact |ΔT| P1-3", "impact_max", "{:.3f}"), ("p level P1-3 %", "plateau_max", pct),
+                              ("p level P4 %", "plateau_P4", pct)],
+             "level_max", lambda e: e["level_max"] <= 0.10 and e["impact_max"] <= 0.05 and e["plateau_max"] <= 0.20,
+             "levels within 10 %, first impact ±0.05, quasi-static pressure within 20 % (sensors 1-3)",
+             slow=True),
+        Case("S7", "standing wave, sloshing mode 1 vs linear theory",
+             case_path("standingwave2d", "CaseStandingWave2D_Def.xml"),
+             [Resolution("d/dp 20", 0.025, scored=False), Resolution("d/dp 40", 0.0125)],
+             score_sloshing, [("period err %", "period", pct), ("loss/period %", "decay", "{:.2f} %")],
+             "period", lambda e: abs(e["period"]) <= 0.02 and e["decay"] <= 0.05,
+             "period within 1-2 %, amplitude loss <= ~5 %/period, at d/dp >= 40"),
+        Case("S9", "Poiseuille flow, laminar viscosity",
+             case_path("poiseuille2d", "CasePoiseuille2D_Def.xml"), _resolutions("poiseuille"),
+             score_poiseuille, [("centre-line err %", "centreline", pct), ("transient err %", "transient", pct)],
+             "centreline", lambda e: abs(e["centreline"]) <= 0.01 and e.get("transient", 0) <= 0.02,
+             "steady centre-line speed within 1 %, transient within 2 %"),
+        Case("S10", "Poiseuille flow, artificial viscosity",
+             case_path("poiseuille2d", "CasePoiseuille2D_Def.xml"), _resolutions("poiseuille", "RESOLUTIONS_S10"),
+             score_poiseuille, [("vs α h c0/8 %", "centreline", pct),
+                                ("vs operator %", "centreline_vs_prediction", pct)],
+             "centreline_vs_prediction", lambda e: abs(e["centreline_vs_prediction"]) <= 0.10,
+             "within ~10 % of ν_eff (here the operator's own prediction, 0.43 α h c0/8: "
+             "DualSPHysics's term acts on approaching pairs only)"),
+        Case("S12", "floating box in still water (ρb/ρw = 0.5)",
+             case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
+             [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),
+              Resolution("box/dp 20", 0.01, ["--tmax", "1.5", "--tout", "0.05"])],
+             score_floating, [("draft err dp", "draft_dp", "{:+.2f}"), ("drift dp", "drift_dp", "{:.3f}"),
+                              ("tilt °", "tilt_deg", "{:.3f}")],
+             "draft_dp", lambda e: abs(e["draft_dp"]) <= 0.5 and e["drift_dp"] < 0.1 and e["tilt_deg"] < 1.0,
+             "draft within 0.5 dp, no drift, upright"),
+    ]
+
+
+# ---- running ----
+
+def run_case(case: Case, res: Resolution, outdir: str, threads: int) -> dict:
+    """Run one resolution through the CLI; return run.json's figures (status, particles, steps,
+    runtime_s, us_per_particle_step) and the wall time of the whole command."""
+    cmd = [sys.executable, "-m", "sphdvi", "run", case.case, "-o", outdir, "--dp", repr(res.dp),
+           "--threads", str(threads), "-q", "--overwrite"] + res.args
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    meta = {}
+    path = os.path.join(outdir, "run.json")
+    if os.path.isfile(path):
+        with open(path) as f:
+            meta = json.load(f)
+    if proc.returncode != 0:
+        meta.setdefault("message", proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "")
+    return {"rc": proc.returncode, "status": meta.get("status", "failed"), "particles": meta.get("particles", 0),
+            "steps": meta.get("steps", 0), "runtime_s": meta.get("runtime_s", float("nan")),
+            "us": meta.get("us_per_particle_step", float("nan")), "command_s": wall,
+            "message": meta.get("message", "")}
+
+
+def observed_order(rows: list, key: str) -> list:
+    """log(e_k/e_k+1) / log(dp_k/dp_k+1) between successive resolutions of one case."""
+    out = []
+    for a, b in zip(rows, rows[1:]):
+        ea, eb = abs(a["errors"].get(key, math.nan)), abs(b["errors"].get(key, math.nan))
+        ok = ea > 0 and eb > 0 and math.isfinite(ea) and math.isfinite(eb)
+        out.append(math.log(ea / eb) / math.log(a["dp"] / b["dp"]) if ok else math.nan)
+    return out
+
+
+def fmt(spec: str, value) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "-"
+    return spec.format(100 * value) if spec.endswith("%") else spec.format(value)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S4 S7 S9 S10 S12); default: all but the slow S4")
+    ap.add_argument("--all", action="store_true", help="every case, S4 included")
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
+    ap.add_argument("--keep", metavar="DIR", help="keep the run folders under DIR (default: a temporary folder)")
+    ap.add_argument("--csv", metavar="FILE", help="also write every row to FILE")
+    args = ap.parse_args(argv)
+    every = cases()
+    known = {c.name: c for c in every}
+    known["S2"] = known["S1"]                      # S1 and S2 are one run of the hydrostatic tank
+    unknown = [n for n in args.names if n.upper() not in known]
+    if unknown:
+        ap.error(f"unknown case(s) {', '.join(unknown)}; expected some of {', '.join(known)}")
+    picked = {known[n.upper()].name for n in args.names}
+    chosen = [c for c in every if c.name in picked] if args.names else [c for c in every if args.all or not c.slow]
+    base = args.keep or tempfile.mkdtemp(prefix="sphdvi-validate-")
+    table, failed = [], 0
+    for case in chosen:
+        print(f"\n{case.name} {case.title}\n  target: {case.target_text}")
+        head = f"  {'resolution':<11}{'dp':>9}{'particles':>10}{'steps':>8}{'runtime_s':>10}{'µs/p-step':>10}"
+        print(head + "".join(f"{h:>{max(len(h) + 2, 12)}}" for h, _, _ in case.columns) + "  target")
+        rows = []
+        resolutions = case.resolutions() if callable(case.resolutions) else case.resolutions
+        for res in resolutions[:1] if args.coarse else resolutions:
+            outdir = os.path.join(base, f"{case.name}_{res.dp:g}")
+            run = run_case(case, res, outdir, args.threads)
+            errors = {}
+            if run["rc"] == 0:
+                errors = case.score(outdir)
+            row = {"case": case.name, "resolution": res.label, "dp": res.dp, "scored": res.scored, **run, "errors": errors,
+                   "meets_target": bool(errors) and bool(case.target(errors))}
+            rows.append(row)
+            line = (f"  {res.label:<11}{res.dp:>9.4g}{run['particles']:>10d}{run['steps']:>8d}"
+                    f"{run['runtime_s']:>10.1f}{run['us']:>10.3f}")
+            if run["rc"] != 0:
+                print(line + f"  run {run['status']} (exit {run['rc']}): {run['message']}")
+                failed += 1
+                continue
+            line += "".join(f"{fmt(f, errors.get(k)):>{max(len(h) + 2, 12)}}" for h, k, f in case.columns)
+            print(line + ("  yes" if row["meets_target"] else "  NO") + ("" if res.scored else " (coarser than the target's)"))
+        orders = observed_order([r for r in rows if r["errors"]], case.headline)
+        if orders:
+            print(f"  observed order of {case.headline}: " + ", ".join(fmt("{:.2f}", o) for o in orders))
+        table.extend(rows)
+    if args.csv:
+        base = ["case", "resolution", "dp", "particles", "steps", "runtime_s", "us_per_particle_step", "status",
+                "meets_target"]
+        keys = sorted({k for r in table for k in r["errors"]} - set(base))
+        with open(args.csv, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(base + ["target_applies"] + keys)
+            for r in table:
+                w.writerow([r["case"], r["resolution"], r["dp"], r["particles"], r["steps"], r["runtime_s"], r["us"],
+                            r["status"], r["meets_target"], r["scored"]] + [r["errors"].get(k, "") for k in keys])
+    if args.keep:
+        print(f"\nrun folders kept in {base}")
+    else:
+        import shutil
+        shutil.rmtree(base, ignore_errors=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
