@@ -91,6 +91,7 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     apply_floating_velocities(particles, bodies)
     domain = resolve_domain(case, particles, consts, reader)
     check_case(case, particles, bodies, mkinfo, domain, reader)
+    warn_gauges_outside(case.special.get("gauges"), domain, consts.is2d, reader)
     reader.warn_unread_attributes(root)
     return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
                          mkinfo=mkinfo, warnings=warnings, primitives=list(drawing.primitives),
@@ -459,6 +460,46 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
         for mk in link.get("mkbound", []):
             if mk not in bound_labels:
                 reader.warn(None, f"<properties><link> line {link['line']}: mkbound {mk} has no particles")
+
+
+def gauge_extent_points(g: dict) -> list:
+    """The points that bound where a gauge samples: velocity its point, swl its line's ends,
+    maxz its column's foot and top, mesh its first and last node (point + Σ size_k vec_k/|vec_k|)."""
+    kind = g["type"]
+    if kind == "velocity":
+        return [g["point"]]
+    if kind == "swl":
+        return [g["point0"], g["point2"]]
+    if kind == "maxz":
+        return [g["point0"], np.add(g["point0"], [0.0, 0.0, g.get("height", 0.0)])]
+    if kind == "mesh":
+        far = np.asarray(g["point"], float).copy()
+        for k in (1, 2, 3):
+            v = np.asarray(g.get(f"vec{k}", np.eye(3)[k - 1]), float)
+            n = np.linalg.norm(v)
+            if n > 0:
+                far += g.get(f"size{k}", 0.0) * v / n
+        return [g["point"], far]
+    return []
+
+
+def warn_gauges_outside(gauges, domain, is2d: bool, reader) -> None:
+    """A gauge whose points lie outside the simulation domain records no fluid there (nor
+    does DualSPHysics's): say so at gencase rather than leave the user an empty file.
+    In 2D the y coordinate is not compared."""
+    if not gauges:
+        return
+    lo, hi = np.asarray(domain["posmin"], float), np.asarray(domain["posmax"], float)
+    axes = [0, 2] if is2d else [0, 1, 2]
+    tol = 1e-9 * max(1.0, float(np.abs(np.r_[lo, hi]).max()))
+    for g in gauges["items"]:
+        for pt in gauge_extent_points(g):
+            p = np.asarray(pt, float)
+            if np.any(p[axes] < lo[axes] - tol) or np.any(p[axes] > hi[axes] + tol):
+                reader.warnings.add(f"{g['type']} gauge '{g['name']}': point {np.round(p, 9).tolist()} lies outside "
+                                    f"the simulation domain {lo.tolist()} .. {hi.tolist()}; it records no fluid there",
+                                    file=reader.file, line=g.get("line"), element=g["type"])
+                break
 
 
 # ---------------------------------------------------------------------------

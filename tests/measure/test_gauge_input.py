@@ -94,7 +94,7 @@ BAD = [
     # absurd numbers of sample points
     ("coefdp_tiny", f'<swl name="g">\n<pointdp coefdp="1e-9" />\n{SWL}\n</swl>', "<pointdp", "pointdp",
      "sample points, more than 1,000,000"),
-    ("pointdp_1e-300", f'<swl name="g">\n<pointdp value="1e-300" />\n<point0 x="0" y="0" z="0" />\n'
+    ("pointdp_1e-300", '<swl name="g">\n<pointdp value="1e-300" />\n<point0 x="0" y="0" z="0" />\n'
      '<point2 x="1e300" y="0" z="0" />\n</swl>', "<pointdp", "pointdp", "more than 1e15 sample points"),
     ("mesh_huge", '<mesh name="g">\n<point x="0" y="0" z="0" />\n<size1 value="1e4" />\n<size3 value="1e4" />\n'
      '</mesh>', '<mesh name="g"', "mesh", "sample points, more than 1,000,000"),
@@ -231,3 +231,28 @@ def test_run_of_old_case_file_with_invalid_gauge_is_exit_2(tmp_path):
         d = {**data, "json": {**data["json"], "gauges": {"default": {}, "items": [item]}}}
         with pytest.raises(InputError, match=words):
             RunGauges(d, data.get("parameters") or {}, str(tmp_path / "run"))
+
+
+@pytest.mark.parametrize("gauge, outside", [
+    ('<velocity name="far">\n<point x="9" y="0" z="0.5" />\n</velocity>', True),
+    ('<swl name="far">\n<point0 x="0.2" y="0" z="0" />\n<point2 x="0.2" y="0" z="9" />\n</swl>', True),
+    ('<maxz name="far">\n<point0 x="0.5" y="0" z="0" />\n<height value="20" />\n</maxz>', True),
+    ('<mesh name="far">\n<point x="0.2" y="0" z="0.2" />\n<vec1 x="1" y="0" z="0" />\n<size1 value="40" />\n</mesh>',
+     True),
+    (f'<velocity name="near">\n{VPOINT}\n</velocity>', False),
+    # 2D: y is not compared (the particles lie on y = 0)
+    ('<velocity name="y2d">\n<point x="0.5" y="3" z="0.5" />\n</velocity>', False),
+])
+def test_gauge_outside_the_domain_is_warned(tmp_path, gauge, outside):
+    """A gauge whose points lie outside the simulation domain records no fluid there: gencase
+    says so with the gauge's line (a warning, as DualSPHysics runs such a gauge)."""
+    case = write_case(tmp_path, gauge)
+    r = invoke("gencase", case, "-o", tmp_path / "out")
+    assert r.exit_code == 0, r.output
+    warned = [ln for ln in r.output.splitlines() if "outside the simulation domain" in ln]
+    if outside:
+        assert len(warned) == 1, r.output
+        line = gauge.splitlines()[0]
+        assert f"{case.name}:{line_of(case.read_text(), line)}:" in warned[0] and "gauge 'far'" in warned[0]
+    else:
+        assert not warned, r.output
