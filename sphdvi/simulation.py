@@ -565,7 +565,10 @@ class SPHRun:
         normals0 = None
         if int(params.get("Boundary", 1)) == 2:
             from .case.normals import boundary_normals
-            normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]))
+            from .sph.periodic import Periodicity
+            axes = [k for k in periodic if not (c["is2d"] and k == "y")]
+            normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
+                                        Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
         # the solids that move boundary particles, and the damping zones: each only when
         # the case has it
         self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)

@@ -38,9 +38,9 @@ def _grid_keys(pos, inv, lo, nx, ny):
 
 
 @njit(cache=True)
-def _normals_kernel(bpos, fpos, dp, is2d, fcentroid):
-    """See the module docstring; brute force over sorted grid cells."""
-    nb = bpos.shape[0]
+def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid):
+    """See the module docstring; brute force over sorted grid cells. The normals of the first
+    ``nb`` rows of ``bpos``; the rows after them (periodic images) are neighbours only."""
     out = np.zeros((nb, 3))
     cell = 2.05 * dp      # a little over the search radius: rounding never hides a neighbour
     lo = np.empty(3)
@@ -176,13 +176,31 @@ def _normals_kernel(bpos, fpos, dp, is2d, fcentroid):
     return out
 
 
-def boundary_normals(pos: np.ndarray, ptype: np.ndarray, dp: float, is2d: bool) -> np.ndarray:
-    """(N, 3) mDBC normals: N for boundary particles (types 0–2), zero for fluid."""
+# how far from a periodic end the images must reach: the fluid search (3 cells of 2.05 dp)
+# and the layer count (8 dp along the normal, plus a cell)
+PERIODIC_REACH = 9.0
+
+
+def boundary_normals(pos: np.ndarray, ptype: np.ndarray, dp: float, is2d: bool,
+                     periodicity=None) -> np.ndarray:
+    """(N, 3) mDBC normals: N for boundary particles (types 0–2), zero for fluid.
+
+    ``periodicity`` (:class:`sphdvi.sph.periodic.Periodicity`): the particles near a periodic
+    end see the images of those across it, so a wall that runs through the periodic boundary
+    keeps its plane normals there (without them its end columns get corner normals)."""
     pos = np.ascontiguousarray(pos, dtype=np.float64)
     bound = ptype != 3
-    fpos = np.ascontiguousarray(pos[~bound])
+    fpos = pos[~bound]
     centroid = fpos.mean(axis=0) if fpos.shape[0] else pos.mean(axis=0)
+    bpos = pos[bound]
+    nb = bpos.shape[0]
+    if periodicity is not None and nb:
+        src, disp = periodicity.ghosts(pos, PERIODIC_REACH * dp)
+        image_bound = bound[src]
+        bpos = np.concatenate([bpos, pos[src[image_bound]] + disp[image_bound]])
+        fpos = np.concatenate([fpos, pos[src[~image_bound]] + disp[~image_bound]])
     out = np.zeros_like(pos)
-    if bound.any():
-        out[bound] = _normals_kernel(np.ascontiguousarray(pos[bound]), fpos, float(dp), bool(is2d), centroid)
+    if nb:
+        out[bound] = _normals_kernel(np.ascontiguousarray(bpos), nb, np.ascontiguousarray(fpos), float(dp),
+                                     bool(is2d), centroid)
     return out

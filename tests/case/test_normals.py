@@ -65,3 +65,29 @@ def test_thick_wall_distances():
     for k, z in enumerate((0.0, -dp, -2 * dp)):
         i = np.flatnonzero((ptype == 0) & np.isclose(pos[:, 0], 0.5) & np.isclose(pos[:, 2], z))[0]
         assert n[i] == pytest.approx([0, 0, (k + 0.5) * dp])
+
+
+@pytest.mark.parametrize("is2d", [True, False])
+def test_periodic_channel_walls_keep_plane_normals(is2d):
+    """A channel periodic in x (and y in 3D): the walls run through the periodic ends, so with
+    the periodic images every wall particle, the end columns included, has the plate normal
+    (0, 0, (k + 1/2) dp) for layer k. Without them the end columns get corner normals."""
+    from sphdvi.sph.periodic import Periodicity
+    dp, n, cols, layers = 0.1, 6, 8, 3
+    ys = [0.0] if is2d else np.arange(cols) * dp
+    X, Y, Z = np.meshgrid(np.arange(cols) * dp, ys, (np.arange(n) + 0.5) * dp, indexing="ij")
+    fluid = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    wz = np.r_[-(np.arange(layers) + 0.5) * dp, n * dp + (np.arange(layers) + 0.5) * dp]
+    X, Y, Z = np.meshgrid(np.arange(cols) * dp, ys, wz, indexing="ij")
+    wall = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    pos = np.vstack([wall, fluid])
+    ptype = np.r_[np.zeros(len(wall), int), np.full(len(fluid), 3)]
+    axes = ["x"] if is2d else ["x", "y"]
+    nrm = boundary_normals(pos, ptype, dp, is2d, Periodicity(axes, pos, dp, {}))[: len(wall)]
+    z = wall[:, 2]
+    depth = np.where(z < 0, -z, z - n * dp)                     # (k + 1/2) dp
+    expected = np.column_stack([0 * z, 0 * z, np.where(z < 0, depth, -depth)])
+    np.testing.assert_allclose(nrm, expected, atol=1e-12)
+    plain = boundary_normals(pos, ptype, dp, is2d)[: len(wall)]
+    ends = np.isclose(wall[:, 0], 0) | np.isclose(wall[:, 0], (cols - 1) * dp)
+    assert np.all(np.abs(plain[ends & (np.abs(z) < dp)][:, 0]) > 0.1 * dp)   # corner normals there

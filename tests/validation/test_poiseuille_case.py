@@ -5,16 +5,13 @@ The case is the set-up of tests/sph/test_poiseuille.py (Morris, Fox & Zhu 1997: 
 mDBC no-slip walls with their surfaces on z = 0 and z = d, ViscoLaminarEta 0) drawn by gencase;
 :func:`sphdvi.validation.poiseuille.case_errors` scores the runs.
 
-As drawn, the runs miss TOLERANCES S9: sphdvi computes the mDBC normals from the particles
-(sphdvi/case/normals.py, called by sphdvi/simulation.py) without the periodic images, so the
-wall particles within 2 dp of the periodic ends (4 of the 12 columns) get corner normals, e.g.
-(−0.35, 0, 0.35) dp instead of (0, 0, 0.5) dp for the outer layer; the walls there act inside
-the wall and the flow is too fast: centre-line +1.97 % (20 across), +1.58 % (30), +1.40 % (40),
-transient up to 3.6 / 2.3 / 1.9 % of u_max. The tests marked xfail(strict) hold the real
-tolerances for that and turn into failures (XPASS) once the normals are fixed. With the normals
-of the drawn walls, (0, 0, distance to the surface), patched in here, the case-file run is the
-API model (centre-line equal to 1e-6) and meets S9: +0.92 / +0.86 / +0.84 %, transient 0.78 /
-0.65 / 0.60 %. Each run takes 1-4 s on one thread; the 40-across runs are marked slow.
+The mDBC normals of the walls, computed from the particles with the periodic images of the
+wall (sphdvi/case/normals.py), are the plates' own, (0, 0, distance to the surface): the
+case-file run is the API model (centre-line equal to 1e-6) and meets S9: +0.92 / +0.86 /
++0.84 % at 20 / 30 / 40 across, transient 0.78 / 0.65 / 0.60 % of u_max. (Before the normals saw
+the periodic images, the wall particles within 2 dp of the periodic ends got corner normals and
+the flow was 1.97 / 1.58 / 1.40 % too fast.) Each run takes 1-4 s on one thread; the 40-across
+runs are marked slow.
 """
 import importlib.util
 from pathlib import Path
@@ -23,7 +20,6 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-import sphdvi.case.normals as normals_module
 from sphdvi.cli import main
 from sphdvi.io.casefile import read_case_h5
 from sphdvi.validation import poiseuille as P
@@ -42,44 +38,23 @@ def _api():
     return mod
 
 
-_original_normals = normals_module.boundary_normals
-
-
-def plate_normals(pos, ptype, dp, is2d):
-    """The mDBC normals of the drawn plates, as GenCase derives them from the geometry and
-    tests/sph/test_poiseuille.py passes them: N = (0, 0, distance to the wall surface), the
-    surfaces dp/2 outside the outer fluid rows."""
-    out = _original_normals(pos, ptype, dp, is2d)
-    bound = ptype != 3
-    zf = pos[~bound, 2]
-    lo, hi = zf.min() - dp / 2, zf.max() + dp / 2
-    z = pos[bound, 2]
-    n = np.zeros((int(bound.sum()), 3))
-    n[:, 2] = np.where(z < lo, lo - z, hi - z)
-    out[bound] = n
-    return out
-
-
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
-    """run(n, artificial=False, exact_normals=False) -> case_errors of that run (cached)."""
+    """run(n, artificial=False) -> case_errors of that run (cached)."""
     cache = {}
 
-    def _run(n, artificial=False, exact_normals=False):
-        key = (n, artificial, exact_normals)
+    def _run(n, artificial=False):
+        key = (n, artificial)
         if key not in cache:
             res = (RES_S10 if artificial else RES)[n]
-            out = tmp_path_factory.mktemp("poiseuille_%d_%s_%s" % key)
-            with pytest.MonkeyPatch.context() as mp:
-                if exact_normals:
-                    mp.setattr(normals_module, "boundary_normals", plate_normals)
-                r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--threads", "1", "-q",
-                                              "--overwrite"] + P.case_args(res))
+            out = tmp_path_factory.mktemp("poiseuille_%d_%s" % key)
+            r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--threads", "1", "-q",
+                                          "--overwrite"] + P.case_args(res))
             assert r.exit_code == 0, r.output
             e = P.case_errors(str(out))
-            print("Poiseuille case %d across, %s, %s normals: centre-line %+.3f %%, transient %s, %s vs "
+            print("Poiseuille case %d across, %s: centre-line %+.3f %%, transient %s, %s vs "
                   "prediction, %d particles, %d steps, %.2f s"
-                  % (n, e["viscosity"], "plate" if exact_normals else "sphdvi", 100 * e["centreline"],
+                  % (n, e["viscosity"], 100 * e["centreline"],
                      None if e["transient"] is None else "%.3f %%" % (100 * e["transient"]),
                      "%+.2f %%" % (100 * e["centreline_vs_prediction"]) if artificial else "-",
                      e["particles"], e["steps"], e["runtime_s"]))
@@ -114,19 +89,19 @@ def test_case_geometry_and_dt_follow_dp(tmp_path):
             (3, pytest.approx(P.NU), 0.0, 2, 2)
 
 
-def test_case_with_plate_normals_is_the_api_model(run):
-    """With the plates' normals the case-file run is tests/sph/test_poiseuille.py's model at
-    the same resolution (20 across): the centre-line speed and the L2 error agree to 1e-6 u_max
-    (the outputs hold float32 velocities; measured 2e-8 and 5e-8), laminar (S9) and with
-    --set ViscoTreatment=1 --set Visco=alpha (S10). The API runs to t_end = (1 - 1e-9) d²/ν:
-    its ``run(d²/ν)`` takes a 2001st step (the time after 2000 steps of DtFixed is
-    0.99999999999995 s), which moves the disordered S10 flow by 1.3e-4 u_max."""
+def test_case_is_the_api_model(run):
+    """The case-file run is tests/sph/test_poiseuille.py's model at the same resolution (20
+    across): the centre-line speed and the L2 error agree to 1e-6 u_max (the outputs hold
+    float32 velocities; measured 2e-8 and 5e-8), laminar (S9) and with --set ViscoTreatment=1
+    --set Visco=alpha (S10). The API runs to t_end = (1 - 1e-9) d²/ν: its ``run(d²/ν)`` takes a
+    2001st step (the time after 2000 steps of DtFixed is 0.99999999999995 s), which moves the
+    disordered S10 flow by 1.3e-4 u_max."""
     api = _api()
     t_end = (1 - 1e-9) * P.D ** 2 / P.NU
     a9 = api.run_poiseuille(20, slip=2, eta=0.0, t_end=t_end)
-    e9 = run(20, exact_normals=True)
+    e9 = run(20)
     a10 = api.run_poiseuille(20, artificial=True, slip=2, t_end=t_end)
-    e10 = run(20, artificial=True, exact_normals=True)
+    e10 = run(20, artificial=True)
     print("case - API, 20 across: S9 centre-line %.2e, L2 %.2e; S10 centre-line %.2e"
           % (e9["centreline"] + 1 - a9["uc"], e9["l2"] - a9["l2"], e10["centreline"] + 1 - a10["uc"]))
     assert e9["steps"] == e10["steps"] == 2000
@@ -135,66 +110,35 @@ def test_case_with_plate_normals_is_the_api_model(run):
     assert abs(e10["centreline"] + 1 - a10["uc"]) < 1e-6
 
 
-@pytest.mark.xfail(strict=True, reason="sphdvi's mDBC normals ignore the periodic images: corner normals at the "
-                                        "periodic ends of the walls (measured +1.97 % against the API's +0.92 %)")
-def test_case_as_drawn_is_the_api_model(run):
-    """The case file as drawn should be the API model too (same particles, same parameters)."""
-    assert abs(run(20)["centreline"] - run(20, exact_normals=True)["centreline"]) < 1e-4
-
-
-def test_s9_tolerance_with_plate_normals(run):
-    """TOLERANCES S9 at 30 across (where the API test meets it): centre-line within 1 %
-    (measured +0.86 %; the lattice sum of the exact Morris operator predicts +0.78 %) and the
-    Morris et al. series within 2 % of u_max at the outputs 0 < t ν/d² ≤ 0.25 (measured 0.65 %)."""
-    e = run(30, exact_normals=True)
+def test_s9_tolerance(run):
+    """TOLERANCES S9 at 30 across: centre-line within 1 % (measured +0.86 %; the lattice sum
+    of the exact Morris operator predicts +0.78 %) and the Morris et al. series within 2 % of
+    u_max at the outputs 0 < t ν/d² ≤ 0.25 (measured 0.65 %); no vertical flow."""
+    e = run(30)
     assert abs(e["centreline"]) < 0.01
     assert e["transient"] < 0.02
     assert e["wmax"] < 1e-3
 
 
-@pytest.mark.xfail(strict=True, reason="sphdvi's mDBC normals ignore the periodic images (measured centre-line "
-                                        "+1.58 %, transient 2.35 % at 30 across)")
-def test_s9_tolerance_as_drawn(run):
-    """TOLERANCES S9 at 30 across for the case file as a user runs it."""
-    e = run(30)
-    assert abs(e["centreline"]) < 0.01
-    assert e["transient"] < 0.02
-
-
-def test_s9_as_drawn_error_falls_with_dp(run):
-    """As drawn the centre-line error falls with dp (+1.97 % at 20 across, +1.58 % at 30):
-    the corner normals put the walls of 4 columns a fixed fraction of dp inside the wall, so
-    the excess over the run with the plates' normals scales with dp (measured ratio 0.69
-    from 20 to 30 across, 20/30 = 0.67)."""
-    e20, e30 = run(20), run(30)
-    p20, p30 = run(20, exact_normals=True), run(30, exact_normals=True)
-    assert 0 < e30["centreline"] < e20["centreline"]
-    ratio = (e30["centreline"] - p30["centreline"]) / (e20["centreline"] - p20["centreline"])
-    assert 0.55 < ratio < 0.8
-
-
 def test_s10_against_operator_prediction(run):
     """S10: the case with --set ViscoTreatment=1 --set Visco=alpha (alpha h c0/8 = nu) against
     the operator prediction nu_eff = 0.426 alpha h c0/8 (approaching pairs only, lattice sum),
-    within the ~10 % of TOLERANCES S10: measured -4.6 % as drawn, -7.6 % with the plates'
-    normals (the API test's value) at 20 across."""
-    for exact in (False, True):
-        e = run(20, artificial=True, exact_normals=exact)
-        assert e["viscosity"] == "artificial"
-        assert abs(e["centreline_vs_prediction"]) < 0.10
+    within the ~10 % of TOLERANCES S10: measured -7.6 % at 20 across (the API test's value)."""
+    e = run(20, artificial=True)
+    assert e["viscosity"] == "artificial"
+    assert abs(e["centreline_vs_prediction"]) < 0.10
 
 
 @pytest.mark.slow
 def test_s9_40_across(run):
-    """40 across: with the plates' normals +0.84 %, transient 0.60 % (inside S9); as drawn
-    +1.40 %, still falling with dp."""
-    p40 = run(40, exact_normals=True)
-    assert abs(p40["centreline"]) < 0.01 and p40["transient"] < 0.02
-    assert 0 < run(40)["centreline"] < run(30)["centreline"]
+    """40 across: +0.84 %, transient 0.60 % (inside S9), below the 30-across error."""
+    e40 = run(40)
+    assert abs(e40["centreline"]) < 0.01 and e40["transient"] < 0.02
+    assert abs(e40["centreline"]) < abs(run(30)["centreline"])
 
 
 @pytest.mark.slow
 def test_s10_30_and_40_across(run):
-    """S10 at 30 and 40 across as drawn: -3.4 %, -2.0 % against the operator prediction."""
+    """S10 at 30 and 40 across against the operator prediction (measured -6.2 %, -4.4 %)."""
     for n in (30, 40):
         assert abs(run(n, artificial=True)["centreline_vs_prediction"]) < 0.10
