@@ -48,6 +48,20 @@ def define_builtin_variables(reader, cdef, casename: str) -> None:
     v.define("CaseName", casename, constant=True)
 
 
+def define_computed_variables(reader, consts) -> None:
+    """GenCase's variables known once the fluid is drawn: H (smoothing length), B, MassFluid,
+    MassBound. A case that defined a variable of the same name keeps its own (its later
+    expressions mean it), with a warning that the built-in is not defined."""
+    for name, value in (("H", consts.h), ("B", consts.b), ("MassFluid", consts.massfluid),
+                        ("MassBound", consts.massbound)):
+        if name in reader.vars.values:
+            reader.warnings.add(f"the case defines a variable '{name}' ({reader.vars.values[name]!r}); it is kept, so "
+                                f"GenCase's built-in {name} ({value:.6g}) is not available to its expressions",
+                                file=reader.file)
+            continue
+        reader.vars.define(name, value, constant=True)
+
+
 def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT_MAX_NODES,
                warnings: Warnings | None = None, dp: float | None = None) -> GenCaseResult:
     """Read, draw and assemble a case (nothing is written).
@@ -80,9 +94,7 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     if fluid_z.size and not consts.cs0 > 0:
         raise reader.error(casedef.find("constantsdef"), "the speed of sound is zero (the fluid has no height)",
                            'a <speedsound value=".."/> or <hswl value=".."/>')
-    for name, value in (("H", consts.h), ("B", consts.b), ("MassFluid", consts.massfluid),
-                        ("MassBound", consts.massbound)):
-        reader.vars.define(name, value, constant=True)
+    define_computed_variables(reader, consts)
     case = Case(name=casename, file=os.path.abspath(path), source=text, constantsdef=cdef,
                 boundcount=boundcount, fluidcount=fluidcount)
     read_sections(case, root, reader)

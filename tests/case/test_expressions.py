@@ -92,3 +92,30 @@ def test_mk_range(text, values):
 def test_mk_range_errors(text):
     with pytest.raises(ValueError):
         parse_mk_range(text)
+
+
+@pytest.mark.parametrize("kind", ["newvarcte", "newvar"])
+def test_case_variable_named_like_a_computed_builtin_is_kept(tmp_path, kind):
+    """GenCase defines H, B, MassFluid and MassBound once the fluid is drawn. A case that
+    defined one of those names itself keeps its value (its later expressions mean it) and
+    gets a warning; it used to stop gencase with an internal error."""
+    from click.testing import CliRunner
+
+    from sphdvi.cli import main
+    from sphdvi.io.casefile import read_case_h5
+    case = tmp_path / "CaseH_Def.xml"
+    case.write_text(f"""<?xml version="1.0" encoding="UTF-8" ?>
+<case><casedef><constantsdef><gravity x="0" y="0" z="-9.81" /><coefsound value="20" /></constantsdef>
+<geometry><predefinition><{kind} H="0.2" /></predefinition>
+<definition dp="0.02"><pointmin x="-0.1" y="0" z="-0.1" /><pointmax x="1" y="0" z="1" /></definition>
+<commands><mainlist><setmkfluid mk="0" />
+<drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="0.4" y="2" z="#H" /></drawbox>
+<setmkbound mk="0" />
+<drawbox><boxfill>bottom|left|right</boxfill><point x="0" y="-1" z="0" /><size x="0.4" y="2" z="#2*H" /></drawbox>
+</mainlist></commands></geometry></casedef>
+<execution><parameters><parameter key="TimeMax" value="#H" /></parameters></execution></case>
+""")
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out")])
+    assert r.exit_code == 0, r.output
+    assert "defines a variable 'H' (0.2); it is kept" in r.output
+    assert read_case_h5(str(tmp_path / "out" / "CaseH.h5"))["parameters"]["TimeMax"] == pytest.approx(0.2)
