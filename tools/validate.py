@@ -264,12 +264,13 @@ def main(argv=None) -> int:
             print(f"  observed order of {case.headline}: " + ", ".join(fmt("{:.2f}", o) for o in orders))
         table.extend(rows)
     if args.csv:
-        base = ["case", "resolution", "dp", "particles", "steps", "runtime_s", "us_per_particle_step", "status",
-                "meets_target"]
-        keys = sorted({k for r in table for k in r["errors"]} - set(base))
+        header = ["case", "resolution", "dp", "particles", "steps", "runtime_s", "us_per_particle_step", "status",
+                  "meets_target"]
+        keys = sorted({k for r in table for k, v in r["errors"].items() if isinstance(v, (int, float, str))}
+                      - set(header))
         with open(args.csv, "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(base + ["target_applies"] + keys)
+            w.writerow(header + ["target_applies"] + keys)
             for r in table:
                 w.writerow([r["case"], r["resolution"], r["dp"], r["particles"], r["steps"], r["runtime_s"], r["us"],
                             r["status"], r["meets_target"], r["scored"]] + [r["errors"].get(k, "") for k in keys])
