@@ -122,3 +122,22 @@ def test_lobovsky_levels_at_h_over_dp_120(errors, run_dir_fine):
         assert err <= 0.10, f"{name}: {100 * err:.1f} %"
     for name in ("H2", "H3", "H4"):
         assert fine[name] < errors[name], f"{name}: {100 * fine[name]:.1f} % vs {100 * errors[name]:.1f} %"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [
+    "P1", pytest.param("P2", marks=pytest.mark.xfail(
+        strict=True, reason="TOLERANCES S4 20 %: at dp 2.5 mm sensor 2 reads a mean p/ρgH of 0.824 over T = 3-5 "
+                            "against 0.685 (+20.3 %; +1.5 % at dp 5 mm): the level after impact rises with "
+                            "resolution at every sensor")),
+    "P3"])
+def test_lobovsky_pressure_after_impact_at_h_over_dp_120(run_dir_fine, name):
+    """At dp 2.5 mm the surge still reaches the wall on time (first impact within 0.01-0.03 T)
+    but the quasi-static level after it is higher than at dp 5 mm at every sensor: measured
+    P1 0.835 (+15.4 %), P2 0.824 (+20.3 %), P3 0.749 (+17.3 %), P4 0.341 (-36.0 %) against
+    0.671 / 0.695 / 0.573 / 0.204 at dp 5 mm."""
+    ti, te, ps, pe = lobovsky.pressure_scores(str(run_dir_fine), str(REF.parent))[name]
+    print(f"S4 {name} at dp 2.5 mm: first impact T {ti:.3f} (exp {te:.3f}), level {ps:.3f} (exp {pe:.3f}, "
+          f"{100 * (ps / pe - 1):+.1f} %)")
+    assert abs(ti - te) <= 0.05
+    assert abs(ps / pe - 1.0) <= 0.20, f"{name}: {ps:.3f} vs {pe:.3f}"
