@@ -65,6 +65,21 @@ def series_profile(z, t: float, f: float = F, nu: float = NU, d: float = D, term
     return steady_profile(z, f, nu, d) - modes.sum(0)
 
 
+def wendland_lattice_pairs(coefh: float = COEFH):
+    """Neighbours of a particle on a unit square lattice (dp = 1, V_b = 1) within 2h,
+    h = coefh √2: h, x, z, r and F(r) = (dW/dr)/r of the 2-D Wendland kernel (eq. 3 of the
+    seed paper, α_D = 7/(4π h²))."""
+    h = coefh * math.sqrt(2)
+    r = int(2 * h) + 1
+    i, j = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1))
+    x, z = i.ravel().astype(float), j.ravel().astype(float)
+    rr = np.hypot(x, z)
+    keep = (rr > 0) & (rr < 2 * h)
+    x, z, rr = x[keep], z[keep], rr[keep]
+    q = rr / h
+    return h, x, z, rr, 7 / (4 * math.pi * h * h) * (-5 * q) * (1 - q / 2) ** 3 / (h * rr)
+
+
 def monaghan_lattice_ratio(coefh: float = COEFH, eta2: float = 0.01, approaching_only: bool = True) -> float:
     """R of eq. (3): ν_eff / (α h c0 / 8) of DualSPHysics's artificial viscosity
     (Monaghan 1992, Π_ab = −α c h (v_ab·r_ab) / (ρ (r² + η²))) in a shear flow u(z) on a square
@@ -75,15 +90,7 @@ def monaghan_lattice_ratio(coefh: float = COEFH, eta2: float = 0.01, approaching
     whose continuum value is α h c0 / 8 (Monaghan 2005, 2-D). With the switch v_ab·r_ab < 0 only
     one of the two sides ±x of each row acts, so the sum halves: R = 0.4262 at coefh 1,
     0.459 at coefh 1.2."""
-    h = coefh * math.sqrt(2)
-    r = int(2 * h) + 1
-    i, j = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1))
-    x, z = i.ravel().astype(float), j.ravel().astype(float)
-    rr = np.hypot(x, z)
-    keep = (rr > 0) & (rr < 2 * h)
-    x, z, rr = x[keep], z[keep], rr[keep]
-    q = rr / h
-    fr = 7 / (4 * math.pi * h * h) * (-5 * q) * (1 - q / 2) ** 3 / (h * rr)
+    h, x, z, rr, fr = wendland_lattice_pairs(coefh)
     ratio = -0.5 * h * float(np.sum(x * x * z * z * fr / (rr * rr + eta2 * h * h))) * 8 / h
     return ratio * (0.5 if approaching_only else 1.0)
 

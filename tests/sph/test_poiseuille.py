@@ -38,22 +38,12 @@ import pytest
 
 from sphdvi.sph import SPHSolver
 from sphdvi.sph.state import FluidState
+from sphdvi.validation.poiseuille import series_profile, wendland_lattice_pairs
 
 D = 1e-3
 NU = 1e-6
 F = 2e-4
 UMAX = F * D * D / (8 * NU)
-
-
-def series_profile(z, t, terms=200):
-    """Transient start-up Poiseuille flow from rest (Morris, Fox & Zhu 1997, eq. 21):
-    u(z,t) = F z (d - z)/(2 nu) - sum_n 4 F d^2/(nu pi^3 (2n+1)^3) sin((2n+1) pi z/d)
-    exp(-(2n+1)^2 pi^2 nu t/d^2)."""
-    k = 2 * np.arange(terms)[:, None] + 1
-    z = np.asarray(z)[None, :]
-    modes = 4 * F * D * D / (NU * math.pi ** 3 * k ** 3) * np.sin(k * math.pi * z / D) \
-        * np.exp(-(k * math.pi) ** 2 * NU * t / (D * D))
-    return F * z[0] * (D - z[0]) / (2 * NU) - modes.sum(0)
 
 
 def run_poiseuille(n, t_end=D * D / NU, nx=12, layers=3, artificial=False, coefh=1.0,
@@ -133,20 +123,6 @@ def test_poiseuille_laminar_periodic():
     print("Poiseuille centre-line error %.4f -> %.4f, observed order %.2f"
           % (e20, e30, math.log(e20 / e30) / math.log(30 / 20)))
     assert e30 < e20
-
-
-def wendland_lattice_pairs(coefh):
-    """Neighbours of a particle on a unit square lattice (dp = 1, V_b = 1) within 2h,
-    h = coefh sqrt(2): h, x, z, r and F(r) = (dW/dr)/r of the 2D Wendland kernel."""
-    h = coefh * math.sqrt(2)
-    r = int(2 * h) + 1
-    i, j = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1))
-    x, z = i.ravel().astype(float), j.ravel().astype(float)
-    rr = np.hypot(x, z)
-    keep = (rr > 0) & (rr < 2 * h)
-    x, z, rr = x[keep], z[keep], rr[keep]
-    q = rr / h
-    return h, x, z, rr, 7 / (4 * math.pi * h * h) * (-5 * q) * (1 - q / 2) ** 3 / (h * rr)
 
 
 def laplacian_lattice_sum(coefh=1.0, eta2=0.01):
