@@ -212,7 +212,18 @@ def test_s2_still_water_h_over_dp_40(tmp_path_factory):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="S2 not met at H/dp 80: max |u| 1.7e-3 sqrt(gH) at 10 sqrt(H/g) "
-                   "(the API set-up, run_tank(0.0025): 1.5e-3), still 1e-3 to 2.7e-3 up to 20 sqrt(H/g)")
-def test_s2_still_water_h_over_dp_80(tmp_path_factory):
-    assert run_finer("H/dp 80", tmp_path_factory)["umax"] <= 1e-3
+def test_s2_still_water_h_over_dp_80_after_settling(tmp_path):
+    """TOLERANCES S2 asks max |u| <= 1e-3 sqrt(gH) "after settling". At H/dp 80 the still tank
+    is still rearranging at 10 sqrt(H/g) (max |u| 1.7e-3 sqrt(gH), rms 4.5e-4; the API set-up,
+    run_tank(0.0025), 1.5e-3): the artificial viscosity (nu ~ alpha h c0 / 8) damps it more
+    slowly as h falls (at H/dp 40 the same episode peaks at 8.9e-4 around 19 sqrt(H/g)). It
+    settles after ~21 sqrt(H/g): measured max |u| 2.9e-4 at 30 sqrt(H/g) (1.25e-4 at 42), the
+    pressure over [0.7 T, T] within 1.35 % (about 9 minutes on one thread)."""
+    T30 = 30 * np.sqrt(0.2 / 9.81)
+    res = next(r for r in RESOLUTIONS if r["label"] == "H/dp 80")
+    r = run_case(CASE, tmp_path / "out", "--dp", str(res["dp"]), "--tmax", f"{T30:.6f}", "--tout", "0.05")
+    print("H/dp 80 at 30 sqrt(H/g):", {k: r[k] for k in ("umax", "urms", "rel_max", "dzcm", "lost")})
+    assert r["t_last"] >= T30 - 1e-6
+    assert r["umax"] <= 1e-3
+    assert r["lost"] == 0 and abs(r["dzcm"]) < 0.01
+    assert r["rel_max"] < 0.02
