@@ -43,3 +43,34 @@ def front_errors(times, front, ref, a: float = 1.0, g: float = 9.81, trange=(1.0
     speed_exp = np.polyfit(ref[late_ref, 0], ref[late_ref, 1], 1)[0]
     speed_sph = np.polyfit(T[late], Z[late], 1)[0]
     return ref[sel, 0], rel, (speed_sph - speed_exp) / speed_exp
+
+
+def load_column_height(reference_dir: str) -> np.ndarray:
+    """(τ, H) pairs of M&M Table 6 as transcribed (τ = t √(g/a), H = h / (2a), h the height of
+    the water at the left wall); the axis convention is the transcriber's, not checked against
+    the original table (TOLERANCES S3), so it is reported, not tested."""
+    path = os.path.join(reference_dir, "dambreak2d_front_martin_moyce_1952", "mm1952_table6_height.csv")
+    return np.loadtxt(path, delimiter=",", comments="#", skiprows=4)
+
+
+def column_height_history(outdir: str, dp: float) -> tuple[np.ndarray, np.ndarray]:
+    """(times, height of the water at the left wall): the top of the fluid particles within
+    1.5 dp of the leftmost one, plus dp/2, at each output."""
+    from ..io.vtkhdf import read_step, step_times
+    path = os.path.join(outdir, "particles.vtkhdf")
+    times = step_times(path)
+    height = np.empty(times.size)
+    for k in range(times.size):
+        s = read_step(path, k)
+        p = s["points"][s["Type"] == 3]
+        near = p[:, 0] < p[:, 0].min() + 1.5 * dp
+        height[k] = p[near, 2].max() + 0.5 * dp
+    return times, height
+
+
+def column_height_errors(times, height, ref, a: float = 1.0, g: float = 9.81):
+    """(τ of the table within the run, relative errors (H_sph − H_exp)/H_exp there)."""
+    tau = np.asarray(times) * math.sqrt(g / a)
+    sel = ref[:, 0] <= tau.max()
+    h_sph = np.interp(ref[sel, 0], tau, np.asarray(height) / (2 * a))
+    return ref[sel, 0], (h_sph - ref[sel, 1]) / ref[sel, 1]
