@@ -87,9 +87,8 @@ def score_front(outdir):
 
 
 def _case_dp(outdir):
-    from sphdvi.io.casefile import read_case_h5
-    from sphdvi.simulation import find_case_file
-    return float(read_case_h5(find_case_file(outdir))["constants"]["dp"])
+    from sphdvi.validation.runs import case_data
+    return float(case_data(outdir)["constants"]["dp"])
 
 
 def score_lobovsky(outdir):

@@ -16,10 +16,9 @@ import numpy as np
 def draft_errors(outdir: str, settle: float = 1.0, x0: float = 0.5) -> dict:
     """``draft_dp`` (mean lowest-particle height − equilibrium, in dp, over outputs t ≥ settle),
     ``drift_dp`` (largest |x_centre − x0| in dp), ``tilt_deg`` (largest |tilt|)."""
-    from ..io.casefile import read_case_h5
     from ..io.vtkhdf import read_step, step_times
-    from ..simulation import find_case_file
-    data = read_case_h5(find_case_file(outdir))
+    from .runs import case_data
+    data = case_data(outdir)
     dp = data["constants"]["dp"]
     rhop0 = data["constants"]["rhop0"]
     p = data["particles"]

@@ -32,34 +32,25 @@ total vertical force of the water on the tank equal to its weight
 """
 from __future__ import annotations
 
-import json
 import math
-import os
 
 import numpy as np
 
 from ..measure.core import FLUID
+from .runs import run_info
 
 #: probe heights [m] on the centre line: >= 1.5 h from the bottom and from the free surface
 #: at H/dp = 20 (h = sqrt(2) dp), as in tests/sph/test_hydrostatic.py
 PROBE_Z = tuple(float(z) for z in np.linspace(0.025, 0.175, 7))
 
 #: H/dp 20 / 40 / 80 of the case file (``sphdvi run CASE -o OUT --dp DP --set ...``); one thread:
-#: 3.5 s, 20 s, 160 s (599, 1959, 7079 particles). S2 (max |u| <= 1e-3 sqrt(gH)) is not met at
-#: H/dp 80 (1.7e-3 at T), see the case file's header.
+#: 3.5 s, 20 s, 160 s (599, 1959, 7079 particles). At H/dp 80 the tank has not settled at T
+#: (max |u| 1.7e-3 sqrt(gH)); it meets S2 after ~21 sqrt(H/g), see the case file's header.
 RESOLUTIONS = [
     {"label": "H/dp 20", "dp": 0.01, "set": []},
     {"label": "H/dp 40", "dp": 0.005, "set": []},
     {"label": "H/dp 80", "dp": 0.0025, "set": []},
 ]
-
-
-def _run_info(outdir: str) -> dict:
-    path = os.path.join(outdir, "run.json")
-    if not os.path.exists(path):
-        return {}
-    with open(path) as fh:
-        return json.load(fh)
 
 
 def case_errors(outdir: str, probe_z=PROBE_Z, window=(0.7, 1.0)) -> dict:
@@ -115,7 +106,7 @@ def case_errors(outdir: str, probe_z=PROBE_Z, window=(0.7, 1.0)) -> dict:
     fl = snap.ptype == FLUID
     u = np.linalg.norm(np.asarray(snap.vel, np.float64)[fl], axis=1)
     zcm = float(np.mean(np.asarray(snap.pos, np.float64)[fl, 2]))
-    info = _run_info(outdir)
+    info = run_info(outdir)
     return {
         "rel_max": float(np.max(np.abs(err) / p_ref)),
         "einf": float(np.max(np.abs(err)) / (rho0 * g * H)),

@@ -33,9 +33,8 @@ PLATEAU = (3.0, 5.0)        # T window of the quasi-static level
 
 
 def _constants(outdir: str) -> dict:
-    from ..io.casefile import read_case_h5
-    from ..simulation import find_case_file
-    return read_case_h5(find_case_file(str(outdir)))["constants"]
+    from .runs import case_data
+    return case_data(outdir)["constants"]
 
 
 def _gauge(outdir: str, kind: str, name: str) -> np.ndarray:

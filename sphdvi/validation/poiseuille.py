@@ -29,8 +29,6 @@ columns, mDBC no-slip walls); :func:`case_errors` scores a run of it. :data:`RES
 """
 from __future__ import annotations
 
-import glob
-import json
 import math
 import os
 
@@ -123,14 +121,6 @@ def case_args(res: dict) -> list[str]:
     return out
 
 
-def _case_h5(outdir: str) -> str:
-    from ..io.checkpoint import RESTART_FILE
-    files = [f for f in sorted(glob.glob(os.path.join(outdir, "*.h5"))) if not f.endswith(RESTART_FILE)]
-    if not files:
-        raise FileNotFoundError(f"{outdir}: no gencase file <casename>.h5")
-    return files[0]
-
-
 def case_errors(outdir: str) -> dict:
     """Score a finished run of the Poiseuille case file in ``outdir``.
 
@@ -156,17 +146,13 @@ def case_errors(outdir: str) -> dict:
     and ``l2`` (RMS of u − eq. (1) over u_max at the last output), ``wmax`` (largest |w| / u_max),
     ``dp``, ``n_across``, ``time``, ``fluid_lost`` and from run.json ``particles``, ``steps``,
     ``runtime_s``, ``status``."""
-    from ..io.casefile import read_case_h5
     from ..io.vtkhdf import read_step, step_times
+    from .runs import case_data, run_info
 
-    case = read_case_h5(_case_h5(outdir))
-    c, par, p = case["constants"], case["parameters"], case["particles"]
-    run_meta = {}
-    run_json = os.path.join(outdir, "run.json")
-    if os.path.isfile(run_json):
-        with open(run_json) as fh:
-            run_meta = json.load(fh)
-        par = dict(par, **run_meta.get("parameters", {}))      # the parameters the run used (--set)
+    case = case_data(outdir)
+    c, p = case["constants"], case["particles"]
+    run_meta = run_info(outdir)
+    par = dict(case["parameters"], **run_meta.get("parameters", {}))   # the parameters the run used (--set)
     dp, h, c0 = float(c["dp"]), float(c["h"]), float(c["cs0"])
     force = float(np.asarray(c["gravity"], dtype=float)[0])
     zf = p["pos"][p["type"] == 3, 2]

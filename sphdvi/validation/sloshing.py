@@ -15,7 +15,6 @@ import math
 
 import numpy as np
 
-from ..io.checkpoint import RESTART_FILE
 
 
 def linear_period(length: float, depth: float, g: float = 9.81, mode: int = 1) -> float:
@@ -57,18 +56,15 @@ def case_periods(outdir: str, length: float = 1.0, gauge: str = "Left") -> dict:
     (``period_gauge``), beside linear theory for the effective tank (``period_theory``;
     ``length_eff`` = L − dp, ``depth_eff`` = fluid area / L_eff) and the amplitude loss per
     period of the centre-of-mass signal (``decay``)."""
-    import glob
     import os
 
-    import h5py
-
     from ..io.vtkhdf import read_step, step_times
+    from .runs import case_data
 
-    case_h5 = [f for f in glob.glob(os.path.join(outdir, "*.h5")) if not f.endswith(RESTART_FILE)]
-    with h5py.File(case_h5[0], "r") as f:
-        dp = float(f["constants"].attrs["dp"])
-        g = -float(f["constants"].attrs["gravity"][2])
-        nfluid = int(np.count_nonzero(f["particles/type"][:] == 3))
+    case = case_data(outdir)
+    dp = float(case["constants"]["dp"])
+    g = -float(case["constants"]["gravity"][2])
+    nfluid = int(np.count_nonzero(case["particles"]["type"] == 3))
     path = os.path.join(outdir, "particles.vtkhdf")
     times = step_times(path)
     xc = np.empty(times.size)

@@ -1,0 +1,22 @@
+"""What every validation scorer reads from a run folder OUT: its gencase case (constants,
+parameters, particles) and its run.json."""
+from __future__ import annotations
+
+import json
+import os
+
+
+def case_data(outdir: str) -> dict:
+    """The gencase file of ``outdir`` (:func:`sphdvi.io.casefile.read_case_h5`)."""
+    from ..io.casefile import read_case_h5
+    from ..simulation import find_case_file
+    return read_case_h5(find_case_file(str(outdir)))
+
+
+def run_info(outdir: str) -> dict:
+    """run.json of ``outdir`` ({} when the run wrote none)."""
+    path = os.path.join(str(outdir), "run.json")
+    if not os.path.isfile(path):
+        return {}
+    with open(path) as fh:
+        return json.load(fh)
