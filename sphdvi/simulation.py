@@ -41,6 +41,7 @@ from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, Progress, RunFiles
 from .io.runfolder import check_new_run_folder, clear_earlier_results, stored_overrides
 from .sph.damping import damping_zones
+from .sph.clock import time_reached
 
 POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
                 "Press": (np.float32, 1), "Type": (np.uint8, 1), "Mk": (np.int32, 1)}
@@ -818,20 +819,20 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start,
             extra = params.get("TimeOutExtra")
             extra = float(extra) if body_log is not None and extra is not None and extra < tout else None
             next_extra = _next_multiple(sol.time, extra) if extra else 0.0
-            while sol.time < tmax - 1e-12 * max(1.0, tmax):
+            while not time_reached(sol.time, tmax):
                 sol.step()
                 dt_lo, dt_hi = min(dt_lo, sol.last_dt), max(dt_hi, sol.last_dt)
                 sph.check(0)
                 if gauges is not None:
                     gauges.after_step(sol)
-                if sol.time >= next_out - 1e-12 * max(1.0, tout) or sol.time >= tmax:
+                if time_reached(sol.time, next_out, tout) or sol.time >= tmax:
                     part += 1
                     write_part(part)
                     dt_lo, dt_hi = math.inf, 0.0
                     next_out = (part + 1) * tout
                     if extra:
                         next_extra = _next_multiple(sol.time, extra)
-                elif extra is not None and sol.time >= next_extra - 1e-12 * max(1.0, extra):
+                elif extra is not None and time_reached(sol.time, next_extra, extra):
                     # TimeOutExtra: floating-body rows between the outputs (0: every step)
                     body_log.record(flush=False)
                     if extra:

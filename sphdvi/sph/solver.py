@@ -47,6 +47,7 @@ from . import timestep as _ts
 from .exclusion import REASON_NAMES
 from .kernels import kernel_alpha, kernel_w
 from .specialise import specialised
+from .clock import time_reached
 from .state import FLUID, FluidState
 
 DEFAULT_PARAMS = {
@@ -846,9 +847,10 @@ class SPHSolver:
         return dt
 
     def run(self, tmax, max_steps=None):
-        """Step until ``time >= tmax`` (or ``max_steps``); returns the number of steps."""
+        """Step until the clock reaches ``tmax`` to round-off, as ``sphdvi run`` does (or
+        ``max_steps``); returns the number of steps."""
         n = 0
-        while self.time < tmax and (max_steps is None or n < max_steps):
+        while not time_reached(self.time, tmax) and (max_steps is None or n < max_steps):
             self.step()
             n += 1
         return n

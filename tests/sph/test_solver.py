@@ -132,6 +132,16 @@ def test_time_step_rules():
     assert sol.step() == 3e-6
 
 
+def test_run_ends_on_the_step_that_reaches_tmax_to_round_off():
+    """200 DtFixed steps of 5e-5 s end at 0.00999999999999999 s, not 0.01: run(0.01) stops
+    there, as ``sphdvi run --tmax 0.01`` does, instead of taking a 201st step."""
+    st, c = small_tank()
+    sol = SPHSolver(st, c, {"DtFixed": 5e-5})
+    assert sum([5e-5] * 200) < 0.01                 # the clock falls short by round-off
+    assert sol.run(0.01) == 200
+    assert sol.time == pytest.approx(0.01, rel=1e-12)
+
+
 @pytest.mark.parametrize("visco", [2, 3])
 def test_3d_column_runs(visco):
     rng = np.random.default_rng(0)
