@@ -101,7 +101,8 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
               help="Continue an interrupted run from its last output, with the --tmax/--tout/--set it was "
                    "started with (--tmax may be raised to extend it).")
 @click.option("--overwrite", is_flag=True,
-              help="Start a new run into an OUT that holds an earlier run's results: they are deleted first.")
+              help="Start a new run into an OUT that holds an earlier run's results: they are deleted first, "
+                   "with what 'sphdvi export' made of them in OUT's sub-folders.")
 @click.option("--dp", type=FiniteFloat(min=0, min_open=True), default=None,
               help="With a case XML: override <definition dp> (gencase runs with it). With a gencase folder "
                    "or --resume, where gencase does not run, only the case's own dp is accepted.")

@@ -19,9 +19,21 @@ def export_dir(outdir: str, subdir: str) -> str:
     return dest
 
 
+def remove_stale_parts(dest: str, collection: str, written: list[str]) -> None:
+    """Delete the numbered parts of ``collection`` (particles.pvd: Part_XXXX.vtp;
+    isosurface.pvd: Iso_XXXX.vtp) in ``dest`` that this export did not write: an earlier
+    export of a longer run left them, and ParaView would show them as part of the series."""
+    from .runfolder import EXPORT_SETS
+    keep = {os.path.basename(f) for f in written}
+    for name in os.listdir(dest):
+        if EXPORT_SETS[collection].fullmatch(name) and name not in keep:
+            os.unlink(os.path.join(dest, name))
+
+
 def export_vtp(outdir: str, subdir: str = "vtp") -> list[str]:
     """Write every step of OUTDIR/particles.vtkhdf as ``Part_XXXX.vtp`` and ``particles.pvd``
-    into :func:`export_dir` (``subdir``), created when missing; returns the files (.pvd last)."""
+    into :func:`export_dir` (``subdir``), created when missing; the parts of an earlier export
+    beyond this run's steps are deleted; returns the files (.pvd last)."""
     src = os.path.join(outdir, "particles.vtkhdf")
     if not os.path.isfile(src):
         raise InputError(f"{src} not found: run 'sphdvi run' first")
@@ -36,6 +48,7 @@ def export_vtp(outdir: str, subdir: str = "vtp") -> list[str]:
         write_vtp_points(os.path.join(dest, name), step["points"], arrays)
         files.append(os.path.join(dest, name))
         entries.append((float(t), name))
+    remove_stale_parts(dest, "particles.pvd", files)
     pvd = os.path.join(dest, "particles.pvd")
     write_pvd(pvd, entries)
     return files + [pvd]

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 
 from ..errors import InputError
 from .checkpoint import RESTART_FILE
@@ -13,6 +14,36 @@ from .checkpoint import RESTART_FILE
 # the files a run writes into OUT (Gauges<Type>_<name>.csv too); a gencase output folder
 # (<casename>.h5, <casename>_All.vtp) holds none of them
 RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "run.csv", "bodies.csv", "links.csv")
+
+
+# what `sphdvi export` writes into a folder: the collection and its numbered parts
+EXPORT_SETS = {"particles.pvd": re.compile(r"Part_\d{4,}\.vtp"), "isosurface.pvd": re.compile(r"Iso_\d{4,}\.vtp")}
+
+
+def export_files(folder: str) -> list[str]:
+    """The files `sphdvi export` wrote into ``folder`` (paths, sorted): each collection
+    (particles.pvd, isosurface.pvd) with its numbered .vtp parts; other files are not
+    counted, nor parts without their collection."""
+    if not os.path.isdir(folder):
+        return []
+    names = os.listdir(folder)
+    found = []
+    for pvd, part in EXPORT_SETS.items():
+        if pvd in names:
+            found += [pvd] + [n for n in names if part.fullmatch(n)]
+    return sorted(os.path.join(folder, n) for n in found)
+
+
+def earlier_exports(outdir: str) -> list[str]:
+    """The files of `sphdvi export` in OUT's sub-folders (the default --dir vtp and iso, or
+    any other relative --dir one level down), as paths relative to OUT."""
+    if not os.path.isdir(outdir):
+        return []
+    found = []
+    for entry in sorted(os.scandir(outdir), key=lambda e: e.name):
+        if entry.is_dir(follow_symlinks=False):
+            found += [os.path.relpath(f, outdir) for f in export_files(entry.path)]
+    return found
 
 
 def earlier_results(outdir: str) -> list[str]:
@@ -46,12 +77,18 @@ def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> 
 
 def clear_earlier_results(outdir: str) -> list[str]:
     """Delete the files of an earlier run in ``outdir`` (a new run with --overwrite), so that
-    nothing of it mixes with the new run's outputs.  Returns their names."""
+    nothing of it mixes with the new run's outputs: its own files and what `sphdvi export`
+    made of them in OUT's sub-folders (a folder left empty goes too; anything else in it
+    stays).  Returns their names, relative to OUT."""
     found = earlier_results(outdir)
-    for name in found:
+    exports = earlier_exports(outdir)
+    for name in found + exports:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(os.path.join(outdir, name))
-    return found
+    for folder in sorted({os.path.dirname(name) for name in exports}):
+        with contextlib.suppress(OSError):
+            os.rmdir(os.path.join(outdir, folder))        # only when empty
+    return found + exports
 
 
 def stored_overrides(outdir: str):

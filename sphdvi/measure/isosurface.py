@@ -92,6 +92,9 @@ def export_isosurface(outdir: str, subdir: str = "iso", spacing: float | None = 
         os.replace(path + ".tmp", path)
         files.append(path)
         entries.append((snap.time, name))
+    if first == 0 and last is None:          # the whole run: parts of a longer earlier one go
+        from ..io.export import remove_stale_parts
+        remove_stale_parts(dest, "isosurface.pvd", files)
     pvd = os.path.join(dest, "isosurface.pvd")
     write_pvd(pvd, entries)
     return files + [pvd]

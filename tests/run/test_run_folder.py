@@ -109,6 +109,38 @@ def test_gencase_folder_runs_and_overwrite_starts_clean(done, tmp_path):
     assert times[0] == 0.0 and times == sorted(times) and len(times) == len(set(times))
 
 
+def test_overwrite_deletes_the_earlier_exports_and_nothing_else(done, tmp_path):
+    """--overwrite: the .vtp series and .pvd that `sphdvi export` made of the earlier run go
+    (a folder left empty goes too); the user's files beside them, and numbered files in a
+    folder without an export's collection, stay."""
+    out = copy_run(done, tmp_path / "o")
+    assert invoke(["export", out]).exit_code == 0
+    assert invoke(["export", out, "--isosurface"]).exit_code == 0
+    assert sorted(p.name for p in (out / "vtp").iterdir()) == ["Part_0000.vtp", "Part_0001.vtp", "Part_0002.vtp",
+                                                              "particles.pvd"]
+    (out / "vtp" / "view.pvsm").write_text("the user's ParaView state")
+    (out / "mine").mkdir()
+    (out / "mine" / "Part_0007.vtp").write_text("not an export")
+    r = invoke(["run", out, "--overwrite", "--tmax", "0.002", "--tout", "0.002", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in (out / "vtp").iterdir()) == ["view.pvsm"]
+    assert not (out / "iso").exists()
+    assert (out / "mine" / "Part_0007.vtp").read_text() == "not an export"
+
+
+def test_export_again_drops_the_parts_of_a_longer_earlier_export(done, tmp_path):
+    out = copy_run(done, tmp_path / "o")
+    assert invoke(["export", out]).exit_code == 0
+    assert invoke(["run", out, "--overwrite", "--tmax", "0.002", "--tout", "0.002", "--threads", "1",
+                   "-q"]).exit_code == 0
+    (out / "vtp").mkdir(exist_ok=True)
+    (out / "vtp" / "Part_0002.vtp").write_text("left by an export of a longer run")
+    (out / "vtp" / "Part_0002.txt").write_text("the user's")
+    assert invoke(["export", out]).exit_code == 0
+    assert sorted(p.name for p in (out / "vtp").iterdir()) == ["Part_0000.vtp", "Part_0001.vtp", "Part_0002.txt",
+                                                              "particles.pvd"]
+
+
 def test_gauge_files_start_anew_in_a_new_run(done, tmp_path):
     """RunGauges of a new run (resume=False) rewrites its files: one series, not two."""
     from sphdvi.io.casefile import read_case_h5
