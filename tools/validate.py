@@ -77,12 +77,15 @@ def score_front(outdir):
     import numpy as np
 
     from sphdvi.validation.dambreak import (column_height_errors, column_height_history, front_errors, front_history,
-                                            load_column_height, load_martin_moyce)
+                                            front_start_delay, load_column_height, load_martin_moyce)
     t, x = front_history(outdir)
-    _, rel, speed = front_errors(t, x, load_martin_moyce(REFERENCE))
+    mm = load_martin_moyce(REFERENCE)
+    _, rel, speed = front_errors(t, x, mm)
+    delay, shifted = front_start_delay(t, x, mm)
     tau, hrel = column_height_errors(*column_height_history(outdir, _case_dp(outdir)), load_column_height(REFERENCE))
     early = tau <= 1.85
     return {"front_max": float(np.abs(rel).max()), "front_min": float(rel.min()), "speed": float(speed),
+            "delay": delay, "shifted": shifted,
             "height_early": float(np.abs(hrel[early]).max()), "height_max": float(np.abs(hrel).max())}
 
 
@@ -146,7 +149,8 @@ def cases() -> list:
              [Resolution("a/dp 25", 0.04, ["--tmax", "0.72", "--tout", "0.01"], scored=False),
               Resolution("a/dp 50", 0.02, ["--tmax", "0.72", "--tout", "0.01"])],
              score_front, [("Z max|err| %", "front_max", pct), ("Z min err %", "front_min", pct),
-                           ("speed err %", "speed", pct), ("height τ≤1.85 %", "height_early", "{:.2f} %"),
+                           ("speed err %", "speed", pct), ("ΔT start", "delay", "{:.3f}"),
+                           ("Z err after ΔT %", "shifted", "{:.2f} %"), ("height τ≤1.85 %", "height_early", "{:.2f} %"),
                            ("height τ≤2.2 %", "height_max", "{:.2f} %")],
              "front_max", lambda e: e["front_max"] <= 0.05,
              "Z(T) within ±5 % for T in [1, 3] at a/dp >= 50 (judgement: the experiment's gate delays the surge)"),

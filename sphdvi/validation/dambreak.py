@@ -45,6 +45,24 @@ def front_errors(times, front, ref, a: float = 1.0, g: float = 9.81, trange=(1.0
     return ref[sel, 0], rel, (speed_sph - speed_exp) / speed_exp
 
 
+def front_start_delay(times, front, ref, a: float = 1.0, g: float = 9.81, trange=(1.0, 3.0),
+                      max_delay: float = 0.6, resolution: float = 0.005):
+    """The start delay ΔT of the experiment that best explains the SPH front's lead: the ΔT
+    (grid of ``resolution`` up to ``max_delay``) that minimises max |Z_sph(T − ΔT) − Z_exp(T)| / Z_exp(T)
+    over T ∈ ``trange``, and that smallest maximum relative error.  A front that runs the
+    experiment's course, only earlier (its gate opened after t = 0, the column's tip held
+    back at first), has a small error after the shift."""
+    T = np.asarray(times) * math.sqrt(2 * g / a)
+    Z = np.asarray(front) / a
+    sel = (ref[:, 0] >= trange[0]) & (ref[:, 0] <= trange[1])
+    best = (math.inf, 0.0)
+    for delay in np.arange(0.0, max_delay + 0.5 * resolution, resolution):
+        err = float(np.max(np.abs(np.interp(ref[sel, 0] - delay, T, Z) - ref[sel, 1]) / ref[sel, 1]))
+        if err < best[0]:
+            best = (err, float(delay))
+    return best[1], best[0]
+
+
 def load_column_height(reference_dir: str) -> np.ndarray:
     """(τ, H) pairs of M&M Table 6 as transcribed (τ = t √(g/a), H = h / (2a), h the height of
     the water at the left wall); the axis convention is the transcriber's, not checked against
