@@ -588,8 +588,10 @@ class SPHRun:
         if str(params.get("ViscoTime") or "").strip():
             from .case.datafiles import read_visco_table
             visco_table = read_visco_table(str(params["ViscoTime"]))
+        from .sph.accinput import acc_inputs
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
-                                normals=normals0, dt_table=dt_table, visco_table=visco_table)
+                                normals=normals0, dt_table=dt_table, visco_table=visco_table,
+                                acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")))
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.excluded_limit = self.max_excluded()      # the parameters do not change in a run
         self.excluded_step_limit = max(MIN_EXCLUDED_PER_STEP, int(MAX_EXCLUDED_PER_STEP * self.n0_fluid))
@@ -862,7 +864,7 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start,
               + (f" -- {message}" if message else ""))
     files.write_json(status=status, message=message, steps=int(sol.nstep), physical_time=float(sol.time),
                      runtime_s=runtime, excluded=dict(sol.n_excluded), dtmin_steps=int(sol.n_dtmin),
-                     particles_final=int(sol.state.n),
+                     particles_final=int(sol.state.n), threads_used=sol.threads_in_use(),
                      **({"dtfixedfile_max_excess_s": float(sol.dt_error)}
                         if sol.dt_table is not None and np.isfinite(sol.dt_error) else {}),
                      us_per_particle_step=(1e6 * (runtime - wall_prev)

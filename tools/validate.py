@@ -196,7 +196,7 @@ def cases() -> list:
 
 def run_case(case: Case, res: Resolution, outdir: str, threads: int) -> dict:
     """Run one resolution through the CLI; return run.json's figures (status, particles, steps,
-    runtime_s, us_per_particle_step) and the wall time of the whole command."""
+    runtime_s, us_per_particle_step, threads_used) and the wall time of the whole command."""
     cmd = [sys.executable, "-m", "sphdvi", "run", case.case, "-o", outdir, "--dp", repr(res.dp),
            "--threads", str(threads), "-q", "--overwrite"] + res.args
     t0 = time.perf_counter()
@@ -211,7 +211,8 @@ def run_case(case: Case, res: Resolution, outdir: str, threads: int) -> dict:
         meta.setdefault("message", proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "")
     return {"rc": proc.returncode, "status": meta.get("status", "failed"), "particles": meta.get("particles", 0),
             "steps": meta.get("steps", 0), "runtime_s": meta.get("runtime_s", float("nan")),
-            "us": meta.get("us_per_particle_step", float("nan")), "command_s": wall,
+            "us": meta.get("us_per_particle_step", float("nan")), "threads_used": meta.get("threads_used", 0),
+            "command_s": wall,
             "message": meta.get("message", "")}
 
 
@@ -252,7 +253,7 @@ def main(argv=None) -> int:
     table, failed = [], 0
     for case in chosen:
         print(f"\n{case.name} {case.title}\n  target: {case.target_text}")
-        head = f"  {'resolution':<11}{'dp':>9}{'particles':>10}{'steps':>8}{'runtime_s':>10}{'µs/p-step':>10}"
+        head = f"  {'resolution':<11}{'dp':>9}{'particles':>10}{'steps':>8}{'runtime_s':>10}{'µs/p-step':>10}{'thr':>4}"
         print(head + "".join(f"{h:>{max(len(h) + 2, 12)}}" for h, _, _ in case.columns) + "  target")
         rows = []
         resolutions = case.resolutions() if callable(case.resolutions) else case.resolutions
@@ -266,7 +267,7 @@ def main(argv=None) -> int:
                    "meets_target": bool(errors) and bool(case.target(errors))}
             rows.append(row)
             line = (f"  {res.label:<11}{res.dp:>9.4g}{run['particles']:>10d}{run['steps']:>8d}"
-                    f"{run['runtime_s']:>10.1f}{run['us']:>10.3f}")
+                    f"{run['runtime_s']:>10.1f}{run['us']:>10.3f}{run['threads_used']:>4d}")
             if run["rc"] != 0:
                 print(line + f"  run {run['status']} (exit {run['rc']}): {run['message']}")
                 failed += 1
@@ -278,8 +279,8 @@ def main(argv=None) -> int:
             print(f"  observed order of {case.headline}: " + ", ".join(fmt("{:.2f}", o) for o in orders))
         table.extend(rows)
     if args.csv:
-        header = ["case", "resolution", "dp", "particles", "steps", "runtime_s", "us_per_particle_step", "status",
-                  "meets_target"]
+        header = ["case", "resolution", "dp", "particles", "steps", "runtime_s", "us_per_particle_step", "threads_used",
+                  "status", "meets_target"]
         keys = sorted({k for r in table for k, v in r["errors"].items() if isinstance(v, (int, float, str))}
                       - set(header))
         with open(args.csv, "w", newline="") as f:
@@ -287,7 +288,7 @@ def main(argv=None) -> int:
             w.writerow(header + ["target_applies"] + keys)
             for r in table:
                 w.writerow([r["case"], r["resolution"], r["dp"], r["particles"], r["steps"], r["runtime_s"], r["us"],
-                            r["status"], r["meets_target"], r["scored"]] + [r["errors"].get(k, "") for k in keys])
+                            r["threads_used"], r["status"], r["meets_target"], r["scored"]] + [r["errors"].get(k, "") for k in keys])
     if args.keep:
         print(f"\nrun folders kept in {base}")
     else:

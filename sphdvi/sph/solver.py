@@ -137,9 +137,10 @@ class SPHSolver:
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
                  parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None,
-                 cell_mode="auto", dt_table=None, visco_table=None):
+                 cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
+        self.acc_inputs = list(acc_inputs or [])     # imposed accelerations (sphdvi.sph.accinput)
         self.dt_table = None if dt_table is None else np.asarray(dt_table, float).reshape(-1, 2)
         self.dt_error = -np.inf
         self.visco_table = None if visco_table is None else np.asarray(visco_table, float).reshape(-1, 2)
@@ -419,6 +420,11 @@ class SPHSolver:
             n = n if n >= LIGHT_THRESHOLD else 0
         return n >= self.parallel_threshold and numba.get_num_threads() > 1
 
+    def threads_in_use(self) -> int:
+        """The threads the interaction runs on now: 1 below ``parallel_threshold`` particles
+        (a small scene runs serially whatever the thread count)."""
+        return int(numba.get_num_threads()) if self._use_parallel() else 1
+
     def _kernels(self, parallel):
         """Entry points of the compiled interaction kernels for this run's flags."""
         key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv,
@@ -538,10 +544,28 @@ class SPHSolver:
     def compute_rates(self):
         """Sort into cells (every ``reorder_every`` steps also moving the
         particles into cell order, for memory locality), then evaluate
-        accelerations, density rates and dt terms."""
+        accelerations, density rates and dt terms; then the imposed accelerations."""
         if self.periodicity is not None:
             self._compute_rates_periodic()
-            return
+        else:
+            self._compute_rates_cells()
+        if self.acc_inputs:
+            self._add_acc_inputs()
+
+    def _add_acc_inputs(self):
+        """``<accinputs>`` at the time the step started; the force term of dt then sees
+        them, as in DualSPHysics (they enter its acceleration before the interaction)."""
+        from .accinput import add_acc_input, fluid_ace_max2
+        s = self.state
+        added = False
+        for inp in self.acc_inputs:
+            added |= add_acc_input(self.ace, s.pos, s.vel, s.mk, s.ptype, inp, self.time, self.gravity, self.is2d,
+                                   parallel=self._use_parallel(light=True))
+        if added:
+            self.dtmax[:, 0] = 0.0
+            self.dtmax[0, 0] = fluid_ace_max2(self.ace, s.ptype)
+
+    def _compute_rates_cells(self):
         if self._reorder_next:
             self._reorder_and_pack()
             self._rows = (self.state.ptype, self._identity, self.tau)

@@ -81,6 +81,14 @@ def test_run_restores_the_callers_thread_count(tmp_path):
         assert r.exit_code == 0, r.output
         assert json.loads((tmp_path / "out" / "run.json").read_text())["threads"] == 1
         assert numba.get_num_threads() == 2
+        # --threads 2: threaded from 1,500 particles; a smaller scene runs serially, and says so
+        (tmp_path / "small").mkdir()
+        for source, out, used in ((tmp_path / "out", tmp_path / "big", 2),
+                                  (small_case(tmp_path / "small", dp="0.08"), tmp_path / "small_out", 1)):
+            r = invoke(["run", source, "-o", out, "--tmax", "0.002", "--tout", "0.002", "--threads", "2", "-q"])
+            assert r.exit_code == 0, r.output
+            meta = json.loads((out / "run.json").read_text())
+            assert meta["threads"] == 2 and meta["threads_used"] == used, (meta["particles"], meta["threads_used"])
     finally:
         numba.set_num_threads(previous)
 

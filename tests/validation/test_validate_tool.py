@@ -21,6 +21,7 @@ def test_validate_tool_scores_s9_and_reports_run_time(tmp_path):
                                                                                      "True")
     assert int(row["particles"]) == 312 and int(row["steps"]) == 2000
     assert 0 < float(row["runtime_s"]) < 120
+    assert int(row["threads_used"]) == 1                # 312 particles: serial whatever --threads
     # the centre-line error of tests/validation/test_poiseuille_case.py at 20 across (+0.92 %)
     assert abs(float(row["centreline"]) - 0.0092) < 0.0005
     assert float(row["transient"]) < 0.02
