@@ -466,7 +466,13 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
                     raise CaseError(f"force gauge '{g['name']}' targets mkbound {mkb}, which has no particles",
                                     file=reader.file, line=g["line"], element="force",
                                     expected="an mkbound drawn by the geometry")
-    known = bound_labels | set(np.unique(label[fluid]).tolist())
+    fluid_labels = set(np.unique(label[fluid]).tolist())
+    for acc in case.special.get("accinputs", []):
+        missing = [mk for mk in acc["mkfluid"] if mk not in fluid_labels]
+        if missing:
+            raise CaseError(f"<accinput> for mkfluid {missing[0]}, which has no particles", file=reader.file,
+                            line=acc["line"], element="accinput", expected="an mkfluid drawn by the geometry")
+    known = bound_labels | fluid_labels
     del known
     for link in case.material_links:
         for mk in link.get("mkbound", []):

@@ -25,9 +25,9 @@ from .xmldoc import CaseReader, load_xml, strip_disabled
 CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initials", "motion",
                     "properties", "normals", "patterns", "vres"}
 EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres"}
-SPECIAL_SUPPORTED = {"chrono", "gauges", "wavepaddles", "damping", "shifting"}
+SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
-    "accinputs", "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
+    "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
     "moorings", "forcepoints", "outputparts", "initialize", "savedt", "timeout", "inout", "vres"}
 
 
@@ -1016,5 +1016,68 @@ def read_shifting(reader, el) -> dict:
     return d
 
 
-SPECIAL_READERS = {"chrono": read_chrono, "gauges": read_gauges, "wavepaddles": read_wavepaddles,
+ACC_COLUMNS = ("linx", "liny", "linz", "angx", "angy", "angz")
+
+
+def read_accinputs(reader, el) -> list:
+    """``<accinputs>``: imposed accelerations of fluid blocks (DualSPHysics's JDsAccInput):
+    per ``<accinput mkfluid="...">`` the active ``<time start end>``, ``<acccentre>``,
+    ``<globalgravity>`` and a table of (time, linear acceleration, angular acceleration)
+    from ``<acctimes><timevalue .../>`` or an ``<acctimesfile>`` of 7 columns."""
+    out, seen = [], {}
+    for c in reader.children(el):
+        if c.tag != "accinput":
+            raise reader.error(c, f"<accinputs><{c.tag}> is not supported by sphdvi", "<accinput>")
+        for old in ("mkfluid", "datafile"):
+            if c.find(old) is not None:
+                raise reader.error(c.find(old), f"<{old}> inside <accinput> is the format of DualSPHysics before "
+                                   "v5.0", 'the mkfluid="..." attribute and <acctimes> or <acctimesfile value="...">')
+        reader.check_children(c, {"time", "acccentre", "globalgravity", "acctimes", "acctimesfile"})
+        if c.get("mkbound") is not None:
+            raise reader.error(c, "an <accinput> on floating bodies (mkbound) is not supported by sphdvi",
+                               'mkfluid="..." (imposed accelerations of fluid particles)')
+        mks = _mk_list(reader, c, "mkfluid")
+        for mk in mks:
+            if mk in seen:
+                raise reader.error(c, f"mkfluid {mk} already has an <accinput> (line {seen[mk]})",
+                                   "one <accinput> per mkfluid")
+            seen[mk] = c.sourceline
+        tel = reader.child(c, "time")
+        start = reader.num(tel, "start", 0.0) if tel is not None else 0.0
+        end = reader.num(tel, "end", None) if tel is not None else None
+        if end is not None and end < start:
+            raise reader.error(tel, f"end={end:g} is before start={start:g}", "end >= start")
+        centre = reader.vec3(reader.child(c, "acccentre", required=True))
+        gravity = reader.boolean(reader.child(c, "globalgravity", required=True), "value")
+        table_el, file_el = reader.child(c, "acctimes"), reader.child(c, "acctimesfile")
+        if (table_el is None) == (file_el is None):
+            raise reader.error(c, "<accinput> needs one of <acctimes> and <acctimesfile>" +
+                               (" (not both)" if table_el is not None else ""),
+                               "<acctimes> with <timevalue> rows, or <acctimesfile value=\"file\">")
+        if table_el is not None:
+            rows = [[reader.num(v, "time")] + [reader.num(v, k, 0.0) for k in ACC_COLUMNS]
+                    for v in reader.children(table_el, "timevalue")]
+            where, line = table_el, None
+        else:
+            from .datafiles import read_columns
+            path = reader.resolve_path(file_el, "value")
+            try:
+                rows = read_columns(path, 7, "<acctimesfile>")[:, :7].tolist()
+            except CaseError as exc:
+                where_text = path + (f":{exc.line}" if exc.line else "")
+                raise reader.error(file_el, f"{where_text}: {exc.message}", exc.expected) from None
+            where, line = file_el, path
+        table = np.asarray(rows, float).reshape(-1, 7)
+        if table.shape[0] < 2:
+            raise reader.error(where, f"{table.shape[0]} row(s) of accelerations" + (f" in {line}" if line else ""),
+                               "at least two (time, linx, liny, linz, angx, angy, angz) rows")
+        if np.any(np.diff(table[:, 0]) <= 0):
+            raise reader.error(where, "the times of the accelerations do not rise" + (f" in {line}" if line else ""),
+                               "rising times")
+        out.append({"line": c.sourceline, "mkfluid": mks, "start": start, "end": end, "centre": centre.tolist(),
+                    "globalgravity": gravity, "table": table.tolist()})
+    return out
+
+
+SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges": read_gauges, "wavepaddles": read_wavepaddles,
                    "damping": read_damping, "shifting": read_shifting}

@@ -3,7 +3,6 @@ a case error at gencase (file:line, element, what was expected), never a crash o
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 import pytest
