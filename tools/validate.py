@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
@@ -87,6 +87,11 @@ def score_front(outdir):
     return {"front_max": float(np.abs(rel).max()), "front_min": float(rel.min()), "speed": float(speed),
             "delay": delay, "shifted": shifted,
             "height_early": float(np.abs(hrel[early]).max()), "height_max": float(np.abs(hrel).max())}
+
+
+def score_accel_tank(outdir):
+    from sphdvi.validation.acceltank import slope_errors
+    return slope_errors(outdir)
 
 
 def _case_dp(outdir):
@@ -181,6 +186,12 @@ def cases() -> list:
              "centreline_vs_prediction", lambda e: abs(e["centreline_vs_prediction"]) <= 0.10,
              "within ~10 % of ν_eff (here the operator's own prediction, 0.43 α h c0/8: "
              "DualSPHysics's term acts on approaching pairs only)"),
+        Case("A1", "tank under an imposed acceleration a_x = 0.1 g (<accinputs>): free-surface slope",
+             case_path("acceltank2d", "CaseAccelTank2D_Def.xml"),
+             [Resolution("depth/dp 15", 0.02), Resolution("depth/dp 30", 0.01)],
+             score_accel_tank, [("slope err %", "slope_mean", pct), ("swing %", "slope_swing", "{:.1f} %")],
+             "slope_mean", lambda e: abs(e["slope_mean"]) <= 0.02,
+             "steady slope (t = 4.5-7 s, the first sloshing mode fitted out) within 2 % of a_x/g (statics; judgement)"),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),
@@ -234,7 +245,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S4 S7 S9 S10 S12); default: all but the slow S4")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S4 S7 S9 S10 S12 A1); default: all but the slow S4")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
