@@ -1,0 +1,53 @@
+"""The wave maker against first-order wavemaker theory (``cases/waveflume2d``): a piston makes
+regular waves H = 0.03 m, T = 1.2 s in d = 0.3 m.  From the run-time gauges WG1-WG3 (x = 0.3,
+0.6, 0.9 m), over the last two periods: the first harmonic's complex amplitude at each gauge,
+split by least squares into an incident and a reflected wave of the linear wave number
+(Mansard & Funke 1980, three gauges); the incident height against H."""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+H = 0.03                   # target wave height [m]
+PERIOD = 1.2               # s
+DEPTH = 0.3                # m
+GAUGES = {"WG1": 0.3, "WG2": 0.6, "WG3": 0.9}
+WINDOW = 2                 # periods, at the end of the run
+
+
+def first_harmonic(t: np.ndarray, eta: np.ndarray, omega: float) -> complex:
+    """Complex amplitude A of η ≈ c + Re(A e^{iωt}) (+ the second harmonic), least squares."""
+    basis = np.column_stack([np.ones(t.size), np.cos(omega * t), np.sin(omega * t),
+                             np.cos(2 * omega * t), np.sin(2 * omega * t)])
+    c = np.linalg.lstsq(basis, eta, rcond=None)[0]
+    return complex(c[1], -c[2])
+
+
+def incident_reflected(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[complex, complex]:
+    """(incident, reflected) complex amplitudes with amp(x) = A_i e^{−ikx} + A_r e^{ikx}."""
+    m = np.column_stack([np.exp(-1j * k * x), np.exp(1j * k * x)])
+    a = np.linalg.lstsq(m, amp, rcond=None)[0]
+    return complex(a[0]), complex(a[1])
+
+
+def wave_errors(outdir: str) -> dict:
+    """Incident height relative to H, the reflection coefficient, the height of the first
+    harmonic at each gauge (relative to H) and the mean level change."""
+    from ..motion import wave_number
+    k = wave_number(PERIOD, DEPTH)
+    omega = 2 * math.pi / PERIOD
+    xs, amps, out = [], [], {}
+    for name, x in GAUGES.items():
+        g = np.genfromtxt(os.path.join(str(outdir), f"GaugesSWL_{name}.csv"), delimiter=";", skip_header=1)
+        t, eta = g[:, 0], g[:, 3]
+        sel = t >= t[-1] - WINDOW * PERIOD - 1e-9
+        a = first_harmonic(t[sel], eta[sel], omega)
+        xs.append(x)
+        amps.append(a)
+        out[f"H_{name}"] = 2 * abs(a) / H - 1.0
+    inc, ref = incident_reflected(np.asarray(xs), np.asarray(amps), k)
+    out["H_incident"] = 2 * abs(inc) / H - 1.0
+    out["reflection"] = abs(ref) / abs(inc)
+    return out

@@ -1,0 +1,39 @@
+"""The wave maker against first-order wavemaker theory (``cases/waveflume2d``): a piston makes
+regular waves H = 0.03 m, T = 1.2 s in d = 0.3 m; the incident height from three gauges.
+
+Measured (README, W1): incident height −13.0 % of H at dp 0.02 (H/dp 1.5), −10.3 % at dp 0.01
+(H/dp 3), reflection from the damping zone 7 %.  DualSPHysics advises H/dp ≥ 10 for generated
+waves; at these coarse resolutions the height falls short by about 10 %, less as dp falls."""
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+from sphdvi.validation.waveflume import wave_errors
+
+REPO = Path(__file__).resolve().parents[2]
+CASE = REPO / "cases" / "waveflume2d" / "CaseWaveFlume2D_Def.xml"
+
+
+def run(tmp_path, dp):
+    out = tmp_path / f"dp{dp}"
+    r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--dp", str(dp), "--threads", "2", "-q"])
+    assert r.exit_code == 0, r.output
+    return wave_errors(out)
+
+
+def test_piston_makes_the_wave_height_of_the_theory_at_h_over_dp_1_5(tmp_path):
+    e = run(tmp_path, 0.02)
+    print({k: round(v, 4) for k, v in e.items()})
+    # the flap's H/S used for a piston would give +84 %, no ramp or a wrong period a poor fit;
+    # the coarse SPH wave is ~13 % short (measured −13.0 %)
+    assert -0.16 < e["H_incident"] < -0.08
+    assert e["reflection"] < 0.10
+
+
+@pytest.mark.slow
+def test_the_height_deficit_falls_with_dp(tmp_path):
+    coarse, fine = run(tmp_path, 0.02), run(tmp_path, 0.01)
+    print(coarse["H_incident"], fine["H_incident"])
+    assert abs(fine["H_incident"]) < abs(coarse["H_incident"]) - 0.015
