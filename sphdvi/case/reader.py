@@ -1047,37 +1047,42 @@ def read_accinputs(reader, el) -> list:
         end = reader.num(tel, "end", None) if tel is not None else None
         if end is not None and end < start:
             raise reader.error(tel, f"end={end:g} is before start={start:g}", "end >= start")
-        centre = reader.vec3(reader.child(c, "acccentre", required=True))
-        gravity = reader.boolean(reader.child(c, "globalgravity", required=True), "value")
-        table_el, file_el = reader.child(c, "acctimes"), reader.child(c, "acctimesfile")
-        if (table_el is None) == (file_el is None):
-            raise reader.error(c, "<accinput> needs one of <acctimes> and <acctimesfile>" +
-                               (" (not both)" if table_el is not None else ""),
-                               "<acctimes> with <timevalue> rows, or <acctimesfile value=\"file\">")
-        if table_el is not None:
-            rows = [[reader.num(v, "time")] + [reader.num(v, k, 0.0) for k in ACC_COLUMNS]
-                    for v in reader.children(table_el, "timevalue")]
-            where, line = table_el, None
-        else:
-            from .datafiles import read_columns
-            path = reader.resolve_path(file_el, "value")
-            try:
-                rows = read_columns(path, 7, "<acctimesfile>")[:, :7].tolist()
-            except CaseError as exc:
-                where_text = path + (f":{exc.line}" if exc.line else "")
-                raise reader.error(file_el, f"{where_text}: {exc.message}", exc.expected) from None
-            where, line = file_el, path
-        table = np.asarray(rows, float).reshape(-1, 7)
-        if table.shape[0] < 2:
-            raise reader.error(where, f"{table.shape[0]} row(s) of accelerations" + (f" in {line}" if line else ""),
-                               "at least two (time, linx, liny, linz, angx, angy, angz) rows")
-        if np.any(np.diff(table[:, 0]) <= 0):
-            raise reader.error(where, "the times of the accelerations do not rise" + (f" in {line}" if line else ""),
-                               "rising times")
-        out.append({"line": c.sourceline, "mkfluid": mks, "start": start, "end": end, "centre": centre.tolist(),
-                    "globalgravity": gravity, "table": table.tolist()})
+        out.append({"line": c.sourceline, "mkfluid": mks, "start": start, "end": end,
+                    "centre": reader.vec3(reader.child(c, "acccentre", required=True)).tolist(),
+                    "globalgravity": reader.boolean(reader.child(c, "globalgravity", required=True), "value"),
+                    "table": _acc_table(reader, c).tolist()})
     return out
 
 
-SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges": read_gauges, "wavepaddles": read_wavepaddles,
-                   "damping": read_damping, "shifting": read_shifting}
+def _acc_table(reader, c) -> np.ndarray:
+    """The (time, linx, liny, linz, angx, angy, angz) rows of one ``<accinput>``: from
+    ``<acctimes>`` (missing values 0) or the ``<acctimesfile>``; two rows at least, rising times."""
+    table_el, file_el = reader.child(c, "acctimes"), reader.child(c, "acctimesfile")
+    if (table_el is None) == (file_el is None):
+        raise reader.error(c, "<accinput> needs one of <acctimes> and <acctimesfile>" +
+                           (" (not both)" if table_el is not None else ""),
+                           "<acctimes> with <timevalue> rows, or <acctimesfile value=\"file\">")
+    if table_el is not None:
+        rows = [[reader.num(v, "time")] + [reader.num(v, k, 0.0) for k in ACC_COLUMNS]
+                for v in reader.children(table_el, "timevalue")]
+        where, place = table_el, ""
+    else:
+        from .datafiles import read_columns
+        path = reader.resolve_path(file_el, "value")
+        try:
+            rows = read_columns(path, 7, "<acctimesfile>")[:, :7].tolist()
+        except CaseError as exc:
+            raise reader.error(file_el, f"{path}{':' + str(exc.line) if exc.line else ''}: {exc.message}",
+                               exc.expected) from None
+        where, place = file_el, f" in {path}"
+    table = np.asarray(rows, float).reshape(-1, 7)
+    if table.shape[0] < 2:
+        raise reader.error(where, f"{table.shape[0]} row(s) of accelerations{place}",
+                           "at least two (time, linx, liny, linz, angx, angy, angz) rows")
+    if np.any(np.diff(table[:, 0]) <= 0):
+        raise reader.error(where, f"the times of the accelerations do not rise{place}", "rising times")
+    return table
+
+
+SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges": read_gauges,
+                   "wavepaddles": read_wavepaddles, "damping": read_damping, "shifting": read_shifting}
