@@ -44,6 +44,7 @@ from . import integrators as _int
 from . import interaction as _ia
 from . import sps as _sps
 from . import timestep as _ts
+from .accinput import add_acc_input, fluid_ace_max2
 from .exclusion import REASON_NAMES
 from .kernels import kernel_alpha, kernel_w
 from .specialise import specialised
@@ -555,7 +556,6 @@ class SPHSolver:
     def _add_acc_inputs(self):
         """``<accinputs>`` at the time the step started; the force term of dt then sees
         them, as in DualSPHysics (they enter its acceleration before the interaction)."""
-        from .accinput import add_acc_input, fluid_ace_max2
         s = self.state
         added = False
         for inp in self.acc_inputs:

@@ -7,12 +7,15 @@ import os
 
 import numpy as np
 
+from .sloshing import linear_period
+
+LENGTH, DEPTH = 1.0, 0.3   # m: the tank and its water
 SLOPE = 0.1                # a_x/g of the case
 HELD_FROM = 4.5            # s: the ramp ends at 3.954 s (three sloshing periods)
 WALL_MARGIN = 0.1          # m: columns this close to a wall are left out (the run-up at the walls)
 
 
-def surface_slope(points: np.ndarray, ptype: np.ndarray, dp: float, length: float = 1.0) -> float:
+def surface_slope(points: np.ndarray, ptype: np.ndarray, dp: float, length: float = LENGTH) -> float:
     """Least-squares slope of the tops of the fluid columns (width dp) between the margins."""
     fluid = ptype == 3
     x, z = points[fluid, 0], points[fluid, 2]
@@ -36,12 +39,6 @@ def slope_history(outdir: str) -> tuple[np.ndarray, np.ndarray]:
     return times, slopes
 
 
-def first_mode_period(length: float = 1.0, depth: float = 0.3, g: float = 9.81) -> float:
-    """T1 = 2π/√(g k tanh(k d)), k = π/L: the first sloshing mode of the tank."""
-    k = np.pi / length
-    return float(2 * np.pi / np.sqrt(g * k * np.tanh(k * depth)))
-
-
 def slope_errors(outdir: str) -> dict:
     """The steady slope once the acceleration is held, relative to a_x/g: the constant of a
     least-squares fit m + A cos ωt + B sin ωt (ω of the first sloshing mode), so that what is
@@ -49,7 +46,7 @@ def slope_errors(outdir: str) -> dict:
     the slope before the acceleration grows (first output after t = 0)."""
     t, s = slope_history(outdir)
     sel = t >= HELD_FROM - 1e-9
-    w = 2 * np.pi / first_mode_period()
+    w = 2 * np.pi / linear_period(LENGTH, DEPTH)          # the tank's first sloshing mode
     basis = np.column_stack([np.ones(sel.sum()), np.cos(w * t[sel]), np.sin(w * t[sel])])
     m = float(np.linalg.lstsq(basis, s[sel], rcond=None)[0][0])
     return {"slope_mean": m / SLOPE - 1.0, "slope_swing": float((s[sel].max() - s[sel].min()) / SLOPE),

@@ -2,17 +2,13 @@
 checked (clear errors, exit 2), and run: two free blocks, one without gravity and one pushed
 sideways while it falls, whose mean velocities follow the imposed accelerations exactly."""
 import json
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from case.casetext import case_xml, write_case      # tests/case (tests/ is on the path: conftest)
 from click.testing import CliRunner
 
 from sphdvi.cli import main
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "case"))
-from casetext import case_xml, write_case  # noqa: E402
 
 BLOCKS = """
                     <setmkfluid mk="0" />
