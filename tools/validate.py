@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1, W1)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1, W1, W2)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
@@ -99,6 +99,17 @@ def score_wave_flume(outdir):
     return wave_errors(outdir)
 
 
+def _wave_flume_case(name, paddle, xml):
+    """W1/W2: the same flume, waves and scoring, made by a piston or a flap."""
+    return Case(name, f"wave flume: {paddle}, regular waves H = 0.03 m, T = 1.2 s, d = 0.3 m",
+                case_path("waveflume2d", xml),
+                [Resolution("H/dp 1.5", 0.02), Resolution("H/dp 3", 0.01)],
+                score_wave_flume, [("H inc err %", "H_incident", PCT), ("refl %", "reflection", "{:.1f} %"),
+                                   ("H WG1 %", "H_WG1", PCT), ("H WG3 %", "H_WG3", PCT)],
+                "H_incident", lambda e: abs(e["H_incident"]) <= 0.10,
+                "incident wave height within 10 % of the target (judgement; DualSPHysics advises H/dp >= 10)")
+
+
 def _case_dp(outdir):
     from sphdvi.validation.runs import case_data
     return float(case_data(outdir)["constants"]["dp"])
@@ -144,8 +155,11 @@ def _resolutions(module: str, attr: str = "RESOLUTIONS") -> Callable:
     return rows
 
 
+PCT = "{:+.2f} %"
+
+
 def cases() -> list:
-    pct = "{:+.2f} %"
+    pct = PCT
     return [
         Case("S1", "hydrostatic tank and still water (S1/S2)",
              case_path("hydrostatic2d", "CaseHydrostatic2D_Def.xml"), _resolutions("hydrostatic"),
@@ -197,13 +211,8 @@ def cases() -> list:
              score_accel_tank, [("slope err %", "slope_mean", pct), ("swing %", "slope_swing", "{:.1f} %")],
              "slope_mean", lambda e: abs(e["slope_mean"]) <= 0.02,
              "steady slope (t = 4.5-7 s, the first sloshing mode fitted out) within 2 % of a_x/g (statics; judgement)"),
-        Case("W1", "wave flume: piston, regular waves H = 0.03 m, T = 1.2 s, d = 0.3 m",
-             case_path("waveflume2d", "CaseWaveFlume2D_Def.xml"),
-             [Resolution("H/dp 1.5", 0.02), Resolution("H/dp 3", 0.01)],
-             score_wave_flume, [("H inc err %", "H_incident", pct), ("refl %", "reflection", "{:.1f} %"),
-                                ("H WG1 %", "H_WG1", pct), ("H WG3 %", "H_WG3", pct)],
-             "H_incident", lambda e: abs(e["H_incident"]) <= 0.10,
-             "incident wave height within 10 % of the target (judgement; DualSPHysics advises H/dp >= 10)"),
+        _wave_flume_case("W1", "piston", "CaseWaveFlume2D_Def.xml"),
+        _wave_flume_case("W2", "flap hinged at the bottom", "CaseWaveFlap2D_Def.xml"),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),
@@ -257,7 +266,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S4 S7 S9 S10 S12 A1 W1); default: all but the slow S4")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S4 S7 S9 S10 S12 A1 W1 W2); default: all but the slow S4")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
