@@ -41,6 +41,7 @@ from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, Progress, RunFiles
 from .io.runfolder import check_new_run_folder, clear_earlier_results, stored_overrides
 from .sph.damping import damping_zones
+from .output_schedule import OutputSchedule
 from .sph.clock import time_reached
 
 POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
@@ -185,6 +186,15 @@ def special_parameters(data: dict) -> dict:
     return params
 
 
+def output_schedule(data: dict, params: dict, tout=None) -> OutputSchedule:
+    """The output times: the case's ``<special><timeout>`` rows, unless --tout (``tout``) asks
+    for outputs TimeOut apart; without rows, TimeOut apart."""
+    rows = (data["json"].get("special") or {}).get("timeout")
+    if rows and tout is None:
+        return OutputSchedule(rows)
+    return OutputSchedule.every(float(params["TimeOut"]))
+
+
 def resume_overrides(base: dict, outdir: str, tmax, tout, sets):
     """The --tmax/--tout/--set a --resume runs with: the interrupted run's (run.json), with
     --tmax replaced when given (a run may be extended); a --tout or --set that changes a
@@ -240,6 +250,7 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
     if resume:
         tmax, tout, sets = resume_overrides(base, outdir, tmax, tout, sets)
     params = apply_overrides(base, sets, tmax, tout)
+    out_times = output_schedule(data, params, tout)
     threads = _usable_threads(threads)
     nfluid = int(np.count_nonzero(data["particles"]["type"] == 3))
     if nfluid:
@@ -259,8 +270,8 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
     }
     with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
         if nfluid == 0:
-            return _run_bodies_only(data, params, outdir, files, base_meta, t_start, quiet, resume, stop)
-        return _run_sph(data, params, outdir, files, base_meta, threads, resume, quiet, t_start, stop)
+            return _run_bodies_only(data, params, out_times, outdir, files, base_meta, t_start, quiet, resume, stop)
+        return _run_sph(data, params, out_times, outdir, files, base_meta, threads, resume, quiet, t_start, stop)
 
 
 def _stopped_at_startup(stop, files: RunFiles, meta: dict, outdir: str, resume: bool):
@@ -327,7 +338,8 @@ def _check_dtfixed(dt: float, params: dict, what: str = "DtFixed") -> None:
                       f"outputs are {dt:g} s apart")
 
 
-def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=False, stop=None) -> RunResult:
+def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quiet, resume=False,
+                     stop=None) -> RunResult:
     """A case with bodies and no fluid: the multibody engine alone, DtFixed steps (default
     1e-3 s), with the outputs, logs, checks, checkpoints and resume of an SPH run."""
     stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
@@ -346,7 +358,8 @@ def _run_bodies_only(data, params, outdir, files, meta, t_start, quiet, resume=F
     tout = float(params["TimeOut"])
     extra = params.get("TimeOutExtra")
     schedule = StepSchedule(float(params["TimeMax"]), tout, dt,
-                            extra if extra is not None and extra < tout else None)
+                            extra if extra is not None and extra < tout else None,
+                            None if out_times.uniform else out_times)
     system, names = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
     if not system._packed:
         system._pack()
@@ -722,7 +735,7 @@ def _warm_up(sph: "SPHRun") -> float:
     return _time.perf_counter() - t0
 
 
-def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start, stop=None) -> RunResult:
+def _run_sph(data, params, out_times, outdir, files, meta, threads, resume, quiet, t_start, stop=None) -> RunResult:
     """The SPH run on ``threads`` numba threads; the caller's thread count is
     restored afterwards (an in-process run must not change it for the rest of
     the process, e.g. a test session)."""
@@ -730,12 +743,12 @@ def _run_sph(data, params, outdir, files, meta, threads, resume, quiet, t_start,
     previous = numba.get_num_threads()
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     try:
-        return _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start, stop)
+        return _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quiet, t_start, stop)
     finally:
         numba.set_num_threads(previous)
 
 
-def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start, stop=None) -> RunResult:
+def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quiet, t_start, stop=None) -> RunResult:
     import numba
     from .io.vtkhdf import VTKHDFParticleWriter
     stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
@@ -817,7 +830,7 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start,
         try:
             if not resume:
                 write_part(0)
-            next_out = (part + 1) * tout
+            next_out = out_times.after(out_times.nth(part))
             extra = params.get("TimeOutExtra")
             extra = float(extra) if body_log is not None and extra is not None and extra < tout else None
             next_extra = _next_multiple(sol.time, extra) if extra else 0.0
@@ -827,11 +840,11 @@ def _run_sph_threaded(data, params, outdir, files, meta, resume, quiet, t_start,
                 sph.check(0)
                 if gauges is not None:
                     gauges.after_step(sol)
-                if time_reached(sol.time, next_out, tout) or sol.time >= tmax:
+                if time_reached(sol.time, next_out, out_times.smallest) or sol.time >= tmax:
                     part += 1
                     write_part(part)
                     dt_lo, dt_hi = math.inf, 0.0
-                    next_out = (part + 1) * tout
+                    next_out = out_times.after(next_out)
                     if extra:
                         next_extra = _next_multiple(sol.time, extra)
                 elif extra is not None and time_reached(sol.time, next_extra, extra):

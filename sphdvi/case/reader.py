@@ -25,10 +25,10 @@ from .xmldoc import CaseReader, load_xml, strip_disabled
 CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initials", "motion",
                     "properties", "normals", "patterns", "vres"}
 EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres"}
-SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting"}
+SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
     "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
-    "moorings", "forcepoints", "outputparts", "initialize", "savedt", "timeout", "inout", "vres"}
+    "moorings", "forcepoints", "outputparts", "initialize", "savedt", "inout", "vres"}
 
 
 def case_name_from_path(path: str) -> str:
@@ -996,6 +996,26 @@ def read_damping(reader, el) -> list:
     return out
 
 
+def read_timeout(reader, el) -> list:
+    """``<timeout><tout time="t" timeout="dt"/>...`` (DualSPHysics's JTimeOut): from time t on,
+    outputs dt apart; rows [[t, dt], ...] with t >= 0 rising and dt > 0
+    (:class:`sphdvi.output_schedule.OutputSchedule`)."""
+    rows = []
+    for c in reader.children(el):
+        if c.tag != "tout":
+            raise reader.error(c, f"<timeout><{c.tag}> is not a DualSPHysics output-time row",
+                               '<tout time="t" timeout="dt"/> rows')
+        t = reader.num(c, "time", nonnegative=True)
+        dt = reader.num(c, "timeout", positive=True)
+        if rows and not t > rows[-1][0]:
+            raise reader.error(c, f"time={t:g} does not follow the row before (time={rows[-1][0]:g})",
+                               "rows in rising time")
+        rows.append([t, dt])
+    if not rows:
+        raise reader.error(el, "<timeout> has no <tout> row", '<tout time="0" timeout="dt"/> rows (or no <timeout>)')
+    return rows
+
+
 def read_shifting(reader, el) -> dict:
     d = {"zones": []}
     for c in reader.children(el):
@@ -1085,4 +1105,5 @@ def _acc_table(reader, c) -> np.ndarray:
 
 
 SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges": read_gauges,
-                   "wavepaddles": read_wavepaddles, "damping": read_damping, "shifting": read_shifting}
+                   "wavepaddles": read_wavepaddles, "damping": read_damping, "shifting": read_shifting,
+                   "timeout": read_timeout}

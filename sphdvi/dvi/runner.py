@@ -69,21 +69,34 @@ def build_system(bodies, links=(), materials=(), **system_kw):
 class StepSchedule:
     """The fixed-step schedule of a body-only run: ``nsteps`` steps of ``dt``, an output every
     ``every`` steps and at the last step, and with TimeOutExtra (``tout_extra``; None: none,
-    0: every step) a row every ``extra`` steps in between."""
+    0: every step) a row every ``extra`` steps in between.  ``output_times``: an
+    :class:`~sphdvi.output_schedule.OutputSchedule` of uneven output times (DualSPHysics's
+    ``<special><timeout>``) instead of one every ``tout``: each output at the step nearest it."""
 
-    def __init__(self, tmax, tout, dt, tout_extra=None):
+    def __init__(self, tmax, tout, dt, tout_extra=None, output_times=None):
         self.dt = float(dt)
         self.nsteps = int(round(tmax / dt))
         self.every = max(1, int(round(tout / dt)))
-        self.extra = self.every if tout_extra is None else max(1, int(round(tout_extra / dt)))
+        self.extra = None if tout_extra is None else max(1, int(round(tout_extra / dt)))
+        self.steps = None
+        if output_times is not None:
+            self.steps, t = set(), 0.0
+            while True:
+                t = output_times.after(t)
+                k = max(1, int(round(t / self.dt)))
+                if k > self.nsteps:
+                    break
+                self.steps.add(k)
 
     def is_output(self, k):
         """Step ``k`` (1-based) ends at an output time."""
+        if self.steps is not None:
+            return k in self.steps or k == self.nsteps
         return k % self.every == 0 or k == self.nsteps
 
     def is_row(self, k):
         """Step ``k`` ends at an output or a TimeOutExtra time."""
-        return k % self.every == 0 or k % self.extra == 0 or k == self.nsteps
+        return self.is_output(k) or (self.extra is not None and k % self.extra == 0)
 
 
 # the columns of bodies.csv after time and body, and of links.csv after time and link

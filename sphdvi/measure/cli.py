@@ -121,15 +121,33 @@ def measure():
 @click.option("--correction", type=click.Choice(["shepard", "linear"]), default="shepard", show_default=True,
               help="shepard: normalised by the kernel sum (MeasureTool); linear: first-order "
                    "MLS correction, exact for linear fields.")
+@click.option("--trackmk", default=None, metavar="MK[,MK...]",
+              help="The points move with these boundary or floating particles (Mk, as in particles.vtkhdf), "
+                   "e.g. the walls of a moving tank: give them where they are at the start (MeasureTool -trackmk).")
+@click.option("--trackmkbound", default=None, metavar="MKBOUND[,...]",
+              help="As --trackmk, by the case's mkbound.")
 @_output_options
 @report_errors
-def points(outdir, points, variables, kclimit, correction, first, last, every, csv_path, sep, plot):
+def points(outdir, points, variables, kclimit, correction, trackmk, trackmkbound, first, last, every, csv_path,
+           sep, plot):
     """Kernel-interpolated fluid values at points, at every output time.
 
     Points closer than 1.5h to a boundary (DBC) particle are named in a warning:
     DBC keeps the fluid about 1.5h away from walls, so values there are unreliable.
+    With --trackmk the points move rigidly with those particles (a pressure sensor
+    on the wall of a moving tank).
     """
     _check_outputs(csv_path, plot)
+    track = None
+    if trackmk is not None and trackmkbound is not None:
+        raise click.UsageError("give at most one of --trackmk and --trackmkbound")
+    if trackmk is not None or trackmkbound is not None:
+        from .post import parse_mk_list
+        try:
+            track = (parse_mk_list(trackmk if trackmk is not None else trackmkbound), trackmkbound is not None)
+        except ValueError as exc:
+            raise click.BadParameter(str(exc), param_hint="'--trackmk'" if trackmk is not None
+                                     else "'--trackmkbound'") from None
     pts = _points_option(points, "'--points'")
     from .post import UNITS, measure_points
     names = [v.strip().lower() for v in variables.split(",") if v.strip()]
@@ -140,7 +158,7 @@ def points(outdir, points, variables, kclimit, correction, first, last, every, c
     run = _run(outdir)
     _warn_y_in_2d(run, pts, "--points")
     table, near = measure_points(run, pts, names, kclimit=kclimit, order=1 if correction == "linear" else 0,
-                                 first=first, last=last, every=every)
+                                 first=first, last=last, every=every, track=track)
     for i, d, t in near:
         p = pts[i]
         click.echo(f"warning: point {i} ({p[0]:g}, {p[1]:g}, {p[2]:g}) is {d:.3g} m from a boundary particle "

@@ -237,15 +237,42 @@ def _component_names(var: str, is2d: bool):
     return [var]
 
 
+def tracked_motion(run: RunOutput, mks, mkbound=False):
+    """A function snapshot -> (R, t), the rigid motion since the case's start of the boundary
+    or floating particles with mk (or mkbound) in ``mks`` (Kabsch fit of their positions to
+    their initial ones, by Idp): MeasureTool's ``-trackmk``, points that move with a tank."""
+    p = run.data["particles"]
+    first = Snapshot(part=0, time=0.0, pos=np.asarray(p["pos"], float), vel=None, rhop=None, press=None,
+                     ptype=np.asarray(p["type"]), idp=np.asarray(p["idp"], np.int64), mk=np.asarray(p["mk"]),
+                     mass=np.asarray(p["mass"], float))
+    sel = target_mask(first, mks, run.fluidcount, mkbound)
+    kind = "mkbound" if mkbound else "mk"
+    if np.count_nonzero(sel) < 3:
+        raise InputError(f"--track{kind} {','.join(str(m) for m in mks)}: the case has "
+                         f"{np.count_nonzero(sel)} boundary or floating particles with that {kind}; "
+                         "expected a rigid set of at least 3 (see the Mk column of particles.vtkhdf)")
+    ref_pos = np.zeros((int(first.idp.max()) + 1, 3))
+    ref_pos[first.idp[sel]] = first.pos[sel]
+    is2d = run.spec.is2d
+
+    def motion(snap: Snapshot):
+        cur = target_mask(snap, mks, run.fluidcount, mkbound)
+        return rigid_fit(ref_pos[snap.idp[cur]], np.asarray(snap.pos[cur], float), is2d)
+    return motion
+
+
 def measure_points(run: RunOutput, points, variables=VARS, kclimit=core.DEFAULT_KCLIMIT, order=0,
-                   wall_factor=1.5, first=0, last=None, every=1):
+                   wall_factor=1.5, first=0, last=None, every=1, track=None):
     """Kernel interpolation of ``variables`` at ``points`` at every output time.
 
+    ``track``: (mks, mkbound) of a rigid set of boundary or floating particles the points
+    move with (their positions are then those at the case's start; :func:`tracked_motion`).
     Returns (table, near_wall) where ``near_wall`` lists (point index, min
     distance, first time) of points closer than ``wall_factor`` h to a
     boundary particle at some output time.
     """
     points = core.as_points(points)
+    motion = tracked_motion(run, *track) if track is not None else None
     variables = list(variables)
     for v in variables:
         if v not in UNITS:
@@ -261,8 +288,12 @@ def measure_points(run: RunOutput, points, variables=VARS, kclimit=core.DEFAULT_
     times, parts, rows = [], [], []
     near: dict = {}
     rwall = wall_factor * spec.h
+    start = points
     for snap in run.snapshots(first=first, last=last, every=every):
         grid = run.fluid_grid(snap)
+        if motion is not None:
+            R, t = motion(snap)
+            points = start @ R.T + t
         vals, _ = core.interpolate(grid, points, variables, order=order, kclimit=kclimit)
         # column order: variable, point, component
         row, col = [], 0

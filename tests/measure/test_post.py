@@ -250,3 +250,53 @@ def test_bodies_of_a_body_only_run_honour_first_last_every(tmp_path):
     np.testing.assert_array_equal(b.data, a.data[1:3])
     r = invoke("measure", "bodies", out, "--first", "10")
     assert r.exit_code == 2 and "--first 10: " in r.output and "4 output times" in r.output
+
+
+def _rotated_tank_run(tmp_path, is2d):
+    """The still-water tank turned and shifted as one rigid block: at time t by θ = 10 t degrees
+    about y (2D) or about a tilted axis (3D), and moved by (0.1 t, 0, 0.05 t)."""
+    from sphdvi.motion import _rotation
+    tank = (hydrostatic_tank(1.0, DEPTH, 0.02, True, layers=3) if is2d
+            else hydrostatic_tank(0.6, DEPTH, 0.04, False, width=0.4, layers=3))
+    axis = np.array([0.0, 1.0, 0.0]) if is2d else np.array([0.3, 1.0, 0.5]) / np.linalg.norm([0.3, 1.0, 0.5])
+    centre = np.array([0.3, 0.0, 0.1])
+
+    def moves(t, tk):
+        R = _rotation(axis, np.radians(10.0 * t))
+        pos = (tk["pos"] - centre) @ R.T + centre + np.array([0.1, 0.0, 0.05]) * t
+        return pos, tk["vel"], tk["rhop"]
+    return tank, write_run(str(tmp_path / ("r2" if is2d else "r3")), tank, times=(0.0, 1.0, 2.0), moves=moves)
+
+
+@pytest.mark.parametrize("is2d", [True, False])
+def test_points_tracking_the_walls_move_with_the_tank(tmp_path, is2d):
+    """--trackmk: a point given at the start rides with the walls (MeasureTool -trackmk), so in a
+    tank moved as one rigid block it reads what it read at the start; a fixed point does not."""
+    tank, out = _rotated_tank_run(tmp_path, is2d)
+    run = RunOutput(out)
+    pts = np.array([[0.3, 0.0 if is2d else 0.2, 0.15]])
+    walls = [int(m) for m in np.unique(tank["mk"][tank["type"] == 0])]
+    moving, _ = measure_points(run, pts, ["press"], track=(walls, False))
+    fixed, _ = measure_points(run, pts, ["press"])
+    p = moving.column("press_0")
+    assert np.allclose(p, p[0], rtol=1e-5) and abs(p[0] / (1000 * 9.81 * (DEPTH - 0.15)) - 1) < 0.02
+    assert not abs(fixed.column("press_0")[2] / p[0] - 1) < 0.05     # another value, or none (NaN)
+    by_mkbound, _ = measure_points(run, pts, ["press"], track=([0, 1], True))
+    assert np.array_equal(by_mkbound.column("press_0"), p)
+    r = invoke("measure", "points", out, "--points", "0.3,0,0.15" if is2d else "0.3,0.2,0.15", "--vars", "press",
+               "--trackmkbound", "0,1")
+    assert r.exit_code == 0, r.output
+    assert np.allclose(read_table_text(r.stdout)[:, -1], p, rtol=1e-6)
+
+
+def read_table_text(text):
+    rows = [ln.split(",") for ln in text.splitlines() if ln and ln[0].isdigit()]
+    return np.array([[float(v) for v in r] for r in rows])
+
+
+def test_trackmk_errors(tank2d):
+    _, out = tank2d
+    r = invoke("measure", "points", out, "--points", "0.5,0,0.2", "--trackmk", "77")
+    assert r.exit_code == 2 and "--trackmk 77" in r.output and "Traceback" not in r.output
+    r = invoke("measure", "points", out, "--points", "0.5,0,0.2", "--trackmk", "2", "--trackmkbound", "0")
+    assert r.exit_code == 2 and "at most one of --trackmk and --trackmkbound" in r.output
