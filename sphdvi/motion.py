@@ -8,7 +8,8 @@ Movements (DualSPHysics ``JMotion``; times τ measured from the start of the mov
 
 * ``wait``, ``mvnull``: no motion;
 * ``mvrect``: d = v τ;  ``mvrectace``: d = v0 τ + a τ²/2 (v0 defaults to the previous speed);
-* ``mvrot``: rotation by ω τ about the axis p1→p2; ``mvrotace``: ω0 τ + α τ²/2;
+* ``mvrot``: rotation by ω τ about the axis through p1 and p2, in DualSPHysics's sense (a
+  positive angle turns right-handed about p2→p1: :func:`_rotational`); ``mvrotace``: ω0 τ + α τ²/2;
 * ``mvcir``: the object translates along the circle that ``ref`` describes when rotated about the axis;
 * ``mvrectsinu``: d = A [sin(2π f τ + φ) − sin φ] per component;
   ``mvrotsinu``: angle A [sin(2π f τ + φ) − sin φ]; ``mvcirsinu`` likewise on a circle;
@@ -121,8 +122,15 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
 
 
 def _rotational(m, angle, w, circular) -> Rigid:
+    """A rotation by ``angle`` (rate ``w``) about the axis through axisp1 and axisp2, in
+    DualSPHysics's sense: its JMatrix4::MatrixRot(ang, p1, p2), which JMotionPos::Rotate applies,
+    turns by −ang in the right-hand sense about p1 → p2 (MatrixRotY(ang), the right-hand
+    rotation about +y, is MatrixRot(ang, 0, (0, −1, 0)) there); so a positive angle turns
+    right-handed about p2 → p1.  (The SPHERIC Test 10 roll record, a positive angle about
+    (0, −1, 0) → (0, 1, 0), then throws the water at the left wall when the experiment's
+    sensor there records the impacts.)"""
     p1, p2 = np.asarray(m["axisp1"], float), np.asarray(m["axisp2"], float)
-    axis = _unit(p2 - p1, f"{m['type']} id={m.get('id')}: axisp1 and axisp2")
+    axis = _unit(p1 - p2, f"{m['type']} id={m.get('id')}: axisp1 and axisp2")
     R = _rotation(axis, angle)
     if not circular:
         return Rigid(R=R, d=p1 - R @ p1, W=w * axis, c=p1)

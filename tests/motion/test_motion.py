@@ -42,9 +42,35 @@ def test_rotation_quarter_turn_about_axis():
     m = {"type": "mvrot", "id": 1, "duration": -1, "next": None, "vel": 90.0, "anglesunits": "degrees",
          "axisp1": [1, 0, 0], "axisp2": [1, 1, 0]}
     x, v = chain_transform(chain([m]), 1.0).apply(np.array([[2.0, 0, 0]]))
-    # rotation about +y through (1,0,0) by +90 degrees takes (2,0,0) to (1,0,-1)
-    assert x[0] == pytest.approx([1, 0, -1], abs=1e-12)
-    assert v[0] == pytest.approx(np.cross([0, math.pi / 2, 0], x[0] - [1, 0, 0]))
+    # DualSPHysics's sense (JMatrix4::MatrixRot): +90 degrees about the axis (1,0,0) -> (1,1,0)
+    # is the right-hand quarter turn about -y, which takes (2,0,0) to (1,0,1)
+    assert x[0] == pytest.approx([1, 0, 1], abs=1e-12)
+    assert v[0] == pytest.approx(np.cross([0, -math.pi / 2, 0], x[0] - [1, 0, 0]))
+
+
+def test_rotation_sense_is_dualsphysics_matrixrot():
+    """DualSPHysics's JMatrix4::MatrixRot(ang, p1, p2), written out as its code composes it
+    (move p1 to the origin, turn the axis onto z, rotate with rz = [[c, s], [-s, c]], undo), for
+    a few axes: mvrot gives the same matrix."""
+    def matrixrot(ang, p1, p2):
+        rad = math.radians(ang)
+        v = np.subtract(p2, p1, dtype=float)
+        L, L1 = np.linalg.norm(v), math.hypot(v[1], v[2])
+        rx, rxm1, ry, rym1, rz = (np.eye(3) for _ in range(5))
+        if L1 == 0:
+            rx[1:, 1:] = [[0, 1], [-1, 0]]
+            rxm1[1:, 1:] = [[0, -1], [1, 0]]
+        else:
+            rx[1:, 1:] = [[v[2] / L1, v[1] / L1], [-v[1] / L1, v[2] / L1]]
+            rxm1[1:, 1:] = [[v[2] / L1, -v[1] / L1], [v[1] / L1, v[2] / L1]]
+        ry[0, 0], ry[0, 2], ry[2, 0], ry[2, 2] = L1 / L, v[0] / L, -v[0] / L, L1 / L
+        rym1[0, 0], rym1[0, 2], rym1[2, 0], rym1[2, 2] = L1 / L, -v[0] / L, v[0] / L, L1 / L
+        rz[:2, :2] = [[math.cos(rad), math.sin(rad)], [-math.sin(rad), math.cos(rad)]]
+        return rx @ ry @ rz @ rym1 @ rxm1
+    for p2 in ([0, 1, 0], [0, -1, 0], [1, 0, 0], [0, 0, 1], [0.3, 0.5, 0.8]):
+        m = {"type": "mvrot", "id": 1, "duration": -1, "next": None, "vel": 30.0, "anglesunits": "degrees",
+             "axisp1": [0, 0, 0], "axisp2": p2}
+        assert chain_transform(chain([m]), 1.0).R == pytest.approx(matrixrot(30.0, [0, 0, 0], p2), abs=1e-12)
 
 
 def test_sinusoid_velocity_is_derivative():

@@ -69,10 +69,11 @@ def test_rotfile_default_and_explicit_columns(tmp_path):
     body = f'<mvrotfile id="1" duration="-1"><file name="a.csv"/>{axis}</mvrotfile>'
     (m,), _ = read(tmp_path, body, {"a.csv": "#time;angle\n0;0\n1;90\n"})
     x = chain_transform(m, 1.0).apply(np.array([[1.0, 0, 0]]))[0]
-    assert x[0] == pytest.approx([0, 0, -1], abs=1e-12)
+    # DualSPHysics's sense: +90 degrees about (0,0,0) -> (0,1,0) takes +x to +z
+    assert x[0] == pytest.approx([0, 0, 1], abs=1e-12)
     body = f'<mvrotfile id="1" duration="-1"><file name="a.csv" fields="3" fieldtime="1" fieldang="2"/>{axis}</mvrotfile>'
     (m,), _ = read(tmp_path, body, {"a.csv": "5;0;0\n5;1;90\n"})
-    assert chain_transform(m, 1.0).apply(np.array([[1.0, 0, 0]]))[0][0] == pytest.approx([0, 0, -1], abs=1e-12)
+    assert chain_transform(m, 1.0).apply(np.array([[1.0, 0, 0]]))[0][0] == pytest.approx([0, 0, 1], abs=1e-12)
 
 
 def test_motionset_reads_the_file_again_at_run_time(tmp_path):
