@@ -355,7 +355,7 @@ def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quie
         raise InputError("the case has neither fluid nor bodies: nothing to simulate")
     dt = params["DtFixed"] if params["DtFixed"] > 0 else 1e-3
     _check_dtfixed(dt, params, "DtFixed" if params["DtFixed"] > 0 else "the default step of a body-only run")
-    tout = float(params["TimeOut"])
+    tout = out_times.rows[0][1] if out_times.uniform else float(params["TimeOut"])
     extra = params.get("TimeOutExtra")
     schedule = StepSchedule(float(params["TimeMax"]), tout, dt,
                             extra if extra is not None and extra < tout else None,

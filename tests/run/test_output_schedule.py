@@ -110,3 +110,21 @@ def test_bad_timeout_rows_are_case_errors(tmp_path, rows, message):
     assert "CaseDB_Def.xml:" in r.output and message in r.output
     assert "Traceback" not in r.output
     assert os.path.basename(str(path)) in r.output
+
+
+def test_a_single_timeout_row_sets_the_interval_of_a_body_only_run(tmp_path):
+    """<timeout> with one row from t = 0 is an even schedule of its own interval, not TimeOut's."""
+    from pathlib import Path
+    src = Path(__file__).resolve().parents[2] / "cases" / "pendulum"
+    xml = next(src.glob("*_Def.xml"))
+    text = xml.read_text()
+    assert "<special>" in text
+    case = tmp_path / xml.name
+    case.write_text(text.replace("<special>", '<special><timeout><tout time="0" timeout="0.02"/></timeout>', 1))
+    for extra in src.iterdir():
+        if extra.name != xml.name and extra.is_file():
+            (tmp_path / extra.name).write_bytes(extra.read_bytes())
+    out = tmp_path / "o"
+    r = invoke(["run", case, "-o", out, "--tmax", "0.1", "-q"])
+    assert r.exit_code == 0, r.output
+    assert np.allclose(run_times(out), np.arange(0, 0.1001, 0.02), atol=1e-9)
