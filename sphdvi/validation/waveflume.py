@@ -1,6 +1,6 @@
 """The wave maker against first-order wavemaker theory (``cases/waveflume2d``): a piston (W1) or
-a flap hinged at the bottom (W2) makes regular waves H = 0.03 m, T = 1.2 s in d = 0.3 m.  From the run-time gauges WG1-WG3 (x = 0.3,
-0.6, 0.9 m), over the last two periods: the first harmonic's complex amplitude at each gauge,
+a flap hinged at the bottom (W2) makes regular waves H = 0.03 m, T = 1.2 s in d = 0.3 m.  From
+the run-time gauges WG1-WG3 (x = 0.3, 0.6, 0.9 m), over the last two periods: the first harmonic's complex amplitude at each gauge,
 split by least squares into an incident and a reflected wave of the linear wave number
 (Mansard & Funke 1980, three gauges); the incident height against H.  ``paddle_stroke`` measures
 the paddle's stroke at the still-water level on its particles, so that a height error is not a
@@ -55,28 +55,20 @@ def wave_errors(outdir: str) -> dict:
     return out
 
 
-def paddle_stroke(outdir: str, kind: str, hinge_x: float = 0.0, hinge_z: float = 0.0) -> float:
-    """Stroke S (peak to peak, at the still-water level z = DEPTH) of the moving particles over the
-    last two periods of the saved steps: their mean x displacement (``kind`` "piston"), or their mean
-    rotation θ about the hinge (hinge_x, hinge_z), S = 2 (DEPTH − hinge_z) tan|θ| ("flap")."""
-    from ..io.vtkhdf import read_step, step_times
-    path = os.path.join(str(outdir), "particles.vtkhdf")
-    times = step_times(path)
-    first = read_step(path, 0)
-    moving = first["Type"] == 1
-    ids, p0 = first["Idp"][moving], first["points"][moving]
-    r0 = np.hypot(p0[:, 0] - hinge_x, p0[:, 2] - hinge_z)
-    a0 = np.arctan2(p0[:, 0] - hinge_x, p0[:, 2] - hinge_z)
-    sel = np.nonzero(times >= times[-1] - WINDOW * PERIOD - 1e-9)[0]
-    motion = []
-    for k in sel:
-        s = read_step(path, int(k))
-        order = np.argsort(s["Idp"])
-        q = s["points"][order[np.searchsorted(s["Idp"], ids, sorter=order)]]
-        if kind == "piston":
-            motion.append(float(np.mean(q[:, 0] - p0[:, 0])))
-        else:
-            a = np.arctan2(q[:, 0] - hinge_x, q[:, 2] - hinge_z) - a0
-            motion.append(float(np.average(a, weights=r0)))
-    amp = abs(first_harmonic(times[sel], np.asarray(motion), 2 * math.pi / PERIOD))
-    return 2 * amp if kind == "piston" else 2 * (DEPTH - hinge_z) * math.tan(amp)
+def paddle_stroke(outdir: str, kind: str, mkbound: int = 10) -> float:
+    """Stroke S (peak to peak, at the still-water level z = DEPTH) of the paddle ``mkbound`` over
+    the last two periods of the saved steps, from its rigid motion fitted to its particles
+    (:func:`sphdvi.measure.post.tracked_motion`): the x displacement (``kind`` "piston"), or the
+    rotation θ about a hinge on the bottom (z = 0), S = 2 DEPTH tan|θ| ("flap")."""
+    from ..measure.post import RunOutput, tracked_motion
+    run = RunOutput(str(outdir))
+    motion = tracked_motion(run, [mkbound], mkbound=True)
+    times = run.times()
+    first = int(np.searchsorted(times, times[-1] - WINDOW * PERIOD - 1e-9))
+    t, x = [], []
+    for snap in run.snapshots(arrays=("Mk",), first=first):
+        R, d = motion(snap)
+        t.append(snap.time)
+        x.append(d[0] if kind == "piston" else math.atan2(R[0, 2], R[0, 0]))
+    amp = abs(first_harmonic(np.asarray(t), np.asarray(x), 2 * math.pi / PERIOD))
+    return 2 * amp if kind == "piston" else 2 * DEPTH * math.tan(amp)
