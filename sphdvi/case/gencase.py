@@ -270,11 +270,13 @@ def apply_initials(case: Case, particles: dict, consts: Constants, reader) -> No
             pos[sel] += np.asarray(item["move"])
         elif kind == "rotateaxis":
             p1, p2 = np.asarray(item["axisp1"]), np.asarray(item["axisp2"])
-            pos[sel] = rotate_about_axis(pos[sel], p1, p2, math.radians(item["angle_deg"]))
+            # DualSPHysics's sense (JMatrix4::MatrixRot, as <rotateline> and <motion>): −angle
+            # right-handed about axisp1 → axisp2, i.e. +angle about axisp2 → axisp1
+            pos[sel] = rotate_about_axis(pos[sel], p2, p1, math.radians(item["angle_deg"]))
 
 
 def rotate_about_axis(points: np.ndarray, p1, p2, angle: float) -> np.ndarray:
-    """Rotate points by ``angle`` (rad) about the line p1→p2 (Rodrigues' formula)."""
+    """Rotate points by ``angle`` (rad, right-handed) about the line p1→p2 (Rodrigues' formula)."""
     k = np.asarray(p2, float) - np.asarray(p1, float)
     k = k / np.linalg.norm(k)
     r = points - p1

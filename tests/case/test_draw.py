@@ -196,7 +196,8 @@ def test_box_params_world_frame(tmp_path):
     p = d.primitives[0]["params"]
     assert np.allclose(p["size"], [1, 4, 3]) and p["local_size"] == [1, 2, 3]
     assert np.allclose(np.abs(p["axes"]), [[0, 1, 0], [1, 0, 0], [0, 0, 1]])
-    assert np.allclose(p["min"], [-3, 1, 1]) and np.allclose(p["max"], [1, 2, 4])
+    # <rotate> turns DualSPHysics's way (clockwise seen from +z): [0,1]x[0,2] -> [0,2]x[-1,0]
+    assert np.allclose(p["min"], [1, 0, 1]) and np.allclose(p["max"], [5, 1, 4])
 
 
 def test_box_rotated_by_angles(tmp_path):
@@ -481,10 +482,11 @@ def test_long_line_clipped(tmp_path):
 
 # ---------------------------------------------------------------- transforms
 def test_move_rotate_order(tmp_path):
-    # rotate first (90 deg about z), then move: box [0,2]x[0,1]x[0,1] -> x in [-1,0] -> +5
+    # rotate first (90 deg about z, DualSPHysics's sense: clockwise seen from +z), then move:
+    # box [0,2]x[0,1]x[0,1] -> x in [0,1], y in [-2,0] -> +5
     d = draw(tmp_path, '<setmkfluid mk="0"/><move x="5" y="5" z="5"/><rotate ang="90" x="0" '
              'y="0" z="1"/>' + box((0, 0, 0), (2, 1, 1)))
-    assert nodes(d) == lattice_box((4, 5, 5), (5, 7, 6))
+    assert nodes(d) == lattice_box((5, 3, 5), (6, 5, 6))
 
 
 def test_rotateline_scale_and_matrix_stack(tmp_path):
@@ -647,13 +649,14 @@ def test_triangle_raster_matches_its_definition():
 
 
 def test_box_faces_follow_a_quarter_turn(tmp_path):
-    # after a 90-degree turn about z, local x runs along world +y: the "left" face (local
-    # x min) becomes the world y-min face, "front" (local y min) becomes world x max
+    # after <rotate ang="90"> about z (DualSPHysics's sense: (x, y) -> (y, -x)), local x runs
+    # along world -y: the "left" face (local x min, x = 1) becomes the world y-max face y = -1,
+    # "front" (local y min, y = -5) the world x-min face x = -5
     body = '<setmkbound mk="0"/><rotate ang="90" x="0" y="0" z="1"/>'
     d = draw(tmp_path, body + box((1, -5, 1), (2, 2, 2), fill="left"), pmin=(-10, -10, -10))
-    assert np.all(d.pos[:, 1] == 1) and len(d.pos) == 9
+    assert np.all(d.pos[:, 1] == -1) and len(d.pos) == 9
     d = draw(tmp_path, body + box((1, -5, 1), (2, 2, 2), fill="front"), pmin=(-10, -10, -10))
-    assert np.all(d.pos[:, 0] == 5) and len(d.pos) == 9
+    assert np.all(d.pos[:, 0] == -5) and len(d.pos) == 9
 
 
 def test_curved_modes_solid_and_wire(tmp_path):

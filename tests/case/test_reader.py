@@ -444,7 +444,7 @@ def test_analytic_inertia_of_rotated_box(tmp_path):
     m = 500 * 0.4 * 0.2 * 0.1
     assert a["mass"] == pytest.approx(m)
     c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
-    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    R = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])      # <rotate> turns DualSPHysics's way: −30° about +z
     local = np.diag([0.2 ** 2 + 0.1 ** 2, 0.4 ** 2 + 0.1 ** 2, 0.4 ** 2 + 0.2 ** 2]) * m / 12
     assert np.allclose(a["inertia"], R @ local @ R.T, rtol=1e-9, atol=1e-12)
     assert b.center == pytest.approx([0.5, 0.5, 0.5], abs=0.011)

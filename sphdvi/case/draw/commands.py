@@ -428,7 +428,7 @@ class GeometryRunner:
         axis = self.reader.vec3(el)
         if not np.linalg.norm(axis) > 0:
             raise self.reader.error(el, "rotation axis (x, y, z) is zero", "a non-zero axis")
-        self._compose(el, tf.rotation_axis(ang, axis))
+        self._compose(el, tf.rotation_line(ang, np.zeros(3), axis))     # DualSPHysics's sense
 
     def cmd_rotateline(self, el):
         self._check(el, {"point"})

@@ -1,5 +1,8 @@
 """4x4 affine matrices for the drawing transforms (move, rotate, rotateline, scale).
 
+``<rotate>`` and ``<rotateline>`` turn the DualSPHysics way (:func:`rotation_line`), the
+opposite of the right-hand rule about the axis they name; :func:`rotation_axis` is right-handed.
+
 Like OpenGL and GenCase, each new transform is multiplied on the right of the
 current matrix: after ``<move>`` then ``<rotate>``, a shape is first rotated
 (about the origin) and then moved. Shapes are defined in their own frame and
@@ -49,10 +52,14 @@ def rotation_axis(angle_deg: float, axis) -> np.ndarray:
 
 
 def rotation_line(angle_deg: float, p1, p2) -> np.ndarray:
-    """Rotation about the line through p1 and p2 (direction p1 -> p2)."""
+    """GenCase's rotation by ``angle_deg`` about the line p1 -> p2 (``<rotateline>``; ``<rotate>``
+    with p1 the origin and p2 its axis): DualSPHysics's JMatrix4::MatrixRot, which turns by
+    **−angle** right-handed about p1 -> p2 (+angle about p2 -> p1).  DesignSPHysics, the
+    DualSPHysics team's FreeCAD front end, writes FreeCAD's right-handed rotation (angle, axis a)
+    as ``<rotate ang="angle" x="-ax" y="-ay" z="-az"/>``; sphdvi's ``<motion>`` turns the same way."""
     p1 = np.asarray(p1, dtype=np.float64)
     p2 = np.asarray(p2, dtype=np.float64)
-    return translation(p1) @ rotation_axis(angle_deg, p2 - p1) @ translation(-p1)
+    return translation(p1) @ rotation_axis(angle_deg, p1 - p2) @ translation(-p1)
 
 
 def rotation_xyz(angles_deg) -> np.ndarray:
