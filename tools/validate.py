@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1, W1, W2)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1, W1, W2, W3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads) and S8 (sloshing)
     python tools/validate.py S9 --csv s9.csv --keep runs/
@@ -97,6 +97,11 @@ def score_accel_tank(outdir):
 def score_wave_flume(outdir):
     from sphdvi.validation.waveflume import wave_errors
     return wave_errors(outdir)
+
+
+def score_flap_waves(outdir):
+    from sphdvi.validation.flapwaves import wave_scores
+    return wave_scores(outdir, REFERENCE)
 
 
 def _wave_flume_case(name, paddle, xml):
@@ -224,6 +229,14 @@ def cases() -> list:
              "impact times within 3 % (here of the roll period), peaks within 20-30 %", slow=True),
         _wave_flume_case("W1", "piston", "CaseWaveFlume2D_Def.xml"),
         _wave_flume_case("W2", "flap hinged at the bottom", "CaseWaveFlap2D_Def.xml"),
+        Case("W3", "waves from a measured flap motion (Hadzic et al. 2005 flume): wave probes",
+             case_path("flapwaves2d", "CaseFlapWavesHadzic2D_Def.xml"),
+             [Resolution("depth/dp 10", 0.04), Resolution("depth/dp 20", 0.02)],
+             score_flap_waves, [("corr WP1", "WP1_corr", "{:.3f}"), ("corr WP2", "WP2_corr", "{:.3f}"),
+                                ("rms WP1 %", "WP1_rms", PCT), ("rms WP2 %", "WP2_rms", PCT),
+                                ("lag WP1 s", "WP1_lag", "{:+.3f}"), ("lag WP2 s", "WP2_lag", "{:+.3f}")],
+             "rms_max", lambda e: e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15,
+             "correlation with the measured probes >= 0.9, rms within 15 % (judgement; no published target)"),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),

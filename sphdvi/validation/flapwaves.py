@@ -1,0 +1,73 @@
+"""W3: waves from a measured flap motion against measured wave gauges, ``cases/flapwaves2d``.
+
+The flume of Hadzic et al. (2005) ("Computation of flow-induced motion of floating bodies", Appl.
+Math. Modelling 29:1196) as DualSPHysics's CaseFloatingWavesVal sets it up, without the floating box:
+a flap hinged at the bottom turns by the recorded angle history and sends a group of waves down
+0.4 m of water.  The run-time gauges WP1 (x = 1.16 m) and WP2 (x = 2.66 m) stand at the
+experiment's wave probes.  Per probe, over the experiment's record up to the end of the run: the
+correlation of the SPH elevation with the measured one, the rms of each and the lag that
+correlates best.  The elevation is taken from the still level each gauge reads before the waves
+arrive (t <= 0.5 s: the flap has turned less than 0.06 degrees), which removes the gauge's offset
+of its own surface criterion.  Turned the other way, the flap would send the waves out inverted:
+the correlation is also a check of the sense of ``<mvrotfile>``.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+DATA = "floating_box_waves_hadzic_2005"
+EXP_FILE = "EXP_FloatingWavesVal_Hadzic_et_al_2005.txt"
+PROBES = {"WP1": 0, "WP2": 1}       # gauge name -> probe column pair in the experiment's file
+STILL_UNTIL = 0.5                   # s: the gauges' still level is their mean before this time
+MAX_LAG = 0.3                       # s: the lags searched for the best correlation
+
+
+def load_probe(reference_dir: str, probe: int) -> tuple[np.ndarray, np.ndarray]:
+    """(time [s], elevation [m]) of wave probe ``probe`` (0: x = 1.16 m, 1: x = 2.66 m) of the
+    experiment (the file pairs a time column with each record; the records differ in length)."""
+    t, z = [], []
+    path = os.path.join(reference_dir, DATA, EXP_FILE)
+    with open(path, encoding="latin-1") as f:          # its header holds a cp1252 dash
+        lines = f.read().splitlines()[2:]
+    for line in lines:
+        cols = line.split("\t")
+        a, b = cols[2 * probe:2 * probe + 2] if len(cols) >= 2 * probe + 2 else ("", "")
+        if a.strip() and b.strip():
+            t.append(float(a))
+            z.append(float(b))
+    return np.asarray(t), np.asarray(z)
+
+
+def gauge_elevation(outdir: str, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """(time, elevation above the still level) of the run-time gauge ``name``."""
+    g = np.genfromtxt(os.path.join(str(outdir), f"GaugesSWL_{name}.csv"), delimiter=";", skip_header=1)
+    t, z = g[:, 0], g[:, 3]
+    return t, z - z[t <= STILL_UNTIL].mean()
+
+
+def probe_scores(t_sph, z_sph, t_exp, z_exp) -> dict:
+    """Correlation, rms ratio − 1, best lag [s] (SPH behind the experiment is positive) and the
+    correlation at that lag, over the experiment's samples within the SPH record."""
+    sel = (t_exp >= t_sph[0]) & (t_exp <= t_sph[-1] - MAX_LAG)
+    te, ze = t_exp[sel], z_exp[sel]
+    zs = np.interp(te, t_sph, z_sph)
+    lags = np.arange(-MAX_LAG, MAX_LAG + 1e-9, 0.005)
+    corr = np.array([np.corrcoef(np.interp(te + lag, t_sph, z_sph), ze)[0, 1] for lag in lags])
+    k = int(np.argmax(corr))
+    rms_e, rms_s = float(np.sqrt(np.mean(ze ** 2))), float(np.sqrt(np.mean(zs ** 2)))
+    return {"corr": float(np.corrcoef(zs, ze)[0, 1]), "rms": rms_s / rms_e - 1.0,
+            "lag": float(lags[k]), "corr_lag": float(corr[k]), "rms_exp": rms_e, "rms_sph": rms_s,
+            "t0": float(te[0]), "t1": float(te[-1])}
+
+
+def wave_scores(outdir: str, reference_dir: str) -> dict:
+    """Per probe (``WP1_corr``, ``WP1_rms``, ``WP1_lag`` ...), and ``corr_min`` / ``rms_max`` over both."""
+    out: dict = {}
+    for name, probe in PROBES.items():
+        s = probe_scores(*gauge_elevation(outdir, name), *load_probe(reference_dir, probe))
+        out.update({f"{name}_{k}": v for k, v in s.items()})
+    out["corr_min"] = min(out[f"{n}_corr"] for n in PROBES)
+    out["rms_max"] = max(abs(out[f"{n}_rms"]) for n in PROBES)
+    return out
