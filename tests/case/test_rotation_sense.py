@@ -9,17 +9,13 @@ vertical centre line, into the mirror images of each other about the channel's c
 share one sense.
 """
 import math
-import pathlib
-import sys
 
 import numpy as np
 import pytest
+from casetext import CONSTANTS, case_xml, write_case
+from test_draw import box, draw, nodes
 
-sys.path.insert(0, str(pathlib.Path(__file__).parent))
-from casetext import CONSTANTS, case_xml, write_case  # noqa: E402
-from test_draw import box, draw, nodes  # noqa: E402
-
-from sphdvi.case.gencase import build_case  # noqa: E402
+from sphdvi.case.gencase import build_case
 
 
 def right_handed(theta_deg, axis):
