@@ -17,6 +17,8 @@ import os
 
 import numpy as np
 
+from .runs import gauge_table
+
 DATA = "floating_box_waves_hadzic_2005"
 EXP_FILE = "EXP_FloatingWavesVal_Hadzic_et_al_2005.txt"
 PROBES = {"WP1": 0, "WP2": 1}       # gauge name -> probe column pair in the experiment's file
@@ -42,7 +44,7 @@ def load_probe(reference_dir: str, probe: int) -> tuple[np.ndarray, np.ndarray]:
 
 def gauge_elevation(outdir: str, name: str) -> tuple[np.ndarray, np.ndarray]:
     """(time, elevation above the still level) of the run-time gauge ``name``."""
-    g = np.genfromtxt(os.path.join(str(outdir), f"GaugesSWL_{name}.csv"), delimiter=";", skip_header=1)
+    g = gauge_table(outdir, "SWL", name)
     t, z = g[:, 0], g[:, 3]
     return t, z - z[t <= STILL_UNTIL].mean()
 

@@ -19,6 +19,8 @@ import os
 
 import numpy as np
 
+from .runs import gauge_table
+
 H = 0.3
 G = 9.81
 DATA_DIR = "dambreak2d_lobovsky_2014"
@@ -37,17 +39,13 @@ def _constants(outdir: str) -> dict:
     return case_data(outdir)["constants"]
 
 
-def _gauge(outdir: str, kind: str, name: str) -> np.ndarray:
-    return np.genfromtxt(os.path.join(str(outdir), f"Gauges{kind}_{name}.csv"), delimiter=";", skip_header=1)
-
-
 def level_errors(outdir: str, reference_dir: str) -> dict:
     """{gauge: mean |h_sph − h_exp| / mean h_exp over its window} (the better repetition)."""
     data = os.path.join(reference_dir, DATA_DIR, "waterLevel")
     bed = 0.5 * _constants(outdir)["dp"]
     out = {}
     for name, ((t0, t1), files) in WINDOWS.items():
-        sim = _gauge(outdir, "SWL", name)
+        sim = gauge_table(outdir, "SWL", name)
         T = sim[:, 0] * math.sqrt(G / H)
         h = np.nan_to_num((sim[:, 3] - bed) / H, nan=0.0)     # no surface found: dry
         errs = []
@@ -64,7 +62,7 @@ def wall_pressures(outdir: str) -> dict:
     c = _constants(outdir)
     out = {}
     for name in SENSORS:
-        sim = _gauge(outdir, "Mesh", name)
+        sim = gauge_table(outdir, "Mesh", name)
         p = c["b"] * ((sim[:, 1] / c["rhop0"]) ** c["gamma"] - 1.0) / (c["rhop0"] * G * H)
         out[name] = (sim[:, 0] * math.sqrt(G / H), np.nan_to_num(p, nan=0.0))
     return out

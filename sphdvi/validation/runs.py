@@ -13,6 +13,13 @@ def case_data(outdir: str) -> dict:
     return read_case_h5(find_case_file(str(outdir)))
 
 
+def gauge_table(outdir: str, kind: str, name: str):
+    """The rows of the run-time gauge file ``Gauges<kind>_<name>.csv`` of ``outdir`` (time first;
+    columns as sphdvi.measure.gauges writes them: for SWL, column 3 is the surface's z)."""
+    import numpy as np
+    return np.genfromtxt(os.path.join(str(outdir), f"Gauges{kind}_{name}.csv"), delimiter=";", skip_header=1)
+
+
 def run_info(outdir: str) -> dict:
     """run.json of ``outdir`` ({} when the run wrote none)."""
     path = os.path.join(str(outdir), "run.json")

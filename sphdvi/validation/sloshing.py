@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 
+from .runs import gauge_table
+
 
 
 def linear_period(length: float, depth: float, g: float = 9.81, mode: int = 1) -> float:
@@ -74,7 +76,7 @@ def case_periods(outdir: str, length: float = 1.0, gauge: str = "Left") -> dict:
     length_eff = length - dp
     depth_eff = nfluid * dp * dp / length_eff
     period_com, decay = period_from_signal(times, xc)
-    gauge_csv = np.genfromtxt(os.path.join(outdir, f"GaugesSWL_{gauge}.csv"), delimiter=";", skip_header=1)
+    gauge_csv = gauge_table(outdir, "SWL", gauge)
     period_gauge, _ = period_from_signal(gauge_csv[:, 0], gauge_csv[:, 3])
     return {"period_theory": linear_period(length_eff, depth_eff, g), "period_com": period_com,
             "period_gauge": period_gauge, "decay": decay, "length_eff": length_eff, "depth_eff": depth_eff,

@@ -8,9 +8,10 @@ wrong stroke (Biesel's transfer function) in disguise."""
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
+
+from .runs import gauge_table
 
 H = 0.03                   # target wave height [m]
 PERIOD = 1.2               # s
@@ -42,7 +43,7 @@ def wave_errors(outdir: str) -> dict:
     omega = 2 * math.pi / PERIOD
     xs, amps, out = [], [], {}
     for name, x in GAUGES.items():
-        g = np.genfromtxt(os.path.join(str(outdir), f"GaugesSWL_{name}.csv"), delimiter=";", skip_header=1)
+        g = gauge_table(outdir, "SWL", name)
         t, eta = g[:, 0], g[:, 3]
         sel = t >= t[-1] - WINDOW * PERIOD - 1e-9
         a = first_harmonic(t[sel], eta[sel], omega)
