@@ -77,14 +77,17 @@ def score_front(outdir):
     import numpy as np
 
     from sphdvi.validation.dambreak import (column_height_errors, column_height_history, front_errors, front_history,
-                                            front_start_delay, load_column_height, load_martin_moyce)
+                                            front_start_delay, load_column_height, load_front_record,
+                                            load_martin_moyce)
     t, x = front_history(outdir)
     mm = load_martin_moyce(REFERENCE)
     _, rel, speed = front_errors(t, x, mm)
+    _, rel_ko, _ = front_errors(t, x, load_front_record(REFERENCE, "Koshizuka & Oka 1996"))
     delay, shifted = front_start_delay(t, x, mm)
     tau, hrel = column_height_errors(*column_height_history(outdir, _case_dp(outdir)), load_column_height(REFERENCE))
     early = tau <= 1.85
     return {"front_max": float(np.abs(rel).max()), "front_min": float(rel.min()), "speed": float(speed),
+            "ko_max": float(np.abs(rel_ko).max()),
             "delay": delay, "shifted": shifted,
             "height_early": float(np.abs(hrel[early]).max()), "height_max": float(np.abs(hrel).max())}
 
@@ -182,7 +185,8 @@ def cases() -> list:
              [Resolution("a/dp 25", 0.04, ["--tmax", "0.72", "--tout", "0.01"], scored=False),
               Resolution("a/dp 50", 0.02, ["--tmax", "0.72", "--tout", "0.01"])],
              score_front, [("Z max|err| %", "front_max", PCT), ("Z min err %", "front_min", PCT),
-                           ("speed err %", "speed", PCT), ("ΔT start", "delay", "{:.3f}"),
+                           ("speed err %", "speed", PCT), ("K&O max|err| %", "ko_max", PCT),
+                           ("ΔT start", "delay", "{:.3f}"),
                            ("Z err after ΔT %", "shifted", "{:.2f} %"), ("height τ≤1.85 %", "height_early", "{:.2f} %"),
                            ("height τ≤2.2 %", "height_max", "{:.2f} %")],
              "front_max", lambda e: e["front_max"] <= 0.05,

@@ -12,10 +12,28 @@ import os
 import numpy as np
 
 
+FRONT_DATA = "dambreak2d_front_martin_moyce_1952"
+#: the experiments' front records in the data folder, (file, header lines), all as (T, Z) with
+#: T = t √(2g/a), Z = x/a: M&M Table 2 (a = 2.25 in), M&M Fig. 3 digitised for both column
+#: sizes, and Koshizuka & Oka (1996), who repeated it with a = 0.146 m
+FRONT_RECORDS = {
+    "M&M Table 2": ("mm1952_table2_front.csv", 3),
+    "M&M Fig. 3, a = 1.125 in": ("pysph_mm1952_fig3_a1.125in.csv", 2),
+    "M&M Fig. 3, a = 2.25 in": ("pysph_mm1952_fig3_a2.25in.csv", 2),
+    "Koshizuka & Oka 1996": ("pysph_koshizuka_oka_1996_exp.csv", 2),
+}
+
+
+def load_front_record(reference_dir: str, name: str = "M&M Table 2") -> np.ndarray:
+    """(T, Z) pairs of one of :data:`FRONT_RECORDS`."""
+    file, header = FRONT_RECORDS[name]
+    return np.loadtxt(os.path.join(reference_dir, FRONT_DATA, file), delimiter=",", comments="#",
+                      skiprows=header)
+
+
 def load_martin_moyce(reference_dir: str) -> np.ndarray:
     """(T, Z) pairs of M&M Table 2."""
-    path = os.path.join(reference_dir, "dambreak2d_front_martin_moyce_1952", "mm1952_table2_front.csv")
-    return np.loadtxt(path, delimiter=",", comments="#", skiprows=3)
+    return load_front_record(reference_dir, "M&M Table 2")
 
 
 def front_history(outdir: str, x0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
