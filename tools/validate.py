@@ -10,7 +10,8 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
     python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1, W1, W2, W3)
     python tools/validate.py S3 S7 --threads 2
-    python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads) and S8 (sloshing)
+    python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
+                                             # and S16 (floating box in waves; dp 0.005 takes ~1.5 h)
     python tools/validate.py S9 --csv s9.csv --keep runs/
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
@@ -152,6 +153,11 @@ def score_poiseuille(outdir):
     return case_errors(outdir)
 
 
+def score_floating_waves(outdir):
+    from sphdvi.validation.floatingwaves import body_scores
+    return body_scores(outdir, REFERENCE)
+
+
 def score_floating(outdir):
     from sphdvi.validation.floating import draft_errors
     return draft_errors(outdir)
@@ -241,6 +247,16 @@ def cases() -> list:
                                 ("lag WP1 s", "WP1_lag", "{:+.3f}"), ("lag WP2 s", "WP2_lag", "{:+.3f}")],
              "rms_max", lambda e: e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15,
              "correlation with the measured probes >= 0.9, rms within 15 % (judgement; no published target)"),
+        Case("S16", "floating box in waves from a measured flap motion (Hadzic et al. 2005): heave, roll, sway",
+             case_path("flapwaves2d", "CaseFloatingWavesHadzic2D_Def.xml"),
+             [Resolution("box/dp 10", 0.01), Resolution("box/dp 20", 0.005)],
+             score_floating_waves, [("heave corr", "heave_corr", "{:.3f}"), ("heave rms %", "heave_rms", PCT),
+                                    ("heave range %", "heave_range", PCT), ("roll corr", "roll_corr", "{:.3f}"),
+                                    ("roll rms %", "roll_rms", PCT), ("roll range %", "roll_range", PCT),
+                                    ("roll lag s", "roll_lag", "{:+.3f}"), ("sway range %", "sway_range", PCT),
+                                    ("corr WP2", "wave_WP2_corr", "{:.3f}")],
+             "amp_max", lambda e: e["amp_max"] <= 0.15,
+             "heave and roll amplitudes (rms and crest to trough over the record) within 10-15 %", slow=True),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),

@@ -27,8 +27,10 @@ MAX_LAG = 0.3                       # s: the lags searched for the best correlat
 
 
 def load_probe(reference_dir: str, probe: int) -> tuple[np.ndarray, np.ndarray]:
-    """(time [s], elevation [m]) of wave probe ``probe`` (0: x = 1.16 m, 1: x = 2.66 m) of the
-    experiment (the file pairs a time column with each record; the records differ in length)."""
+    """(time [s], value) of record ``probe`` of the experiment: 0 / 1 the wave probes at x = 1.16 /
+    2.66 m (elevation [m]), 2 / 3 / 4 the box's heave [m], roll [degrees] and sway [m] (the file pairs
+    a time column with each record; the records differ in length; the roll's times are rounded to
+    10 ms, so some repeat or step back: use them as sample times, not as an ordered axis)."""
     t, z = [], []
     path = os.path.join(reference_dir, DATA, EXP_FILE)
     with open(path, encoding="latin-1") as f:          # its header holds a cp1252 dash
@@ -50,8 +52,9 @@ def gauge_elevation(outdir: str, name: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def probe_scores(t_sph, z_sph, t_exp, z_exp) -> dict:
-    """Correlation, rms ratio − 1, best lag [s] (SPH behind the experiment is positive) and the
-    correlation at that lag, over the experiment's samples within the SPH record."""
+    """Correlation, rms ratio − 1, range (largest less smallest) ratio − 1, best lag [s] (SPH
+    behind the experiment is positive) and the correlation at that lag, over the experiment's
+    samples within the SPH record."""
     sel = (t_exp >= t_sph[0]) & (t_exp <= t_sph[-1] - MAX_LAG)
     te, ze = t_exp[sel], z_exp[sel]
     zs = np.interp(te, t_sph, z_sph)
@@ -60,7 +63,8 @@ def probe_scores(t_sph, z_sph, t_exp, z_exp) -> dict:
     k = int(np.argmax(corr))
     rms_e, rms_s = float(np.sqrt(np.mean(ze ** 2))), float(np.sqrt(np.mean(zs ** 2)))
     return {"corr": float(np.corrcoef(zs, ze)[0, 1]), "rms": rms_s / rms_e - 1.0,
-            "lag": float(lags[k]), "corr_lag": float(corr[k]), "rms_exp": rms_e, "rms_sph": rms_s,
+            "range": float(np.ptp(zs) / np.ptp(ze)) - 1.0, "lag": float(lags[k]),
+            "corr_lag": float(corr[k]), "rms_exp": rms_e, "rms_sph": rms_s,
             "t0": float(te[0]), "t1": float(te[-1])}
 
 
