@@ -59,8 +59,9 @@ def from_start(t: np.ndarray, v: np.ndarray, t0: float) -> np.ndarray:
 
 def body_scores(outdir: str, reference_dir: str, with_waves: bool = True) -> dict:
     """``heave_corr``, ``heave_rms``, ``heave_range``, ``heave_lag`` ... for heave, roll and sway;
-    ``amp_max``: the largest |rms − 1| and |range − 1| of heave and roll (TOLERANCES S16: their
-    amplitudes within 10–15 %); with ``with_waves``, the wave gauges' scores of W3 as well."""
+    ``amp_max``: the largest |rms| and |range| (each a ratio − 1) of heave and roll (TOLERANCES
+    S16: their amplitudes within 10–15 %); ``corr_min`` of heave and roll; with ``with_waves``,
+    the wave gauges' scores of W3 as well (``wave_WP1_corr`` ...)."""
     sph = body_records(outdir)
     out: dict = {}
     for name, column in RECORDS.items():
