@@ -11,7 +11,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
     python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1, W1, W2, W3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
-                                             # and S16 (floating box in waves; dp 0.005 takes ~1.5 h)
+                                             # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).

@@ -18,7 +18,6 @@ import numpy as np
 from .runs import gauge_table
 
 
-
 def linear_period(length: float, depth: float, g: float = 9.81, mode: int = 1) -> float:
     k = mode * math.pi / length
     return 2 * math.pi / math.sqrt(g * k * math.tanh(k * depth))
