@@ -583,6 +583,7 @@ class SPHRun:
             axes = [k for k in periodic if not (c["is2d"] and k == "y")]
             normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
                                         Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
+            normals0 = self._mdbc_only_on(normals0, p, fluidcount, str(params.get("MdbcMkbound") or "").strip())
         # the solids that move boundary particles, and the damping zones: each only when
         # the case has it
         self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)
@@ -612,6 +613,23 @@ class SPHRun:
         self.case_id = case_identity(p, c)             # written into restart.h5; --resume checks it
         self.dtmin_run = 0
         self.dtmin_seen = 0
+
+    @staticmethod
+    def _mdbc_only_on(normals, p, fluidcount: int, mkbound_list: str):
+        """``MdbcMkbound``: the normals of the listed mkbounds only (the others keep DBC)."""
+        if not mkbound_list:
+            return normals
+        from .case.normals import keep_normals_of
+        from .coupling import body_labels
+        try:
+            normals, missing = keep_normals_of(normals, body_labels(p["mk"], fluidcount), p["type"], mkbound_list)
+        except ValueError as exc:
+            raise InputError(f"MdbcMkbound '{mkbound_list}': {exc} (expected mkbound values and ranges "
+                             "such as '0-3,7')") from None
+        if missing:
+            warnings.warn(f"MdbcMkbound '{mkbound_list}': no boundary particles of mkbound "
+                          f"{', '.join(map(str, missing))}")
+        return normals
 
     def _hook(self, solver, t, dt):
         """The end of each step: imposed motions, floating bodies, damping zones."""

@@ -204,3 +204,20 @@ def boundary_normals(pos: np.ndarray, ptype: np.ndarray, dp: float, is2d: bool,
         out[bound] = _normals_kernel(np.ascontiguousarray(bpos), nb, np.ascontiguousarray(fpos), float(dp),
                                      bool(is2d), centroid)
     return out
+
+
+def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
+                    mkbound_list: str) -> tuple[np.ndarray, list[int]]:
+    """The normals with those of every boundary particle whose mkbound is not in
+    ``mkbound_list`` (DualSPHysics's mk-list form, ``"0-3,7"``) set to zero: mDBC acts
+    on the listed boundaries and floating bodies only, the others keep DBC (a particle
+    without a normal is a DBC particle, as in DualSPHysics).  ``mkbound``: GenCase's
+    mkbound of each particle (any value for fluid ones).  Returns the normals and the
+    listed mkbounds that no boundary particle has.  Raises ValueError for a bad list."""
+    from .mkrange import parse_mk_range
+    wanted = np.asarray(parse_mk_range(mkbound_list), dtype=np.int64)
+    bound = ptype != 3
+    keep = bound & np.isin(mkbound, wanted)
+    out = np.where(keep[:, None], normals, 0.0)
+    present = set(np.unique(mkbound[bound]).tolist())
+    return out, [int(m) for m in wanted if int(m) not in present]

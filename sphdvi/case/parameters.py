@@ -37,6 +37,9 @@ PARAMETERS: dict[str, Param] = {
     "MdbcThreshold": Param("float", 0.0, "mDBC kernel-sum threshold (SlipMode 1 only)", (), 0.0, 1.0),
     "MdbcGhostVelocity": Param("int", 1, "sphdvi: mDBC SlipMode 2, 3 ghost-node velocity 1:first-order "
                                "corrected, 0:Shepard average (DualSPHysics v5.4)", (0, 1)),
+    "MdbcMkbound": Param("str", "", "sphdvi: the mkbound list ('0-3,7') of the boundaries and floating bodies "
+                         "mDBC acts on, the others keeping DBC (empty: all; DualSPHysics gives normals to "
+                         "what its <normals> element names)"),
     "NoPenetration": Param("int", 0, "mDBC no-penetration correction (SlipMode 2, 3 only)", (0, 1)),
     "StepAlgorithm": Param("int", 1, "1:Verlet, 2:Symplectic", (1, 2)),
     "VerletSteps": Param("int", 40, "Verlet: steps between Euler steps (0: Euler every step)", (), 0, 1e9),

@@ -13,6 +13,16 @@ interpolation (Liu & Liu 2006) gives the density and its gradient at g:
 with the matrix A on the left.  Particles with N_b = 0 keep plain DBC
 behaviour in every mode.
 
+Floating bodies: with SlipMode 1 their particles with a normal are corrected as
+the walls are (DualSPHysics's ``UseNormalsFt``: the correction runs over every
+particle, fluid excluded), the normals turning with the body
+(:mod:`sphdvi.coupling`); the fluid force on the body then comes from the
+extrapolated pressure instead of the DBC density, and the water no longer keeps
+the DBC gap of ~1 dp off the body.  With SlipMode 2 and 3 a floating body keeps
+DBC (the solver warns): the mDBC2 switch-off of dry particles and the tangential
+ghost velocity act on wall neighbours only, and a floating particle's force is
+summed from its own side.
+
 SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
     rho_b = rho_g + (r_b - g) . grad rho_g; the Shepard value
     sum m w / sum V w where |det A| is below ``threshold`` (1e-3); with a kernel
@@ -243,14 +253,14 @@ def _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz
 @njit(cache=True, error_model="numpy")
 def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell,
                 ncx, ncy, ncz, cst, threshold, ksum_min, rhop):
-    """SlipMode 1: density only (module docstring)."""
+    """SlipMode 1: density only, walls and floating particles (module docstring)."""
     rhop0 = cst[10]
     n = 3 if is2d else 4
     a = np.zeros((4, 4))
     b = np.zeros((4, 1))
     novel = np.zeros(0)
     for i in range(i0, i1):
-        if ptype[i] >= 2:
+        if ptype[i] == 3:
             continue
         o = oi[i]   # row of particle i in normals and rhop
         nx = normals[o, 0]
@@ -395,8 +405,9 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
 
 @njit(cache=True, error_model="numpy")
 def _refresh_packed(i0, i1, is2d, ptype, oi, rhop, cst, nb):
+    """Packed density, pressure and 1/rho of the boundary and floating rows from ``rhop``."""
     for i in range(i0, i1):
-        if ptype[i] >= 2:
+        if ptype[i] == 3:
             continue
         _set_packed(nb, i, is2d, rhop[oi[i]], cst, False)
 

@@ -169,6 +169,9 @@ class SPHSolver:
                 raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
             self.normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(state.n, 3).copy()
         # mDBC2 (SlipMode 2, 3) with moving walls: their acceleration, for the pressure cloning
+        if self.boundary == 2 and self.slip > 1 and np.any(self.normals[state.ptype == 2] != 0.0):
+            warnings.warn(f"SlipMode {self.slip}: the floating bodies keep DBC (mDBC acts on floating "
+                          "bodies with SlipMode 1 only)")
         self._wall_ace_on = self.boundary == 2 and self.slip > 1 and bool(np.any(state.ptype == 1))
         if self._wall_ace_on:
             self.wall_ace = np.zeros((state.n, 3))
@@ -709,7 +712,7 @@ class SPHSolver:
             fn(self.kernel, self.is2d, nb, ptype_e, np.arange(ne), normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
                self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
-            bound = (order < n) & (ptype_e < 2)
+            bound = (order < n) & ((ptype_e < 2) | ((ptype_e == 2) & (self.slip == 1)))
             s.rhop[order[bound]] = rhop_e[bound]
             if self.nopen and self._need_nopen:
                 ar_e = np.arange(ne)

@@ -241,6 +241,30 @@ def test_mdbc_from_case(tmp_path, slip):
     assert layered.mean() > 0.9 and np.isclose(lengths.min(), 0.02)   # walls; corners and tops differ
 
 
+def test_mdbc_on_the_floating_box_only(tmp_path):
+    """``--set MdbcMkbound=5`` with Boundary=2: the S12 box (mkbound 5) gets mDBC normals and
+    its particles the extrapolated density, the tank's single-layer walls (mkbound 0) none,
+    so they stay DBC; a bad list is an input error (exit 2), an absent mkbound a warning."""
+    case = REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
+    out = tmp_path / "o"
+    with pytest.warns(UserWarning, match="MdbcMkbound '5,7': no boundary particles of mkbound 7"):
+        r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.01", "--threads", "1", "-q",
+                    "--set", "Boundary=2", "--set", "MdbcMkbound=5,7"])
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "restart.h5") as f:
+        normals = f["aux/normals"][...]
+        ptype = f["state/ptype"][...]
+        rhop = f["state/rhop"][...]
+    lengths = np.linalg.norm(normals, axis=1)
+    assert np.all(lengths[ptype == 0] == 0) and np.all(lengths[ptype == 1] == 0)
+    assert np.all(lengths[ptype == 2] > 0)
+    # the box's wet particles: the water's pressure extrapolated, not DBC's rho0 start
+    assert rhop[ptype == 2].max() > 1000.5
+    bad = invoke(["run", case, "-o", tmp_path / "b", "--tmax", "0.01", "-q",
+                  "--set", "Boundary=2", "--set", "MdbcMkbound=five"])
+    assert bad.exit_code == 2 and "MdbcMkbound 'five'" in bad.output and "Traceback" not in bad.output
+
+
 def test_dtfixedfile_from_case(tmp_path):
     """DtFixedFile: a (time [s], dt [ms]) file next to the case sets every dt; a
     missing or malformed file is a case error (exit 2) naming the file."""

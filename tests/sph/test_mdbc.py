@@ -108,3 +108,40 @@ def test_corrector_without_mdbc_keeps_the_predicted_wall_density():
     sa, sr = a.state.sorted_by_idp(), s.sorted_by_idp()
     for x, y in ((sa.pos, sr.pos), (sa.vel, sr.vel), (sa.rhop, sr.rhop)):
         assert np.array_equal(x, y)
+
+
+def _tank_with_a_floating_floor(slip):
+    """The hydrostatic column of the first test with a stretch of its floor (all three
+    layers, 0.1 < x < 0.2) turned into floating particles, normals as the walls'."""
+    dp = 0.01
+    st, c = tank_2d(0.3, 0.3, 0.3, 0.2, dp, layers=3)
+    nor = tank_normals_2d(st, 0.3, dp)
+    x, z = st.pos[:, 0], st.pos[:, 2]
+    body = (st.ptype == 0) & (z <= 0) & (x > 0.1) & (x < 0.2)
+    st.ptype[body] = 2
+    st.rhop[st.ptype < 3] = c["rhop0"]
+    sol = SPHSolver(st, c, {"Boundary": 2, "SlipMode": slip}, normals=nor)
+    return sol, body, c, dp
+
+
+def test_mdbc_sets_the_density_of_floating_particles_with_slipmode_1():
+    """SlipMode 1 corrects floating particles with a normal as it does walls
+    (DualSPHysics's UseNormalsFt): their density is the hydrostatic one at the particle,
+    to the accuracy of the walls beside them."""
+    sol, body, c, dp = _tank_with_a_floating_floor(1)
+    sol.compute_rates()
+    s = sol.state
+    top = 0.2 + 0.5 * dp
+    rho_h = c["rhop0"] * (1 + c["rhop0"] * 9.81 * (top - s.pos[:, 2]) / c["b"]) ** (1 / c["gamma"])
+    err = np.abs(s.rhop[body] - rho_h[body]) / (rho_h[body] - c["rhop0"])
+    assert body.sum() == 27 and err.max() < 1e-3
+
+
+def test_floating_particles_keep_dbc_with_slipmode_2_and_3():
+    """SlipMode 2, 3 leave the floating particles to DBC and say so."""
+    import pytest
+    for slip in (2, 3):
+        with pytest.warns(UserWarning, match=f"SlipMode {slip}: the floating bodies keep DBC"):
+            sol, body, c, dp = _tank_with_a_floating_floor(slip)
+        sol.compute_rates()
+        assert np.all(sol.state.rhop[body] == c["rhop0"])
