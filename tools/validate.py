@@ -11,7 +11,8 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
     python tools/validate.py                 # the fast cases (S1/S2, S3, S7, S9, S10, S12, A1, W1, W2, W3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
-                                             # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads)
+                                             # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
+                                             # S16M: S16 with mDBC on the box (dp 0.02 and 0.01, 16 min)
     python tools/validate.py S9 --csv s9.csv --keep runs/
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
@@ -38,6 +39,9 @@ REFERENCE = os.path.join(os.path.dirname(REPO), "shared", "reference")
 
 def case_path(folder: str, name: str) -> str:
     return os.path.join(REPO, "cases", folder, name)
+
+
+MDBC_BOX = ["--set", "Boundary=2", "--set", "MdbcMkbound=50"]     # S16M: mDBC on the floating box only
 
 
 @dataclass
@@ -257,6 +261,16 @@ def cases() -> list:
                                     ("corr WP2", "wave_WP2_corr", "{:.3f}")],
              "amp_max", lambda e: e["amp_max"] <= 0.15,
              "heave and roll amplitudes (rms and crest to trough over the record) within 10-15 %", slow=True),
+        Case("S16M", "S16 with mDBC on the box only (--set Boundary=2 --set MdbcMkbound=50; walls and flap DBC)",
+             case_path("flapwaves2d", "CaseFloatingWavesHadzic2D_Def.xml"),
+             [Resolution("box/dp 5", 0.02, MDBC_BOX), Resolution("box/dp 10", 0.01, MDBC_BOX)],
+             score_floating_waves, [("heave corr", "heave_corr", "{:.3f}"), ("heave rms %", "heave_rms", PCT),
+                                    ("heave range %", "heave_range", PCT), ("roll corr", "roll_corr", "{:.3f}"),
+                                    ("roll rms %", "roll_rms", PCT), ("roll range %", "roll_range", PCT),
+                                    ("roll lag s", "roll_lag", "{:+.3f}"), ("sway range %", "sway_range", PCT),
+                                    ("corr WP2", "wave_WP2_corr", "{:.3f}")],
+             "amp_max", lambda e: e["amp_max"] <= 0.15,
+             "heave and roll amplitudes (rms and crest to trough over the record) within 10-15 %", slow=True),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),
@@ -310,7 +324,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S4 S7 S8 S9 S10 S12 A1 W1 W2); default: all but the slow S4 and S8")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S4 S7 S8 S9 S10 S12 S16 S16M A1 W1 W2 W3); default: all but the slow S4, S8, S16 and S16M")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
