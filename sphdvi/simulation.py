@@ -584,6 +584,10 @@ class SPHRun:
             normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
                                         Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
             normals0 = self._mdbc_only_on(normals0, p, fluidcount, str(params.get("MdbcMkbound") or "").strip())
+            from .case.normals import mdbc_floating_mask
+            from .coupling import body_labels
+            mdbc_floating = mdbc_floating_mask(p["type"], body_labels(p["mk"], fluidcount), params)
+            state.mass[mdbc_floating & np.any(normals0 != 0.0, axis=1)] = float(c["massbound"])
         # the solids that move boundary particles, and the damping zones: each only when
         # the case has it
         self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)

@@ -221,3 +221,21 @@ def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
     out = np.where(keep[:, None], normals, 0.0)
     present = set(np.unique(mkbound[bound]).tolist())
     return out, [int(m) for m in wanted if int(m) not in present]
+
+
+def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict) -> np.ndarray:
+    """The floating particles mDBC corrects: ``Boundary`` 2 with ``SlipMode`` 1, of the
+    mkbounds ``MdbcMkbound`` lists (every floating body without a list).  The fluid sees each
+    of them with the lattice's volume dp^d, its mass rho0 dp^d (``MassBound``), not its share of
+    the body's mass: a boundary particle whose density is extrapolated from the water does not
+    rise as a DBC particle's does to make up for a small mass, so a light body's particles would
+    be a soft wall that the water slips through (S12's box, rho/rho0 0.5, flooded within 1 s).
+    The body's mass and inertia stay the case's (the multibody system's)."""
+    from .mkrange import parse_mk_range
+    floating = np.asarray(ptype) == 2
+    if int(params.get("Boundary", 1)) != 2 or int(params.get("SlipMode", 1)) != 1:
+        return np.zeros_like(floating)
+    listed = str(params.get("MdbcMkbound") or "").strip()
+    if not listed:
+        return floating
+    return floating & np.isin(mkbound, np.asarray(parse_mk_range(listed), dtype=np.int64))

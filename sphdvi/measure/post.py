@@ -63,9 +63,22 @@ class RunOutput:
         p = self.data["particles"]
         idp = np.asarray(p["idp"], np.int64)
         self.mass_by_idp = np.zeros(int(idp.max(initial=-1)) + 1)
-        self.mass_by_idp[idp] = p["mass"]
         self.fluidcount = int((self.data["json"].get("mkconfig") or {}).get("fluidcount", 0))
+        self.mass_by_idp[idp] = self._run_masses(p)
         self.vtk_path = os.path.join(outdir, "particles.vtkhdf")
+
+    def _run_masses(self, p) -> np.ndarray:
+        """The particle masses the run used: the case's, but rho0 dp^d for the floating
+        particles mDBC corrects (:func:`sphdvi.case.normals.mdbc_floating_mask`)."""
+        from ..case.normals import mdbc_floating_mask
+        from ..coupling import body_labels
+        mass = np.array(p["mass"], float)
+        try:
+            mask = mdbc_floating_mask(p["type"], body_labels(p["mk"], self.fluidcount), self.params)
+        except ValueError:
+            return mass         # a bad MdbcMkbound: the run refused it
+        mass[mask] = float(self.data["constants"]["massbound"])
+        return mass
 
     @property
     def has_particles(self) -> bool:

@@ -18,7 +18,11 @@ the walls are (DualSPHysics's ``UseNormalsFt``: the correction runs over every
 particle, fluid excluded), the normals turning with the body
 (:mod:`sphdvi.coupling`); the fluid force on the body then comes from the
 extrapolated pressure instead of the DBC density, and the water no longer keeps
-the DBC gap of ~1 dp off the body.  With SlipMode 2 and 3 a floating body keeps
+the DBC gap of ~1 dp off the body.  The fluid sees those particles with the
+lattice's mass rho0 dp^d (:func:`sphdvi.case.normals.mdbc_floating_mask`), not
+their share of the body's mass as DualSPHysics does: an extrapolated density
+does not rise to make up for a light body's small particle mass as a DBC
+density does, and the water slipped into the particles of a box of rho/rho0 0.5.  With SlipMode 2 and 3 a floating body keeps
 DBC (the solver warns): the mDBC2 switch-off of dry particles and the tangential
 ghost velocity act on wall neighbours only, and a floating particle's force is
 summed from its own side.

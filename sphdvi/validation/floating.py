@@ -39,3 +39,32 @@ def draft_errors(outdir: str, settle: float = 1.0, x0: float = 0.5) -> dict:
     return {"draft_dp": float((np.mean(zs) - bottom_eq) / dp),
             "drift_dp": float(np.max(np.abs(np.array(xs) - x0)) / dp),
             "tilt_deg": float(np.max(np.abs(tilt))), "dp": dp}
+
+
+def fluid_inside_box(outdir: str, settle: float = 0.0) -> dict:
+    """Water inside a rectangular floating body: at each output from ``settle`` on, the fluid
+    particles within the rectangle of the body's particle centres, taken in the body's own axes
+    (the principal axes of its particles, so that a rolled box is measured as drawn). 2D (x, z).
+    ``max_count`` and ``last_count`` of those particles, ``max_depth_dp``: how far the deepest
+    one lies inside the outer particle row (dp)."""
+    from ..io.vtkhdf import read_step, step_times
+    from .runs import case_data
+    dp = case_data(outdir)["constants"]["dp"]
+    path = os.path.join(outdir, "particles.vtkhdf")
+    counts, depth = [], 0.0
+    for k, t in enumerate(step_times(path)):
+        if t < settle:
+            continue
+        s = read_step(path, k)
+        xz = s["points"][:, [0, 2]]
+        body = xz[s["Type"] == 2]
+        centre = body.mean(axis=0)
+        axes = np.linalg.eigh(np.cov((body - centre).T))[1]
+        local = (body - centre) @ axes
+        lo, hi = local.min(axis=0), local.max(axis=0)
+        fluid = (xz[s["Type"] == 3] - centre) @ axes
+        inside = np.all((fluid > lo) & (fluid < hi), axis=1)
+        counts.append(int(inside.sum()))
+        if inside.any():
+            depth = max(depth, float(np.minimum(fluid[inside] - lo, hi - fluid[inside]).min(axis=1).max()))
+    return {"max_count": max(counts), "last_count": counts[-1], "max_depth_dp": depth / dp}

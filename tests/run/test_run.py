@@ -260,9 +260,29 @@ def test_mdbc_on_the_floating_box_only(tmp_path):
     assert np.all(lengths[ptype == 2] > 0)
     # the box's wet particles: the water's pressure extrapolated, not DBC's rho0 start
     assert rhop[ptype == 2].max() > 1000.5
+    # the fluid sees the box's particles with the lattice's mass rho0 dp^2, not the body's share
+    # (rhopbody 500: half of it); `sphdvi measure` takes the same masses
+    with h5py.File(out / "restart.h5") as f:
+        mass = f["state/mass"][...]
+        idp = f["state/idp"][...]
+    assert np.allclose(mass[ptype == 2], 1000 * 0.01 ** 2)
+    from sphdvi.measure.post import RunOutput
+    assert np.allclose(RunOutput(str(out)).mass_by_idp[idp[ptype == 2]], 1000 * 0.01 ** 2)
     bad = invoke(["run", case, "-o", tmp_path / "b", "--tmax", "0.01", "-q",
                   "--set", "Boundary=2", "--set", "MdbcMkbound=five"])
     assert bad.exit_code == 2 and "MdbcMkbound 'five'" in bad.output and "Traceback" not in bad.output
+
+
+def test_mdbc_floating_mask():
+    """The floating particles mDBC corrects, whose mass the fluid takes as rho0 dp^d: Boundary 2
+    with SlipMode 1 only, of the MdbcMkbound list when there is one."""
+    from sphdvi.case.normals import mdbc_floating_mask
+    ptype = np.array([0, 2, 2, 3])
+    mkbound = np.array([0, 5, 7, 0])
+    assert not mdbc_floating_mask(ptype, mkbound, {}).any()
+    assert not mdbc_floating_mask(ptype, mkbound, {"Boundary": 2, "SlipMode": 2}).any()
+    assert mdbc_floating_mask(ptype, mkbound, {"Boundary": "2"}).tolist() == [False, True, True, False]
+    assert mdbc_floating_mask(ptype, mkbound, {"Boundary": 2, "MdbcMkbound": "7"}).tolist() == [False, False, True, False]
 
 
 def test_dtfixedfile_from_case(tmp_path):
