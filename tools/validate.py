@@ -123,6 +123,18 @@ def _wave_flume_case(name, paddle, xml):
                 "incident wave height within 10 % of the target (judgement; DualSPHysics advises H/dp >= 10)")
 
 
+def _floating_waves_case(name, title, resolutions):
+    """S16/S16M: the floating box in the Hadzic flume, scored on its heave, roll and sway (slow)."""
+    return Case(name, title, case_path("flapwaves2d", "CaseFloatingWavesHadzic2D_Def.xml"), resolutions,
+                score_floating_waves, [("heave corr", "heave_corr", "{:.3f}"), ("heave rms %", "heave_rms", PCT),
+                                       ("heave range %", "heave_range", PCT), ("roll corr", "roll_corr", "{:.3f}"),
+                                       ("roll rms %", "roll_rms", PCT), ("roll range %", "roll_range", PCT),
+                                       ("roll lag s", "roll_lag", "{:+.3f}"), ("sway range %", "sway_range", PCT),
+                                       ("corr WP2", "wave_WP2_corr", "{:.3f}")],
+                "amp_max", lambda e: e["amp_max"] <= 0.15,
+                "heave and roll amplitudes (rms and crest to trough over the record) within 10-15 %", slow=True)
+
+
 def score_sloshing_impact(outdir):
     from sphdvi.validation.sloshing_impact import impact_errors
     return impact_errors(outdir, REFERENCE)
@@ -251,26 +263,11 @@ def cases() -> list:
                                 ("lag WP1 s", "WP1_lag", "{:+.3f}"), ("lag WP2 s", "WP2_lag", "{:+.3f}")],
              "rms_max", lambda e: e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15,
              "correlation with the measured probes >= 0.9, rms within 15 % (judgement; no published target)"),
-        Case("S16", "floating box in waves from a measured flap motion (Hadzic et al. 2005): heave, roll, sway",
-             case_path("flapwaves2d", "CaseFloatingWavesHadzic2D_Def.xml"),
-             [Resolution("box/dp 10", 0.01), Resolution("box/dp 20", 0.005)],
-             score_floating_waves, [("heave corr", "heave_corr", "{:.3f}"), ("heave rms %", "heave_rms", PCT),
-                                    ("heave range %", "heave_range", PCT), ("roll corr", "roll_corr", "{:.3f}"),
-                                    ("roll rms %", "roll_rms", PCT), ("roll range %", "roll_range", PCT),
-                                    ("roll lag s", "roll_lag", "{:+.3f}"), ("sway range %", "sway_range", PCT),
-                                    ("corr WP2", "wave_WP2_corr", "{:.3f}")],
-             "amp_max", lambda e: e["amp_max"] <= 0.15,
-             "heave and roll amplitudes (rms and crest to trough over the record) within 10-15 %", slow=True),
-        Case("S16M", "S16 with mDBC on the box only (--set Boundary=2 --set MdbcMkbound=50; walls and flap DBC)",
-             case_path("flapwaves2d", "CaseFloatingWavesHadzic2D_Def.xml"),
-             [Resolution("box/dp 5", 0.02, MDBC_BOX), Resolution("box/dp 10", 0.01, MDBC_BOX)],
-             score_floating_waves, [("heave corr", "heave_corr", "{:.3f}"), ("heave rms %", "heave_rms", PCT),
-                                    ("heave range %", "heave_range", PCT), ("roll corr", "roll_corr", "{:.3f}"),
-                                    ("roll rms %", "roll_rms", PCT), ("roll range %", "roll_range", PCT),
-                                    ("roll lag s", "roll_lag", "{:+.3f}"), ("sway range %", "sway_range", PCT),
-                                    ("corr WP2", "wave_WP2_corr", "{:.3f}")],
-             "amp_max", lambda e: e["amp_max"] <= 0.15,
-             "heave and roll amplitudes (rms and crest to trough over the record) within 10-15 %", slow=True),
+        _floating_waves_case("S16", "floating box in waves from a measured flap motion (Hadzic et al. 2005): "
+                             "heave, roll, sway", [Resolution("box/dp 10", 0.01), Resolution("box/dp 20", 0.005)]),
+        _floating_waves_case("S16M", "S16 with mDBC on the box only (--set Boundary=2 --set MdbcMkbound=50; "
+                             "walls and flap DBC)",
+                             [Resolution("box/dp 5", 0.02, MDBC_BOX), Resolution("box/dp 10", 0.01, MDBC_BOX)]),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),

@@ -22,10 +22,10 @@ the DBC gap of ~1 dp off the body.  The fluid sees those particles with the
 lattice's mass rho0 dp^d (:func:`sphdvi.case.normals.mdbc_floating_mask`), not
 their share of the body's mass as DualSPHysics does: an extrapolated density
 does not rise to make up for a light body's small particle mass as a DBC
-density does, and the water slipped into the particles of a box of rho/rho0 0.5.  With SlipMode 2 and 3 a floating body keeps
-DBC (the solver warns): the mDBC2 switch-off of dry particles and the tangential
-ghost velocity act on wall neighbours only, and a floating particle's force is
-summed from its own side.
+density does, and the water slipped into the particles of a box of rho/rho0
+0.5.  With SlipMode 2 and 3 a floating body keeps DBC (the solver warns): the
+mDBC2 switch-off of dry particles and the tangential ghost velocity act on wall
+neighbours only, and a floating particle's force is summed from its own side.
 
 SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
     rho_b = rho_g + (r_b - g) . grad rho_g; the Shepard value
