@@ -7,9 +7,10 @@ Two kinds, as in DualSPHysics:
   ``CalcMotion`` / ``MoveLinBound`` / ``MoveMatBound``);
 * :class:`FloatingBodies`: floating particles (type 2) move with rigid bodies that
   the multibody engine (``sphdvi.dvi``, the Chrono NSC DVI) integrates, driven by
-  the force and moment the fluid and gravity exert on the bodies' particles,
+  the force and moment the fluid exerts on the bodies' particles,
   F = sum m_k a_k and T = sum (r_k - R) x m_k a_k (DualSPHysics's ``FtPartsSumAce``
-  and ``FtComputeAceVel``, Canelas et al. 2018); the particles then take the
+  and ``FtComputeAceVel``, Canelas et al. 2018; a floating particle's a_k has no
+  gravity: the multibody system adds m g to each body); the particles then take the
   body's rigid-body motion, v_k = V + Omega x (r_k - R) (``FtPartsUpdate``), their
   positions by the exact rigid transform of their body-frame offsets rather than by
   dt times their old velocity.
@@ -91,8 +92,8 @@ class FloatingBodies:
 
     def loads(self, solver, sel: np.ndarray, body: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Force and moment about each body's centre of the accelerations of its particles
-        (``sel``: rows of the floating particles, ``body``: their body): fluid plus gravity,
-        in 2D restricted to the x-z plane."""
+        (``sel``: rows of the floating particles, ``body``: their body): the fluid's alone
+        (gravity is the multibody system's), in 2D restricted to the x-z plane."""
         s = solver.state
         nb = self.system.nb
         f = s.mass[sel, None] * solver.ace[sel]
@@ -107,7 +108,7 @@ class FloatingBodies:
 
     def step(self, solver, dt: float) -> None:
         """Advance the bodies by ``dt`` under this step's loads and carry their particles
-        (``solver.ace`` holds this step's accelerations, gravity included)."""
+        (``solver.ace`` holds this step's accelerations; a floating particle's has no gravity)."""
         s = solver.state
         sel = np.flatnonzero(s.ptype == 2)
         body = self.body_of_idp[s.idp[sel]]
