@@ -29,10 +29,18 @@ neighbours only, and a floating particle's force is summed from its own side.
 
 SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
     rho_b = rho_g + (r_b - g) . grad rho_g; the Shepard value
-    sum m w / sum V w where |det A| is below ``threshold`` (1e-3); with a kernel
-    sum sum V w at g not above ``MdbcThreshold`` the density is left as it is;
-    the result is clamped to rho >= rho0.  The wall particle shows the fluid its
-    own (wall) velocity.
+    sum m w / sum V w where |det A| is below ``threshold`` (1e-3); with no fluid
+    particle within reach of g (sum V w = 0) rho_b = rho0; with a kernel sum
+    not above ``MdbcThreshold`` (default 0; DualSPHysics v5.4 has none) the
+    density is left as it is.  Not clamped: where the hydrostatic line extends
+    above a free surface rho_b falls below rho0 and the fluid sees a negative
+    wall pressure for that interaction, as DualSPHysics v5.4
+    (``JSphCpu_mdbc.cpp`` InteractionMdbcCorrectionT2); the integrator's
+    rho >= rho0 for boundary particles holds between corrections.  (sphdvi
+    clamped the result to rho0 until 2026-11: S16M's roll rms was -23.0 /
+    -8.6 % at box/dp 5 / 10 against -15.2 / -10.5 % now; README, S16.)  The
+    wall particle shows
+    the fluid its own (wall) velocity.
 
 SlipMode 2 (no-slip) and 3 (free-slip): DualSPHysics's mDBC2 with a choice of
 ghost velocity (``JSphCpu_mdbc.cpp`` InteractionMdbc2CorrectionT2, ``JSphGpu_mdbc_iker.cu``
@@ -274,7 +282,10 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, in
             continue
         _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
                     i, nx, ny, nz, a, b, novel)
-        if a[0, 0] <= ksum_min or a[0, 0] <= 0.0:
+        if a[0, 0] <= 0.0:
+            rhop[o] = rhop0
+            continue
+        if a[0, 0] <= ksum_min:
             continue
         # Shepard value, kept where the corrected system is near-singular
         rho = b[0, 0] / a[0, 0]
@@ -283,7 +294,7 @@ def _mdbc_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, in
                 rho = b[0, 0] - 2.0 * (nx * b[1, 0] + nz * b[2, 0])
             else:
                 rho = b[0, 0] - 2.0 * (nx * b[1, 0] + ny * b[2, 0] + nz * b[3, 0])
-        rhop[o] = max(rho, rhop0)
+        rhop[o] = rho
 
 
 @njit(cache=True, error_model="numpy")

@@ -30,6 +30,31 @@ def test_mdbc_extrapolates_hydrostatic_density_to_the_walls():
     assert np.all(dbc.state.rhop[dbc.state.ptype < 2] == c["rhop0"])
 
 
+def test_mdbc_slipmode_1_extrapolates_below_rho0_and_sets_dry_walls_to_rho0():
+    """DualSPHysics v5.4 (JSphCpu_mdbc.cpp, InteractionMdbcCorrectionT2): the extrapolated
+    density is stored as it comes, below rho0 where the hydrostatic line extends above
+    the free surface (sphdvi clamped it to rho0 until 2026-11), and a boundary particle whose ghost node has no fluid within reach
+    gets rho0, whatever its density was."""
+    dp = 0.01
+    st, c = tank_2d(0.3, 0.3, 0.3, 0.2, dp, layers=3)
+    st.rhop[st.ptype < 2] = 1.01 * c["rhop0"]
+    sol = SPHSolver(st, c, {"Boundary": 2}, normals=tank_normals_2d(st, 0.3, dp))
+    sol.compute_rates()
+    s = sol.state
+    rho0 = c["rhop0"]
+    top = 0.2 + 0.5 * dp
+    rho_h = rho0 * (1 + rho0 * 9.81 * (top - s.pos[:, 2]) / c["b"]) ** (1 / c["gamma"])
+    outer = (s.ptype == 0) & (s.pos[:, 0] < s.pos[s.ptype == 0, 0].min() + 0.5 * dp)
+    z = s.pos[:, 2]
+    above = outer & np.isclose(z, top + 0.5 * dp)          # ghost node dp/2 above the surface
+    assert above.sum() == 1
+    assert s.rhop[above][0] < rho0
+    # the hydrostatic line's value there to 0.16 % of its deficit (clamped: 100 %)
+    assert abs(s.rhop[above][0] - rho_h[above][0]) < 0.01 * (rho0 - rho_h[above][0])
+    dry = outer & (z > top + 2 * dp)
+    assert dry.sum() > 5 and np.all(s.rhop[dry] == rho0)
+
+
 def test_mdbc_tank_runs_and_stays_still():
     dp = 0.02
     st, c = tank_2d(0.4, 0.4, 0.4, 0.3, dp, layers=3, bound_hydrostatic=True)

@@ -11,7 +11,7 @@ assumes. Measured: −0.72 % (d/dp = 20), −0.71 % (d/dp = 40); amplitude loss 
 earlier free-slip, which reflected the ghost velocity in continuity and viscosity alike: −0.88 / −0.71 %,
 4.2 / 4.0 %). With the default SlipMode 1 the
 walls carry Stokes layers of the artificial viscosity (ν_eff ≈ 0.46 α h c0/8 ≈ 1.1e-3 m²/s at
-d/dp = 20): period −1.46 / −0.72 %, loss 9.3 / 8.0 % per period, against 8.7 / 5.7 % from linear
+d/dp = 20): period −1.46 / −0.78 %, loss 10.3 / 8.9 % per period, against 8.7 / 5.7 % from linear
 theory with ν_eff (bulk 2νk² plus the walls' Stokes layers, :func:`viscous_decay_per_period`).
 At coefh 1.0 (h = √2 dp) the period is ~5 % short at every resolution and does not converge with
 dp (−5.4 %, −4.6 %), with or without walls, whatever the initial condition, boundary condition,
