@@ -177,12 +177,19 @@ def periodic_axes(data: dict, params: dict) -> list[str]:
 
 
 def special_parameters(data: dict) -> dict:
-    """Parameters with ``<special><shifting>`` applied (it overrides Shifting, ShiftCoef, ShiftTFS)."""
+    """Parameters with ``<special><shifting>`` applied (it overrides Shifting, ShiftCoef, ShiftTFS),
+    and ``MdbcMkbound`` from ``<normals>`` where the case does not write it (the mkbounds its
+    children name get mDBC, the others keep DBC; --set MdbcMkbound overrides)."""
     params = dict(data["parameters"])
     shifting = (data["json"].get("special") or {}).get("shifting") or {}
     for key, name in (("mode", "Shifting"), ("coefficient", "ShiftCoef"), ("fsthreshold", "ShiftTFS")):
         if key in shifting:
             params[name] = shifting[key]
+    if "MdbcMkbound" not in set(data["json"].get("parameters_set", [])):
+        from .case.normals import mkbounds_named_by_normals
+        named = mkbounds_named_by_normals(data["json"].get("normals"))
+        if named:
+            params["MdbcMkbound"] = named
     return params
 
 

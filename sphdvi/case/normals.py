@@ -223,6 +223,22 @@ def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
     return out, [int(m) for m in wanted if int(m) not in present]
 
 
+def mkbounds_named_by_normals(entries: list) -> str:
+    """The mkbound list (``"0,3-5"``) that the case's ``<normals>`` gives normals to, as
+    :func:`sphdvi.case.reader.read_normals` stores its children; ``""`` (every boundary and
+    floating body) when the case has no ``<normals>`` or a child names no mkbound (a
+    ``norgeometry`` over a geometry file covers all that it touches).  GenCase sets mDBC
+    normals only where ``<normals>`` says, and DualSPHysics corrects only particles with a
+    normal: the others keep DBC."""
+    lists = []
+    for entry in entries or []:
+        listed = str(entry.get("mkbound") or "").strip()
+        if not listed:
+            return ""
+        lists.append(listed)
+    return ",".join(lists)
+
+
 def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict) -> np.ndarray:
     """The floating particles mDBC corrects: ``Boundary`` 2 with ``SlipMode`` 1, of the
     mkbounds ``MdbcMkbound`` lists (every floating body without a list).  The fluid sees each

@@ -578,15 +578,32 @@ def load_xml_any(path, reader):
 
 
 def read_normals(reader, casedef) -> list:
+    """``<normals>`` (GenCase's mDBC normals: norgeometry, norplane, norsphere, ...): each
+    child as a dict.  sphdvi computes every normal from the particles
+    (:mod:`sphdvi.case.normals`); what it takes from here is which boundaries get one:
+    the children's ``mkbound`` lists (:func:`sphdvi.case.normals.mkbounds_named_by_normals`),
+    checked here.  Said once per case, at the first child that names an mkbound."""
     el = reader.child(casedef, "normals")
     out = []
     if el is None:
         return out
+    said = False
     for c in reader.children(el):
         d = {"type": c.tag, "line": c.sourceline}
         for k in c.keys():
             d[k] = c.get(k)
             reader.mark(c, k)
+        if c.get("mkbound") is not None:
+            try:
+                parse_mk_range(c.get("mkbound"))
+            except ValueError as exc:
+                raise reader.error(c, f"mkbound={c.get('mkbound')!r}: {exc}",
+                                   "mkbound values and ranges such as mkbound=\"0-3,7\"") from None
+            if not said:
+                reader.warn(c, "sphdvi computes the mDBC normals from the particles: of <normals> it uses "
+                               "which mkbounds get them (Boundary=2), not the planes, shapes or geometry "
+                               "files that set them in GenCase")
+                said = True
         for sub in reader.children(c):
             d[sub.tag] = reader.vec3(sub, default=None) if any(sub.get(a) is not None for a in "xyz") \
                 else {k: sub.get(k) for k in sub.keys()}

@@ -273,6 +273,51 @@ def test_mdbc_on_the_floating_box_only(tmp_path):
     assert bad.exit_code == 2 and "MdbcMkbound 'five'" in bad.output and "Traceback" not in bad.output
 
 
+def _floating_box_with_normals(tmp_path, normals: str):
+    tmp_path.mkdir(exist_ok=True)
+    case = tmp_path / "CaseBoxNormals_Def.xml"
+    text = (REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml").read_text()
+    assert text.count("</casedef>") == 1
+    case.write_text(text.replace("</casedef>", f"<normals>{normals}</normals></casedef>"))
+    return case
+
+
+def test_normals_element_names_the_mkbounds_that_get_mdbc(tmp_path):
+    """GenCase gives mDBC normals only to what ``<normals>`` names: a norplane of mkbound 5
+    (the S12 box) makes MdbcMkbound 5 (run.json), so the box gets normals and the walls keep
+    DBC; gencase says that the plane itself is not used; --set MdbcMkbound overrides; a
+    child without mkbound (norgeometry) leaves every boundary to mDBC; a bad mkbound is a
+    case error naming the line (exit 2)."""
+    plane = ('<norplane mkbound="5"><point x="0" y="0" z="0" /><normal x="0" y="0" z="1" />'
+             '<maxdisth v="2" /></norplane>')
+    case = _floating_box_with_normals(tmp_path, plane)
+    runs = {}
+    for name, extra in (("named", []), ("set", ["--set", "MdbcMkbound=0,5"])):
+        out = tmp_path / name
+        r = invoke(["run", case, "-o", out, "--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q",
+                    "--set", "Boundary=2", *extra])
+        assert r.exit_code == 0, r.output
+        assert "sphdvi computes the mDBC normals from the particles" in r.output
+        with h5py.File(out / "restart.h5") as f:
+            runs[name] = (np.linalg.norm(f["aux/normals"][...], axis=1), f["state/ptype"][...])
+        runs[name] += (json.loads((out / "run.json").read_text())["parameters"]["MdbcMkbound"],)
+    lengths, ptype, listed = runs["named"]
+    assert listed == "5"
+    assert np.all(lengths[ptype == 0] == 0) and np.all(lengths[ptype == 2] > 0)
+    lengths, ptype, listed = runs["set"]
+    assert listed == "0,5" and np.all(lengths[ptype == 0] > 0)
+    from sphdvi.case.normals import mkbounds_named_by_normals
+    assert mkbounds_named_by_normals([]) == ""
+    assert mkbounds_named_by_normals([{"type": "norplane", "mkbound": "5"},
+                                      {"type": "norsphere", "mkbound": "0-2"}]) == "5,0-2"
+    assert mkbounds_named_by_normals([{"type": "norplane", "mkbound": "5"}, {"type": "norgeometry"}]) == ""
+    bad = _floating_box_with_normals(tmp_path / "bad", plane.replace('mkbound="5"', 'mkbound="five"'))
+    r = invoke(["gencase", bad, "-o", tmp_path / "bad" / "o"])
+    line = bad.read_text().splitlines().index(next(x for x in bad.read_text().splitlines() if "<normals>" in x)) + 1
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    assert f"{bad.name}:{line}: <norplane>: mkbound='five'" in r.output
+
+
 def test_mdbc_floating_mask():
     """The floating particles mDBC corrects, whose mass the fluid takes as rho0 dp^d: Boundary 2
     with SlipMode 1 only, of the MdbcMkbound list when there is one."""
