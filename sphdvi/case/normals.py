@@ -240,7 +240,7 @@ def mkbounds_named_by_normals(entries: list) -> str:
 
 
 def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict) -> np.ndarray:
-    """The floating particles mDBC corrects: ``Boundary`` 2 with ``SlipMode`` 1, of the
+    """The floating particles mDBC corrects: ``Boundary`` 2 (any ``SlipMode``), of the
     mkbounds ``MdbcMkbound`` lists (every floating body without a list).  The fluid sees each
     of them with the lattice's volume dp^d, its mass rho0 dp^d (``MassBound``), not its share of
     the body's mass: a boundary particle whose density is extrapolated from the water does not
@@ -249,7 +249,7 @@ def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict) -> 
     The body's mass and inertia stay the case's (the multibody system's)."""
     from .mkrange import parse_mk_range
     floating = np.asarray(ptype) == 2
-    if int(params.get("Boundary", 1)) != 2 or int(params.get("SlipMode", 1)) != 1:
+    if int(params.get("Boundary", 1)) != 2:
         return np.zeros_like(floating)
     listed = str(params.get("MdbcMkbound") or "").strip()
     if not listed:

@@ -13,9 +13,9 @@ interpolation (Liu & Liu 2006) gives the density and its gradient at g:
 with the matrix A on the left.  Particles with N_b = 0 keep plain DBC
 behaviour in every mode.
 
-Floating bodies: with SlipMode 1 their particles with a normal are corrected as
-the walls are (DualSPHysics's ``UseNormalsFt``: the correction runs over every
-particle, fluid excluded), the normals turning with the body
+Floating bodies: their particles with a normal get the density the walls get
+(DualSPHysics's ``UseNormalsFt``: the correction runs over every particle, fluid
+excluded), the normals turning with the body
 (:mod:`sphdvi.coupling`); the fluid force on the body then comes from the
 extrapolated pressure instead of the DBC density, and the water no longer keeps
 the DBC gap of ~1 dp off the body.  The fluid sees those particles with the
@@ -23,9 +23,12 @@ lattice's mass rho0 dp^d (:func:`sphdvi.case.normals.mdbc_floating_mask`), not
 their share of the body's mass as DualSPHysics does: an extrapolated density
 does not rise to make up for a light body's small particle mass as a DBC
 density does, and the water slipped into the particles of a box of rho/rho0
-0.5.  With SlipMode 2 and 3 a floating body keeps DBC (the solver warns): the
-mDBC2 switch-off of dry particles and the tangential ghost velocity act on wall
-neighbours only, and a floating particle's force is summed from its own side.
+0.5.  With SlipMode 2 and 3 that density is the only part of mDBC2 a floating
+particle takes, as in DualSPHysics v5.4 (InteractionMdbc2CorrectionT2 over Np,
+InteractionForcesFluid): a dry one gets rho0 but keeps its mass (the switch-off
+acts on wall neighbours only), the viscosity sees its own velocity (the
+tangential ghost velocity is the walls'), and the pressure cloning has no wall
+acceleration (DualSPHysics's MotionAce is zero for floating particles).
 
 SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
     rho_b = rho_g + (r_b - g) . grad rho_g; the Shepard value
@@ -333,7 +336,9 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
     """SlipMode 2, 3 (DualSPHysics's mDBC2, module docstring): density with
     pressure cloning, zero mass for a dry ghost node, and the tangential velocity
     the viscosity sees in tvel[i] (packed row i); ghost velocity corrected
-    (``ghostvel`` 1) or the Shepard average (0, DualSPHysics)."""
+    (``ghostvel`` 1) or the Shepard average (0, DualSPHysics).  Floating rows
+    (ptype 2) with a normal get the density alone: rho0 when dry, their mass kept,
+    no wall acceleration in the cloning."""
     rhop0 = cst[10]
     cs02 = cst[5] * cst[5]
     n = 3 if is2d else 4
@@ -345,8 +350,9 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
     vw = np.zeros(3)
     v2 = np.zeros(3)
     for i in range(i0, i1):
-        if ptype[i] >= 2:
+        if ptype[i] == 3:
             continue
+        floating = ptype[i] == 2
         if is2d:
             vw[0] = nb[i, 2]
             vw[1] = 0.0
@@ -372,7 +378,7 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
         if not vsum[3] > 0.0:
             # dry ghost node: the particle is switched off (zero mass, rho0, wall velocity)
             rhop[o] = rhop0
-            _set_packed(nb, i, is2d, rhop0, cst, True)
+            _set_packed(nb, i, is2d, rhop0, cst, not floating)
             vn = vw[0] * ex + vw[1] * ey + vw[2] * ez
             tvel[i, 0] = vw[0] - vn * ex
             tvel[i, 1] = vw[1] - vn * ey
@@ -397,7 +403,7 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
         fx = cst[12]
         fy = cst[13]
         fz = cst[14]
-        if has_ace:
+        if has_ace and not floating:
             fx -= wace[o, 0]
             fy -= wace[o, 1]
             fz -= wace[o, 2]

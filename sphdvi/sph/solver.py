@@ -169,9 +169,6 @@ class SPHSolver:
                 raise ValueError("Boundary=2 (mDBC) needs the boundary normals (normals=...)")
             self.normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(state.n, 3).copy()
         # mDBC2 (SlipMode 2, 3) with moving walls: their acceleration, for the pressure cloning
-        if self.boundary == 2 and self.slip > 1 and np.any(self.normals[state.ptype == 2] != 0.0):
-            warnings.warn(f"SlipMode {self.slip}: the floating bodies keep DBC (mDBC acts on floating "
-                          "bodies with SlipMode 1 only)")
         self._wall_ace_on = self.boundary == 2 and self.slip > 1 and bool(np.any(state.ptype == 1))
         if self._wall_ace_on:
             self.wall_ace = np.zeros((state.n, 3))

@@ -320,12 +320,12 @@ def test_normals_element_names_the_mkbounds_that_get_mdbc(tmp_path):
 
 def test_mdbc_floating_mask():
     """The floating particles mDBC corrects, whose mass the fluid takes as rho0 dp^d: Boundary 2
-    with SlipMode 1 only, of the MdbcMkbound list when there is one."""
+    with any SlipMode, of the MdbcMkbound list when there is one."""
     from sphdvi.case.normals import mdbc_floating_mask
     ptype = np.array([0, 2, 2, 3])
     mkbound = np.array([0, 5, 7, 0])
     assert not mdbc_floating_mask(ptype, mkbound, {}).any()
-    assert not mdbc_floating_mask(ptype, mkbound, {"Boundary": 2, "SlipMode": 2}).any()
+    assert mdbc_floating_mask(ptype, mkbound, {"Boundary": 2, "SlipMode": 2}).tolist() == [False, True, True, False]
     assert mdbc_floating_mask(ptype, mkbound, {"Boundary": "2"}).tolist() == [False, True, True, False]
     assert mdbc_floating_mask(ptype, mkbound, {"Boundary": 2, "MdbcMkbound": "7"}).tolist() == [False, False, True, False]
 

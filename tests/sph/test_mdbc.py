@@ -162,11 +162,28 @@ def test_mdbc_sets_the_density_of_floating_particles_with_slipmode_1():
     assert body.sum() == 27 and err.max() < 1e-3
 
 
-def test_floating_particles_keep_dbc_with_slipmode_2_and_3():
-    """SlipMode 2, 3 leave the floating particles to DBC and say so."""
-    import pytest
+def test_slipmode_2_and_3_give_floating_particles_the_walls_density():
+    """DualSPHysics v5.4 runs mDBC2 over the floating particles too (UseNormalsFt): their
+    density is the pressure-cloned one the same particles get as fixed walls, to round-off;
+    one whose ghost node is dry (a floating stretch of the side wall above the water)
+    gets rho0, as a wall does."""
+    import warnings
     for slip in (2, 3):
-        with pytest.warns(UserWarning, match=f"SlipMode {slip}: the floating bodies keep DBC"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")            # no "floating bodies keep DBC" any more
             sol, body, c, dp = _tank_with_a_floating_floor(slip)
+        s = sol.state
+        dry = (s.ptype == 0) & (s.pos[:, 0] < 0) & (s.pos[:, 2] > 0.25)
+        s.ptype[dry] = 2
+        s.rhop[dry] = 1.01 * c["rhop0"]
         sol.compute_rates()
-        assert np.all(sol.state.rhop[body] == c["rhop0"])
+        st, c = tank_2d(0.3, 0.3, 0.3, 0.2, dp, layers=3)
+        st.rhop[st.ptype < 3] = c["rhop0"]
+        walls = SPHSolver(st, c, {"Boundary": 2, "SlipMode": slip}, normals=tank_normals_2d(st, 0.3, dp))
+        walls.compute_rates()
+        a, b = s.sorted_by_idp(), walls.state.sorted_by_idp()
+        sel = np.isin(a.idp, s.idp[body])
+        assert sel.sum() == 27
+        assert np.all(a.rhop[sel] > c["rhop0"])
+        assert np.allclose(a.rhop[sel], b.rhop[sel], rtol=0, atol=1e-9 * c["rhop0"])
+        assert dry.sum() > 5 and np.all(s.rhop[dry] == c["rhop0"])
