@@ -12,7 +12,12 @@ geometry at hand we derive it from the particle arrangement:
    −(mean of r_j − r_i) when that offset is clear, pointing away from the boundary's own
    mass, and the layer normal when it is not;
 3. the sign is chosen to face the fluid: towards the nearest fluid particle within
-   6 dp, or, with no fluid near, towards the centroid of all fluid particles;
+   6 dp, or, with no fluid near, towards the centroid of all fluid particles; except
+   on floating bodies: a body is wet on every side in time, so its normals point
+   out of it, to the nearer of its surfaces along the direction where step 2's
+   offset is not clear, as GenCase's from the body's outline (the top rows of a
+   floating box, dry at the start, would otherwise face the water under the box and
+   point down through it);
 4. N = n̂ · (k + 1/2) dp, k the number of boundary layers in front of the particle along n̂
    (found by stepping dp along n̂), so that the ghost node r + 2N lies in the fluid for
    every layer of a thick wall.
@@ -38,9 +43,10 @@ def _grid_keys(pos, inv, lo, nx, ny):
 
 
 @njit(cache=True)
-def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid):
+def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
     """See the module docstring; brute force over sorted grid cells. The normals of the first
-    ``nb`` rows of ``bpos``; the rows after them (periodic images) are neighbours only."""
+    ``nb`` rows of ``bpos``; the rows after them (periodic images) are neighbours only.
+    ``outward[i]``: row i belongs to a floating body (its clear directions are not flipped)."""
     out = np.zeros((nb, 3))
     cell = 2.05 * dp      # a little over the search radius: rounding never hides a neighbour
     lo = np.empty(3)
@@ -113,10 +119,21 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid):
             thin = w[0] < 0.1 * w[1]                # a single layer (line in 2D, sheet in 3D)
         else:
             n[2] = 1.0
-        if not thin and cx * cx + cy * cy + cz * cz > (0.25 * dp) ** 2:
+        clear = not thin and cx * cx + cy * cy + cz * cz > (0.25 * dp) ** 2
+        if clear:
             n[0], n[1], n[2] = -cx, -cy, -cz        # away from the boundary's own mass
         if is2d:
             n[1] = 0.0
+        if outward[i]:
+            # a floating body: out of it, the nearer surface along n when n is not clear
+            norm = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+            for k in range(3):
+                out[i, k] = n[k] / norm
+            if not clear and (_layers_along(bpos, i, -1.0, out, dp, lo, inv, nx, ny, bsorted, border)
+                              < _layers_along(bpos, i, 1.0, out, dp, lo, inv, nx, ny, bsorted, border)):
+                for k in range(3):
+                    out[i, k] = -out[i, k]
+            continue
         # face the fluid
         best = 1e300
         tx = fcentroid[0] - bpos[i, 0]
@@ -144,36 +161,44 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid):
             for k in range(3):
                 out[i, k] = n[k] / norm
     # distance to the surface: dp/2 in front of the last boundary layer along the normal
-    tol2 = (0.45 * dp) ** 2
     for i in range(nb):
-        layers = 0
-        for step in range(1, 9):
-            px = bpos[i, 0] + step * dp * out[i, 0]
-            py = bpos[i, 1] + step * dp * out[i, 1]
-            pz = bpos[i, 2] + step * dp * out[i, 2]
-            ix = int((px - lo[0]) * inv)
-            iy = int((py - lo[1]) * inv)
-            iz = int((pz - lo[2]) * inv)
-            hit = False
-            for dz in range(-1, 2):
-                for dy in range(-1, 2):
-                    for dx in range(-1, 2):
-                        key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
-                        a = np.searchsorted(bsorted, key)
-                        b = np.searchsorted(bsorted, key + 1)
-                        for q in range(a, b):
-                            j = border[q]
-                            ddx = bpos[j, 0] - px
-                            ddy = bpos[j, 1] - py
-                            ddz = bpos[j, 2] - pz
-                            if ddx * ddx + ddy * ddy + ddz * ddz < tol2:
-                                hit = True
-            if not hit:
-                break
-            layers += 1
+        layers = _layers_along(bpos, i, 1.0, out, dp, lo, inv, nx, ny, bsorted, border)
         for k in range(3):
             out[i, k] *= (0.5 + layers) * dp
     return out
+
+
+@njit(cache=True)
+def _layers_along(bpos, i, sign, unit, dp, lo, inv, nx, ny, bsorted, border):
+    """The boundary layers in front of particle i along sign * unit[i] (steps of dp that
+    land within 0.45 dp of a boundary particle, at most 8)."""
+    tol2 = (0.45 * dp) ** 2
+    layers = 0
+    for step in range(1, 9):
+        px = bpos[i, 0] + sign * step * dp * unit[i, 0]
+        py = bpos[i, 1] + sign * step * dp * unit[i, 1]
+        pz = bpos[i, 2] + sign * step * dp * unit[i, 2]
+        ix = int((px - lo[0]) * inv)
+        iy = int((py - lo[1]) * inv)
+        iz = int((pz - lo[2]) * inv)
+        hit = False
+        for dz in range(-1, 2):
+            for dy in range(-1, 2):
+                for dx in range(-1, 2):
+                    key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
+                    a = np.searchsorted(bsorted, key)
+                    b = np.searchsorted(bsorted, key + 1)
+                    for q in range(a, b):
+                        j = border[q]
+                        ddx = bpos[j, 0] - px
+                        ddy = bpos[j, 1] - py
+                        ddz = bpos[j, 2] - pz
+                        if ddx * ddx + ddy * ddy + ddz * ddz < tol2:
+                            hit = True
+        if not hit:
+            break
+        layers += 1
+    return layers
 
 
 # how far from a periodic end the images must reach: the fluid search (3 cells of 2.05 dp)
@@ -201,8 +226,9 @@ def boundary_normals(pos: np.ndarray, ptype: np.ndarray, dp: float, is2d: bool,
         fpos = np.concatenate([fpos, pos[src[~image_bound]] + disp[~image_bound]])
     out = np.zeros_like(pos)
     if nb:
+        outward = np.ascontiguousarray(ptype[bound] == 2)
         out[bound] = _normals_kernel(np.ascontiguousarray(bpos), nb, np.ascontiguousarray(fpos), float(dp),
-                                     bool(is2d), centroid)
+                                     bool(is2d), centroid, outward)
     return out
 
 

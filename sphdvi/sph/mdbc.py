@@ -41,9 +41,9 @@ SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
     (``JSphCpu_mdbc.cpp`` InteractionMdbcCorrectionT2); the integrator's
     rho >= rho0 for boundary particles holds between corrections.  (sphdvi
     clamped the result to rho0 until 2026-11: S16M's roll rms was -23.0 /
-    -8.6 % at box/dp 5 / 10 against -15.2 / -10.5 % now; README, S16.)  The
-    wall particle shows
-    the fluid its own (wall) velocity.
+    -8.6 % at box/dp 5 / 10 against -15.2 / -10.5 % unclamped, with the box
+    normals of then; README, S16.)  The wall particle shows the fluid its own
+    (wall) velocity.
 
 SlipMode 2 (no-slip) and 3 (free-slip): DualSPHysics's mDBC2 with a choice of
 ghost velocity (``JSphCpu_mdbc.cpp`` InteractionMdbc2CorrectionT2, ``JSphGpu_mdbc_iker.cu``

@@ -57,6 +57,34 @@ def test_solid_body_normals_point_outwards():
     assert n[top] == pytest.approx([0, 0, dp / 2]) and n[side] == pytest.approx([-dp / 2, 0, 0])
 
 
+def test_floating_body_normals_point_out_of_it_where_it_is_dry():
+    """A floating box half out of the water: its dry top row points up, dp/2 to its top
+    surface, as GenCase's normals from the outline (facing the nearest water it pointed
+    down through the box, 4.5 dp, its ghost nodes in the water under it); the second row
+    1.5 dp up; the wet bottom down. The same block as a fixed solid keeps the
+    face-the-fluid rule that the back layers of thick walls need."""
+    dp = 0.05
+    g = np.arange(-0.2, 0.2 + dp / 2, dp)
+    X, Z = np.meshgrid(g, g)
+    body = np.column_stack([X.ravel(), 0 * X.ravel(), Z.ravel() + 1.0])
+    fx, fz = np.meshgrid(np.arange(-0.6, 0.6, dp), np.arange(0.5, 1.0, dp))
+    fl = np.column_stack([fx.ravel(), 0 * fx.ravel(), fz.ravel()])
+    keep = np.max(np.abs(fl - [0, 0, 1.0]), axis=1) > 0.2 + dp / 2
+    pos = np.vstack([body, fl[keep]])
+
+    def at(n, x, z):
+        return n[np.flatnonzero(np.isclose(pos[:, 0], x) & np.isclose(pos[:, 2], z))[0]]
+
+    ptype = np.array([2] * len(body) + [3] * int(keep.sum()))
+    n = boundary_normals(pos, ptype, dp, True)
+    assert at(n, 0.0, 1.2) == pytest.approx([0, 0, dp / 2])
+    assert at(n, 0.0, 1.15) == pytest.approx([0, 0, 1.5 * dp])
+    assert at(n, 0.0, 0.8) == pytest.approx([0, 0, -dp / 2])
+    assert at(n, -0.2, 1.1) == pytest.approx([-dp / 2, 0, 0])
+    fixed = boundary_normals(pos, np.where(ptype == 2, 0, ptype), dp, True)
+    assert at(fixed, 0.0, 1.2)[2] < 0
+
+
 def test_thick_wall_distances():
     """Three wall layers: |N| = 0.5, 1.5, 2.5 dp from the fluid side outwards."""
     dp = 0.05
