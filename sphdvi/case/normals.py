@@ -15,9 +15,9 @@ geometry at hand we derive it from the particle arrangement:
    6 dp, or, with no fluid near, towards the centroid of all fluid particles; except
    on floating bodies: a body is wet on every side in time, so its normals point
    out of it, to the nearer of its surfaces along the direction where step 2's
-   offset is not clear, as GenCase's from the body's outline (the top rows of a
-   floating box, dry at the start, would otherwise face the water under the box and
-   point down through it);
+   offset is not clear (facing the fluid on a tie, as on a one-layer plate), as
+   GenCase's from the body's outline (the top rows of a floating box, dry at the
+   start, would otherwise face the water under the box and point down through it);
 4. N = n̂ · (k + 1/2) dp, k the number of boundary layers in front of the particle along n̂
    (found by stepping dp along n̂), so that the ghost node r + 2N lies in the fluid for
    every layer of a thick wall.
@@ -125,15 +125,20 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
         if is2d:
             n[1] = 0.0
         if outward[i]:
-            # a floating body: out of it, the nearer surface along n when n is not clear
+            # a floating body: out of it; where n is not clear, to the nearer surface along
+            # it (a tie, as on a one-layer plate: face the fluid as a wall does)
             norm = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
             for k in range(3):
                 out[i, k] = n[k] / norm
-            if not clear and (_layers_along(bpos, i, -1.0, out, dp, lo, inv, nx, ny, bsorted, border)
-                              < _layers_along(bpos, i, 1.0, out, dp, lo, inv, nx, ny, bsorted, border)):
-                for k in range(3):
-                    out[i, k] = -out[i, k]
-            continue
+            if clear:
+                continue
+            ahead = _layers_along(bpos, i, 1.0, out, dp, lo, inv, nx, ny, bsorted, border)
+            behind = _layers_along(bpos, i, -1.0, out, dp, lo, inv, nx, ny, bsorted, border)
+            if ahead != behind:
+                if behind < ahead:
+                    for k in range(3):
+                        out[i, k] = -out[i, k]
+                continue
         # face the fluid
         best = 1e300
         tx = fcentroid[0] - bpos[i, 0]

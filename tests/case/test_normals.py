@@ -83,6 +83,11 @@ def test_floating_body_normals_point_out_of_it_where_it_is_dry():
     assert at(n, -0.2, 1.1) == pytest.approx([-dp / 2, 0, 0])
     fixed = boundary_normals(pos, np.where(ptype == 2, 0, ptype), dp, True)
     assert at(fixed, 0.0, 1.2)[2] < 0
+    # a one-layer floating plate on the water: no side is nearer, so it faces the fluid
+    plate = np.column_stack([g, 0 * g, 0 * g + 1.0 + dp])
+    pos = np.vstack([plate, fl[fl[:, 2] < 1.0]])
+    n = boundary_normals(pos, np.array([2] * len(g) + [3] * int((fl[:, 2] < 1.0).sum())), dp, True)
+    assert at(n, 0.0, 1.0 + dp) == pytest.approx([0, 0, -dp / 2])
 
 
 def test_thick_wall_distances():
