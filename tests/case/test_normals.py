@@ -41,20 +41,30 @@ def test_tank_normals(layers):
         assert np.allclose(np.linalg.norm(n[b], axis=1), dp / 2)
 
 
-def test_solid_body_normals_point_outwards():
-    dp = 0.05
+def _square_body_in_water(dp, water_top):
+    """A solid 9 x 9 square of floating particles centred at z = 1 (side 0.4 m at dp 0.05)
+    in water from z = 0.5 up to ``water_top``: positions, types, the lattice of the body's
+    rows and the water's positions."""
     g = np.arange(-0.2, 0.2 + dp / 2, dp)
     X, Z = np.meshgrid(g, g)
     body = np.column_stack([X.ravel(), 0 * X.ravel(), Z.ravel() + 1.0])
-    fx, fz = np.meshgrid(np.arange(-0.6, 0.6, dp), np.arange(0.5, 1.5, dp))
+    fx, fz = np.meshgrid(np.arange(-0.6, 0.6, dp), np.arange(0.5, water_top, dp))
     fl = np.column_stack([fx.ravel(), 0 * fx.ravel(), fz.ravel()])
-    keep = np.max(np.abs(fl - [0, 0, 1.0]), axis=1) > 0.2 + dp / 2
-    pos = np.vstack([body, fl[keep]])
-    ptype = np.array([2] * len(body) + [3] * int(keep.sum()))
+    fl = fl[np.max(np.abs(fl - [0, 0, 1.0]), axis=1) > 0.2 + dp / 2]
+    pos = np.vstack([body, fl])
+    return pos, np.array([2] * len(body) + [3] * len(fl)), g, fl
+
+
+def _at(pos, n, x, z):
+    return n[np.flatnonzero(np.isclose(pos[:, 0], x) & np.isclose(pos[:, 2], z))[0]]
+
+
+def test_solid_body_normals_point_outwards():
+    dp = 0.05
+    pos, ptype, _, _ = _square_body_in_water(dp, 1.5)
     n = boundary_normals(pos, ptype, dp, True)
-    top = np.flatnonzero(np.isclose(pos[:, 2], 1.2) & np.isclose(pos[:, 0], 0.0))[0]
-    side = np.flatnonzero(np.isclose(pos[:, 0], -0.2) & np.isclose(pos[:, 2], 1.0))[0]
-    assert n[top] == pytest.approx([0, 0, dp / 2]) and n[side] == pytest.approx([-dp / 2, 0, 0])
+    assert _at(pos, n, 0.0, 1.2) == pytest.approx([0, 0, dp / 2])
+    assert _at(pos, n, -0.2, 1.0) == pytest.approx([-dp / 2, 0, 0])
 
 
 def test_floating_body_normals_point_out_of_it_where_it_is_dry():
@@ -64,30 +74,18 @@ def test_floating_body_normals_point_out_of_it_where_it_is_dry():
     1.5 dp up; the wet bottom down. The same block as a fixed solid keeps the
     face-the-fluid rule that the back layers of thick walls need."""
     dp = 0.05
-    g = np.arange(-0.2, 0.2 + dp / 2, dp)
-    X, Z = np.meshgrid(g, g)
-    body = np.column_stack([X.ravel(), 0 * X.ravel(), Z.ravel() + 1.0])
-    fx, fz = np.meshgrid(np.arange(-0.6, 0.6, dp), np.arange(0.5, 1.0, dp))
-    fl = np.column_stack([fx.ravel(), 0 * fx.ravel(), fz.ravel()])
-    keep = np.max(np.abs(fl - [0, 0, 1.0]), axis=1) > 0.2 + dp / 2
-    pos = np.vstack([body, fl[keep]])
-
-    def at(n, x, z):
-        return n[np.flatnonzero(np.isclose(pos[:, 0], x) & np.isclose(pos[:, 2], z))[0]]
-
-    ptype = np.array([2] * len(body) + [3] * int(keep.sum()))
+    pos, ptype, g, fl = _square_body_in_water(dp, 1.0)
     n = boundary_normals(pos, ptype, dp, True)
-    assert at(n, 0.0, 1.2) == pytest.approx([0, 0, dp / 2])
-    assert at(n, 0.0, 1.15) == pytest.approx([0, 0, 1.5 * dp])
-    assert at(n, 0.0, 0.8) == pytest.approx([0, 0, -dp / 2])
-    assert at(n, -0.2, 1.1) == pytest.approx([-dp / 2, 0, 0])
+    assert _at(pos, n, 0.0, 1.2) == pytest.approx([0, 0, dp / 2])
+    assert _at(pos, n, 0.0, 1.15) == pytest.approx([0, 0, 1.5 * dp])
+    assert _at(pos, n, 0.0, 0.8) == pytest.approx([0, 0, -dp / 2])
+    assert _at(pos, n, -0.2, 1.1) == pytest.approx([-dp / 2, 0, 0])
     fixed = boundary_normals(pos, np.where(ptype == 2, 0, ptype), dp, True)
-    assert at(fixed, 0.0, 1.2)[2] < 0
+    assert _at(pos, fixed, 0.0, 1.2)[2] < 0
     # a one-layer floating plate on the water: no side is nearer, so it faces the fluid
-    plate = np.column_stack([g, 0 * g, 0 * g + 1.0 + dp])
-    pos = np.vstack([plate, fl[fl[:, 2] < 1.0]])
-    n = boundary_normals(pos, np.array([2] * len(g) + [3] * int((fl[:, 2] < 1.0).sum())), dp, True)
-    assert at(n, 0.0, 1.0 + dp) == pytest.approx([0, 0, -dp / 2])
+    pos = np.vstack([np.column_stack([g, 0 * g, 0 * g + 1.0 + dp]), fl])
+    n = boundary_normals(pos, np.array([2] * len(g) + [3] * len(fl)), dp, True)
+    assert _at(pos, n, 0.0, 1.0 + dp) == pytest.approx([0, 0, -dp / 2])
 
 
 def test_thick_wall_distances():
