@@ -12,7 +12,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
-                                             # S16M: S16 with mDBC on the box (dp 0.02 and 0.01, 16 min)
+                                             # S16M: S16 with mDBC on the box (dp 0.02 and 0.01, about 16 min alone)
     python tools/validate.py S9 --csv s9.csv --keep runs/
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
