@@ -376,7 +376,8 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
         _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
                     i, nx, ny, nz, a, b, vsum)
         if not vsum[3] > 0.0:
-            # dry ghost node: the particle is switched off (zero mass, rho0, wall velocity)
+            # dry ghost node: rho0 and the wall velocity; a wall particle is switched off
+            # (zero mass), a floating one keeps its mass (DualSPHysics: walls only)
             rhop[o] = rhop0
             _set_packed(nb, i, is2d, rhop0, cst, not floating)
             vn = vw[0] * ex + vw[1] * ey + vw[2] * ez

@@ -33,8 +33,8 @@ def test_mdbc_extrapolates_hydrostatic_density_to_the_walls():
 def test_mdbc_slipmode_1_extrapolates_below_rho0_and_sets_dry_walls_to_rho0():
     """DualSPHysics v5.4 (JSphCpu_mdbc.cpp, InteractionMdbcCorrectionT2): the extrapolated
     density is stored as it comes, below rho0 where the hydrostatic line extends above
-    the free surface (sphdvi clamped it to rho0 until 2026-11), and a boundary particle whose ghost node has no fluid within reach
-    gets rho0, whatever its density was."""
+    the free surface (sphdvi clamped it to rho0 until 2026-11), and a boundary particle
+    whose ghost node has no fluid within reach gets rho0, whatever its density was."""
     dp = 0.01
     st, c = tank_2d(0.3, 0.3, 0.3, 0.2, dp, layers=3)
     st.rhop[st.ptype < 2] = 1.01 * c["rhop0"]
