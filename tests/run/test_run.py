@@ -218,6 +218,29 @@ def test_resume_bitwise_with_floating_body(tmp_path):
     assert len(rows) == 1 + 5 and float(rows[-1].split(",")[4]) != float(rows[1].split(",")[4])
 
 
+@pytest.mark.parametrize("slip", [1, 2])
+def test_resume_bitwise_with_mdbc_on_a_floating_body(tmp_path, slip):
+    """mDBC on the S12 box (normals, extrapolated densities, the wall acceleration of SlipMode 2,
+    the body's state): a resumed run ends bitwise equal to an uninterrupted one (DualSPHysics
+    users report that an mDBC restart needs data its restart files do not keep)."""
+    case = REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
+    common = ["--dp", "0.02", "--tout", "0.01", "--threads", "1", "-q", "--set", "FtPause=0",
+              "--set", "Boundary=2", "--set", "MdbcMkbound=5", "--set", f"SlipMode={slip}"]
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert invoke(["run", case, "-o", a, "--tmax", "0.04"] + common).exit_code == 0
+    assert invoke(["run", case, "-o", b, "--tmax", "0.02"] + common).exit_code == 0
+    r = invoke(["run", b, "--resume", "--tmax", "0.04"] + common[2:])
+    assert r.exit_code == 0, r.output
+    sa, _ = final_state(a)
+    sb, _ = final_state(b)
+    for k in sa:
+        assert np.array_equal(sa[k], sb[k]), k
+    with h5py.File(a / "restart.h5") as f:
+        ptype, rhop = f["state/ptype"][...], f["state/rhop"][...]
+    assert rhop[ptype == 2].max() > 1000.2            # the box's particles carry mDBC densities
+    assert (a / "bodies.csv").read_text() == (b / "bodies.csv").read_text()
+
+
 @pytest.mark.parametrize("slip", [1, 2, 3])
 def test_mdbc_from_case(tmp_path, slip):
     """Boundary=2 (mDBC) with each SlipMode: normals are computed from the particles; with
