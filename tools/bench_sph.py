@@ -10,11 +10,13 @@ c0 = 20 sqrt(9.81 * 2).
 Prints microseconds per particle-step and interactions (neighbour pairs
 visited by the gather loop, i != j within 2h) per second on 1 and 2 threads.
 
-    NUMBA_NUM_THREADS=2 python tools/bench_sph.py [--steps 100] [--rounds 10] [--3d] [--flags]
+    NUMBA_NUM_THREADS=2 python tools/bench_sph.py [--steps 100] [--rounds 10] [--3d] [--flags] [--boundaries]
 
 ``--flags`` times the same scene with features switched on and off
 (1 thread, on the developed flow at ``--t0``, interleaved rounds), to show
-that an unused feature costs nothing.
+that an unused feature costs nothing.  ``--boundaries`` times the dam break
+with three wall layers (what mDBC needs) under DBC and under mDBC with each
+SlipMode, on 1 and 2 threads: the price of the accurate boundary.
 
 The scene is first advanced to ``--t0`` (2D, default 0.1 s) or ``--t0-3d``
 (default 0.05 s): once the particles have left their initial lattice the
@@ -42,7 +44,7 @@ import numpy as np  # noqa: E402
 
 from sphdvi.sph import SPHSolver  # noqa: E402
 from sphdvi.sph import cells as _cells  # noqa: E402
-from sphdvi.sph.scenes import dambreak_2d  # noqa: E402
+from sphdvi.sph.scenes import dambreak_2d, tank_2d, tank_normals_2d  # noqa: E402
 from sphdvi.sph.state import FIXED, FLUID, FluidState  # noqa: E402
 
 BENCH_PARAMS = {"StepAlgorithm": 1, "VerletSteps": 40, "Kernel": 2, "ViscoTreatment": 1,
@@ -108,6 +110,8 @@ def main():
     ap.add_argument("--3d", dest="three_d", action="store_true", help="also time the 3D dam break")
     ap.add_argument("--dp3d", type=float, default=0.02)
     ap.add_argument("--flags", action="store_true", help="time feature variants on 1 thread")
+    ap.add_argument("--boundaries", action="store_true",
+                    help="time DBC against mDBC (SlipMode 1, 2, 3) with three wall layers")
     ap.add_argument("--threads", type=int, nargs="*", default=None)
     ap.add_argument("--t0", type=float, default=0.1, help="2D: time advanced before timing (s)")
     ap.add_argument("--t0-3d", dest="t0_3d", type=float, default=0.05,
@@ -191,6 +195,48 @@ def main():
                 best[label] = min(best[label], (time.perf_counter() - t0) / steps)
         for label, _ in variants:
             print("  %-36s %.3f" % (label, best[label] / state.n * 1e6))
+    if a.boundaries:
+        time_boundaries(a, threads)
+
+
+def time_boundaries(a, threads):
+    """DBC against mDBC on the dam break with three wall layers: the same developed flow
+    (advanced to ``--t0`` with DBC), then each boundary treatment timed from that state in
+    interleaved rounds on each thread count."""
+    state, c = tank_2d(4.0, 3.0, 1.0, 2.0, a.dp, layers=3, coefh=1.0, cs0=20.0 * math.sqrt(9.81 * 2.0))
+    numba.set_num_threads(max(threads))
+    dev = SPHSolver(state.copy(), c, BENCH_PARAMS, cell_mode=a.cellmode)
+    dev.run(a.t0)
+    normals = tank_normals_2d(dev.state, 4.0, a.dp)
+    variants = [("DBC", {"Boundary": 1}), ("mDBC SlipMode 1", {"Boundary": 2, "SlipMode": 1}),
+                ("mDBC SlipMode 2 (no-slip)", {"Boundary": 2, "SlipMode": 2}),
+                ("mDBC SlipMode 3 (free-slip)", {"Boundary": 2, "SlipMode": 3})]
+    sols = {}
+    for label, upd in variants:
+        p = dict(BENCH_PARAMS)
+        p.update(upd)
+        sols[label] = SPHSolver(dev.state.copy(), c, p, cell_mode=a.cellmode,
+                                normals=normals if upd["Boundary"] == 2 else None)
+        for t in threads:
+            numba.set_num_threads(t)
+            sols[label].run(1e9, max_steps=5)            # compile / warm up
+    steps = max(50, a.steps // 2)
+    best = {(label, t): math.inf for label, _ in variants for t in threads}
+    for _ in range(a.rounds):
+        for label, _ in variants:
+            for t in threads:
+                numba.set_num_threads(t)
+                t0 = time.perf_counter()
+                sols[label].run(1e9, max_steps=steps)
+                best[label, t] = min(best[label, t], (time.perf_counter() - t0) / steps)
+    print("\nBoundary treatments, 2D dam break with 3 wall layers (%d particles, %d boundary) at t = %.3f s "
+          "(us/particle-step, best of %d x %d steps):"
+          % (state.n, int((state.ptype < 2).sum()), dev.time, a.rounds, steps))
+    base = {t: best["DBC", t] for t in threads}
+    for label, _ in variants:
+        print("  %-30s " % label + "   ".join(
+            "%d thread(s) %.3f (x%.2f of DBC)" % (t, best[label, t] / state.n * 1e6, best[label, t] / base[t])
+            for t in threads))
 
 if __name__ == "__main__":
     main()

@@ -12,7 +12,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
-                                             # S16M: S16 with mDBC on the box (dp 0.02 and 0.01, about 16 min alone)
+                                             # S16M: S16 with mDBC on the box (dp 0.02, 0.01 and 0.005: 2, 25 and 107 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
@@ -267,7 +267,8 @@ def cases() -> list:
                              "heave, roll, sway", [Resolution("box/dp 10", 0.01), Resolution("box/dp 20", 0.005)]),
         _floating_waves_case("S16M", "S16 with mDBC on the box only (--set Boundary=2 --set MdbcMkbound=50; "
                              "walls and flap DBC)",
-                             [Resolution("box/dp 5", 0.02, MDBC_BOX), Resolution("box/dp 10", 0.01, MDBC_BOX)]),
+                             [Resolution("box/dp 5", 0.02, MDBC_BOX), Resolution("box/dp 10", 0.01, MDBC_BOX),
+                              Resolution("box/dp 20", 0.005, MDBC_BOX)]),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),
