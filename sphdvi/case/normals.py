@@ -43,6 +43,13 @@ def _grid_keys(pos, inv, lo, nx, ny):
 
 
 @njit(cache=True)
+def _cell_span(sorted_keys, ix, iy, iz, nx, ny):
+    """The rows [a, b) of the key-sorted particles that lie in grid cell (ix, iy, iz)."""
+    key = (iz * ny + iy) * nx + ix
+    return np.searchsorted(sorted_keys, key), np.searchsorted(sorted_keys, key + 1)
+
+
+@njit(cache=True)
 def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
     """See the module docstring; brute force over sorted grid cells. The normals of the first
     ``nb`` rows of ``bpos``; the rows after them (periodic images) are neighbours only.
@@ -81,9 +88,7 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
         for dz in range(-1, 2):
             for dy in range(-1, 2):
                 for dx in range(-1, 2):
-                    key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
-                    a = np.searchsorted(bsorted, key)
-                    b = np.searchsorted(bsorted, key + 1)
+                    a, b = _cell_span(bsorted, ix + dx, iy + dy, iz + dz, nx, ny)
                     for q in range(a, b):
                         j = border[q]
                         if j == i:
@@ -147,9 +152,7 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
         for dz in range(-reach, reach + 1):
             for dy in range(-reach, reach + 1):
                 for dx in range(-reach, reach + 1):
-                    key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
-                    a = np.searchsorted(fsorted, key)
-                    b = np.searchsorted(fsorted, key + 1)
+                    a, b = _cell_span(fsorted, ix + dx, iy + dy, iz + dz, nx, ny)
                     for q in range(a, b):
                         j = forder[q]
                         ddx = fpos[j, 0] - bpos[i, 0]
@@ -190,9 +193,7 @@ def _layers_along(bpos, i, sign, unit, dp, lo, inv, nx, ny, bsorted, border):
         for dz in range(-1, 2):
             for dy in range(-1, 2):
                 for dx in range(-1, 2):
-                    key = ((iz + dz) * ny + (iy + dy)) * nx + ix + dx
-                    a = np.searchsorted(bsorted, key)
-                    b = np.searchsorted(bsorted, key + 1)
+                    a, b = _cell_span(bsorted, ix + dx, iy + dy, iz + dz, nx, ny)
                     for q in range(a, b):
                         j = border[q]
                         ddx = bpos[j, 0] - px
