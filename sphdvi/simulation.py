@@ -177,19 +177,12 @@ def periodic_axes(data: dict, params: dict) -> list[str]:
 
 
 def special_parameters(data: dict) -> dict:
-    """Parameters with ``<special><shifting>`` applied (it overrides Shifting, ShiftCoef, ShiftTFS),
-    and ``MdbcMkbound`` from ``<normals>`` where the case does not write it (the mkbounds its
-    children name get mDBC, the others keep DBC; --set MdbcMkbound overrides)."""
+    """Parameters with ``<special><shifting>`` applied (it overrides Shifting, ShiftCoef, ShiftTFS)."""
     params = dict(data["parameters"])
     shifting = (data["json"].get("special") or {}).get("shifting") or {}
     for key, name in (("mode", "Shifting"), ("coefficient", "ShiftCoef"), ("fsthreshold", "ShiftTFS")):
         if key in shifting:
             params[name] = shifting[key]
-    if "MdbcMkbound" not in set(data["json"].get("parameters_set", [])):
-        from .case.normals import mkbounds_named_by_normals
-        named = mkbounds_named_by_normals(data["json"].get("normals"))
-        if named:
-            params["MdbcMkbound"] = named
     return params
 
 
@@ -588,13 +581,20 @@ class SPHRun:
             from .case.normals import boundary_normals
             from .sph.periodic import Periodicity
             axes = [k for k in periodic if not (c["is2d"] and k == "y")]
-            normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
-                                        Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
+            if data.get("normals") is not None:       # the case's own (<normals>, <initialize>)
+                normals0 = np.array(data["normals"], dtype=np.float64)
+                if not np.any(normals0[p["type"] != 3]):
+                    raise InputError("Boundary=2 (mDBC), but the normals the case defines (<normals>, <special>"
+                                     "<initialize>) reach no boundary particle: nothing for mDBC to correct "
+                                     "(expected operations that reach the walls, within maxdisth/distanceh h)")
+            else:
+                normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
+                                            Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
             normals0 = self._mdbc_only_on(normals0, p, fluidcount, str(params.get("MdbcMkbound") or "").strip())
             from .case.normals import mdbc_floating_mask
             from .coupling import body_labels
-            mdbc_floating = mdbc_floating_mask(p["type"], body_labels(p["mk"], fluidcount), params)
-            state.mass[mdbc_floating & np.any(normals0 != 0.0, axis=1)] = float(c["massbound"])
+            state.mass[mdbc_floating_mask(p["type"], body_labels(p["mk"], fluidcount), params,
+                                          normals0)] = float(c["massbound"])
         # the solids that move boundary particles, and the damping zones: each only when
         # the case has it
         self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)

@@ -38,6 +38,7 @@ class GenCaseResult:
     warnings: Warnings
     primitives: list = field(default_factory=list)
     files: list = field(default_factory=list)
+    normals: np.ndarray | None = None      # the mDBC normals the case defines (None: none)
 
 
 def define_builtin_variables(reader, cdef, casename: str) -> None:
@@ -99,6 +100,7 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
                 boundcount=boundcount, fluidcount=fluidcount)
     read_sections(case, root, reader)
     particles, mkinfo = assemble_particles(case, drawing, consts, reader)
+    normals = case_normals(case, particles, consts, drawing, reader)
     bodies = floating_bodies(case, particles, consts, drawing.primitives, reader)
     apply_floating_velocities(particles, bodies)
     domain = resolve_domain(case, particles, consts, reader)
@@ -107,7 +109,7 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     reader.warn_unread_attributes(root)
     return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
                          mkinfo=mkinfo, warnings=warnings, primitives=list(drawing.primitives),
-                         files=list(drawing.shape_files))
+                         files=list(drawing.shape_files), normals=normals)
 
 
 def warn_no_fluid(drawing, reader) -> None:
@@ -208,7 +210,8 @@ def _select(case, particles, item):
     ptype, label, pos = particles["type"], particles["label"], particles["pos"]
     sel = np.zeros(ptype.size, dtype=bool)
     if "mkfluid" in item:
-        sel |= (ptype == TYPE_FLUID) & np.isin(label, item["mkfluid"])
+        fluid = ptype == TYPE_FLUID
+        sel |= fluid if item["mkfluid"] is None else fluid & np.isin(label, item["mkfluid"])
     if "mkbound" in item:
         sel |= (ptype != TYPE_FLUID) & np.isin(label, item["mkbound"])
     box = item.get("onlypos")
@@ -223,13 +226,16 @@ def _select(case, particles, item):
 
 
 def apply_initials(case: Case, particles: dict, consts: Constants, reader) -> None:
-    """``<initials>``: velocities, densities, moves and rotations of selected particles."""
+    """``<initials>``: velocities, densities, moves and rotations of selected particles; then the
+    ``<fluidvelocity>`` items of ``<special><initialize>``."""
     pos, vel, rhop = particles["pos"], particles["vel"], particles["rhop"]
-    for item in case.initials:
+    items = list(case.initials) + list((case.special.get("initialize") or {}).get("velocity", []))
+    for item in items:
         sel = _select(case, particles, item)
         if not sel.any():
-            raise CaseError(f"<{item['type']}> selects no particles", file=reader.file, line=item["line"],
-                            element=item["type"], expected="mkfluid/mkbound labels that were drawn")
+            tag = item.get("element", item["type"])
+            raise CaseError(f"<{tag}> selects no particles", file=reader.file, line=item["line"],
+                            element=tag, expected="mkfluid/mkbound labels that were drawn")
         kind = item["type"]
         if kind == "velocity":
             if "vel" in item:
@@ -245,8 +251,8 @@ def apply_initials(case: Case, particles: dict, consts: Constants, reader) -> No
                 p = item["params"]
                 if item["profile"] == "velocity":
                     mag = np.full(z.shape, p["v"])
-                elif item["profile"] == "velocity2":
-                    mag = np.interp(z, [p["z"], p["z2"]], [p["v"], p["v2"]])
+                elif item["profile"] == "velocity2":      # linear, extrapolated beyond z..z2
+                    mag = p["v"] + (p["v2"] - p["v"]) * (z - p["z"]) / (p["z2"] - p["z"])
                 else:
                     coef = np.polyfit([p["z"], p["z2"], p["z3"]], [p["v"], p["v2"], p["v3"]], 2)
                     mag = np.polyval(coef, z)
@@ -273,6 +279,71 @@ def apply_initials(case: Case, particles: dict, consts: Constants, reader) -> No
             # DualSPHysics's sense (JMatrix4::MatrixRot, as <rotateline> and <motion>): −angle
             # right-handed about axisp1 → axisp2, i.e. +angle about axisp2 → axisp1
             pos[sel] = rotate_about_axis(pos[sel], p2, p1, math.radians(item["angle_deg"]))
+
+
+def case_normals(case: Case, particles: dict, consts: Constants, drawing, reader) -> np.ndarray | None:
+    """The mDBC normals the case defines: ``<normals>`` (GenCase), then the boundnormal
+    operations of ``<special><initialize>`` (the solver's), in document order
+    (:mod:`sphdvi.case.normal_ops`). None when it defines none: the run then derives every
+    boundary's normal from the particles. Warns of an operation that selects no boundary
+    particle and of normals that reach no particle at all."""
+    ops = list(case.normals) + list((case.special.get("initialize") or {}).get("normals", []))
+    if not ops:
+        return None
+    import functools
+
+    from .normal_ops import apply_normal_ops
+    from .normals import boundary_normals
+    pos, ptype = particles["pos"], particles["type"]
+    mkbound = np.where(ptype != TYPE_FLUID, particles["label"], -1)
+    normals = np.zeros_like(pos)
+    empty = apply_normal_ops(
+        normals, ops, pos, ptype, mkbound, dp=consts.dp, h=consts.h, is2d=consts.is2d, posy2d=drawing.posy2d,
+        geometry=lambda op: geometry_triangles(op, case.name, drawing, reader),
+        computed=functools.cache(lambda: boundary_normals(pos, ptype, consts.dp, consts.is2d)))
+    for op in empty:
+        reader.warnings.add(f"<{op['tag']}> selects no boundary particle (mkbound '{op['mkbound'] or 'all'}'"
+                            f"{' inside its onlypos box' if op.get('onlypos') else ''})",
+                            file=reader.file, line=op["line"], element=op["tag"])
+    if not np.any(normals[ptype != TYPE_FLUID]):
+        reader.warnings.add("the case's normals reach no boundary particle: mDBC (Boundary=2) would have "
+                            "nothing to correct, and a run with it stops", file=reader.file,
+                            line=ops[0]["line"], element=ops[0]["tag"])
+    return normals
+
+
+SHAPE_SUFFIXES = ("_Actual", "_Dp")   # GenCase's names for a <shapeout>'s shapes as drawn / on the lattice
+
+
+def geometry_triangles(op: dict, casename: str, drawing, reader) -> tuple:
+    """The boundary triangles (T, 3, 3) of a ``norgeometry`` and the mk of each (None for a
+    mesh file): a ``<shapeout>`` of this case (``[CaseName]_hdp_Actual.vtk`` names the shapes
+    that ``<shapeout file="hdp">`` wrote), else a mesh file in the case folder."""
+    text = op["file"].replace("[CaseName]", casename).replace("[casename]", casename)
+    stem, ext = os.path.splitext(os.path.basename(text.replace("\\", "/")))
+    names = [stem] + [stem[: -len(s)] for s in SHAPE_SUFFIXES if stem.endswith(s)]
+    names += [n[len(casename) + 1:] for n in names if n.startswith(casename + "_")]
+    for name in names:
+        if name in drawing.shape_sets:
+            tris, mk, fluid = drawing.shape_sets[name]
+            return tris[~fluid], mk[~fluid]
+    base = os.path.normpath(os.path.abspath(reader.base_dir))
+    path = os.path.normpath(os.path.join(base, text))
+    where = dict(file=reader.file, line=op["line"], element=op["tag"])
+    if os.path.commonpath([path, base]) != base:
+        raise CaseError(f"geometryfile '{op['file']}' lies outside the case folder {base}",
+                        expected="a <shapeout> of the case or a mesh file beside it", **where)
+    if not os.path.isfile(path):
+        raise CaseError(f"geometryfile '{op['file']}': no <shapeout file=\"{names[-1]}\"> in the geometry and no "
+                        f"file {path}", expected="the shapes of a <shapeout> (e.g. file=\"[CaseName]_hdp_Actual.vtk\" "
+                        "for <shapeout file=\"hdp\"/>) or a mesh file (STL, PLY, VTK)", **where)
+    from .draw.meshfile import MeshError, read_triangles
+    kind = {".stl": "stl", ".ply": "ply"}.get(ext.lower(), "vtk")
+    try:
+        return read_triangles(path, kind), None
+    except (MeshError, OSError) as exc:
+        raise CaseError(f"geometryfile '{op['file']}': {exc}", expected="a triangle mesh (STL, PLY, VTK)",
+                        **where) from None
 
 
 def rotate_about_axis(points: np.ndarray, p1, p2, angle: float) -> np.ndarray:
@@ -545,13 +616,15 @@ def write_outputs(result: GenCaseResult, outdir: str) -> list[str]:
     particles = {k: p[k] for k in ("pos", "vel", "rhop", "mass", "type", "mk", "idp")}
     write_case_h5(h5, casename=case.name, source_file=case.file, source_xml=case.source, version=__version__,
                   particles=particles, constants=consts.to_dict(), parameters=case.parameters,
-                  domain=result.domain, bodies=result.bodies, json_items=json_items)
+                  domain=result.domain, bodies=result.bodies, json_items=json_items, normals=result.normals)
     vtp = os.path.join(outdir, f"{case.name}_All.vtp")
     press = consts.b * (np.power(p["rhop"] / consts.rhop0, consts.gamma) - 1.0)
     write_vtp_points(vtp, p["pos"], {"Idp": p["idp"].astype(np.int64), "Vel": p["vel"].astype(np.float32),
                                      "Rhop": p["rhop"].astype(np.float32), "Press": press.astype(np.float32),
                                      "Mass": p["mass"].astype(np.float32), "Type": p["type"],
-                                     "Mk": p["mk"].astype(np.int32)})
+                                     "Mk": p["mk"].astype(np.int32),
+                                     **({"Normal": result.normals.astype(np.float32)}
+                                        if result.normals is not None else {})})
     return [h5, vtp] + list(result.files)
 
 

@@ -2,8 +2,10 @@
 
 DualSPHysics's GenCase computes a normal per boundary particle from the drawn
 geometry: the vector N from the particle to the boundary surface, which lies
-dp/2 in front of the outer particle layer; the ghost node is r + 2N. Without the
-geometry at hand we derive it from the particle arrangement:
+dp/2 in front of the outer particle layer; the ghost node is r + 2N. A case that
+defines its normals (``<normals>``, ``<special><initialize>``) gets those
+(:mod:`sphdvi.case.normal_ops`); for one that does not, or where it asks for them
+from the parts (``norparts``), we derive them from the particle arrangement:
 
 1. the neighbours j of boundary particle i (other boundary particles within 2 dp);
 2. where the neighbours form a single layer (the smallest eigenvalue of their covariance
@@ -255,34 +257,22 @@ def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
     return out, [int(m) for m in wanted if int(m) not in present]
 
 
-def mkbounds_named_by_normals(entries: list) -> str:
-    """The mkbound list (``"0,3-5"``) that the case's ``<normals>`` gives normals to, as
-    :func:`sphdvi.case.reader.read_normals` stores its children; ``""`` (every boundary and
-    floating body) when the case has no ``<normals>`` or a child names no mkbound (a
-    ``norgeometry`` over a geometry file covers all that it touches).  GenCase sets mDBC
-    normals only where ``<normals>`` says, and DualSPHysics corrects only particles with a
-    normal: the others keep DBC."""
-    lists = []
-    for entry in entries or []:
-        listed = str(entry.get("mkbound") or "").strip()
-        if not listed:
-            return ""
-        lists.append(listed)
-    return ",".join(lists)
-
-
-def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict) -> np.ndarray:
+def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict,
+                       normals: np.ndarray | None = None) -> np.ndarray:
     """The floating particles mDBC corrects: ``Boundary`` 2 (any ``SlipMode``), of the
     mkbounds ``MdbcMkbound`` lists (every floating body without a list).  The fluid sees each
     of them with the lattice's volume dp^d, its mass rho0 dp^d (``MassBound``), not its share of
     the body's mass: a boundary particle whose density is extrapolated from the water does not
     rise as a DBC particle's does to make up for a small mass, so a light body's particles would
     be a soft wall that the water slips through (S12's box, rho/rho0 0.5, flooded within 1 s).
-    The body's mass and inertia stay the case's (the multibody system's)."""
+    The body's mass and inertia stay the case's (the multibody system's). With ``normals``
+    (the case's own, or the run's), only the particles that have one: mDBC corrects no other."""
     from .mkrange import parse_mk_range
     floating = np.asarray(ptype) == 2
     if int(params.get("Boundary", 1)) != 2:
         return np.zeros_like(floating)
+    if normals is not None:
+        floating = floating & np.any(np.asarray(normals) != 0.0, axis=1)
     listed = str(params.get("MdbcMkbound") or "").strip()
     if not listed:
         return floating

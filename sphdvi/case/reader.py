@@ -17,6 +17,7 @@ from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
+from .normals_xml import read_initialize, read_normals
 from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
                          coerce, constant_hint, default_parameters, domain_from_deprecated, parameter_warnings)
 from .schema import validate_structure
@@ -25,10 +26,10 @@ from .xmldoc import CaseReader, load_xml, strip_disabled
 CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initials", "motion",
                     "properties", "normals", "patterns", "vres"}
 EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres"}
-SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout"}
+SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout", "initialize"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
     "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
-    "moorings", "forcepoints", "outputparts", "initialize", "savedt", "inout", "vres"}
+    "moorings", "forcepoints", "outputparts", "savedt", "inout", "vres"}
 
 
 def case_name_from_path(path: str) -> str:
@@ -577,43 +578,6 @@ def load_xml_any(path, reader):
     return parse_xml_text(raw.decode("utf-8", errors="replace"), path), None
 
 
-def read_normals(reader, casedef) -> list:
-    """``<normals>`` (GenCase's mDBC normals: norgeometry, norplane, norsphere, ...): each
-    child as a dict.  sphdvi computes every normal from the particles
-    (:mod:`sphdvi.case.normals`); what it takes from here is which boundaries get one:
-    the children's ``mkbound`` lists (:func:`sphdvi.case.normals.mkbounds_named_by_normals`),
-    checked here.  Said once per case, at the first child that names an mkbound."""
-    el = reader.child(casedef, "normals")
-    out = []
-    if el is None:
-        return out
-    said = False
-    for c in reader.children(el):
-        d = {"type": c.tag, "line": c.sourceline}
-        for k in c.keys():
-            d[k] = c.get(k)
-            reader.mark(c, k)
-        if c.get("mkbound") is not None:
-            try:
-                parse_mk_range(c.get("mkbound"))
-            except ValueError as exc:
-                raise reader.error(c, f"mkbound={c.get('mkbound')!r}: {exc}",
-                                   "mkbound values and ranges such as mkbound=\"0-3,7\"") from None
-            if not said:
-                reader.warn(c, "sphdvi computes the mDBC normals from the particles: of <normals> it uses "
-                               "which mkbounds get them (Boundary=2), not the planes, shapes or geometry "
-                               "files that set them in GenCase")
-                said = True
-        for sub in reader.children(c):
-            d[sub.tag] = reader.vec3(sub, default=None) if any(sub.get(a) is not None for a in "xyz") \
-                else {k: sub.get(k) for k in sub.keys()}
-            if isinstance(d[sub.tag], np.ndarray):
-                d[sub.tag] = d[sub.tag].tolist()
-            reader.mark(sub, *sub.keys())
-        out.append(d)
-    return out
-
-
 # ---------------------------------------------------------------------------
 # execution
 # ---------------------------------------------------------------------------
@@ -1123,4 +1087,4 @@ def _acc_table(reader, c) -> np.ndarray:
 
 SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges": read_gauges,
                    "wavepaddles": read_wavepaddles, "damping": read_damping, "shifting": read_shifting,
-                   "timeout": read_timeout}
+                   "timeout": read_timeout, "initialize": read_initialize}

@@ -16,6 +16,8 @@ Layout::
     /bodies/<datasets>     one row per floating body: mkbound, mk, begin, count, mass, masspart,
                            center (nb,3), inertia (nb,3,3), translation_dof, rotation_dof,
                            linearvelini, angularvelini
+    /normals               (N,3) f8     the mDBC normals the case defines (only when it does):
+                                        the vector from each boundary particle to the surface
     /json/<name>           UTF-8 JSON text: links, chrono, motions, materials, material_links,
                            gauges, special, initials, normals, bodies_extra, mkinfo
     /source_xml            the case XML text as read
@@ -47,7 +49,7 @@ def _clean_attr(value):
 
 def write_case_h5(path: str, *, casename: str, source_file: str, source_xml: str, version: str,
                   particles: dict, constants: dict, parameters: dict, domain: dict,
-                  bodies: list, json_items: dict) -> None:
+                  bodies: list, json_items: dict, normals=None) -> None:
     """Write the case file atomically (see the module docstring for the layout)."""
     import h5py
     with atomic_path(path) as tmp:
@@ -73,6 +75,8 @@ def write_case_h5(path: str, *, casename: str, source_file: str, source_xml: str
             for name in BODY_FIELDS:
                 if bodies:
                     b.create_dataset(name, data=np.asarray([getattr(x, name) for x in bodies]))
+            if normals is not None:
+                f.create_dataset("normals", data=np.asarray(normals, dtype=np.float64))
             j = f.create_group("json")
             for k, v in json_items.items():
                 j.create_dataset(k, data=json.dumps(v, default=_json_default))
@@ -129,6 +133,7 @@ def _read_case_h5(h5py, path: str) -> dict:
         out["parameters"] = {k: _attr_value(v) for k, v in f["parameters"].attrs.items()}
         out["domain"] = {k: _attr_value(v) for k, v in f["domain"].attrs.items()}
         out["bodies"] = {k: f["bodies"][k][...] for k in BODY_FIELDS if k in f["bodies"]}
+        out["normals"] = f["normals"][...] if "normals" in f else None
         out["json"] = {k: json.loads(f["json"][k][()].decode() if isinstance(f["json"][k][()], bytes)
                                      else f["json"][k][()]) for k in f["json"]}
         src = f["source_xml"][()]

@@ -69,12 +69,14 @@ class RunOutput:
 
     def _run_masses(self, p) -> np.ndarray:
         """The particle masses the run used: the case's, but rho0 dp^d for the floating
-        particles mDBC corrects (:func:`sphdvi.case.normals.mdbc_floating_mask`)."""
+        particles mDBC corrects (:func:`sphdvi.case.normals.mdbc_floating_mask`: of the case's
+        own normals, those that have one; computed ones reach every floating particle)."""
         from ..case.normals import mdbc_floating_mask
         from ..coupling import body_labels
         mass = np.array(p["mass"], float)
         try:
-            mask = mdbc_floating_mask(p["type"], body_labels(p["mk"], self.fluidcount), self.params)
+            mask = mdbc_floating_mask(p["type"], body_labels(p["mk"], self.fluidcount), self.params,
+                                      self.data.get("normals"))
         except ValueError:
             return mass         # a bad MdbcMkbound: the run refused it
         mass[mask] = float(self.data["constants"]["massbound"])

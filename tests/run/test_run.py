@@ -305,40 +305,126 @@ def _floating_box_with_normals(tmp_path, normals: str):
     return case
 
 
-def test_normals_element_names_the_mkbounds_that_get_mdbc(tmp_path):
-    """GenCase gives mDBC normals only to what ``<normals>`` names: a norplane of mkbound 5
-    (the S12 box) makes MdbcMkbound 5 (run.json), so the box gets normals and the walls keep
-    DBC; gencase says that the plane itself is not used; --set MdbcMkbound overrides; a
-    child without mkbound (norgeometry) leaves every boundary to mDBC; a bad mkbound is a
-    case error naming the line (exit 2)."""
-    plane = ('<norplane mkbound="5"><point x="0" y="0" z="0" /><normal x="0" y="0" z="1" />'
-             '<maxdisth v="2" /></norplane>')
-    case = _floating_box_with_normals(tmp_path, plane)
-    runs = {}
-    for name, extra in (("named", []), ("set", ["--set", "MdbcMkbound=0,5"])):
-        out = tmp_path / name
-        r = invoke(["run", case, "-o", out, "--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q",
-                    "--set", "Boundary=2", *extra])
-        assert r.exit_code == 0, r.output
-        assert "sphdvi computes the mDBC normals from the particles" in r.output
-        with h5py.File(out / "restart.h5") as f:
-            runs[name] = (np.linalg.norm(f["aux/normals"][...], axis=1), f["state/ptype"][...])
-        runs[name] += (json.loads((out / "run.json").read_text())["parameters"]["MdbcMkbound"],)
-    lengths, ptype, listed = runs["named"]
-    assert listed == "5"
-    assert np.all(lengths[ptype == 0] == 0) and np.all(lengths[ptype == 2] > 0)
-    lengths, ptype, listed = runs["set"]
-    assert listed == "0,5" and np.all(lengths[ptype == 0] > 0)
-    from sphdvi.case.normals import mkbounds_named_by_normals
-    assert mkbounds_named_by_normals([]) == ""
-    assert mkbounds_named_by_normals([{"type": "norplane", "mkbound": "5"},
-                                      {"type": "norsphere", "mkbound": "0-2"}]) == "5,0-2"
-    assert mkbounds_named_by_normals([{"type": "norplane", "mkbound": "5"}, {"type": "norgeometry"}]) == ""
-    bad = _floating_box_with_normals(tmp_path / "bad", plane.replace('mkbound="5"', 'mkbound="five"'))
-    r = invoke(["gencase", bad, "-o", tmp_path / "bad" / "o"])
-    line = bad.read_text().splitlines().index(next(x for x in bad.read_text().splitlines() if "<normals>" in x)) + 1
-    assert r.exit_code == 2 and "Traceback" not in r.output
-    assert f"{bad.name}:{line}: <norplane>: mkbound='five'" in r.output
+NORMALS_GEOMETRY = """<list name="GeometryForNormals">
+<setactive drawpoints="0" drawshapes="1"/><setshapemode>actual | bound</setshapemode>
+<setmkbound mk="0"/><setnormalinvert invert="true"/>
+<drawbox><boxfill>bottom | left | right</boxfill><point x="0" y="-1" z="0"/><size x="1" y="2" z="0.6"/>
+<layers vdp="-0.5"/></drawbox>
+<setmkbound mk="5"/><setnormalinvert invert="false"/>
+<drawbox><boxfill>all</boxfill><point x="0.4" y="-1" z="0.25"/><size x="0.2" y="2" z="0.1"/>
+<layers vdp="0.5"/></drawbox>
+<shapeout file="hdp"/><resetdraw/></list>
+<mainlist><runlist name="GeometryForNormals"/>"""
+
+
+def test_case_normals_from_geometry_reach_the_run(tmp_path):
+    """DualSPHysics's mDBC set-up: the walls and the S12 box drawn dp/2 in front of their particles
+    (GeometryForNormals), ``<normals><norgeometry>`` over that shape file. gencase stores the
+    vectors to those outlines (case.h5 /normals, Normal in _All.vtp): dp/2 up from the floor, dp/2
+    down from the box's bottom row, none deeper in the box than distanceh h; the run starts from
+    them (restart.h5 aux/normals after 0.01 s); the fluid takes the corrected floating particles'
+    mass as rho0 dp^2, the others' (DBC) as their share of the body's, and so does measure."""
+    case = _floating_box_with_normals(
+        tmp_path, '<norgeometry><geometryfile file="[CaseName]_hdp_Actual.vtk"/><distanceh v="2.0"/></norgeometry>')
+    text = case.read_text().replace("<mainlist>", NORMALS_GEOMETRY, 1)
+    case.write_text(text)
+    out = tmp_path / "out"
+    r = invoke(["run", case, "-o", out, "--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q",
+                "--set", "Boundary=2"])
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "CaseBoxNormals.h5") as f:
+        normals = f["normals"][...]
+        pos, ptype = f["particles/pos"][...], f["particles/type"][...]
+        h = f["constants"].attrs["h"]
+    dp = 0.01
+    floor = (ptype == 0) & np.isclose(pos[:, 2], 0) & (pos[:, 0] > 0.05) & (pos[:, 0] < 0.95)
+    assert floor.sum() > 80 and np.allclose(normals[floor], [0, 0, dp / 2])
+    box = ptype == 2
+    bottom = box & np.isclose(pos[:, 2], 0.25) & (pos[:, 0] > 0.42) & (pos[:, 0] < 0.58)
+    assert bottom.sum() > 10 and np.allclose(normals[bottom], [0, 0, -dp / 2])
+    depth = np.minimum.reduce([pos[:, 0] - 0.395, 0.605 - pos[:, 0], pos[:, 2] - 0.245, 0.355 - pos[:, 2]])
+    assert np.all(np.linalg.norm(normals[box], axis=1)[depth[box] > 2 * h + 1e-9] == 0)
+    assert np.allclose(np.linalg.norm(normals[box], axis=1)[depth[box] <= 2 * h - 1e-9],
+                       depth[box][depth[box] <= 2 * h - 1e-9])
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(str(out / "CaseBoxNormals_All.vtp"))
+    reader.Update()
+    shown = vtk_to_numpy(reader.GetOutput().GetPointData().GetArray("Normal"))
+    assert np.allclose(shown, normals, atol=1e-7)
+    with h5py.File(out / "restart.h5") as f:
+        run_normals, idp, mass = f["aux/normals"][...], f["state/idp"][...], f["state/mass"][...]
+        run_type = f["state/ptype"][...]
+    assert np.allclose(run_normals, normals[idp], atol=1e-6)
+    corrected = (run_type == 2) & np.any(run_normals != 0, axis=1)
+    assert corrected.any() and np.allclose(mass[corrected], 1000 * dp ** 2)
+    inner = (run_type == 2) & ~corrected            # out of the outline's reach: DBC, the body's share
+    assert inner.any() and np.allclose(mass[inner], 500 * dp ** 2)
+    from sphdvi.measure.post import RunOutput
+    assert np.array_equal(RunOutput(str(out)).mass_by_idp[idp], mass)   # measure takes the run's masses
+
+
+def test_initialize_boundnormals_and_fluidvelocity(tmp_path):
+    """The solver's ``<special><initialize>``: boundnormal_plane over the floor (auto point: dp/2
+    above it), boundnormal_set on the box, applied after ``<normals>`` (an earlier norset of the
+    floor is overridden); fluidvelocity sets a linear profile, extrapolated above its top
+    height as DualSPHysics does."""
+    case = _floating_box_with_normals(tmp_path, '<norset mkbound="0"><normal x="1" y="0" z="0"/></norset>')
+    init = ('<initialize><boundnormal_plane mkbound="0"><point auto="true"/><normal x="0" y="0" z="1"/>'
+            '<onlypos><posmax z="0.001"/></onlypos></boundnormal_plane>'
+            '<boundnormal_set mkbound="5"><normal x="0" y="0" z="-0.005"/></boundnormal_set>'
+            '<fluidvelocity mkfluid="0"><direction x="1" y="0" z="0"/><velocity2 v="0" v2="0.1" z="0" z2="0.1"/>'
+            '</fluidvelocity></initialize>')
+    text = case.read_text()
+    assert "<special>" not in text
+    case.write_text(text.replace("<execution>", f"<execution><special>{init}</special>", 1))
+    out = tmp_path / "out"
+    r = invoke(["gencase", case, "-o", out])
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "CaseBoxNormals.h5") as f:
+        normals, pos, ptype = f["normals"][...], f["particles/pos"][...], f["particles/type"][...]
+        vel = f["particles/vel"][...]
+    floor = (ptype == 0) & np.isclose(pos[:, 2], 0)
+    side = (ptype == 0) & (pos[:, 2] > 0.001)
+    assert np.allclose(normals[floor], [0, 0, 0.005]) and np.allclose(normals[side], [1, 0, 0])
+    assert np.allclose(normals[ptype == 2], [0, 0, -0.005])
+    fluid = ptype == 3
+    assert np.allclose(vel[fluid, 0], pos[fluid, 2]) and np.all(vel[fluid, 1:] == 0)
+    assert vel[fluid, 0].max() > 0.25          # z up to 0.3: beyond z2, extrapolated
+
+
+@pytest.mark.parametrize("normals,fragment", [
+    ('<norplane><point x="0" y="0" z="0"/><normal x="0" y="0" z="1"/></norplane>', "missing attribute 'mkbound'"),
+    ('<norplane mkbound="five"><point x="0" y="0" z="0"/><normal x="0" y="0" z="1"/></norplane>', "mkbound='five'"),
+    ('<norsphere><center x="0" y="0" z="0"/><radius v="-1"/><inside v="true"/></norsphere>', "is not positive"),
+    ('<norplane mkbound="0"><point x="0" y="0" z="0"/><normal x="0" y="0" z="0"/></norplane>', "zero vector"),
+    ('<norgeometry><geometryfile file="[CaseName]_nothere_Actual.vtk"/></norgeometry>', "no <shapeout file=\"nothere\">"),
+    ('<norset mkbound="0"><normal x="0" y="0" z="1"/><clear v="true"/></norset>', "unknown element <clear>"),
+])
+def test_case_normals_errors_name_the_line(tmp_path, normals, fragment):
+    case = _floating_box_with_normals(tmp_path, normals)
+    r = invoke(["gencase", case, "-o", tmp_path / "o"])
+    lines = case.read_text().splitlines()
+    line = lines.index(next(x for x in lines if "<normals>" in x)) + 1
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert f"{case.name}:{line}:" in r.output and fragment in r.output, r.output
+
+
+def test_case_normals_that_reach_nothing(tmp_path):
+    """Normals that reach no boundary particle: gencase warns (and of an operation that selects
+    none), a run with mDBC stops with exit 2 saying so, a DBC run is unaffected."""
+    case = _floating_box_with_normals(
+        tmp_path, '<norplane mkbound="5"><point x="0" y="0" z="0"/><normal x="0" y="0" z="1"/></norplane>'
+                  '<norset mkbound="7"><normal x="0" y="0" z="1"/></norset>')
+    r = invoke(["gencase", case, "-o", tmp_path / "o"])
+    assert r.exit_code == 0
+    assert "<norset> selects no boundary particle (mkbound '7')" in r.output
+    assert "the case's normals reach no boundary particle" in r.output
+    r = invoke(["run", tmp_path / "o", "--tmax", "0.002", "-q", "--threads", "1", "--set", "Boundary=2"])
+    assert r.exit_code == 2 and "reach no boundary particle" in r.output and "Traceback" not in r.output
+    r = invoke(["run", tmp_path / "o", "--tmax", "0.002", "-q", "--threads", "1"])
+    assert r.exit_code == 0, r.output
 
 
 def test_mdbc_floating_mask():

@@ -55,6 +55,7 @@ class Drawing:
     mk: np.ndarray
     primitives: list = field(default_factory=list)
     shape_files: list = field(default_factory=list)
+    shape_sets: dict = field(default_factory=dict)   # <shapeout file> name -> (triangles, mk)
     messages: list = field(default_factory=list)
     origin: np.ndarray | None = None   # first lattice node (pointmin, or pointref-aligned)
 
@@ -121,6 +122,7 @@ class GeometryRunner:
         self.keep_shapes = True      # False when the document has no <shapeout>
         self.shape_triangles = 0
         self.shape_files: list = []
+        self.shape_sets: dict = {}
         self.messages: list = []
         self.handlers = self._handler_table()
 
@@ -904,6 +906,7 @@ class GeometryRunner:
         if not base or base in (".", "..") or not re.fullmatch(r"[A-Za-z0-9_.\-]+", base):
             raise self.reader.error(el, f"file={value!r} is not a usable file name",
                                     "a plain name of letters, digits, '_', '-', '.'")
+        self.shape_sets[base] = _shape_arrays(self.shapes)
         if self.outdir is not None:
             name = f"{self.casename}_{base}.{fmt}" if self.casename else f"{base}.{fmt}"
             path = os.path.join(self.outdir, name)
@@ -915,6 +918,16 @@ class GeometryRunner:
         if reset:
             self.shapes = []
             self.shape_triangles = 0
+
+
+def _shape_arrays(shapes) -> tuple:
+    """(triangles (T, 3, 3), mk of each (T,), fluid flag of each) of the recorded shapes."""
+    tris = [np.asarray(x["triangles"], dtype=np.float64).reshape(-1, 3, 3) for x in shapes]
+    if not tris:
+        return np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0, bool)
+    mk = np.concatenate([np.full(len(t), x["mk"], np.int64) for x, t in zip(shapes, tris)])
+    fluid = np.concatenate([np.full(len(t), bool(x["fluid"])) for x, t in zip(shapes, tris)])
+    return np.concatenate(tris), mk, fluid
 
 
 VARIABLE_COMMANDS = {"newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",
@@ -996,4 +1009,5 @@ def _run_geometry(reader, geometry_el, casename, outdir, max_nodes) -> Drawing:
     return Drawing(dp=dp, pointmin=pmin, pointmax=pmax, pointref=lat.pointref, is2d=lat.is2d,
                    posy2d=float(pmin[1]) if lat.is2d else 0.0, pos=pos, is_fluid=is_fluid,
                    mk=mk, primitives=runner.primitives, shape_files=runner.shape_files,
+                   shape_sets=runner.shape_sets,
                    messages=runner.messages, origin=lat.origin)
