@@ -231,3 +231,29 @@ def test_geometry_normals_keep_to_their_own_mk():
     assert np.allclose(n[mk == 0], [0, 0, DP / 2])
     assert np.allclose(n[mk == 1], [[0, 0, -DP / 2], [0, 0, DP / 2]])
     assert np.allclose(n[mk == 2], [0, 0, 1.5 * DP])
+
+
+def test_geometry_normals_3d_tank_against_the_clamped_point():
+    """3D: a tank of two wall layers (floor and four walls, 0.4 x 0.3 m, 0.2 m high) and its inner
+    outline dp/2 in front of them, open at the top (0.5 m, above the walls): every wall particle
+    lies outside the outline's box, so the nearest point of the outline is the particle clamped
+    into that box (faces, edges and corners alike); N within distanceh h = 2 dp, none beyond
+    (the outer layer's edges and corners, 2.1 and 2.6 dp away)."""
+    xs = np.arange(-DP, 0.4 + 1.5 * DP, DP)
+    ys = np.arange(-DP, 0.3 + 1.5 * DP, DP)
+    zs = np.arange(-DP, 0.2 + DP / 2, DP)
+    g = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
+    wall = (g[:, 0] < DP / 2) | (g[:, 0] > 0.4 - DP / 2) | (g[:, 1] < DP / 2) | (g[:, 1] > 0.3 - DP / 2) \
+        | (g[:, 2] < DP / 2)
+    pos = g[wall]
+    ptype = np.zeros(len(pos), int)
+    lo, hi = np.array([DP / 2, DP / 2, DP / 2]), np.array([0.4 - DP / 2, 0.3 - DP / 2, 0.5])
+    tris = box_triangles(lo, hi - lo, skip=("z1",))
+    reach = 2 * DP
+    geo = op("geometry", file="hdp", distanceh=reach / H)
+    n, _ = run_ops([geo], pos, ptype, np.zeros(len(pos), int), is2d=False, geometry=lambda o: (tris, None))
+    want = np.clip(pos, lo, hi) - pos
+    near = np.linalg.norm(want, axis=1) <= reach
+    assert near.sum() > 350 and (~near).sum() > 40
+    assert np.allclose(n[near], want[near], atol=1e-12)
+    assert np.all(n[~near] == 0)
