@@ -257,6 +257,18 @@ def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
     return out, [int(m) for m in wanted if int(m) not in present]
 
 
+def one_layer_mkbounds(normals: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray, dp: float) -> list[int]:
+    """The fixed and moving mkbounds whose particles with a normal all lie within 0.75 dp of the
+    surface: walls one particle thick (the normal of a second layer is 1.5 dp long)."""
+    length = np.linalg.norm(normals, axis=1)
+    wall = (np.asarray(ptype) <= 1) & (length > 0)
+    thin = []
+    for mk in np.unique(mkbound[wall]):
+        if length[wall & (mkbound == mk)].max() < 0.75 * dp:
+            thin.append(int(mk))
+    return thin
+
+
 def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict,
                        normals: np.ndarray | None = None) -> np.ndarray:
     """The floating particles mDBC corrects: ``Boundary`` 2 (any ``SlipMode``), of the

@@ -5,6 +5,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 
 import h5py
 import numpy as np
@@ -329,8 +330,9 @@ def test_case_normals_from_geometry_reach_the_run(tmp_path):
     text = case.read_text().replace("<mainlist>", NORMALS_GEOMETRY, 1)
     case.write_text(text)
     out = tmp_path / "out"
-    r = invoke(["run", case, "-o", out, "--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q",
-                "--set", "Boundary=2"])
+    with pytest.warns(UserWarning, match="mDBC on mkbound 0: a wall one particle thick"):   # the S12 tank's
+        r = invoke(["run", case, "-o", out, "--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q",
+                    "--set", "Boundary=2"])
     assert r.exit_code == 0, r.output
     with h5py.File(out / "CaseBoxNormals.h5") as f:
         normals = f["normals"][...]
@@ -427,6 +429,28 @@ def test_case_normals_that_reach_nothing(tmp_path):
     assert r.exit_code == 0, r.output
 
 
+def test_mdbc_on_one_layer_walls_is_warned(tmp_path):
+    """mDBC on a wall one particle thick leaks (README): the run warns, naming the mkbound and the
+    layers to draw; with three layers it does not."""
+    case = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
+    args = ["--dp", "0.1", "--tmax", "0.002", "-q", "--threads", "1", "--set", "Boundary=2"]
+    with pytest.warns(UserWarning, match=r'mDBC on mkbound 0: a wall one particle thick.*<layers vdp="0,1,2">'):
+        r = invoke(["run", case, "-o", tmp_path / "one", *args])
+    assert r.exit_code == 0
+    thick = tmp_path / "CaseThick_Def.xml"
+    text = case.read_text()
+    wall = '<size x="4" y="2" z="3" />'
+    assert text.count(wall) == 1
+    thick.write_text(text.replace(wall, wall + '<layers vdp="0,1,2" />'))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = invoke(["run", thick, "-o", tmp_path / "three", *args])
+    assert r.exit_code == 0 and not any("one particle thick" in str(w.message) for w in caught)
+    from sphdvi.case.normals import one_layer_mkbounds
+    n = np.array([[0, 0, 0.05], [0, 0, 0.15], [0.05, 0, 0], [0, 0, 0], [0, 0, 0.05]])
+    assert one_layer_mkbounds(n, np.array([0, 0, 1, 0, 2]), np.array([0, 0, 3, 4, 5]), 0.1) == [3]
+
+
 def test_mdbc_floating_mask():
     """The floating particles mDBC corrects, whose mass the fluid takes as rho0 dp^d: Boundary 2
     with any SlipMode, of the MdbcMkbound list when there is one."""
@@ -500,7 +524,6 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
     assert ExclusionWarnings(False, 1000, 1200).check(500, 500, 500, 0.1, 1) == []
     # from a run: densities above RhopOutMax exclude ~7 % of the column's deepest particles
     case = small_case(tmp_path)
-    import warnings
     for flag, expect in (("1", True), ("0", False)):
         out = tmp_path / f"o{flag}"
         with warnings.catch_warnings(record=True) as caught:
