@@ -659,6 +659,12 @@ def summary(result: GenCaseResult) -> str:
             a = b.analytic
             diag = ", ".join(f"{a['inertia'][i][i]:.6g}" for i in range(3))
             lines.append(f"    analytic {a['shape']}: mass {a['mass']:.6g} {unit}, inertia diag ({diag})")
+    if result.normals is not None:
+        bound = np.asarray(p["type"]) != TYPE_FLUID
+        has = bound & np.any(result.normals != 0.0, axis=1)
+        labels = ", ".join(str(int(v)) for v in np.unique(p["label"][has])) or "none"
+        lines.append(f"mDBC normals (the case's): {int(has.sum())} of {int(bound.sum())} boundary particles "
+                     f"(mkbound {labels}); the others keep DBC with Boundary=2")
     mem = sum(np.asarray(p[k]).nbytes for k in ("pos", "vel", "rhop", "mass", "type", "mk", "idp"))
     lines.append(f"Memory: {mem / 1e6:.2f} MB of particle data ({mem / max(n, 1):.0f} bytes per particle)")
     return "\n".join(lines)

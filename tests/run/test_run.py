@@ -387,6 +387,8 @@ def test_initialize_boundnormals_and_fluidvelocity(tmp_path):
     with h5py.File(out / "CaseBoxNormals.h5") as f:
         normals, pos, ptype = f["normals"][...], f["particles/pos"][...], f["particles/type"][...]
         vel = f["particles/vel"][...]
+    nb = int(np.count_nonzero(ptype != 3))
+    assert f"mDBC normals (the case's): {nb} of {nb} boundary particles (mkbound 0, 5)" in r.output
     floor = (ptype == 0) & np.isclose(pos[:, 2], 0)
     side = (ptype == 0) & (pos[:, 2] > 0.001)
     assert np.allclose(normals[floor], [0, 0, 0.005]) and np.allclose(normals[side], [1, 0, 0])
