@@ -94,10 +94,8 @@ def read_normal_op(reader, el, kind: str) -> dict:
         if point is None and not auto:
             raise reader.error(el, "missing child element <point>", '<point x=".." y=".." z=".."/> or <point auto="true"/>')
         op["point"] = None if auto else reader.vec3(point).tolist()
-        op["limitdist"] = _scalar_el(reader, el, "limitdist", 0.5)
-        limit = reader.child(el, "limitdist")
-        if limit is not None and limit.get("vdp") is not None:
-            op["limitdist"] = reader.num(limit, "vdp")
+        limit = reader.child(el, "limitdist")            # <limitdist vdp="0.5"/>: in dp
+        op["limitdist"] = 0.5 if limit is None else reader.num(limit, "vdp" if limit.get("v") is None else "v")
     elif kind == "sphere":
         op["center"] = _vector(reader, el, "center")
         op["radius"] = _scalar_el(reader, el, "radius", None, positive=True)

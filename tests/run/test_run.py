@@ -368,13 +368,13 @@ def test_case_normals_from_geometry_reach_the_run(tmp_path):
 
 
 def test_initialize_boundnormals_and_fluidvelocity(tmp_path):
-    """The solver's ``<special><initialize>``: boundnormal_plane over the floor (auto point: dp/2
-    above it), boundnormal_set on the box, applied after ``<normals>`` (an earlier norset of the
+    """The solver's ``<special><initialize>``: boundnormal_plane over the floor (auto point: limitdist
+    1 dp above it), boundnormal_set on the box, applied after ``<normals>`` (an earlier norset of the
     floor is overridden); fluidvelocity sets a linear profile, extrapolated above its top
     height as DualSPHysics does."""
     case = _floating_box_with_normals(tmp_path, '<norset mkbound="0"><normal x="1" y="0" z="0"/></norset>')
     init = ('<initialize><boundnormal_plane mkbound="0"><point auto="true"/><normal x="0" y="0" z="1"/>'
-            '<onlypos><posmax z="0.001"/></onlypos></boundnormal_plane>'
+            '<limitdist vdp="1"/><onlypos><posmax z="0.001"/></onlypos></boundnormal_plane>'
             '<boundnormal_set mkbound="5"><normal x="0" y="0" z="-0.005"/></boundnormal_set>'
             '<fluidvelocity mkfluid="0"><direction x="1" y="0" z="0"/><velocity2 v="0" v2="0.1" z="0" z2="0.1"/>'
             '</fluidvelocity></initialize>')
@@ -391,7 +391,7 @@ def test_initialize_boundnormals_and_fluidvelocity(tmp_path):
     assert f"mDBC normals (the case's): {nb} of {nb} boundary particles (mkbound 0, 5)" in r.output
     floor = (ptype == 0) & np.isclose(pos[:, 2], 0)
     side = (ptype == 0) & (pos[:, 2] > 0.001)
-    assert np.allclose(normals[floor], [0, 0, 0.005]) and np.allclose(normals[side], [1, 0, 0])
+    assert np.allclose(normals[floor], [0, 0, 0.01]) and np.allclose(normals[side], [1, 0, 0])
     assert np.allclose(normals[ptype == 2], [0, 0, -0.005])
     fluid = ptype == 3
     assert np.allclose(vel[fluid, 0], pos[fluid, 2]) and np.all(vel[fluid, 1:] == 0)
