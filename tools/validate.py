@@ -13,6 +13,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
                                              # S16M: S16 with mDBC on the box (dp 0.02, 0.01 and 0.005: 2, 25 and 107 min on 2 threads)
+                                             # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
     python tools/validate.py S9 --csv s9.csv --keep runs/
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
@@ -137,9 +138,9 @@ def _front_case(name, title, file):
                 "Z(T) within ±5 % for T in [1, 3] at a/dp >= 50 (judgement: the experiment's gate delays the surge)")
 
 
-def _floating_waves_case(name, title, resolutions):
-    """S16/S16M: the floating box in the Hadzic flume, scored on its heave, roll and sway (slow)."""
-    return Case(name, title, case_path("flapwaves2d", "CaseFloatingWavesHadzic2D_Def.xml"), resolutions,
+def _floating_waves_case(name, title, resolutions, file="CaseFloatingWavesHadzic2D_Def.xml"):
+    """S16/S16M/S16O: the floating box in the Hadzic flume, scored on its heave, roll and sway (slow)."""
+    return Case(name, title, case_path("flapwaves2d", file), resolutions,
                 score_floating_waves, [("heave corr", "heave_corr", "{:.3f}"), ("heave rms %", "heave_rms", PCT),
                                        ("heave range %", "heave_range", PCT), ("roll corr", "roll_corr", "{:.3f}"),
                                        ("roll rms %", "roll_rms", PCT), ("roll range %", "roll_range", PCT),
@@ -275,6 +276,10 @@ def cases() -> list:
                              "walls and flap DBC)",
                              [Resolution("box/dp 5", 0.02, MDBC_BOX), Resolution("box/dp 10", 0.01, MDBC_BOX),
                               Resolution("box/dp 20", 0.005, MDBC_BOX)]),
+        _floating_waves_case("S16O", "S16 with mDBC on the box, its normals from its outline as GenCase's "
+                             "(norgeometry; CaseFloatingWavesHadzicOutline2D_Def.xml)",
+                             [Resolution("box/dp 5", 0.02), Resolution("box/dp 10", 0.01)],
+                             "CaseFloatingWavesHadzicOutline2D_Def.xml"),
         Case("S12", "floating box in still water (ρb/ρw = 0.5)",
              case_path("floatingbox2d", "CaseFloatingBox2D_Def.xml"),
              [Resolution("box/dp 10", 0.02, ["--tmax", "1.5", "--tout", "0.05"]),
@@ -328,7 +333,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S7 S8 S9 S10 S12 S16 S16M A1 W1 W2 W3); default: all but the slow S4, S8, S16 and S16M")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S7 S8 S9 S10 S12 S16 S16M S16O A1 W1 W2 W3); default: all but the slow S4, S8, S16, S16M and S16O")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
