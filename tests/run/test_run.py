@@ -242,6 +242,28 @@ def test_resume_bitwise_with_mdbc_on_a_floating_body(tmp_path, slip):
     assert (a / "bodies.csv").read_text() == (b / "bodies.csv").read_text()
 
 
+def test_resume_bitwise_with_the_cases_own_normals(tmp_path):
+    """The same with the box's normals from its outline (norgeometry; case.h5 /normals): a resumed
+    run ends bitwise equal to an uninterrupted one."""
+    case = _floating_box_with_normals(
+        tmp_path, '<norgeometry><geometryfile file="[CaseName]_hdp_Actual.vtk"/><distanceh v="2.0"/></norgeometry>')
+    case.write_text(case.read_text().replace("<mainlist>", normals_geometry(BOX_OUTLINE), 1))
+    common = ["--dp", "0.02", "--tout", "0.01", "--threads", "1", "-q", "--set", "FtPause=0", "--set", "Boundary=2"]
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert invoke(["run", case, "-o", a, "--tmax", "0.04"] + common).exit_code == 0
+    assert invoke(["run", case, "-o", b, "--tmax", "0.02"] + common).exit_code == 0
+    r = invoke(["run", b, "--resume", "--tmax", "0.04"] + common[2:])
+    assert r.exit_code == 0, r.output
+    sa, _ = final_state(a)
+    sb, _ = final_state(b)
+    for k in sa:
+        assert np.array_equal(sa[k], sb[k]), k
+    with h5py.File(a / "restart.h5") as f:
+        normals, ptype = f["aux/normals"][...], f["state/ptype"][...]
+    assert np.all(normals[ptype == 0] == 0) and np.any(normals[ptype == 2] != 0)   # the box only
+    assert (a / "bodies.csv").read_text() == (b / "bodies.csv").read_text()
+
+
 @pytest.mark.parametrize("slip", [1, 2, 3])
 def test_mdbc_from_case(tmp_path, slip):
     """Boundary=2 (mDBC) with each SlipMode: normals are computed from the particles; with
@@ -306,16 +328,22 @@ def _floating_box_with_normals(tmp_path, normals: str):
     return case
 
 
-NORMALS_GEOMETRY = """<list name="GeometryForNormals">
-<setactive drawpoints="0" drawshapes="1"/><setshapemode>actual | bound</setshapemode>
-<setmkbound mk="0"/><setnormalinvert invert="true"/>
+TANK_OUTLINE = """<setmkbound mk="0"/><setnormalinvert invert="true"/>
 <drawbox><boxfill>bottom | left | right</boxfill><point x="0" y="-1" z="0"/><size x="1" y="2" z="0.6"/>
-<layers vdp="-0.5"/></drawbox>
-<setmkbound mk="5"/><setnormalinvert invert="false"/>
+<layers vdp="-0.5"/></drawbox>"""
+BOX_OUTLINE = """<setmkbound mk="5"/><setnormalinvert invert="false"/>
 <drawbox><boxfill>all</boxfill><point x="0.4" y="-1" z="0.25"/><size x="0.2" y="2" z="0.1"/>
-<layers vdp="0.5"/></drawbox>
-<shapeout file="hdp"/><resetdraw/></list>
-<mainlist><runlist name="GeometryForNormals"/>"""
+<layers vdp="0.5"/></drawbox>"""
+
+
+def normals_geometry(*outlines):
+    """A GeometryForNormals list of the given outlines (shapes only), run first in <mainlist>."""
+    return ('<list name="GeometryForNormals"><setactive drawpoints="0" drawshapes="1"/>'
+            '<setshapemode>actual | bound</setshapemode>' + "".join(outlines)
+            + '<shapeout file="hdp"/><resetdraw/></list><mainlist><runlist name="GeometryForNormals"/>')
+
+
+NORMALS_GEOMETRY = normals_geometry(TANK_OUTLINE, BOX_OUTLINE)
 
 
 def test_case_normals_from_geometry_reach_the_run(tmp_path):
