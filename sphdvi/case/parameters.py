@@ -38,8 +38,8 @@ PARAMETERS: dict[str, Param] = {
     "MdbcGhostVelocity": Param("int", 1, "sphdvi: mDBC SlipMode 2, 3 ghost-node velocity 1:first-order "
                                "corrected, 0:Shepard average (DualSPHysics v5.4)", (0, 1)),
     "MdbcMkbound": Param("str", "", "sphdvi: the mkbound list ('0-3,7') of the boundaries and floating bodies "
-                         "mDBC acts on, the others keeping DBC (empty: all; DualSPHysics gives normals to "
-                         "what its <normals> element names)"),
+                         "mDBC acts on, the others keeping DBC (empty: every one with a normal, from the "
+                         "case's <normals> and <initialize>, or from the particles when it defines none)"),
     "NoPenetration": Param("int", 0, "mDBC no-penetration correction (SlipMode 2, 3 only)", (0, 1)),
     "StepAlgorithm": Param("int", 1, "1:Verlet, 2:Symplectic", (1, 2)),
     "VerletSteps": Param("int", 40, "Verlet: steps between Euler steps (0: Euler every step)", (), 0, 1e9),
