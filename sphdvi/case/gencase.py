@@ -597,7 +597,8 @@ def warn_gauges_outside(gauges, domain, is2d: bool, reader) -> None:
 # output
 # ---------------------------------------------------------------------------
 def write_outputs(result: GenCaseResult, outdir: str) -> list[str]:
-    """Write ``<casename>.h5`` and ``<casename>_All.vtp`` into ``outdir``."""
+    """Write ``<casename>.h5``, ``<casename>_All.vtp`` and, when the case defines mDBC normals,
+    ``<casename>_Normals.vtp`` into ``outdir``."""
     from ..io.casefile import write_case_h5
     from ..io.vtkxml import write_vtp_points
     os.makedirs(outdir, exist_ok=True)
@@ -625,7 +626,24 @@ def write_outputs(result: GenCaseResult, outdir: str) -> list[str]:
                                      "Mk": p["mk"].astype(np.int32),
                                      **({"Normal": result.normals.astype(np.float32)}
                                         if result.normals is not None else {})})
-    return [h5, vtp] + list(result.files)
+    files = [h5, vtp]
+    if result.normals is not None:
+        files.append(write_normals_vtp(os.path.join(outdir, f"{case.name}_Normals.vtp"), p, result.normals))
+    return files + list(result.files)
+
+
+def write_normals_vtp(path: str, particles: dict, normals: np.ndarray) -> str:
+    """The boundary particles that have an mDBC normal, for ParaView's Glyph filter (as
+    DualSPHysics's CfgInit_Normals): ``Normal`` its direction, ``NormalSize`` |N| (the distance to
+    the boundary surface; the ghost node lies 2 |N| away), ``Mk``."""
+    from ..io.vtkxml import write_vtp_points
+    size = np.linalg.norm(normals, axis=1)
+    has = (np.asarray(particles["type"]) != TYPE_FLUID) & (size > 0)
+    unit_n = normals[has] / size[has, None]
+    write_vtp_points(path, particles["pos"][has], {"Normal": unit_n.astype(np.float32),
+                                                  "NormalSize": size[has].astype(np.float32),
+                                                  "Mk": particles["mk"][has].astype(np.int32)})
+    return path
 
 
 def summary(result: GenCaseResult) -> str:

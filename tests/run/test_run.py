@@ -383,6 +383,15 @@ def test_case_normals_from_geometry_reach_the_run(tmp_path):
     reader.Update()
     shown = vtk_to_numpy(reader.GetOutput().GetPointData().GetArray("Normal"))
     assert np.allclose(shown, normals, atol=1e-7)
+    reader = vtk.vtkXMLPolyDataReader()                     # the glyph file: particles with a normal
+    reader.SetFileName(str(out / "CaseBoxNormals_Normals.vtp"))
+    reader.Update()
+    data = reader.GetOutput().GetPointData()
+    has = np.linalg.norm(normals, axis=1) > 0
+    assert reader.GetOutput().GetNumberOfPoints() == has.sum()
+    size = vtk_to_numpy(data.GetArray("NormalSize"))
+    assert np.allclose(size, np.linalg.norm(normals[has], axis=1), rtol=1e-6)
+    assert np.allclose(vtk_to_numpy(data.GetArray("Normal")) * size[:, None], normals[has], atol=1e-7)
     with h5py.File(out / "restart.h5") as f:
         run_normals, idp, mass = f["aux/normals"][...], f["state/idp"][...], f["state/mass"][...]
         run_type = f["state/ptype"][...]
