@@ -1,6 +1,7 @@
 """sphdvi run: outputs, resume (bitwise on 1 thread), divergence, body-only runs."""
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -433,6 +434,40 @@ def test_initialize_boundnormals_and_fluidvelocity(tmp_path):
     fluid = ptype == 3
     assert np.allclose(vel[fluid, 0], pos[fluid, 2]) and np.all(vel[fluid, 1:] == 0)
     assert vel[fluid, 0].max() > 0.25          # z up to 0.3: beyond z2, extrapolated
+
+
+def test_case_normals_from_a_mesh_file(tmp_path):
+    """norgeometry over an STL file beside the case (no mk per triangle: every particle sees all of
+    it) gives the box the same normals as the same outline drawn with <shapeout>; the tank, out of
+    its reach, gets none."""
+    lo, hi = np.array([0.395, -1, 0.245]), np.array([0.605, 1, 0.355])
+    corners = np.array([[lo[0] if i & 1 == 0 else hi[0], lo[1] if i & 2 == 0 else hi[1],
+                         lo[2] if i & 4 == 0 else hi[2]] for i in range(8)])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    facets = "".join(f"facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {' '.join(repr(float(v)) for v in corners[k])}\n"
+                                                                     for k in tri) + "endloop\nendfacet\n"
+                     for q in quads for tri in ((q[0], q[1], q[2]), (q[0], q[2], q[3])))
+    (tmp_path / "BoxOutline.stl").write_text("solid box\n" + facets + "endsolid box\n")
+    results = {}
+    for name, normals, lists in (("stl", '<norgeometry><geometryfile file="BoxOutline.stl"/></norgeometry>', None),
+                                 ("shape", '<norgeometry><geometryfile file="[CaseName]_hdp_Actual.vtk"/></norgeometry>',
+                                  normals_geometry(BOX_OUTLINE))):
+        case = _floating_box_with_normals(tmp_path / name, normals)
+        if lists:
+            case.write_text(case.read_text().replace("<mainlist>", lists, 1))
+        shutil.copy(tmp_path / "BoxOutline.stl", tmp_path / name)
+        r = invoke(["gencase", case, "-o", tmp_path / name / "o"])
+        assert r.exit_code == 0, r.output
+        with h5py.File(tmp_path / name / "o" / "CaseBoxNormals.h5") as f:
+            results[name] = (f["normals"][...], f["particles/type"][...], f["particles/pos"][...])
+    (stl, ptype, pos), (shape, _, _) = results["stl"], results["shape"]
+    assert np.any(stl[ptype == 2] != 0) and np.all(stl[ptype == 0] == 0)
+    # vtk reads STL in single precision; a particle as far from two faces picks either
+    assert np.allclose(np.linalg.norm(stl, axis=1), np.linalg.norm(shape, axis=1), atol=1e-7)
+    same = np.all(np.abs(stl - shape) <= 1e-7, axis=1)
+    foot = pos[~same] + stl[~same]
+    on_face = np.isclose(foot[:, [0, 0, 2, 2]], [0.395, 0.605, 0.245, 0.355], atol=1e-7).any(axis=1)
+    assert same.mean() > 0.9 and np.all(on_face)
 
 
 @pytest.mark.parametrize("normals,fragment", [
