@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -319,7 +320,7 @@ def geometry_triangles(op: dict, casename: str, drawing, reader) -> tuple:
     """The boundary triangles (T, 3, 3) of a ``norgeometry`` and the mk of each (None for a
     mesh file): a ``<shapeout>`` of this case (``[CaseName]_hdp_Actual.vtk`` names the shapes
     that ``<shapeout file="hdp">`` wrote), else a mesh file in the case folder."""
-    text = op["file"].replace("[CaseName]", casename).replace("[casename]", casename)
+    text = re.sub(r"\[casename\]", lambda _: casename, op["file"], flags=re.IGNORECASE)
     stem, ext = os.path.splitext(os.path.basename(text.replace("\\", "/")))
     names = [stem] + [stem[: -len(s)] for s in SHAPE_SUFFIXES if stem.endswith(s)]
     names += [n[len(casename) + 1:] for n in names if n.startswith(casename + "_")]

@@ -244,10 +244,10 @@ def test_resume_bitwise_with_mdbc_on_a_floating_body(tmp_path, slip):
 
 
 def test_resume_bitwise_with_the_cases_own_normals(tmp_path):
-    """The same with the box's normals from its outline (norgeometry; case.h5 /normals): a resumed
-    run ends bitwise equal to an uninterrupted one."""
+    """The same with the box's normals from its outline (norgeometry; case.h5 /normals; the file named
+    with [CASENAME], matched in any case): a resumed run ends bitwise equal to an uninterrupted one."""
     case = _floating_box_with_normals(
-        tmp_path, '<norgeometry><geometryfile file="[CaseName]_hdp_Actual.vtk"/><distanceh v="2.0"/></norgeometry>')
+        tmp_path, '<norgeometry><geometryfile file="[CASENAME]_hdp_Actual.vtk"/><distanceh v="2.0"/></norgeometry>')
     case.write_text(case.read_text().replace("<mainlist>", normals_geometry(BOX_OUTLINE), 1))
     common = ["--dp", "0.02", "--tout", "0.01", "--threads", "1", "-q", "--set", "FtPause=0", "--set", "Boundary=2"]
     a, b = tmp_path / "a", tmp_path / "b"
