@@ -477,9 +477,14 @@ def test_case_normals_from_a_mesh_file(tmp_path):
     ('<norplane mkbound="0"><point x="0" y="0" z="0"/><normal x="0" y="0" z="0"/></norplane>', "zero vector"),
     ('<norgeometry><geometryfile file="[CaseName]_nothere_Actual.vtk"/></norgeometry>', "no <shapeout file=\"nothere\">"),
     ('<norset mkbound="0"><normal x="0" y="0" z="1"/><clear v="true"/></norset>', "unknown element <clear>"),
+    ('<norgeometry><geometryfile file="../outside.stl"/></norgeometry>', "lies outside the case folder"),
+    ('<norgeometry><geometryfile file="notamesh.stl"/></norgeometry>', "geometryfile 'notamesh.stl'"),
+    ('<norcylinder><center1 x="0" y="0" z="0"/><center2 x="0" y="0" z="0"/><radius v="1"/><inside v="true"/>'
+     '</norcylinder>', "center2 is center1"),
 ])
 def test_case_normals_errors_name_the_line(tmp_path, normals, fragment):
     case = _floating_box_with_normals(tmp_path, normals)
+    (tmp_path / "notamesh.stl").write_text("this is not an STL file\n")
     r = invoke(["gencase", case, "-o", tmp_path / "o"])
     lines = case.read_text().splitlines()
     line = lines.index(next(x for x in lines if "<normals>" in x)) + 1
