@@ -10,7 +10,8 @@ restart.h5 in ``io.checkpoint``, the text outputs in ``io.runfiles``). Outputs i
 * ``run.log`` / ``run.csv``: one line per output time (like Run.out and RunPARTs.csv);
 * ``restart.h5``: the complete solver state at the last output, written atomically;
   ``--resume`` continues from it (on 1 thread the result is bitwise that of an
-  uninterrupted run), with the run's --tmax/--tout/--set (run.json ``overrides``).
+  uninterrupted run), with the run's --tmax/--tout/--set (run.json ``overrides``);
+* ``normals.vtp`` with mDBC: the boundary normals at the start (Normal, NormalSize, Mk).
 
 A new run into an OUT holding an earlier run's results is refused unless ``--overwrite``
 (which deletes them first); SIGTERM/SIGINT, start-up included, end a run as ``interrupted``.
@@ -39,7 +40,7 @@ from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, Progress, RunFiles
-from .io.runfolder import check_new_run_folder, clear_earlier_results, stored_overrides
+from .io.runfolder import NORMALS_FILE, check_new_run_folder, clear_earlier_results, stored_overrides
 from .sph.damping import damping_zones
 from .output_schedule import OutputSchedule
 from .sph.clock import time_reached
@@ -819,6 +820,10 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     else:
         writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS)
         files.start()
+        if sol.boundary == 2:                   # the normals mDBC starts from, for a look in ParaView
+            from .io.vtkxml import write_normals_vtp
+            st = sol.state
+            write_normals_vtp(os.path.join(outdir, NORMALS_FILE), st.pos, st.ptype, st.mk, sol.normals)
     stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
     if stopped is None:
         jit_s = _warm_up(sph)

@@ -601,7 +601,7 @@ def write_outputs(result: GenCaseResult, outdir: str) -> list[str]:
     """Write ``<casename>.h5``, ``<casename>_All.vtp`` and, when the case defines mDBC normals,
     ``<casename>_Normals.vtp`` into ``outdir``."""
     from ..io.casefile import write_case_h5
-    from ..io.vtkxml import write_vtp_points
+    from ..io.vtkxml import write_normals_vtp, write_vtp_points
     os.makedirs(outdir, exist_ok=True)
     case, consts, p = result.case, result.constants, result.particles
     h5 = os.path.join(outdir, f"{case.name}.h5")
@@ -629,22 +629,9 @@ def write_outputs(result: GenCaseResult, outdir: str) -> list[str]:
                                         if result.normals is not None else {})})
     files = [h5, vtp]
     if result.normals is not None:
-        files.append(write_normals_vtp(os.path.join(outdir, f"{case.name}_Normals.vtp"), p, result.normals))
+        files.append(write_normals_vtp(os.path.join(outdir, f"{case.name}_Normals.vtp"), p["pos"], p["type"], p["mk"],
+                                       result.normals))
     return files + list(result.files)
-
-
-def write_normals_vtp(path: str, particles: dict, normals: np.ndarray) -> str:
-    """The boundary particles that have an mDBC normal, for ParaView's Glyph filter (as
-    DualSPHysics's CfgInit_Normals): ``Normal`` its direction, ``NormalSize`` |N| (the distance to
-    the boundary surface; the ghost node lies 2 |N| away), ``Mk``."""
-    from ..io.vtkxml import write_vtp_points
-    size = np.linalg.norm(normals, axis=1)
-    has = (np.asarray(particles["type"]) != TYPE_FLUID) & (size > 0)
-    unit_n = normals[has] / size[has, None]
-    write_vtp_points(path, particles["pos"][has], {"Normal": unit_n.astype(np.float32),
-                                                  "NormalSize": size[has].astype(np.float32),
-                                                  "Mk": particles["mk"][has].astype(np.int32)})
-    return path
 
 
 def summary(result: GenCaseResult) -> str:

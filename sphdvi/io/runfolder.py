@@ -13,7 +13,9 @@ from .checkpoint import RESTART_FILE
 
 # the files a run writes into OUT (Gauges<Type>_<name>.csv too); a gencase output folder
 # (<casename>.h5, <casename>_All.vtp) holds none of them
-RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "run.csv", "bodies.csv", "links.csv")
+NORMALS_FILE = "normals.vtp"            # with mDBC: the boundary normals at the start
+RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "run.csv", "bodies.csv", "links.csv",
+                    NORMALS_FILE)
 
 
 # what `sphdvi export` writes into a folder: the collection and its numbered parts

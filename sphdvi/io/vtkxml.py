@@ -78,3 +78,17 @@ def write_pvd(path: str, entries: list[tuple[float, str]]) -> None:
     with atomic_path(path) as tmp:
         with open(tmp, "w", encoding="ascii") as fh:
             fh.write("\n".join(lines))
+
+
+def write_normals_vtp(path: str, pos: np.ndarray, ptype: np.ndarray, mk: np.ndarray, normals: np.ndarray) -> str:
+    """The boundary particles that have an mDBC normal, for ParaView's Glyph filter (as
+    DualSPHysics's CfgInit_Normals): ``Normal`` its direction, ``NormalSize`` |N| (the distance to
+    the boundary surface; the ghost node lies 2 |N| away), ``Mk``."""
+    normals = np.asarray(normals, dtype=np.float64)
+    size = np.linalg.norm(normals, axis=1)
+    has = (np.asarray(ptype) != 3) & (size > 0)
+    write_vtp_points(path, np.asarray(pos)[has], {"Normal": (normals[has] / size[has, None]).astype(np.float32),
+                                                  "NormalSize": size[has].astype(np.float32),
+                                                  "Mk": np.asarray(mk)[has].astype(np.int32)})
+    return path
+

@@ -507,6 +507,32 @@ def test_case_normals_that_reach_nothing(tmp_path):
     assert r.exit_code == 0, r.output
 
 
+def test_mdbc_run_writes_its_normals(tmp_path):
+    """A run with mDBC writes normals.vtp at its start: the boundary particles with a normal, its
+    direction and length (as restart.h5 holds them); a DBC run writes none; --overwrite removes it."""
+    case = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
+    args = ["--dp", "0.1", "--tmax", "0.002", "-q", "--threads", "1"]
+    out = tmp_path / "o"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")             # one wall layer: warned, tested below
+        assert invoke(["run", case, "-o", out, *args, "--set", "Boundary=2"]).exit_code == 0
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(str(out / "normals.vtp"))
+    reader.Update()
+    data = reader.GetOutput().GetPointData()
+    with h5py.File(out / "restart.h5") as f:
+        normals, ptype = f["aux/normals"][...], f["state/ptype"][...]
+    has = (ptype != 3) & np.any(normals != 0, axis=1)
+    assert reader.GetOutput().GetNumberOfPoints() == has.sum() > 0
+    size = vtk_to_numpy(data.GetArray("NormalSize"))
+    assert np.allclose(np.sort(size), np.sort(np.linalg.norm(normals[has], axis=1)), rtol=1e-6)
+    assert np.allclose(np.linalg.norm(vtk_to_numpy(data.GetArray("Normal")), axis=1), 1, atol=1e-6)
+    assert invoke(["run", case, "-o", out, *args, "--overwrite"]).exit_code == 0
+    assert not (out / "normals.vtp").exists()
+
+
 def test_mdbc_on_one_layer_walls_is_warned(tmp_path):
     """mDBC on a wall one particle thick leaks (README): the run warns, naming the mkbound and the
     layers to draw; with three layers it does not."""
