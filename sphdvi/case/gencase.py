@@ -215,15 +215,8 @@ def _select(case, particles, item):
         sel |= fluid if item["mkfluid"] is None else fluid & np.isin(label, item["mkfluid"])
     if "mkbound" in item:
         sel |= (ptype != TYPE_FLUID) & np.isin(label, item["mkbound"])
-    box = item.get("onlypos")
-    if box:
-        for i in range(3):
-            lo, hi = box["posmin"][i], box["posmax"][i]
-            if lo is not None:
-                sel &= pos[:, i] >= lo
-            if hi is not None:
-                sel &= pos[:, i] <= hi
-    return sel
+    from .normal_ops import onlypos_mask
+    return sel & onlypos_mask(pos, item.get("onlypos"))
 
 
 def apply_initials(case: Case, particles: dict, consts: Constants, reader) -> None:

@@ -49,15 +49,20 @@ def selection(op: dict, pos: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray)
     listed = str(op.get("mkbound") or "").strip()
     if listed:
         sel &= np.isin(mkbound, np.asarray(parse_mk_range(listed), dtype=np.int64))
-    box = op.get("onlypos")
-    if box:
-        for k in range(3):
-            lo, hi = box[0][k], box[1][k]
-            if lo is not None:
-                sel &= pos[:, k] >= lo
-            if hi is not None:
-                sel &= pos[:, k] <= hi
-    return sel
+    return sel & onlypos_mask(pos, op.get("onlypos"))
+
+
+def onlypos_mask(pos: np.ndarray, box: dict | None) -> np.ndarray:
+    """The particles inside an ``onlypos`` box ({"posmin": [...], "posmax": [...]}, bounds
+    inclusive, None an open side); all of them without a box."""
+    inside = np.ones(len(pos), dtype=bool)
+    for k in range(3):
+        lo, hi = (box["posmin"][k], box["posmax"][k]) if box else (None, None)
+        if lo is not None:
+            inside &= pos[:, k] >= lo
+        if hi is not None:
+            inside &= pos[:, k] <= hi
+    return inside
 
 
 def _write(normals, sel, reached, vectors, clear: bool) -> None:
@@ -140,15 +145,14 @@ def apply_cylinder(normals, op, pos, sel, h) -> None:
     out1 = unit(c1 - c2)                            # out through cap 1
     out2 = -out1                                    # out through cap 2
     r = pos[sel]
-    s = (r - c1) @ out2
-    axis_pt = c1 + s[:, None] * out2[None, :]
+    d_cap1 = (r - c1) @ out2                        # along the axis from cap 1; > 0 on its inner side
+    axis_pt = c1 + d_cap1[:, None] * out2[None, :]
     radial = r - axis_pt
     rdist = np.linalg.norm(radial, axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         side = axis_pt + radial * (radius / np.where(rdist > 0, rdist, 1.0))[:, None]
     d_side = radius - rdist                         # > 0 inside the side
-    d_cap1 = (r - c1) @ out2                        # > 0 on the inner side of cap 1
-    d_cap2 = (r - c2) @ out1
+    d_cap2 = (r - c2) @ out1                        # > 0 on the inner side of cap 2
     foot = np.full_like(r, np.nan)
     if op["inside"]:
         inside = (d_side > 0) & (d_cap1 > 0) & (d_cap2 > 0)
@@ -379,8 +383,6 @@ def apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, triangles, t
     own = np.isin(pmk, prim_mk[prim_mk >= 0]) if tri_mk is not None else np.zeros(len(r), bool)
     vec = _nearest_surface(r, pmk, own, np.ascontiguousarray(prims), np.ascontiguousarray(prim_mk),
                            bool(is2d), float(reach)) if len(prims) else np.zeros_like(r)
-    if is2d:
-        vec[:, 1] = 0.0
     _write(normals, sel, np.any(vec != 0.0, axis=1), vec, True)
 
 

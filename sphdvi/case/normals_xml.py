@@ -42,15 +42,17 @@ def _vector(reader, el, tag):
     return reader.vec3(c).tolist()
 
 
-def _onlypos(reader, el):
+def read_onlypos(reader, el):
+    """``<onlypos><posmin x y z/><posmax x y z/></onlypos>`` of ``el``: {"posmin": [...], "posmax":
+    [...]} with None for a bound not given (open), or None without the element."""
     box = reader.child(el, "onlypos")
     if box is None:
         return None
     reader.check_children(box, {"posmin", "posmax", "rem"})
-    out = []
+    out = {}
     for tag in ("posmin", "posmax"):
         c = reader.child(box, tag)
-        out.append([reader.num(c, k) if c is not None and c.get(k) is not None else None for k in "xyz"])
+        out[tag] = [reader.num(c, k) if c is not None and c.get(k) is not None else None for k in "xyz"]
     return out
 
 
@@ -80,7 +82,7 @@ def read_normal_op(reader, el, kind: str) -> dict:
     reader.check_children(el, CHILDREN[kind] | {"rem"})
     op = {"kind": kind, "tag": el.tag, "line": el.sourceline,
           "mkbound": _mkbound(reader, el, kind == "plane")}
-    op["onlypos"] = _onlypos(reader, el) if kind != "geometry" else None
+    op["onlypos"] = read_onlypos(reader, el) if kind != "geometry" else None
     if kind in ("plane", "sphere", "cylinder", "parts"):
         op["maxdisth"] = _scalar_el(reader, el, "maxdisth", 2.0)
     if kind in ("plane", "sphere", "cylinder"):
@@ -167,9 +169,9 @@ def read_fluid_velocity(reader, el) -> dict:
             raise reader.error(el, f"mkfluid={text!r}: {exc}", 'mkfluid values and ranges such as mkfluid="0-2"') from None
     else:
         item["mkfluid"] = None                  # every fluid particle
-    box = _onlypos(reader, el)
+    box = read_onlypos(reader, el)
     if box is not None:
-        item["onlypos"] = {"posmin": box[0], "posmax": box[1]}
+        item["onlypos"] = box
     item["direction"] = _nonzero(reader, el, "direction", _vector(reader, el, "direction"))
     given = [t for t in ("velocity", "velocity2", "velocity3") if reader.child(el, t) is not None]
     if len(given) > 1:

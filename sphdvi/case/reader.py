@@ -17,7 +17,7 @@ from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
-from .normals_xml import read_initialize, read_normals
+from .normals_xml import read_initialize, read_normals, read_onlypos
 from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
                          coerce, constant_hint, default_parameters, domain_from_deprecated, parameter_warnings)
 from .schema import validate_structure
@@ -302,13 +302,9 @@ def read_initials(reader, casedef) -> list:
             d["mkbound"] = _mk_list(reader, item, "mkbound")
         if "mkfluid" not in d and "mkbound" not in d:
             raise reader.error(item, "missing mkfluid or mkbound", 'mkfluid="..." or mkbound="..."')
-        onlypos = reader.child(item, "onlypos")
+        onlypos = read_onlypos(reader, item)
         if onlypos is not None:
-            lo = reader.child(onlypos, "posmin")
-            hi = reader.child(onlypos, "posmax")
-            d["onlypos"] = {
-                "posmin": [reader.num(lo, c, -np.inf) if lo is not None and lo.get(c) is not None else None for c in "xyz"],
-                "posmax": [reader.num(hi, c) if hi is not None and hi.get(c) is not None else None for c in "xyz"]}
+            d["onlypos"] = onlypos
         if tag == "velocity":
             direction = reader.child(item, "direction")
             if direction is not None:

@@ -139,7 +139,7 @@ def test_cylinder_inside_side_caps_and_rim():
 
 def test_set_onlypos_and_order():
     pos, ptype, mk = floor_rows(1)
-    ops = [op("set", normal=[0, 0, 1]), op("set", normal=[1, 0, 0], onlypos=[[0.5, None, None], [None, None, None]])]
+    ops = [op("set", normal=[0, 0, 1]), op("set", normal=[1, 0, 0], onlypos={"posmin": [0.5, None, None], "posmax": [None, None, None]})]
     n, _ = run_ops(ops, pos, ptype, mk)
     right = pos[:, 0] >= 0.5
     assert np.all(n[right] == [1, 0, 0]) and np.all(n[~right] == [0, 0, 1])

@@ -15,7 +15,7 @@ from ..expressions import ExpressionError
 from . import raster, shapes
 from . import transform as tf
 from .lattice import Canvas, Lattice, round_idx
-from .shapeout import FORMATS, write_shapes
+from .shapeout import FORMATS, merge_shapes, write_shapes
 
 MAX_COMMANDS = 1_000_000      # commands executed in all (runlist loops included)
 MAX_LIST_DEPTH = 64
@@ -906,7 +906,8 @@ class GeometryRunner:
         if not base or base in (".", "..") or not re.fullmatch(r"[A-Za-z0-9_.\-]+", base):
             raise self.reader.error(el, f"file={value!r} is not a usable file name",
                                     "a plain name of letters, digits, '_', '-', '.'")
-        self.shape_sets[base] = _shape_arrays(self.shapes)
+        tris, _, mk, fluid = merge_shapes(self.shapes)
+        self.shape_sets[base] = (tris, mk, fluid.astype(bool))
         if self.outdir is not None:
             name = f"{self.casename}_{base}.{fmt}" if self.casename else f"{base}.{fmt}"
             path = os.path.join(self.outdir, name)
@@ -918,16 +919,6 @@ class GeometryRunner:
         if reset:
             self.shapes = []
             self.shape_triangles = 0
-
-
-def _shape_arrays(shapes) -> tuple:
-    """(triangles (T, 3, 3), mk of each (T,), fluid flag of each) of the recorded shapes."""
-    tris = [np.asarray(x["triangles"], dtype=np.float64).reshape(-1, 3, 3) for x in shapes]
-    if not tris:
-        return np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0, bool)
-    mk = np.concatenate([np.full(len(t), x["mk"], np.int64) for x, t in zip(shapes, tris)])
-    fluid = np.concatenate([np.full(len(t), bool(x["fluid"])) for x, t in zip(shapes, tris)])
-    return np.concatenate(tris), mk, fluid
 
 
 VARIABLE_COMMANDS = {"newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",

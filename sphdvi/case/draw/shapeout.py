@@ -10,7 +10,8 @@ import numpy as np
 FORMATS = ("vtk", "vtp", "vtu", "stl")
 
 
-def _merge(shapes):
+def merge_shapes(shapes):
+    """(triangles (T, 3, 3), shape number, mk and fluid flag of each triangle) of the recorded shapes."""
     tris = [np.asarray(s["triangles"], dtype=np.float64).reshape(-1, 3, 3) for s in shapes]
     ids = [np.full(len(t), i, dtype=np.int64) for i, t in enumerate(tris)]
     mks = [np.full(len(t), s["mk"], dtype=np.int64) for s, t in zip(shapes, tris)]
@@ -27,7 +28,7 @@ def _fmt(a) -> str:
 
 def write_shapes(path: str, shapes, fmt: str) -> None:
     """Write the triangles of ``shapes`` (dicts with triangles, mk, fluid) to ``path``."""
-    tris, ids, mks, fl = _merge(shapes)
+    tris, ids, mks, fl = merge_shapes(shapes)
     pts = tris.reshape(-1, 3)
     n = len(tris)
     conn = np.arange(3 * n).reshape(-1, 3)
