@@ -5,22 +5,37 @@ geometry: the vector N from the particle to the boundary surface, which lies
 dp/2 in front of the outer particle layer; the ghost node is r + 2N. A case that
 defines its normals (``<normals>``, ``<special><initialize>``) gets those
 (:mod:`sphdvi.case.normal_ops`); for one that does not, or where it asks for them
-from the parts (``norparts``), we derive them from the particle arrangement:
+from the parts (``norparts``), we derive them from the particle arrangement.
 
-1. the neighbours j of boundary particle i (other boundary particles within 2 dp);
-2. where the neighbours form a single layer (the smallest eigenvalue of their covariance
-   is under a tenth of the next one) the direction is the normal of that layer (its
-   eigenvector); otherwise (solid bodies, several wall layers, corners) it is
-   −(mean of r_j − r_i) when that offset is clear, pointing away from the boundary's own
-   mass, and the layer normal when it is not;
-3. the sign is chosen to face the fluid: towards the nearest fluid particle within
-   6 dp, or, with no fluid near, towards the centroid of all fluid particles; except
-   on floating bodies: a body is wet on every side in time, so its normals point
-   out of it, to the nearer of its surfaces along the direction where step 2's
-   offset is not clear (facing the fluid on a tie, as on a one-layer plate), as
-   GenCase's from the body's outline (the top rows of a floating box, dry at the
-   start, would otherwise face the water under the box and point down through it);
-4. N = n̂ · (k + 1/2) dp, k the number of boundary layers in front of the particle along n̂
+Where the boundary particles lie on GenCase's lattice (every drawn shape does), the
+surface is the one they fill: the boundary of the union of their dp cells. N is the
+vector to the nearest point of an open (particle-free) cell, which is GenCase's outline
+dp/2 in front of the wall for flat walls, edges and corners alike (the particles under a
+corner point to the outline's corner, the floor beside it straight up):
+
+1. a fixed or moving boundary looks at the open cells inside the particles' bounding box
+   (a tank's outside is not water) on the side of the fluid: the vector to the surface must
+   have a positive component towards the nearest fluid particle within 6 dp, or, with no
+   fluid near, towards the centroid of all fluid particles (the back layers of a thick wall
+   or flap face the water, not the dry air behind them);
+2. a floating body looks at every open cell around it: a body is wet on every side in time,
+   so its normals point out of it (the top rows of a floating box, dry at the start, would
+   otherwise face the water under the box and point down through it); of equally near
+   cells, the one towards the fluid.
+
+The lattice surface of a curved or sloping wall is a staircase. So where a particle's
+neighbours (other boundary particles within 2 dp) form a single layer (the smallest
+eigenvalue of their covariance under a tenth of the next one) that is oblique (its normal
+more than 15 degrees from every axis), and on one-layer floating plates, or where the
+particles are off the lattice, the normal is derived from the neighbours instead:
+
+a. the direction is the normal of that layer (its eigenvector) on a single layer; otherwise
+   −(mean of r_j − r_i) when that offset is clear, pointing away from the boundary's own mass,
+   and the layer normal when it is not;
+b. its sign faces the fluid as in 1, except on floating bodies, where it points out of the
+   body, to the nearer of its surfaces along it (facing the fluid on a tie, as on a one-layer
+   plate);
+c. N = n̂ · (k + 1/2) dp, k the number of boundary layers in front of the particle along n̂
    (found by stepping dp along n̂), so that the ghost node r + 2N lies in the fluid for
    every layer of a thick wall.
 
@@ -30,6 +45,16 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+# a single layer whose normal is further than 15 degrees from every axis is a slope or a curve
+# (its lattice surface a staircase): its normal comes from its neighbours
+OBLIQUE_COS = float(np.cos(np.radians(15.0)))
+# a face of the lattice surface in a straight run this long (in faces: it and those in line with it,
+# both ways, along each of its axes) is part of a flat wall; the staircase of a slope steeper than
+# about 20 degrees has shorter runs
+RUN_MIN = 3
+# the most cells of the lattice grid (bytes); a bigger scene derives every normal from the neighbours
+MAX_LATTICE_CELLS = 200_000_000
 
 
 @njit(cache=True)
@@ -52,11 +77,147 @@ def _cell_span(sorted_keys, ix, iy, iz, nx, ny):
 
 
 @njit(cache=True)
-def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
+def _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, reach):
+    """The vector from boundary particle i to the nearest fluid particle within ``reach``
+    grid cells, or to the centroid of all fluid particles when none is that near."""
+    ix = int((bpos[i, 0] - lo[0]) * inv)
+    iy = int((bpos[i, 1] - lo[1]) * inv)
+    iz = int((bpos[i, 2] - lo[2]) * inv)
+    best = 1e300
+    t = np.empty(3)
+    for k in range(3):
+        t[k] = fcentroid[k] - bpos[i, k]
+    for dz in range(-reach, reach + 1):
+        for dy in range(-reach, reach + 1):
+            for dx in range(-reach, reach + 1):
+                a, b = _cell_span(fsorted, ix + dx, iy + dy, iz + dz, nx, ny)
+                for q in range(a, b):
+                    j = forder[q]
+                    ddx = fpos[j, 0] - bpos[i, 0]
+                    ddy = fpos[j, 1] - bpos[i, 1]
+                    ddz = fpos[j, 2] - bpos[i, 2]
+                    d2 = ddx * ddx + ddy * ddy + ddz * ddz
+                    if d2 < best:
+                        best = d2
+                        t[0], t[1], t[2] = ddx, ddy, ddz
+    return t
+
+
+@njit(cache=True)
+def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floating, t, out, won):
+    """The nearest point to ``p`` of the open lattice cells (``solid`` False) within 9 cells of
+    ``cell`` (p's lattice index): the cell boxes of side dp about origin + index * dp. A fixed
+    boundary (not ``floating``) takes cells inside [ilo, ihi] (the particles' bounding box) whose
+    point lies towards ``t`` (the fluid); of equally near points the one most along ``t``.
+    Writes the vector p -> point to ``out`` and that cell's index to ``won``; False when no open
+    cell is that near."""
+    tn = np.sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2])
+    tol = 1e-9 * dp
+    best = 1e300
+    best_along = -2.0
+    found = False
+    half = 0.5 * dp
+    for r in range(1, 10):
+        if found and (r - 0.5) * dp > best + tol:
+            break
+        ry = 0 if is2d else r
+        for dz in range(-r, r + 1):
+            for dy in range(-ry, ry + 1):
+                for dx in range(-r, r + 1):
+                    if max(abs(dx), abs(dy), abs(dz)) != r:
+                        continue
+                    c0, c1, c2 = cell[0] + dx, cell[1] + dy, cell[2] + dz
+                    g0, g1, g2 = c0 - glo[0], c1 - glo[1], c2 - glo[2]
+                    if (g0 < 0 or g1 < 0 or g2 < 0 or g0 >= solid.shape[0] or g1 >= solid.shape[1]
+                            or g2 >= solid.shape[2] or solid[g0, g1, g2]):
+                        continue
+                    if not floating and (c0 < ilo[0] or c0 > ihi[0] or c1 < ilo[1] or c1 > ihi[1]
+                                         or c2 < ilo[2] or c2 > ihi[2]):
+                        continue
+                    v = np.empty(3)
+                    cc = (c0, c1, c2)
+                    for k in range(3):
+                        centre = origin[k] + cc[k] * dp
+                        q = min(max(p[k], centre - half), centre + half)
+                        v[k] = q - p[k]
+                    if is2d:
+                        v[1] = 0.0
+                    along = v[0] * t[0] + v[1] * t[1] + v[2] * t[2]
+                    if not floating and along <= 0.0:
+                        continue
+                    d = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+                    along = along / (d * tn) if d > 0.0 and tn > 0.0 else 0.0
+                    if d < best - tol or (d <= best + tol and along > best_along):
+                        best = min(best, d)
+                        best_along = along
+                        found = True
+                        out[0], out[1], out[2] = v[0], v[1], v[2]
+                        won[0], won[1], won[2] = c0, c1, c2
+    return found
+
+
+@njit(cache=True)
+def _is_solid(solid, glo, c0, c1, c2):
+    g0, g1, g2 = c0 - glo[0], c1 - glo[1], c2 - glo[2]
+    if g0 < 0 or g1 < 0 or g2 < 0 or g0 >= solid.shape[0] or g1 >= solid.shape[1] or g2 >= solid.shape[2]:
+        return False
+    return solid[g0, g1, g2]
+
+
+@njit(cache=True)
+def _run_along(solid, glo, cell, a, sgn, b):
+    """The faces in line with the face of open ``cell`` towards the solid cell ``sgn`` along axis
+    ``a``, along axis ``b`` (both ways, this one included, at most 2 RUN_MIN - 1): open cells
+    with a solid cell beside them on the same side."""
+    n = 1
+    for direction in (1, -1):
+        c = cell.copy()
+        for _ in range(RUN_MIN):
+            c[b] += direction
+            beside = c.copy()
+            beside[a] += sgn
+            if _is_solid(solid, glo, c[0], c[1], c[2]) or not _is_solid(solid, glo, beside[0], beside[1], beside[2]):
+                break
+            n += 1
+    return n
+
+
+@njit(cache=True)
+def _on_flat_walls(solid, glo, cell, q, origin, dp, is2d):
+    """Whether the point ``q`` of open ``cell`` lies on flat walls of the lattice surface: every
+    face of the cell that holds q and borders a solid cell runs straight for RUN_MIN faces or
+    more along each of its axes (a wall, or a corner of two walls), not a staircase of a slope or
+    a curve, whose steps are shorter."""
+    faces = 0
+    for a in range(3):
+        if is2d and a == 1:
+            continue
+        for sgn in (-1, 1):
+            plane = origin[a] + (cell[a] + 0.5 * sgn) * dp
+            if abs(q[a] - plane) > 1e-9 * dp:
+                continue
+            beside = cell.copy()
+            beside[a] += sgn
+            if not _is_solid(solid, glo, beside[0], beside[1], beside[2]):
+                continue
+            faces += 1
+            for b in range(3):
+                if b == a or (is2d and b == 1):
+                    continue
+                if _run_along(solid, glo, cell, a, sgn, b) < RUN_MIN:
+                    return False
+    return faces > 0
+
+
+@njit(cache=True)
+def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward, lattice, solid, glo, ilo, ihi, origin):
     """See the module docstring; brute force over sorted grid cells. The normals of the first
     ``nb`` rows of ``bpos``; the rows after them (periodic images) are neighbours only.
-    ``outward[i]``: row i belongs to a floating body (its clear directions are not flipped)."""
+    ``outward[i]``: row i belongs to a floating body. ``lattice``: the boundary particles lie
+    on the lattice of ``origin`` and dp; then ``solid`` flags the cells they fill (index minus
+    ``glo``) and [ilo, ihi] bound the cells of the particles' bounding box."""
     out = np.zeros((nb, 3))
+    done = np.zeros(nb, np.bool_)            # N final (the lattice surface)
     cell = 2.05 * dp      # a little over the search radius: rounding never hides a neighbour
     lo = np.empty(3)
     hi = np.empty(3)
@@ -78,6 +239,7 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
     fsorted = fkeys[forder]
     r2 = (2.0 * dp) ** 2 * 1.0001
     reach = 3            # fluid search radius about 6 dp = 3 cells
+    lidx = np.zeros(3, np.int64)
     for i in range(nb):
         ix = int((bpos[i, 0] - lo[0]) * inv)
         iy = int((bpos[i, 1] - lo[1]) * inv)
@@ -126,6 +288,20 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
             thin = w[0] < 0.1 * w[1]                # a single layer (line in 2D, sheet in 3D)
         else:
             n[2] = 1.0
+        t = _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, reach)
+        oblique = thin and max(abs(n[0]), abs(n[1]), abs(n[2])) < OBLIQUE_COS
+        if lattice and not (thin and (oblique or outward[i])):
+            for k in range(3):
+                lidx[k] = int(np.rint((bpos[i, k] - origin[k]) / dp))
+            if is2d:
+                lidx[1] = 0
+            v = np.zeros(3)
+            won = np.zeros(3, np.int64)
+            if (_nearest_open_point(bpos[i], lidx, solid, glo, ilo, ihi, origin, dp, is2d, outward[i], t, v, won)
+                    and _on_flat_walls(solid, glo, won, bpos[i] + v, origin, dp, is2d)):
+                out[i, :] = v
+                done[i] = True
+                continue
         clear = not thin and cx * cx + cy * cy + cz * cz > (0.25 * dp) ** 2
         if clear:
             n[0], n[1], n[2] = -cx, -cy, -cz        # away from the boundary's own mass
@@ -147,24 +323,7 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
                         out[i, k] = -out[i, k]
                 continue
         # face the fluid
-        best = 1e300
-        tx = fcentroid[0] - bpos[i, 0]
-        ty = fcentroid[1] - bpos[i, 1]
-        tz = fcentroid[2] - bpos[i, 2]
-        for dz in range(-reach, reach + 1):
-            for dy in range(-reach, reach + 1):
-                for dx in range(-reach, reach + 1):
-                    a, b = _cell_span(fsorted, ix + dx, iy + dy, iz + dz, nx, ny)
-                    for q in range(a, b):
-                        j = forder[q]
-                        ddx = fpos[j, 0] - bpos[i, 0]
-                        ddy = fpos[j, 1] - bpos[i, 1]
-                        ddz = fpos[j, 2] - bpos[i, 2]
-                        d2 = ddx * ddx + ddy * ddy + ddz * ddz
-                        if d2 < best:
-                            best = d2
-                            tx, ty, tz = ddx, ddy, ddz
-        if n[0] * tx + n[1] * ty + n[2] * tz < 0.0:
+        if n[0] * t[0] + n[1] * t[1] + n[2] * t[2] < 0.0:
             n[0], n[1], n[2] = -n[0], -n[1], -n[2]
         norm = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
         if norm > 0.0:
@@ -172,6 +331,8 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward):
                 out[i, k] = n[k] / norm
     # distance to the surface: dp/2 in front of the last boundary layer along the normal
     for i in range(nb):
+        if done[i]:
+            continue
         layers = _layers_along(bpos, i, 1.0, out, dp, lo, inv, nx, ny, bsorted, border)
         for k in range(3):
             out[i, k] *= (0.5 + layers) * dp
@@ -235,9 +396,45 @@ def boundary_normals(pos: np.ndarray, ptype: np.ndarray, dp: float, is2d: bool,
     out = np.zeros_like(pos)
     if nb:
         outward = np.ascontiguousarray(ptype[bound] == 2)
+        grid = lattice_cells(bpos, fpos, float(dp), bool(is2d))
+        lattice = grid is not None
+        if grid is None:
+            grid = (np.zeros((1, 1, 1), np.bool_), np.zeros(3, np.int64), np.zeros(3, np.int64),
+                    np.zeros(3, np.int64), np.zeros(3))
         out[bound] = _normals_kernel(np.ascontiguousarray(bpos), nb, np.ascontiguousarray(fpos), float(dp),
-                                     bool(is2d), centroid, outward)
+                                     bool(is2d), centroid, outward, lattice, *grid)
     return out
+
+
+def lattice_cells(bpos: np.ndarray, fpos: np.ndarray, dp: float, is2d: bool):
+    """The lattice the boundary particles fill: (solid, glo, ilo, ihi, origin), with ``solid``
+    a grid of cells (index minus ``glo``) that flags those holding a boundary particle, 10 cells
+    beyond the particles' bounding box [ilo, ihi] (cell indices, fluid included) on each side
+    (none across the plane of a 2D case). None when a boundary particle lies off the lattice
+    of the first one (more than dp/1000 away: a body rotated off it, particles loaded from a
+    file) or the grid would exceed MAX_LATTICE_CELLS."""
+    origin = bpos[0].copy()
+    rel = (bpos - origin) / dp
+    idx = np.rint(rel)
+    axes = [0, 2] if is2d else [0, 1, 2]
+    if np.abs(rel - idx)[:, axes].max() > 1e-3:
+        return None
+    idx = idx.astype(np.int64)
+    allrel = rel if not len(fpos) else np.vstack([rel, (fpos - origin) / dp])
+    ilo = np.ceil(allrel.min(axis=0) - 1e-6).astype(np.int64)
+    ihi = np.floor(allrel.max(axis=0) + 1e-6).astype(np.int64)
+    margin = np.array([10, 0 if is2d else 10, 10])
+    if is2d:
+        idx[:, 1] = 0
+        ilo[1] = ihi[1] = 0
+    glo = ilo - margin
+    shape = ihi - ilo + 1 + 2 * margin
+    if np.prod(shape.astype(float)) > MAX_LATTICE_CELLS:
+        return None
+    solid = np.zeros(tuple(int(s) for s in shape), np.bool_)
+    g = idx - glo
+    solid[g[:, 0], g[:, 1], g[:, 2]] = True
+    return solid, glo, ilo, ihi, origin
 
 
 def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
@@ -258,13 +455,14 @@ def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
 
 
 def one_layer_mkbounds(normals: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray, dp: float) -> list[int]:
-    """The fixed and moving mkbounds whose particles with a normal all lie within 0.75 dp of the
-    surface: walls one particle thick (the normal of a second layer is 1.5 dp long)."""
+    """The fixed and moving mkbounds whose particles with a normal all lie within dp of the
+    surface: walls one particle thick (the normal of a second layer is 1.5 dp long, that of a
+    first layer's corner dp/sqrt(2) in 2D and dp sqrt(3)/2 in 3D)."""
     length = np.linalg.norm(normals, axis=1)
     wall = (np.asarray(ptype) <= 1) & (length > 0)
     thin = []
     for mk in np.unique(mkbound[wall]):
-        if length[wall & (mkbound == mk)].max() < 0.75 * dp:
+        if length[wall & (mkbound == mk)].max() < dp:
             thin.append(int(mk))
     return thin
 
