@@ -15,6 +15,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S16M: S16 with mDBC on the box (dp 0.02, 0.01 and 0.005: 2, 25 and 107 min on 2 threads)
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
     python tools/validate.py S9 --csv s9.csv --keep runs/
+    python tools/validate.py S16M --dp 0.02 --dp 0.01 --threads 2     # some of a case's resolutions
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
 """
@@ -337,6 +338,8 @@ def main(argv=None) -> int:
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
+    ap.add_argument("--dp", type=float, action="append", metavar="DP",
+                    help="only the resolutions of this dp (repeatable)")
     ap.add_argument("--keep", metavar="DIR", help="keep the run folders under DIR (default: a temporary folder)")
     ap.add_argument("--csv", metavar="FILE", help="also write every row to FILE")
     args = ap.parse_args(argv)
@@ -356,7 +359,11 @@ def main(argv=None) -> int:
         print(head + "".join(f"{h:>{max(len(h) + 2, 12)}}" for h, _, _ in case.columns) + "  target")
         rows = []
         resolutions = case.resolutions() if callable(case.resolutions) else case.resolutions
-        for res in resolutions[:1] if args.coarse else resolutions:
+        if args.coarse:
+            resolutions = resolutions[:1]
+        if args.dp:
+            resolutions = [r for r in resolutions if any(math.isclose(r.dp, d, rel_tol=1e-9) for d in args.dp)]
+        for res in resolutions:
             outdir = os.path.join(base, f"{case.name}_{res.dp:g}")
             run = run_case(case, res, outdir, args.threads)
             errors = {}

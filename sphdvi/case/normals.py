@@ -104,18 +104,21 @@ def _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, re
 
 
 @njit(cache=True)
-def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floating, t, out, won):
+def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floating, t, out):
     """The nearest point to ``p`` of the open lattice cells (``solid`` False) within 9 cells of
     ``cell`` (p's lattice index): the cell boxes of side dp about origin + index * dp. A fixed
     boundary (not ``floating``) takes cells inside [ilo, ihi] (the particles' bounding box) whose
-    point lies towards ``t`` (the fluid); of equally near points the one most along ``t``.
-    Writes the vector p -> point to ``out`` and that cell's index to ``won``; False when no open
-    cell is that near."""
+    point lies towards ``t`` (the fluid); of equally near points one on flat walls
+    (:func:`_on_flat_walls`), then the one most along ``t``. Writes the vector p -> point to
+    ``out``; True when that point lies on flat walls (False also when no open cell is that near)."""
     tn = np.sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2])
     tol = 1e-9 * dp
     best = 1e300
     best_along = -2.0
     found = False
+    flat = False
+    cc_arr = np.zeros(3, np.int64)
+    q_arr = np.zeros(3)
     half = 0.5 * dp
     for r in range(1, 10):
         if found and (r - 0.5) * dp > best + tol:
@@ -143,17 +146,24 @@ def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floatin
                     if is2d:
                         v[1] = 0.0
                     along = v[0] * t[0] + v[1] * t[1] + v[2] * t[2]
-                    if not floating and along <= 0.0:
+                    if not floating and along <= 1e-6 * dp * tn:      # not towards the fluid (rounding aside)
                         continue
                     d = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+                    if d > best + tol:
+                        continue
                     along = along / (d * tn) if d > 0.0 and tn > 0.0 else 0.0
-                    if d < best - tol or (d <= best + tol and along > best_along):
+                    cc_arr[0], cc_arr[1], cc_arr[2] = c0, c1, c2
+                    for k in range(3):
+                        q_arr[k] = p[k] + v[k]
+                    is_flat = _on_flat_walls(solid, glo, cc_arr, q_arr, origin, dp, is2d)
+                    if (d < best - tol or (is_flat and not flat)
+                            or (is_flat == flat and along > best_along)):
                         best = min(best, d)
                         best_along = along
+                        flat = is_flat
                         found = True
                         out[0], out[1], out[2] = v[0], v[1], v[2]
-                        won[0], won[1], won[2] = c0, c1, c2
-    return found
+    return found and flat
 
 
 @njit(cache=True)
@@ -296,9 +306,7 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward, lattice, solid
             if is2d:
                 lidx[1] = 0
             v = np.zeros(3)
-            won = np.zeros(3, np.int64)
-            if (_nearest_open_point(bpos[i], lidx, solid, glo, ilo, ihi, origin, dp, is2d, outward[i], t, v, won)
-                    and _on_flat_walls(solid, glo, won, bpos[i] + v, origin, dp, is2d)):
+            if _nearest_open_point(bpos[i], lidx, solid, glo, ilo, ihi, origin, dp, is2d, outward[i], t, v):
                 out[i, :] = v
                 done[i] = True
                 continue
