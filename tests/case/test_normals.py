@@ -192,3 +192,20 @@ def test_curved_wall_normals(layers, inner_mean, inner_max):
     wet = r[ring] < radius + dp / 2
     assert angle[wet].mean() < inner_mean and angle[wet].max() < inner_max
     assert np.all((n * inward).sum(axis=1) > 0)                 # every one towards the water
+
+
+@pytest.mark.parametrize("layers, thin", [(1, [0]), (2, [])])
+def test_one_layer_walls_are_found_in_3d(layers, thin):
+    """A 3D tank one particle thick is a one-layer wall though its corner particles' normals are
+    dp sqrt(3)/2 long; with two layers the second layer's are 1.5 dp."""
+    from sphdvi.case.normals import one_layer_mkbounds
+    dp = 0.05
+    k = np.arange(-(layers - 1), 9 + layers)
+    g = np.stack(np.meshgrid(k, k, np.arange(-(layers - 1), 8), indexing="ij"), axis=-1).reshape(-1, 3)
+    wall = (g[:, 0] <= 0) | (g[:, 0] >= 9) | (g[:, 1] <= 0) | (g[:, 1] >= 9) | (g[:, 2] <= 0)
+    water = ~wall & (g[:, 2] < 5)
+    pos = np.vstack([g[wall], g[water]]) * dp
+    ptype = np.r_[np.zeros(wall.sum(), int), np.full(water.sum(), 3)]
+    n = boundary_normals(pos, ptype, dp, False)
+    assert np.linalg.norm(n[ptype == 0], axis=1).max() == pytest.approx(dp * (layers - 0.5) * np.sqrt(3))
+    assert one_layer_mkbounds(n, ptype, np.zeros(len(pos), int), dp) == thin

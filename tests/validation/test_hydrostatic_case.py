@@ -198,10 +198,11 @@ def _with_geometry_normals(path: Path) -> Path:
 
 def test_s1_mdbc_with_the_cases_own_normals(tmp_path):
     """S1/S2 with mDBC (Boundary=2) at H/dp 20, the normals from the case's outline (norgeometry)
-    and from the particles: both within S1's 2 % (measured 1.380 % and 1.375 % of rho0 g H at the
-    worst probe, DBC 1.257 %), wall force = weight within 0.1 %, nothing lost; the two sets of
-    normals agree off the corners (tests/case/test_normal_ops.py), so the pressures agree to
-    5e-5 rho0 g H."""
+    and from the particles: both within S1's 2 % (measured 1.380 % of rho0 g H at the worst probe
+    with either, DBC 1.257 %), wall force = weight within 0.1 %, nothing lost; the two sets of
+    normals are the same but at the walls' free top ends (tests/case/test_normal_ops.py), so the
+    pressures agree to round-off (3e-14 rho0 g H; 5e-5 before the particle route reached the
+    outline's corners, 1.375 %)."""
     geo = run_case(_with_geometry_normals(tmp_path), tmp_path / "geo", "--set", "Boundary=2")
     own = run_case(CASE, tmp_path / "own", "--set", "Boundary=2")
     print("S1 mDBC, geometry normals:", geo["rel_max"], geo["einf"], "particle normals:", own["rel_max"], own["einf"])
@@ -209,7 +210,7 @@ def test_s1_mdbc_with_the_cases_own_normals(tmp_path):
         assert r["rel_max"] < 0.02 and r["einf"] < 0.015
         assert abs(r["wall_force"] - 1) < 1e-3 and abs(r["bottom_force"] - 1) < 1e-3
         assert r["lost"] == 0 and r["umax"] <= 1e-3
-    assert np.max(np.abs(np.asarray(geo["err"]) - np.asarray(own["err"]))) < 5e-5
+    assert np.max(np.abs(np.asarray(geo["err"]) - np.asarray(own["err"]))) < 1e-9
 
 
 _FINER = {}
