@@ -20,14 +20,16 @@ corner point to the outline's corner, the floor beside it straight up):
    or flap face the water, not the dry air behind them);
 2. a floating body looks at every open cell around it: a body is wet on every side in time,
    so its normals point out of it (the top rows of a floating box, dry at the start, would
-   otherwise face the water under the box and point down through it); of equally near
-   cells, the one towards the fluid.
+   otherwise face the water under the box and point down through it).
 
-The lattice surface of a curved or sloping wall is a staircase. So where a particle's
-neighbours (other boundary particles within 2 dp) form a single layer (the smallest
-eigenvalue of their covariance under a tenth of the next one) that is oblique (its normal
-more than 15 degrees from every axis), and on one-layer floating plates, or where the
-particles are off the lattice, the normal is derived from the neighbours instead:
+Of equally near points, one on a flat wall, then the one most towards the fluid. The lattice
+surface of a curved or sloping wall is a staircase. So where the nearest point lies on a
+face whose straight run is shorter than RUN_MIN faces along one of its axes (the steps of a
+slope steeper than about 20 degrees or of a curve; a wall or a corner of two walls runs on),
+where a particle's neighbours (other boundary particles within 2 dp) form a single layer
+(the smallest eigenvalue of their covariance under a tenth of the next one) that is oblique
+(its normal more than 15 degrees from every axis), on one-layer floating plates, and where
+the particles are off the lattice, the normal is derived from the neighbours instead:
 
 a. the direction is the normal of that layer (its eigenvector) on a single layer; otherwise
    −(mean of r_j − r_i) when that offset is clear, pointing away from the boundary's own mass,
