@@ -121,6 +121,7 @@ def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floatin
     flat = False
     cc_arr = np.zeros(3, np.int64)
     q_arr = np.zeros(3)
+    v = np.empty(3)
     half = 0.5 * dp
     for r in range(1, 10):
         if found and (r - 0.5) * dp > best + tol:
@@ -139,7 +140,6 @@ def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floatin
                     if not floating and (c0 < ilo[0] or c0 > ihi[0] or c1 < ilo[1] or c1 > ihi[1]
                                          or c2 < ilo[2] or c2 > ihi[2]):
                         continue
-                    v = np.empty(3)
                     cc = (c0, c1, c2)
                     for k in range(3):
                         centre = origin[k] + cc[k] * dp
