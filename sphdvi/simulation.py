@@ -598,8 +598,8 @@ class SPHRun:
             thin = one_layer_mkbounds(normals0, p["type"], labels, float(c["dp"]))
             if thin:
                 warnings.warn(f"mDBC on mkbound {', '.join(map(str, thin))}: a wall one particle thick, through which "
-                              "the fluid leaks (S3's dam break at dp 0.02: 185-210 of 5,501 particles out by 0.72 s; "
-                              "with two layers 1, three 2, DBC 0); draw it with <layers vdp=\"0,1,2\"> (the kernel "
+                              "the fluid leaks (S3's dam break at dp 0.02: 200-210 of 5,501 particles out by 0.72 s; "
+                              "with two or three layers 1-2, DBC 0); draw it with <layers vdp=\"0,1,2\"> (the kernel "
                               f"reaches 2h = {2 * float(c['h']) / float(c['dp']):.1f} dp), or keep it DBC (MdbcMkbound)")
             state.mass[mdbc_floating_mask(p["type"], labels, params, normals0)] = float(c["massbound"])
         # the solids that move boundary particles, and the damping zones: each only when

@@ -23,13 +23,18 @@ def linear_period(length: float, depth: float, g: float = 9.81, mode: int = 1) -
     return 2 * math.pi / math.sqrt(g * k * math.tanh(k * depth))
 
 
-def period_from_signal(t, x) -> tuple[float, float]:
-    """Mean period from up-crossings of x − mean(x) (with hysteresis: the signal must swing
+def period_from_signal(t, x, centre: float | None = None) -> tuple[float, float]:
+    """Mean period from up-crossings of y = x − centre (with hysteresis: the signal must swing
     below −30 % of its amplitude between two crossings, so noise does not count), and the
-    relative amplitude loss per period, 1 − exp(−λ T), λ fitted to log |x − mean| at the
-    signal's extrema (maxima and minima alike, those beyond 30 % of its amplitude)."""
+    relative amplitude loss per period, 1 − exp(−λ T), λ fitted to log |y| at the signal's
+    extrema (maxima and minima alike, those beyond 30 % of its amplitude).
+
+    ``centre`` is the signal's equilibrium where it is known (the tank's middle for the
+    centre of mass); else the mean of x, which is biased over a record of a few decaying
+    periods that does not end on a whole period, and that bias shifts the crossings and the
+    extrema alternately."""
     t, y = np.asarray(t, float), np.asarray(x, float)
-    y = y - y.mean()
+    y = y - (y.mean() if centre is None else centre)
     amp = np.abs(y).max()
     if amp == 0:
         return float("nan"), float("nan")
@@ -74,7 +79,7 @@ def case_periods(outdir: str, length: float = 1.0, gauge: str = "Left") -> dict:
         xc[k] = s["points"][s["Type"] == 3, 0].mean()
     length_eff = length - dp
     depth_eff = nfluid * dp * dp / length_eff
-    period_com, decay = period_from_signal(times, xc)
+    period_com, decay = period_from_signal(times, xc, centre=0.5 * length)
     gauge_csv = gauge_table(outdir, "SWL", gauge)
     period_gauge, _ = period_from_signal(gauge_csv[:, 0], gauge_csv[:, 3])
     return {"period_theory": linear_period(length_eff, depth_eff, g), "period_com": period_com,
