@@ -55,20 +55,25 @@ def _cell_range(i0, i1, pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell):
 
 @njit(cache=True, error_model="numpy")
 def _sort_by_cell(cell, order, cell_start):
-    """Stable counting sort of the particles by their cell index."""
+    """Stable counting sort of the particles by their cell index.
+
+    The counts become each cell's end by an inclusive prefix sum; the particles are then
+    placed from the last one back, each cell's pointer moving down to its start, so no
+    cursor array is allocated (a 2D grid of cells of h has ~3 cells per particle)."""
     n = cell.shape[0]
     ncells = cell_start.shape[0] - 1
     for c in range(ncells + 1):
         cell_start[c] = 0
     for i in range(n):
-        cell_start[cell[i] + 1] += 1
-    for c in range(ncells):
-        cell_start[c + 1] += cell_start[c]
-    cursor = cell_start[:ncells].copy()
-    for i in range(n):
+        cell_start[cell[i]] += 1
+    for c in range(1, ncells):
+        cell_start[c] += cell_start[c - 1]
+    cell_start[ncells] = n
+    for i in range(n - 1, -1, -1):
         c = cell[i]
-        order[cursor[c]] = i
-        cursor[c] += 1
+        k = cell_start[c] - 1
+        cell_start[c] = k
+        order[k] = i
 
 
 @njit(cache=True, error_model="numpy")

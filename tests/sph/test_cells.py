@@ -36,3 +36,21 @@ def test_grid_covers_given_box_and_clamps_outside():
     cl.build(pos, pmin=np.zeros(3), pmax=np.ones(3))
     assert cl.shape == (6, 1, 6)
     assert cl.cell[2] == 5            # clamped to cell (5, 0)
+
+
+@pytest.mark.parametrize("is2d", [True, False])
+def test_counting_sort_is_stable_and_every_cell_start_is_right(is2d):
+    """The order is numpy's stable argsort of the cells (equal cells keep their order, which
+    resumed runs rely on to repeat a run bitwise), and cell_start is the first sorted row of
+    every cell, empty ones included (the search reads the start of a stencil row's first cell
+    and of the cell after its last one), with n at the end."""
+    rng = np.random.default_rng(7)
+    pos = rng.random((900, 3)) * np.array([1.0, 0.5, 0.7])
+    pos[::3] = pos[::3].round(1)                 # clusters of particles in the same cells
+    cl = cells.CellList(0.005 if is2d else 0.02, is2d)      # more cells than particles
+    order = cl.build(pos)
+    np.testing.assert_array_equal(order, np.argsort(cl.cell, kind="stable"))
+    ncells = int(np.prod(cl.shape))
+    assert cl.cell_start.shape == (ncells + 1,)
+    np.testing.assert_array_equal(cl.cell_start, np.searchsorted(cl.cell[order], np.arange(ncells + 1)))
+    assert ncells > 2 * len(pos) and cl.cell_start[-1] == len(pos)
