@@ -7,7 +7,7 @@ plane is x-z (DualSPHysics convention), y is ignored.
 """
 import numpy as np
 
-from . import _env  # noqa: F401
+from ._env import CHUNK
 from numba import njit, prange
 
 
@@ -95,8 +95,8 @@ def counting_sort_cells_parallel(pos, pmin, inv_cell, ncx, ncy, ncz, is2d, cell,
                                  cell_start):
     """:func:`counting_sort_cells` with the cell indices computed by threads."""
     n = pos.shape[0]
-    for c in prange((n + 1023) // 1024):
-        _cell_range(c * 1024, min(n, (c + 1) * 1024), pos, pmin, inv_cell, ncx, ncy, ncz,
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _cell_range(c * CHUNK, min(n, (c + 1) * CHUNK), pos, pmin, inv_cell, ncx, ncy, ncz,
                     is2d, cell)
     _sort_by_cell(cell, order, cell_start)
 

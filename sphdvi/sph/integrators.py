@@ -33,11 +33,8 @@ velocity (no motion hook).
 """
 import math
 
-from . import _env  # noqa: F401
+from ._env import CHUNK
 from numba import njit, prange, literally
-
-# particles per work item of the threaded drivers
-CHUNK = 256
 
 
 @njit(cache=True, error_model="numpy")

@@ -57,13 +57,10 @@ paths are separate functions.
 """
 import math
 
-from . import _env  # noqa: F401
+from ._env import CHUNK
 from numba import njit, prange, literally
 
 from .kernels import kernel_fac, kernel_w
-
-# particles per work item of the threaded drivers
-CHUNK = 128
 
 
 @njit(cache=True, error_model="numpy")
@@ -170,8 +167,8 @@ def sort_pack_parallel(order, is2d, cst, nb, pos, vel, rhop, mass, ptype, ptype_
                        tau, tau_s):
     """Threaded :func:`sort_pack_serial`."""
     n = order.shape[0]
-    for c in prange((n + 1023) // 1024):
-        _sort_pack_range(c * 1024, min(n, (c + 1) * 1024), order, is2d, cst, nb, pos, vel, rhop,
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _sort_pack_range(c * CHUNK, min(n, (c + 1) * CHUNK), order, is2d, cst, nb, pos, vel, rhop,
                          mass, ptype, ptype_s, cell, cell_s, tau, tau_s)
 
 
@@ -935,7 +932,7 @@ def reorder_pack_parallel(order, is2d, cst, nb, f2_src, f2_dst, f1_src, f1_dst, 
                           ptype_dst, idp_src, idp_dst, mk_src, mk_dst, cell_src, cell_dst):
     """Threaded :func:`reorder_pack_serial`."""
     n = order.shape[0]
-    for c in prange((n + 1023) // 1024):
-        _reorder_pack_range(c * 1024, min(n, (c + 1) * 1024), order, is2d, cst, nb, f2_src,
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _reorder_pack_range(c * CHUNK, min(n, (c + 1) * CHUNK), order, is2d, cst, nb, f2_src,
                             f2_dst, f1_src, f1_dst, ptype_src, ptype_dst, idp_src, idp_dst,
                             mk_src, mk_dst, cell_src, cell_dst)

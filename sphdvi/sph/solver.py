@@ -69,6 +69,12 @@ PARALLEL_THRESHOLD = 1500
 # put (a full permutation of every array costs ~5 % of a 2D step and does not
 # speed up on 2 threads; the gather is a third of it).
 REORDER_EVERY = 16
+# From this many particles the light kernels (cell indices, packing, integrators) run
+# threaded too, on the interaction's rows (sphdvi.sph._env.CHUNK).  2D dam break on 2
+# threads, the step threaded against the step with these kernels serial, the median of 40
+# paired interleaved rounds: 1.056 of the time at 2,500 particles, 1.008 at 5,500 and
+# 10,800, 0.988-0.996 at 21,000, 0.986 at 42,000, each round +-5 % (quartiles): no gain to
+# measure on this machine below ~50,000.
 LIGHT_THRESHOLD = 50000
 
 # Compiled entry points shared by all solvers, keyed by the feature flags
@@ -104,6 +110,9 @@ class SPHSolver:
         with their current velocity, r += v dt.
     parallel_threshold : int
         Below this many particles the serial kernels run (no thread launch).
+    light_threshold : int
+        Below this many particles the light kernels (cell indices, packing, integrators:
+        a few ns per particle) run serially, the interaction threaded or not.
     periodic : iterable of "x", "y", "z" or None
         Periodic axes.  DualSPHysics switches an axis on when its
         ``*PeriodicInc*`` key is present in the case (even with value 0), which
@@ -137,7 +146,8 @@ class SPHSolver:
     """
 
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
-                 parallel_threshold=PARALLEL_THRESHOLD, periodic=None, normals=None,
+                 parallel_threshold=PARALLEL_THRESHOLD, light_threshold=LIGHT_THRESHOLD,
+                 periodic=None, normals=None,
                  cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
@@ -150,6 +160,7 @@ class SPHSolver:
         self.params = resolve_params(params)
         self.motion_hook = motion_hook
         self.parallel_threshold = int(parallel_threshold)
+        self.light_threshold = int(light_threshold)
         self.time = 0.0
         self.nstep = 0
         self.n_dtmin = 0          # steps where dt was raised to DtMin (DtModif)
@@ -410,15 +421,15 @@ class SPHSolver:
 
     # ------------------------------------------------------------------ kernels
     def _use_parallel(self, light=False):
-        """Threaded kernels for this N?  ``light`` kernels (packing, the
-        integrators: a few ns per particle, bound by memory traffic) are threaded
-        only above LIGHT_THRESHOLD: below it, waking the passive pool (5-8 us for
-        an empty region) and moving cache lines between the cores cost what they
-        save (2D dam break, 21k particles: a threaded packing makes the next serial
-        integrator 2-3x slower; all light kernels threaded x1.72-1.82 vs x1.83)."""
+        """Threaded kernels for this N?  ``light`` kernels (cell indices, packing, the
+        integrators: a few ns per particle, bound by memory traffic) are threaded from
+        ``light_threshold`` particles on.  Below it, waking the passive pool (5-8 us for an
+        empty region) and moving cache lines between the cores cost what they save (see
+        LIGHT_THRESHOLD).  Threaded, they give each thread the rows it interacts
+        (``_env.CHUNK``)."""
         n = self.state.n
-        if light:
-            n = n if n >= LIGHT_THRESHOLD else 0
+        if light and n < self.light_threshold:
+            n = 0
         return n >= self.parallel_threshold and numba.get_num_threads() > 1
 
     def threads_in_use(self) -> int:
@@ -500,9 +511,10 @@ class SPHSolver:
         the domain when one is set, else their bounding box); returns ``order``."""
         self._check_state_arrays()
         pos = self.state.pos
+        par = self._use_parallel(light=True)
         if self._domain is not None:
-            return self.cells.build(pos, self._domain[0], self._domain[1])
-        return self.cells.build(pos)
+            return self.cells.build(pos, self._domain[0], self._domain[1], parallel=par)
+        return self.cells.build(pos, parallel=par)
 
     def _reorder_and_pack(self):
         """Counting-sort the particles by cell, permute every per-particle array

@@ -40,12 +40,13 @@ def random_state(pos, dp, is2d, rng, ptype=None, vscale=0.5, drho=5.0):
 
 
 def assert_threaded_equals_serial(state, consts, params, steps=30):
-    """Run the same scene with the serial and the threaded kernels (two numba threads)
-    and assert bitwise equal step results, positions, velocities and densities."""
+    """Run the same scene with the serial and the threaded kernels (two numba threads; the
+    light ones, cell indices, packing and integrators, threaded too) and assert bitwise equal
+    step results, positions, velocities and densities."""
     import numba
     from sphdvi.sph import SPHSolver
     ser = SPHSolver(state.copy(), consts, params, parallel_threshold=10 ** 9)
-    par = SPHSolver(state.copy(), consts, params, parallel_threshold=0)
+    par = SPHSolver(state.copy(), consts, params, parallel_threshold=0, light_threshold=0)
     old = numba.get_num_threads()
     numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
     try:

@@ -33,7 +33,7 @@ def test_parallel_kernels_bitwise_equal_serial(alg):
 def test_default_threshold_threads_a_few_thousand_particles():
     """Two threads pay from about 500 particles on (x1.1 at 530-1,000, x1.35-1.58 at 1,900:
     solver.PARALLEL_THRESHOLD); a few hundred stay serial, and the light kernels
-    (packing, integrators) stay serial below LIGHT_THRESHOLD."""
+    (cell indices, packing, integrators) stay serial below LIGHT_THRESHOLD."""
     import numba
     from sphdvi.sph import solver as sv
     if numba.config.NUMBA_NUM_THREADS < 2:
