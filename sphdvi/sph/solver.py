@@ -429,7 +429,7 @@ class SPHSolver:
         (``_env.CHUNK``)."""
         n = self.state.n
         if light and n < self.light_threshold:
-            n = 0
+            return False
         return n >= self.parallel_threshold and numba.get_num_threads() > 1
 
     def threads_in_use(self) -> int:

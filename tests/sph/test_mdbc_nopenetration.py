@@ -314,7 +314,7 @@ def _threaded_vs_serial(step):
     runs = []
     for thr in (10 ** 9, 0):
         st, normals, nb = flat_wall(fpos, fvel)
-        sol = SPHSolver(st, c, p, normals=normals, parallel_threshold=thr)
+        sol = SPHSolver(st, c, p, normals=normals, parallel_threshold=thr, light_threshold=thr)
         ncorr = 0
         for _ in range(20):
             sol.step()

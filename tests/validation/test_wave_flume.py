@@ -5,7 +5,10 @@ height from three gauges, and the paddle's stroke on its particles against Biese
 Measured (README, W1): incident height −13.0 % of H at dp 0.02 (H/dp 1.5), −10.3 % at dp 0.01
 (H/dp 3), reflection from the damping zone 7 %.  DualSPHysics advises H/dp ≥ 10 for generated
 waves; at these coarse resolutions the height falls short by about 10 %, less as dp falls.
-W2 (flap): −9.8 % at dp 0.02, reflection 6.4 %."""
+W2 (flap): −9.8 % at dp 0.02, reflection 6.4 %.
+
+Slow (each 8.4 s of waves, about a minute at dp 0.02 on a slow 2-core host, two at dp 0.01): the
+paddles' strokes and ramps are tested fast in tests/motion and tests/run/test_moving.py."""
 from pathlib import Path
 
 import pytest
@@ -32,6 +35,7 @@ def run(tmp_path, dp, case=CASE):
     return wave_errors(run_case(tmp_path, dp, case))
 
 
+@pytest.mark.slow
 def test_piston_makes_the_wave_height_of_the_theory_at_h_over_dp_1_5(tmp_path):
     out = run_case(tmp_path, 0.02)
     # the paddle moves with Biesel's stroke (S = H / 1.0405) to the sampling's round-off
@@ -44,6 +48,7 @@ def test_piston_makes_the_wave_height_of_the_theory_at_h_over_dp_1_5(tmp_path):
     assert e["reflection"] < 0.10
 
 
+@pytest.mark.slow
 def test_flap_makes_the_wave_height_of_the_theory_at_h_over_dp_1_5(tmp_path):
     out = run_case(tmp_path, 0.02, FLAP_CASE)
     # the flap turns about its bottom hinge with Biesel's stroke at the still-water level (H / 0.5644)
