@@ -5,6 +5,12 @@ from pathlib import Path
 import pytest
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+if int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) > 1:
+    # a worker of ``-n auto`` (pyproject addopts): its share of the CPUs, and at least 2 for the
+    # threaded-vs-serial tests; set before numba is imported (NUMBA_NUM_THREADS is read then)
+    from sphdvi.simulation import default_threads     # imports no numba
+    os.environ.setdefault("NUMBA_NUM_THREADS",
+                          str(max(2, default_threads() // int(os.environ["PYTEST_XDIST_WORKER_COUNT"]))))
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_REFERENCE = REPO.parent / "shared" / "reference"
