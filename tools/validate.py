@@ -14,6 +14,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
                                              # S16M: S16 with mDBC on the box (dp 0.02, 0.01 and 0.005: 2, 25 and 107 min on 2 threads)
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
+                                             # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
     python tools/validate.py S16M --dp 0.02 --dp 0.01 --threads 2     # some of a case's resolutions
 
@@ -205,6 +206,11 @@ def _buchner_case(name, title, file):
                 "impact within ±0.1 in T, level over T = 3-5 within 20 %, second peak within ±0.15 in T (judgement)")
 
 
+def score_hinged_flap(outdir):
+    from sphdvi.validation.hingedflap import case_errors
+    return case_errors(outdir)
+
+
 def score_taylor_green(outdir):
     from sphdvi.validation.taylorgreen import case_errors
     return case_errors(outdir)
@@ -283,6 +289,13 @@ def cases() -> list:
              "rate_error", lambda e: abs(e["rate_error"]) <= 0.05 and e["monotone"] and e["fluid_lost"] == 0,
              "kinetic-energy decay rate within 5 % of 16π²ν/L², energy monotone, at 100² particles",
              prepare=prepare_taylor_green),
+        Case("S18", "hinged buoyant flap in still water (Chrono link_hinge with a spring): equilibrium tilt",
+             case_path("hingedflap2d", "CaseHingedFlap2D_Def.xml"),
+             [Resolution("dp 0.04", 0.04, scored=False), Resolution("dp 0.02", 0.02), Resolution("dp 0.01", 0.01)],
+             score_hinged_flap, [("tilt err °", "tilt_error", "{:+.2f}"), ("reaction %", "reaction_error", PCT),
+                                 ("horizontal %", "reaction_x", PCT), ("torque %", "torque_error", PCT)],
+             "tilt_error", lambda e: abs(e["tilt_error"]) <= 1.0,
+             "settled tilt within 1° of F r_c sin φ = K (φ0 − φ)", slow=True),
         Case("A1", "tank under an imposed acceleration a_x = 0.1 g (<accinputs>): free-surface slope",
              case_path("acceltank2d", "CaseAccelTank2D_Def.xml"),
              [Resolution("depth/dp 15", 0.02), Resolution("depth/dp 30", 0.01)],
@@ -376,7 +389,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S16 S16M S16O A1 W1 W2 W3); default: all but the slow S4, S8, S16, S16M and S16O")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S16 S16M S16O S18 A1 W1 W2 W3); default: all but the slow S4, S8, S16, S16M, S16O and S18")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
