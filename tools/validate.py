@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, A1, W1, W2, W3)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
@@ -211,6 +211,11 @@ def score_hinged_flap(outdir):
     return case_errors(outdir)
 
 
+def score_cylinder(outdir):
+    from sphdvi.validation.cylinder import case_errors
+    return case_errors(outdir, REFERENCE)
+
+
 def score_taylor_green(outdir):
     from sphdvi.validation.taylorgreen import case_errors
     return case_errors(outdir)
@@ -289,6 +294,13 @@ def cases() -> list:
              "rate_error", lambda e: abs(e["rate_error"]) <= 0.05 and e["monotone"] and e["fluid_lost"] == 0,
              "kinetic-energy decay rate within 5 % of 16π²ν/L², energy monotone, at 100² particles",
              prepare=prepare_taylor_green),
+        Case("S13", "heavy cylinder released at the free surface vs Fekken (2004) and Moyo & Greenhow (2000)",
+             case_path("cylinder2d", "CaseCylinderSinking2D_Def.xml"),
+             [Resolution("R/dp 10", 0.1), Resolution("R/dp 20", 0.05)],
+             score_cylinder, [("vs Fekken %", "Fekken", "{:.1f} %"), ("vs Moyo %", "Moyo", "{:.1f} %"),
+                              ("T=3 vs Fekken %", "at3_Fekken", PCT)],
+             "Fekken", lambda e: e["Fekken"] <= 0.10 and e["Moyo"] <= 0.10,
+             "displacement up to T = 3 within 5-10 % of both references (largest error over T = 0.5-3)"),
         Case("S18", "hinged buoyant flap in still water (Chrono link_hinge with a spring): equilibrium tilt",
              case_path("hingedflap2d", "CaseHingedFlap2D_Def.xml"),
              [Resolution("dp 0.04", 0.04, scored=False), Resolution("dp 0.02", 0.02), Resolution("dp 0.01", 0.01)],
@@ -389,7 +401,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S16 S16M S16O S18 A1 W1 W2 W3); default: all but the slow S4, S8, S16, S16M, S16O and S18")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3); default: all but the slow S4, S8, S16, S16M, S16O and S18")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
