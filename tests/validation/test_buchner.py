@@ -7,9 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
+from _caseruns import cached_runs
 
-from sphdvi.cli import main
 from sphdvi.validation import buchner as B
 
 REPO = Path(__file__).resolve().parents[2]
@@ -23,23 +22,15 @@ def run(tmp_path_factory):
     """run(dp, case=CASE) -> case_errors of that run (cached)."""
     if not (REF / B.DATA[0]).is_dir():
         pytest.skip("reference data not found")
-    cache = {}
 
-    def _run(dp, case=CASE):
-        if (dp, case) not in cache:
-            out = tmp_path_factory.mktemp("buchner")
-            r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--dp", repr(dp), "--threads", "2", "-q"])
-            assert r.exit_code == 0, r.output
-            e = B.case_errors(str(out), str(REF))
-            print("S5 Buchner, %s, H/dp %.0f: impact T %.3f (exp %.3f), level T 3-5 %.3f (exp %.3f, %+.1f %%), second "
-                  "peak T %.3f (exp %.3f), %.3f (exp %.3f); %d particles, %d steps, %.1f s"
-                  % (case.stem, B.H / dp, e["sim"]["impact"], e["exp"]["impact"], e["sim"]["plateau"],
-                     e["exp"]["plateau"], 100 * e["plateau"], e["sim"]["peak_T"], e["exp"]["peak_T"], e["sim"]["peak"],
-                     e["exp"]["peak"], e["particles"], e["steps"], e["runtime_s"]))
-            assert e["status"] == "completed"
-            cache[(dp, case)] = e
-        return cache[(dp, case)]
-    return _run
+    def report(dp, case, e):
+        return ("S5 Buchner, %s, H/dp %.0f: impact T %.3f (exp %.3f), level T 3-5 %.3f (exp %.3f, %+.1f %%), second "
+                "peak T %.3f (exp %.3f), %.3f (exp %.3f); %d particles, %d steps, %.1f s"
+                % (case.stem, B.H / dp, e["sim"]["impact"], e["exp"]["impact"], e["sim"]["plateau"],
+                   e["exp"]["plateau"], 100 * e["plateau"], e["sim"]["peak_T"], e["exp"]["peak_T"], e["sim"]["peak"],
+                   e["exp"]["peak"], e["particles"], e["steps"], e["runtime_s"]))
+    runs = cached_runs(tmp_path_factory, lambda out: B.case_errors(out, str(REF)), report)
+    return lambda dp, case=CASE: runs(dp, case)
 
 
 def test_reference_record_features():

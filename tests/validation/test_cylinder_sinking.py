@@ -7,9 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
+from _caseruns import cached_runs
 
-from sphdvi.cli import main
 from sphdvi.validation import cylinder as C
 
 REPO = Path(__file__).resolve().parents[2]
@@ -22,22 +21,14 @@ def run(tmp_path_factory):
     """run(dp) -> case_errors of that run (cached)."""
     if not (REF / C.DATA_DIR).is_dir():
         pytest.skip("reference data not found")
-    cache = {}
 
-    def _run(dp):
-        if dp not in cache:
-            out = tmp_path_factory.mktemp("cylinder")
-            r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--dp", repr(dp), "--threads", "2", "-q"])
-            assert r.exit_code == 0, r.output
-            e = C.case_errors(str(out), str(REF))
-            print("S13 cylinder, R/dp %.0f: displacement at T = 3 %.3f R (%+.1f %% against Fekken, %+.1f %% against "
-                  "Moyo & Greenhow); largest error over T = 0.5-3: %.1f / %.1f %%; %d particles, %d steps, %.1f s"
-                  % (C.RADIUS / dp, e["z3"], 100 * e["at3_Fekken"], 100 * e["at3_Moyo"], 100 * e["Fekken"],
-                     100 * e["Moyo"], e["particles"], e["steps"], e["runtime_s"]))
-            assert e["status"] == "completed"
-            cache[dp] = e
-        return cache[dp]
-    return _run
+    def report(dp, case, e):
+        return ("S13 cylinder, R/dp %.0f: displacement at T = 3 %.3f R (%+.1f %% against Fekken, %+.1f %% against "
+                "Moyo & Greenhow); largest error over T = 0.5-3: %.1f / %.1f %%; %d particles, %d steps, %.1f s"
+                % (C.RADIUS / dp, e["z3"], 100 * e["at3_Fekken"], 100 * e["at3_Moyo"], 100 * e["Fekken"],
+                   100 * e["Moyo"], e["particles"], e["steps"], e["runtime_s"]))
+    runs = cached_runs(tmp_path_factory, lambda out: C.case_errors(out, str(REF)), report)
+    return lambda dp: runs(dp, CASE)
 
 
 def test_references_as_read():

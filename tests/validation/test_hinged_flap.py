@@ -6,9 +6,8 @@ balance F r_c sin φ = K (φ0 − φ) and the hinge's reaction against the net b
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
+from _caseruns import cached_runs
 
-from sphdvi.cli import main
 from sphdvi.validation import hingedflap as HF
 
 REPO = Path(__file__).resolve().parents[2]
@@ -17,26 +16,17 @@ CASE = REPO / "cases" / "hingedflap2d" / "CaseHingedFlap2D_Def.xml"
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
-    """run(dp, threads) -> case_errors of that run (cached)."""
-    cache = {}
-
-    def _run(dp, threads=1):
-        if dp not in cache:
-            out = tmp_path_factory.mktemp("hingedflap")
-            r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--dp", repr(dp), "--threads",
-                                          str(threads), "-q"])
-            assert r.exit_code == 0, r.output
-            e = HF.case_errors(str(out))
-            print("S18 hinged flap, dp %g: settled tilt %.2f deg against %.2f (%+.2f deg; drawn %.2f), hinge reaction "
-                  "%+.1f %% of the net buoyancy (horizontal %.1f %%), torque %+.2f %% of the spring's; %d particles, "
-                  "%d steps, %.1f s"
-                  % (dp, e["settled_deg"], e["equilibrium_deg"], e["tilt_error"], e["phi0_deg"],
-                     100 * e["reaction_error"], 100 * e["reaction_x"], 100 * e["torque_error"], e["particles"],
-                     e["steps"], e["runtime_s"]))
-            assert e["status"] == "completed"
-            cache[dp] = e
-        return cache[dp]
-    return _run
+    """run(dp, threads=1) -> case_errors of that run (cached by dp)."""
+    def report(dp, case, e):
+        return ("S18 hinged flap, dp %g: settled tilt %.2f deg against %.2f (%+.2f deg; drawn %.2f), hinge reaction "
+                "%+.1f %% of the net buoyancy (horizontal %.1f %%), torque %+.2f %% of the spring's; %d particles, "
+                "%d steps, %.1f s"
+                % (dp, e["settled_deg"], e["equilibrium_deg"], e["tilt_error"], e["phi0_deg"],
+                   100 * e["reaction_error"], 100 * e["reaction_x"], 100 * e["torque_error"], e["particles"],
+                   e["steps"], e["runtime_s"]))
+    serial = cached_runs(tmp_path_factory, HF.case_errors, report, threads=1)
+    threaded = cached_runs(tmp_path_factory, HF.case_errors, report, threads=2)
+    return lambda dp, threads=1: (serial if threads == 1 else threaded)(dp, CASE)
 
 
 def test_equilibrium_tilt_solves_the_moment_balance():
