@@ -18,7 +18,7 @@ import os
 
 import numpy as np
 
-from .runs import case_data, run_info
+from .runs import body_log, case_data, run_info
 
 G = 9.81
 RADIUS = 1.0
@@ -37,8 +37,7 @@ def reference(reference_dir: str, name: str) -> tuple[np.ndarray, np.ndarray]:
 
 def displacement(outdir: str) -> tuple[np.ndarray, np.ndarray]:
     """(T, displacement / R) of the cylinder's centre from bodies.csv (its first row at t = 0)."""
-    rows = np.genfromtxt(os.path.join(str(outdir), "bodies.csv"), delimiter=",", names=True, dtype=None,
-                         encoding=None)
+    rows = body_log(outdir)
     t, z = np.asarray(rows["time"], dtype=float), np.asarray(rows["z"], dtype=float)
     return t * math.sqrt(G / RADIUS), (z - z[0]) / RADIUS
 

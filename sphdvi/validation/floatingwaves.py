@@ -26,8 +26,6 @@ experiment's samples within the run.
 """
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from .flapwaves import load_probe, probe_scores, wave_scores
@@ -40,8 +38,8 @@ REST = (1.0, 2.0)                   # s: the box's rest height is its mean over 
 def body_records(outdir: str, body: str = BODY) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """{"heave" [m], "roll" [degrees, about −y], "sway" [m]}: (time, value) of the run's box,
     heave from its rest height, sway from x = its rest x (see the module's docstring)."""
-    rows = np.genfromtxt(os.path.join(outdir, "bodies.csv"), delimiter=",", names=True,
-                         dtype=None, encoding="utf-8")
+    from .runs import body_log
+    rows = body_log(outdir)
     rows = rows[rows["body"] == body]
     t = np.asarray(rows["time"], float)
     rest = (t >= REST[0]) & (t <= REST[1])

@@ -28,11 +28,10 @@ fluid's load on the body.
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 
-from .runs import case_data, run_info
+from .runs import body_log, case_data, run_info
 
 SETTLED_FROM = 3.0          # t [s] from which the flap has settled (the run's last second)
 
@@ -51,8 +50,7 @@ def case_geometry(outdir: str) -> dict:
     area = count * dp * dp
     r = centre - hinge
     inertia_y = float(body["inertia"][0][1][1])                 # about the centre of mass
-    return {"hinge": hinge, "stiffness": float(link["stiffness"]), "damping": float(link.get("damping") or 0.0),
-            "mass": mass, "area": area, "centre": centre, "r_c": float(math.hypot(r[0], r[2])),
+    return {"hinge": hinge, "stiffness": float(link["stiffness"]), "mass": mass, "area": area, "centre": centre, "r_c": float(math.hypot(r[0], r[2])),
             "phi0": float(math.atan2(r[0], r[2])), "force": (rho_w * area - mass) * g,
             "inertia_hinge": inertia_y + mass * float(r[0] ** 2 + r[2] ** 2), "dp": dp}
 
@@ -77,8 +75,7 @@ def period_lower_bound(geo: dict, phi: float) -> float:
 
 def tilt_series(outdir: str, geo: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(t, φ, r) of the centroid about the hinge from bodies.csv (r its distance from the hinge)."""
-    rows = np.genfromtxt(os.path.join(str(outdir), "bodies.csv"), delimiter=",", names=True, dtype=None,
-                         encoding=None)
+    rows = body_log(outdir)
     dx, dz = rows["x"] - geo["hinge"][0], rows["z"] - geo["hinge"][2]
     return np.asarray(rows["time"], dtype=float), np.arctan2(dx, dz), np.hypot(dx, dz)
 
@@ -106,8 +103,7 @@ def first_swing_period(outdir: str) -> dict:
 
 def hinge_reaction(outdir: str, since: float) -> list:
     """Mean (fx, fz, ty) the hinge puts on the flap over t >= ``since`` (links.csv)."""
-    rows = np.genfromtxt(os.path.join(str(outdir), "links.csv"), delimiter=",", names=True, dtype=None,
-                         encoding=None)
+    rows = body_log(outdir, "links")
     late = np.asarray(rows["time"], dtype=float) >= since - 1e-9
     return [float(np.mean(rows[k][late])) for k in ("fx", "fz", "ty")]
 

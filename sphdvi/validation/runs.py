@@ -1,5 +1,5 @@
 """What every validation scorer reads from a run folder OUT: its gencase case (constants,
-parameters, particles) and its run.json."""
+parameters, particles), its gauge files, body and link logs, and its run.json."""
 from __future__ import annotations
 
 import json
@@ -18,6 +18,14 @@ def gauge_table(outdir: str, kind: str, name: str):
     columns as sphdvi.measure.gauges writes them: for SWL, column 3 is the surface's z)."""
     import numpy as np
     return np.genfromtxt(os.path.join(str(outdir), f"Gauges{kind}_{name}.csv"), delimiter=";", skip_header=1)
+
+
+def body_log(outdir: str, name: str = "bodies"):
+    """The rows of the run's ``bodies.csv`` or ``links.csv`` (``name`` "bodies" or "links") as a
+    numpy structured array, one field per header column (time, body or link, x, ..., fx, ...)."""
+    import numpy as np
+    return np.genfromtxt(os.path.join(str(outdir), f"{name}.csv"), delimiter=",", names=True, dtype=None,
+                         encoding="utf-8")
 
 
 def run_info(outdir: str) -> dict:

@@ -65,7 +65,14 @@ def pressure(pos, rhop0: float, t: float = 0.0, u0: float = U0, nu: float = NU, 
     return amp * (np.cos(2 * k * pos[:, 0]) + np.cos(2 * k * pos[:, 2]))
 
 
-def impose_initial_field(outdir: str, u0: float = U0, background: float = 0.0) -> None:
+def lattice_side(case: dict) -> float:
+    """L of a gencase file of the case: the extent of its fluid lattice along x plus dp."""
+    p = case["particles"]
+    x = p["pos"][p["type"] == 3, 0]
+    return float(x.max() - x.min()) + float(case["constants"]["dp"])
+
+
+def impose_initial_field(outdir: str, u0: float = U0) -> None:
     """Write the t = 0 field of eqs. (1)–(2) into the gencase file of ``outdir`` (atomically):
     the fluid particles' velocity and their density ρ0 (1 + p/B)^(1/γ) (Tait, p of eq. (2)).
     The side L is the extent of the fluid lattice plus dp, ν the case's ``Visco``."""
@@ -80,13 +87,13 @@ def impose_initial_field(outdir: str, u0: float = U0, background: float = 0.0) -
     c, p = case["constants"], case["particles"]
     fluid = p["type"] == 3
     pos = p["pos"]
-    side = float(pos[fluid, 0].max() - pos[fluid, 0].min()) + float(c["dp"])
+    side = lattice_side(case)
     nu = float(case["parameters"]["Visco"])
     vel = p["vel"].copy()
     rhop = p["rhop"].copy()
     vel[fluid] = velocity(pos[fluid], 0.0, u0, nu, side)
     rhop0, b, gamma = float(c["rhop0"]), float(c["b"]), float(c["gamma"])
-    rhop[fluid] = rhop0 * (1 + (background + pressure(pos[fluid], rhop0, 0.0, u0, nu, side)) / b) ** (1 / gamma)
+    rhop[fluid] = rhop0 * (1 + pressure(pos[fluid], rhop0, 0.0, u0, nu, side) / b) ** (1 / gamma)
     with atomic_path(path) as tmp:
         with open(path, "rb") as src, open(tmp, "wb") as dst:
             dst.write(src.read())
@@ -144,8 +151,7 @@ def case_errors(outdir: str) -> dict:
     run_meta = run_info(outdir)
     par = dict(case["parameters"], **run_meta.get("parameters", {}))
     dp = float(c["dp"])
-    fluid0 = p["pos"][p["type"] == 3]
-    side = float(fluid0[:, 0].max() - fluid0[:, 0].min()) + dp
+    side = lattice_side(case)
     nu = float(par["Visco"])
     times, energy = kinetic_energy_series(outdir)
     fit = times >= FIT_FROM - 1e-9
