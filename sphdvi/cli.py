@@ -113,7 +113,8 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
 
     \b
     Outputs in OUT: particles.vtkhdf (one temporal VTKHDF file), run.json,
-    run.log, run.csv, restart.h5; body-only cases write bodies.csv and links.csv.
+    run.log, run.csv, restart.h5; cases with bodies write bodies.csv and links.csv,
+    runs that exclude fluid particles excluded.csv (one row per particle).
     A new run into an OUT holding an earlier run's results needs --overwrite.
     Exit codes: 0 completed, 1 failed or interrupted, 2 bad input, 3 diverged.
     """

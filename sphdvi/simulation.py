@@ -39,7 +39,7 @@ from .errors import DivergenceError, InputError
 from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint, load_sph_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import remove_leftover_temporaries
-from .io.runfiles import BodyLog, Progress, RunFiles
+from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
 from .io.runfolder import NORMALS_FILE, check_new_run_folder, clear_earlier_results, stored_overrides
 from .sph.damping import damping_zones
 from .output_schedule import OutputSchedule
@@ -855,6 +855,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         for line in excl_lines:
             files.log("WARNING: " + line)
             warnings.warn(line)
+        excluded_log.record(sol.take_excluded())
         if body_log is not None:
             body_log.record()
         sph.save_checkpoint(ckpt, {"part": k, "runtime_s": wall})
@@ -863,6 +864,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     excl_warn = ExclusionWarnings(int(params.get("WrnPartsOut", 1)) != 0, sph.n0_fluid,
                                   int(data["particles"]["type"].size))
     gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
+    excluded_log = ExcludedLog(outdir, float(sol.time) if resume else None)
     body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None)
                 if sph.bodies is not None else None)
     status, code, message = "completed", 0, ""
@@ -900,6 +902,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             status, code, message = "diverged", 3, str(exc)
         except BaseException as exc:
             status, code, message = "failed", 1, f"{type(exc).__name__}: {exc}"
+            excluded_log.record(sol.take_excluded())
             runtime += _time.perf_counter() - t_loop
             if gauges is not None:
                 gauges.close()
@@ -908,6 +911,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             writer.close()
             raise
     runtime += _time.perf_counter() - t_loop
+    excluded_log.record(sol.take_excluded())       # those after the last output (a stopped run)
     if gauges is not None:
         gauges.close()
     progress.update(sol.time, sol.nstep, sol.state.n, force=True)

@@ -5,6 +5,8 @@
   RunPARTs.csv), appended;
 * ``bodies.csv`` / ``links.csv``: one row per body and per link at every output (and
   TimeOutExtra) time, appended; a resume cuts them back to the restart time;
+* ``excluded.csv``: one row per fluid particle the run removed (DualSPHysics's PartOut
+  files), appended at each output, written from the first exclusion on;
 * a progress line on a terminal, a log line every so often otherwise.
 """
 from __future__ import annotations
@@ -19,6 +21,8 @@ import numpy as np
 from .atomic import append_text, complete_lines, write_text_atomic
 
 RUN_CSV_HEADER = "part,time,steps,particles,excluded,dtmin,dtmax,walltime"
+EXCLUDED_FILE = "excluded.csv"
+EXCLUDED_HEADER = "time,idp,x,y,z,vx,vy,vz,rhop,reason"
 
 
 class RunFiles:
@@ -111,26 +115,31 @@ class Progress:
 
 
 
+def _rows_until(path: str, resume_time: float | None) -> list[str]:
+    """The complete data rows (with their newline) of a row file whose first column is the
+    time, up to ``resume_time``; none for a new run (``resume_time`` None)."""
+    if resume_time is None:
+        return []
+    from ..dvi.runner import csv_time
+    # compare as printed: the row written at the restart time may have been rounded up in
+    # its 9 digits, and must stay
+    limit = float(csv_time(resume_time))
+    return [line + "\n" for line in complete_lines(path)[1:] if line and float(line.split(",", 1)[0]) <= limit]
+
+
 class BodyLog:
     """``bodies.csv`` and ``links.csv`` of a run with bodies (one row per body
     and per link at every output time, and at TimeOutExtra between outputs): the rows are
     appended at each output; a resume cuts the files back to the restart time, atomically."""
 
     def __init__(self, outdir: str, system, names, resume_time: float | None = None):
-        from ..dvi.runner import BODIES_HEADER, LINKS_HEADER, csv_time
+        from ..dvi.runner import BODIES_HEADER, LINKS_HEADER
         self.system, self.names = system, names
         self.paths = (os.path.join(outdir, "bodies.csv"), os.path.join(outdir, "links.csv"))
         self.headers = (BODIES_HEADER, LINKS_HEADER)
         self.rows: tuple[list, list] = ([], [])        # rows not yet written
         for path, header in zip(self.paths, self.headers):
-            kept = []
-            if resume_time is not None:
-                # compare as printed: the row written at the restart time may have been
-                # rounded up in its 9 digits, and must stay
-                limit = float(csv_time(resume_time))
-                kept = [line + "\n" for line in complete_lines(path)[1:]
-                        if line and float(line.split(",", 1)[0]) <= limit]
-            write_text_atomic(path, header + "\n" + "".join(kept))
+            write_text_atomic(path, header + "\n" + "".join(_rows_until(path, resume_time)))
 
     def record(self, flush: bool = True) -> None:
         """Add a row per body and link at the current time; append the pending rows to the
@@ -144,3 +153,35 @@ class BodyLog:
                 if rows:
                     append_text(path, "".join(rows))
                     rows.clear()
+
+
+class ExcludedLog:
+    """``excluded.csv``: a row per fluid particle the run excluded (DualSPHysics's PartOut),
+    columns :data:`EXCLUDED_HEADER`: the time of the end of the step that removed it, its id,
+    its position, velocity and density at that moment and the reason (``rhop``: density
+    outside RhopOutMin/RhopOutMax; ``position``: out of the domain; ``not finite``).  The
+    file appears with the first exclusion; rows are appended at each output; a resume cuts
+    them back to the restart time, atomically."""
+
+    def __init__(self, outdir: str, resume_time: float | None = None):
+        self.path = os.path.join(outdir, EXCLUDED_FILE)
+        if resume_time is not None and os.path.exists(self.path):
+            write_text_atomic(self.path, EXCLUDED_HEADER + "\n" + "".join(_rows_until(self.path, resume_time)))
+
+    def record(self, events: list) -> None:
+        """Append the rows of ``events`` (the solver's exclusion events: dicts of time, idp,
+        pos, vel, rhop, reason)."""
+        events = [ev for ev in events if len(ev["idp"])]
+        if not events:
+            return
+        from ..dvi.runner import csv_time
+        lines = []
+        for ev in events:          # one event per step that excluded particles
+            t = csv_time(ev["time"])
+            pos, vel = np.asarray(ev["pos"], float), np.asarray(ev["vel"], float)
+            cols = np.column_stack([pos, vel, np.asarray(ev["rhop"], float)])
+            values = [",".join(f"{v:.9g}" for v in row) for row in cols.tolist()]
+            lines.extend(f"{t},{int(i)},{v},{r}\n" for i, v, r in zip(ev["idp"], values, ev["reason"]))
+        if not os.path.exists(self.path):
+            write_text_atomic(self.path, EXCLUDED_HEADER + "\n")
+        append_text(self.path, "".join(lines))

@@ -165,7 +165,8 @@ class SPHSolver:
         self.nstep = 0
         self.n_dtmin = 0          # steps where dt was raised to DtMin (DtModif)
         self.n_excluded = {name: 0 for name in REASON_NAMES.values()}
-        self.excluded = []        # list of dicts: time, idp, pos, vel, rhop, reason
+        self.excluded = []        # exclusion events since take_excluded(): dicts of time (the end of
+                                  # the step that removed them), idp, pos, vel, rhop, reason
         self.last_dt = 0.0
         self._setup_constants()
         self._domain = None
@@ -851,7 +852,7 @@ class SPHSolver:
         if self.nopen:
             nout += self._nopen_apply(False)
         if nout:
-            self._exclude()
+            self._exclude(self.time + dt)
         return dt
 
     def _step_symplectic(self):
@@ -879,7 +880,7 @@ class SPHSolver:
             nout += self._nopen_apply(True)
         self.dt_pre = self._variable_dt(self.time + dt)
         if nout:
-            self._exclude()
+            self._exclude(self.time + dt)
         return dt
 
     def run(self, tmax, max_steps=None):
@@ -892,15 +893,16 @@ class SPHSolver:
         return n
 
     # ------------------------------------------------------------------ exclusion
-    def _exclude(self):
-        """Remove the flagged fluid particles from the state and work arrays."""
+    def _exclude(self, t_end: float):
+        """Remove the flagged fluid particles from the state and work arrays, and keep an
+        event of them (what they were when the step ending at ``t_end`` removed them)."""
         s = self.state
         codes = self.out.copy()
         bad = codes != 0
         for code, name in REASON_NAMES.items():
             self.n_excluded[name] += int(np.count_nonzero(codes == code))
         self.excluded.append({
-            "time": self.time, "idp": s.idp[bad].copy(), "pos": s.pos[bad].copy(),
+            "time": t_end, "idp": s.idp[bad].copy(), "pos": s.pos[bad].copy(),
             "vel": s.vel[bad].copy(), "rhop": s.rhop[bad].copy(),
             "reason": [REASON_NAMES[int(c)] for c in codes[bad]]})
         keep = ~bad
@@ -910,6 +912,11 @@ class SPHSolver:
             if a.shape[0] == keep.shape[0]:
                 setattr(self, name, np.ascontiguousarray(a[keep]))
         self._alloc()
+
+    def take_excluded(self) -> list:
+        """The exclusion events since the last call (oldest first); the list starts anew."""
+        events, self.excluded = self.excluded, []
+        return events
 
     # ------------------------------------------------------------------ checkpoints
     CHECKPOINT_SCALARS = ("time", "nstep", "n_dtmin", "_verlet_count", "dt_pre", "last_dt")

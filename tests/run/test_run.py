@@ -640,6 +640,38 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
         assert any("more than 1%" in str(c.message) for c in caught) == expect
 
 
+def test_excluded_particles_file_and_resume(tmp_path):
+    """excluded.csv (DualSPHysics's PartOut): a row per excluded fluid particle, its time, id,
+    position, velocity, density and reason, as many as run.json counts, none of them left in
+    the run; a run stopped at an output and resumed writes the same file, bitwise; a run that
+    excludes nothing writes none."""
+    case = small_case(tmp_path)
+    common = ["--tout", "0.01", "--threads", "1", "-q", "--set", "RhopOutMax=1002.3"]
+    a, b, c = tmp_path / "a", tmp_path / "b", tmp_path / "c"
+    assert invoke(["run", case, "-o", a, "--tmax", "0.04"] + common).exit_code == 0
+    assert invoke(["run", case, "-o", b, "--tmax", "0.02"] + common).exit_code == 0
+    with open(b / "excluded.csv", "a") as fh:          # a row after the restart output, as a killed run leaves
+        fh.write("0.03,1,0,0,0,0,0,0,1003,rhop\n")
+    assert invoke(["run", b, "--resume", "--tmax", "0.04"] + common).exit_code == 0
+    text = (a / "excluded.csv").read_text()
+    assert text == (b / "excluded.csv").read_text()
+    lines = text.splitlines()
+    assert lines[0] == "time,idp,x,y,z,vx,vy,vz,rhop,reason"
+    rows = [line.split(",") for line in lines[1:]]
+    meta = json.loads((a / "run.json").read_text())
+    assert len(rows) == meta["excluded"]["rhop"] == sum(meta["excluded"].values()) > 10
+    assert {r[-1] for r in rows} == {"rhop"}
+    assert all(float(r[8]) > 1002.3 for r in rows)                # the density that excluded it
+    assert all(0 < float(r[0]) <= meta["physical_time"] for r in rows)
+    assert all(float(r[4]) < 0.3 for r in rows)                   # the foot of the 2 m column
+    ids = [int(r[1]) for r in rows]
+    with h5py.File(a / "restart.h5", "r") as f:
+        left = set(f["state/idp"][...].tolist())
+    assert len(set(ids)) == len(ids) and not set(ids) & left and len(left) == meta["particles"] - len(ids)
+    assert invoke(["run", case, "-o", c, "--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q"]).exit_code == 0
+    assert not (c / "excluded.csv").exists()
+
+
 def test_timeoutextra_floating_rows_between_outputs_and_resume(tmp_path):
     """TimeOutExtra: bodies.csv gets a row per body at every multiple of TimeOutExtra
     between the TimeOut outputs (the first step at or after it); a killed-and-resumed run

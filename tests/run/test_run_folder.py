@@ -91,14 +91,14 @@ def test_gencase_folder_runs_and_overwrite_starts_clean(done, tmp_path):
     assert nsteps(g / "particles.vtkhdf") == 2
     # --overwrite: nothing of the earlier run stays (stale body and gauge files included)
     out = copy_run(done, tmp_path / "o")
-    for name in ("bodies.csv", "links.csv", "GaugesVel_old.csv"):
+    for name in ("bodies.csv", "links.csv", "GaugesVel_old.csv", "excluded.csv"):
         (out / name).write_text("earlier run\n")
     (out / "notes.txt").write_text("the user's")
     r = invoke(["run", DAMBREAK, "-o", out, "--overwrite", "--dp", "0.1", "--tmax", "0.002", "--tout", "0.002",
                 "--threads", "1", "-q"])
     assert r.exit_code == 0, r.output
     names = {p.name for p in out.iterdir()}
-    assert not names & {"bodies.csv", "links.csv", "GaugesVel_old.csv"}
+    assert not names & {"bodies.csv", "links.csv", "GaugesVel_old.csv", "excluded.csv"}
     assert "notes.txt" in names
     assert nsteps(out / "particles.vtkhdf") == 2 and len(csv_rows(out / "run.csv")) == 2
     meta = json.loads((out / "run.json").read_text())

@@ -255,6 +255,10 @@ def test_dtfixed_that_throws_the_fluid_out_stops_the_run(done, tmp_path):
     assert any("DtFixed (1 s) is longer than TimeOut (0.01 s)" in str(w.message) for w in caught)
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "diverged" and "excluded in one step" in meta["message"]
+    # the particles of that step are in excluded.csv, though no output followed it
+    rows = [line.split(",") for line in (out / "excluded.csv").read_text().splitlines()[1:]]
+    n_out = int(meta["message"].split(": ")[1].split(" of")[0])
+    assert len(rows) == n_out and {r[-1] for r in rows} <= {"position", "rhop"} and "position" in {r[-1] for r in rows}
 
 
 # -- --threads and --dp --------------------------------------------------------------------------
