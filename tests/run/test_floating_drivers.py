@@ -4,6 +4,7 @@ time (the DualSPHysics chrono/12_ExternalVelocity examples; they were read and d
 from pathlib import Path
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 
 from sphdvi.cli import main
@@ -53,3 +54,40 @@ def test_external_force_table(tmp_path):
     assert np.allclose(vx, -0.1 + t, atol=1e-6)
     assert np.allclose(x - x[0], -0.1 * t + 0.5 * t ** 2, atol=1e-3)
     assert np.allclose(z, z[0], atol=1e-9)
+
+
+FLOATING_BOX = (REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml").read_text()
+
+
+@pytest.mark.parametrize("algo", [1, 2])
+def test_initial_velocity_in_an_sph_run_flies_ballistic(tmp_path, algo):
+    """DualSPHysics issue #74 (a floating body with an initial velocity moves wrongly, Verlet
+    against Symplectic): the S12 box lifted into the air with <linearvelini> (0.5, 0, 2) m/s and
+    <angularvelini> 3 rad/s about y, through the SPH time loop and either integrator: x = x0 +
+    0.5 t exactly, the pitch 3t exactly, z = z0 + 2t − g t²/2 within the first-order offset of
+    the body solver's semi-implicit Euler step (g t dt)."""
+    text = FLOATING_BOX.replace('<pointmax x="1.1" y="0" z="1" />', '<pointmax x="1.1" y="0" z="2" />')
+    text = text.replace('<point x="0.4" y="-1" z="0.25" /><size x="0.2" y="2" z="0.1" />',
+                        '<point x="0.4" y="-1" z="0.75" /><size x="0.2" y="2" z="0.1" />')
+    text = text.replace('<floating mkbound="5" rhopbody="500" />',
+                        '<floating mkbound="5" rhopbody="500"><linearvelini x="0.5" y="0" z="2" />'
+                        '<angularvelini x="0" y="3" z="0" /></floating>')
+    assert text.count('z="0.75"') == 2 and "linearvelini" in text
+    case = tmp_path / "CaseBallistic_Def.xml"
+    case.write_text(text)
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "-q", "--dp", "0.02", "--tmax", "0.3",
+                                  "--tout", "0.05", "--threads", "1", "--set", "FtPause=0",
+                                  "--set", f"StepAlgorithm={algo}"])
+    assert r.exit_code == 0, r.output
+    d = np.genfromtxt(out / "bodies.csv", delimiter=",", names=True)
+    dtmax = max(float(ln.split(",")[6]) for ln in (out / "run.csv").read_text().splitlines()[1:])
+    t = d["time"]
+    assert len(t) == 7 and t[-1] >= 0.3
+    # exact to the 9 digits bodies.csv prints
+    assert np.abs(d["x"] - d["x"][0] - 0.5 * t).max() < 1e-8
+    assert np.abs(d["pitch"] - np.degrees(3.0 * t)).max() < 1e-5
+    assert np.allclose(d["vx"], 0.5) and np.allclose(d["wy"], 3.0)
+    z_exact = d["z"][0] + 2.0 * t - 0.5 * 9.81 * t ** 2
+    assert np.abs(d["z"] - z_exact).max() <= 9.81 * t[-1] * dtmax
+    assert np.abs(d["vz"] - (2.0 - 9.81 * t)).max() < 1e-8
