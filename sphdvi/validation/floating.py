@@ -68,3 +68,27 @@ def fluid_inside_box(outdir: str, settle: float = 0.0) -> dict:
         if inside.any():
             depth = max(depth, float(np.minimum(fluid[inside] - lo, hi - fluid[inside]).min(axis=1).max()))
     return {"max_count": max(counts), "last_count": counts[-1], "max_depth_dp": depth / dp}
+
+
+def slider_reactions(outdir: str, settle: float = 1.0, body: str = "box", link: str = "slider",
+                     g: float = 9.81) -> dict:
+    """TOLERANCES' coupled check (c), ``cases/floatingbox2d/CaseSliderBox2D_Def.xml``: a floating box
+    on a vertical point-line link in still water. Over the outputs t ≥ ``settle``: the mean lateral
+    reaction ``fx_w`` of the link on the box over the box's weight m g, its largest |fx| (``fx_max_w``),
+    the mean torque about y over m g b/2 (``ty_wb``, b the box's width: the moment its weight makes
+    at a corner), the largest drift off the line in x (``dx``, m) and the largest pitch (deg)."""
+    from .runs import body_log, case_data
+    data = case_data(outdir)
+    dp = data["constants"]["dp"]
+    p = data["particles"]
+    box = p["type"] == 2
+    weight = p["mass"][box].sum() * g
+    width = np.ptp(p["pos"][box, 0]) + dp
+    bodies, links = body_log(outdir, "bodies"), body_log(outdir, "links")
+    rows = bodies[bodies["body"] == body]
+    reac = links[links["link"] == link]
+    late = reac["time"] >= settle
+    return {"fx_w": float(reac["fx"][late].mean() / weight), "fx_max_w": float(np.abs(reac["fx"][late]).max() / weight),
+            "ty_wb": float(reac["ty"][late].mean() / (weight * width / 2)),
+            "dx": float(np.abs(rows["x"] - rows["x"][0]).max()), "pitch_deg": float(np.abs(rows["pitch"]).max())}
+
