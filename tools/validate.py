@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3, C3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
@@ -231,6 +231,11 @@ def score_floating(outdir):
     return draft_errors(outdir)
 
 
+def score_slider(outdir):
+    from sphdvi.validation.floating import draft_errors, slider_reactions
+    return {**draft_errors(outdir, x0=0.3), **slider_reactions(outdir)}
+
+
 def _resolutions(module: str, attr: str = "RESOLUTIONS") -> Callable:
     """A validation module's RESOLUTIONS ({"label", "dp", "set": [...]}) as Resolution rows
     (imported when the case runs)."""
@@ -349,6 +354,13 @@ def cases() -> list:
                               ("tilt °", "tilt_deg", "{:.3f}")],
              "draft_dp", lambda e: abs(e["draft_dp"]) <= 0.5 and e["drift_dp"] < 0.1 and e["tilt_deg"] < 1.0,
              "draft within 0.5 dp, no drift, upright"),
+        Case("C3", "TOLERANCES' coupled check (c): the S12 box off centre on a vertical slider (link_pointline)",
+             case_path("floatingbox2d", "CaseSliderBox2D_Def.xml"),
+             [Resolution("box/dp 10", 0.02), Resolution("box/dp 20", 0.01)],
+             score_slider, [("draft err dp", "draft_dp", "{:+.2f}"), ("fx / W %", "fx_w", PCT),
+                            ("|fx| max / W %", "fx_max_w", "{:.2f} %"), ("ty / (W b/2) %", "ty_wb", PCT)],
+             "fx_w", lambda e: abs(e["draft_dp"]) <= 0.5 and abs(e["fx_w"]) < 0.01 and abs(e["ty_wb"]) < 0.01,
+             "the free-floating draft within 0.5 dp; the slider's lateral reaction and torque ~0 (within 1 %)"),
     ]
 
 
@@ -401,7 +413,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3); default: all but the slow S4, S8, S16, S16M, S16O and S18")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 C3); default: all but the slow S4, S8, S16, S16M, S16O and S18")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
