@@ -287,40 +287,40 @@ def _coth_over_sinh2(x: float) -> float:
     return 4 * q2 * (1 + q2) / (-math.expm1(-2 * x)) ** 3
 
 
-class WavePaddle:
-    """A piston (displacement along ``pistondir``) or flap (rotation about its axis)."""
+class _Paddle:
+    """What regular and irregular wave paddles share: a piston moves its particles along
+    ``pistondir``; a flap turns them about the axis flapaxis0 → flapaxis1 by atan(X / hinge depth),
+    X the stroke at the still-water level; the clock starts at ``start`` and stops after
+    ``duration`` (0: never), where the paddle stays; a linear ramp over ``ramp_time`` seconds."""
 
-    def __init__(self, spec: dict, g: float = 9.81):
+    def _set_geometry(self, spec: dict) -> None:
         self.spec = spec
-        self.kind = spec["type"]
-        d, H, T = spec["depth"], spec["waveheight"], spec["waveperiod"]
-        self.omega = 2 * math.pi / T
-        self.k = wave_number(T, d, g)
-        self.phase = spec.get("phase", 0.0) * math.pi
-        self.gain = spec.get("gainstroke", 1.0)
-        self.ramp_time = spec.get("ramp", 0.0) * T
+        self.kind = "piston" if spec["type"].startswith("piston") else "flap"
         self.start = spec.get("start", 0.0)
         self.duration = spec.get("duration", 0.0)
+        self.gain = spec.get("gainstroke", 1.0)
+        mk = spec.get("mkbound")
         if self.kind == "piston":
-            m1 = piston_height_to_stroke(self.k, d)
-            self.stroke = H / m1 * self.gain
-            self.second = 0.0
-            if spec.get("waveorder", 1) == 2:
-                kd = self.k * d
-                self.second = (H * H / (32 * d)) * (3 * _coth_over_sinh2(kd) - 2 / m1) * self.gain
             direction = np.asarray(spec.get("pistondir", [1, 0, 0]), float)
-            self.direction = _unit(direction, f"piston mkbound={spec.get('mkbound')}: <pistondir>")
+            self.direction = _unit(direction, f"piston mkbound={mk}: <pistondir>")
         else:
-            m1 = flap_height_to_stroke(self.k, d)
-            self.stroke = H / m1 * self.gain
-            self.second = 0.0
-            if spec.get("waveorder", 1) == 2:
-                # DualSPHysics generates second-order waves with pistons only (Madsen 1971)
-                warnings.warn("flap mkbound=%s: waveorder=2 is implemented for pistons only; "
-                              "the flap moves with first-order theory" % spec.get("mkbound"))
-            self.hinge_depth = d + spec.get("variabledraft", 0.0)
+            self.hinge_depth = spec["depth"] + spec.get("variabledraft", 0.0)
             p0, p1 = np.asarray(spec["flapaxis0"], float), np.asarray(spec["flapaxis1"], float)
-            self.p0, self.axis = p0, _unit(p1 - p0, f"flap mkbound={spec.get('mkbound')}: <flapaxis0> and <flapaxis1>")
+            self.p0, self.axis = p0, _unit(p1 - p0, f"flap mkbound={mk}: <flapaxis0> and <flapaxis1>")
+
+    def _height_to_stroke(self, k: float, d: float) -> float:
+        """Biesel's H/S of this paddle for the wave number k in depth d."""
+        return piston_height_to_stroke(k, d) if self.kind == "piston" else flap_height_to_stroke(k, d)
+
+    def _clock(self, t: float) -> tuple[float, bool]:
+        """(τ, moving): the time since ``start`` held within [0, duration], and whether the
+        paddle is moving at t."""
+        tau = t - self.start
+        if tau <= 0:
+            return 0.0, False
+        if self.duration > 0 and tau > self.duration:
+            return self.duration, False
+        return tau, True
 
     def _ramp(self, tau):
         if self.ramp_time <= 0 or tau >= self.ramp_time:
@@ -329,19 +329,12 @@ class WavePaddle:
 
     def stroke_position(self, t: float):
         """Paddle displacement at the free surface and its rate (m, m/s)."""
-        tau = t - self.start
-        if tau <= 0 or (self.duration > 0 and tau > self.duration):
-            tau = 0.0 if tau <= 0 else self.duration
-            if tau == 0.0:
-                return 0.0, 0.0
+        tau, moving = self._clock(t)
+        if tau == 0.0:
+            return 0.0, 0.0
+        x, v = self._series(tau)
         r, dr = self._ramp(tau)
-        a = self.omega * tau + self.phase
-        x1 = 0.5 * self.stroke * (math.sin(a) - math.sin(self.phase))
-        v1 = 0.5 * self.stroke * self.omega * math.cos(a)
-        x2 = self.second * (math.sin(2 * a) - math.sin(2 * self.phase))
-        v2 = self.second * 2 * self.omega * math.cos(2 * a)
-        x, v = x1 + x2, v1 + v2
-        return r * x, r * v + dr * x
+        return r * x, (r * v + dr * x) if moving else 0.0
 
     def transform(self, t: float) -> Rigid:
         x, v = self.stroke_position(t)
@@ -353,12 +346,84 @@ class WavePaddle:
         return Rigid(R=R, d=self.p0 - R @ self.p0, W=w * self.axis, c=self.p0)
 
 
+class WavePaddle(_Paddle):
+    """Regular waves from a piston (displacement along ``pistondir``) or flap (rotation about
+    its axis): ``<piston>``/``<flap>``; the ramp lasts ``ramp`` periods."""
+
+    def __init__(self, spec: dict, g: float = 9.81):
+        self._set_geometry(spec)
+        d, H, T = spec["depth"], spec["waveheight"], spec["waveperiod"]
+        self.omega = 2 * math.pi / T
+        self.k = wave_number(T, d, g)
+        self.phase = spec.get("phase", 0.0) * math.pi
+        self.ramp_time = spec.get("ramp", 0.0) * T
+        m1 = self._height_to_stroke(self.k, d)
+        self.stroke = H / m1 * self.gain
+        self.second = 0.0
+        if spec.get("waveorder", 1) == 2:
+            if self.kind == "piston":
+                kd = self.k * d
+                self.second = (H * H / (32 * d)) * (3 * _coth_over_sinh2(kd) - 2 / m1) * self.gain
+            else:
+                # DualSPHysics generates second-order waves with pistons only (Madsen 1971)
+                warnings.warn("flap mkbound=%s: waveorder=2 is implemented for pistons only; "
+                              "the flap moves with first-order theory" % spec.get("mkbound"))
+
+    def _series(self, tau: float):
+        a = self.omega * tau + self.phase
+        x1 = 0.5 * self.stroke * (math.sin(a) - math.sin(self.phase))
+        v1 = 0.5 * self.stroke * self.omega * math.cos(a)
+        x2 = self.second * (math.sin(2 * a) - math.sin(2 * self.phase))
+        v2 = self.second * 2 * self.omega * math.cos(2 * a)
+        return x1 + x2, v1 + v2
+
+
+class SpectrumPaddle(_Paddle):
+    """Irregular long-crested waves from a piston or flap (``<piston_spectrum>``/``<flap_spectrum>``),
+    first order: the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: amplitude
+    a_i, frequency f_i, phase φ_i) each made by Biesel's stroke S_i = 2 a_i / (H/S)(k_i d), so that
+    X(τ) = r(τ) Σ S_i/2 [sin(ω_i (τ + t0) + φ_i) − sin(ω_i t0 + φ_i)] (times ``gainstroke``), t0 =
+    ``serieini``, r a linear ramp over ``ramptime`` seconds. The linear wave it makes at a
+    distance x from the paddle is :meth:`elevation`."""
+
+    def __init__(self, spec: dict, g: float = 9.81):
+        from .wavespectra import components
+        self._set_geometry(spec)
+        d = spec["depth"]
+        comp = components(spec["spectrum"], spec["waveheight"], spec["waveperiod"], int(spec["waves"]),
+                          spec["discretization"], spec["peakcoef"], int(spec["randomseed"]))
+        self.components = comp
+        self.omega = 2 * np.pi * comp["f"]
+        self.k = np.array([wave_number(1.0 / f, d, g) for f in comp["f"]])
+        self.amp = comp["amp"] * self.gain
+        self.half_stroke = self.amp / np.array([self._height_to_stroke(k, d) for k in self.k])
+        self.phase = comp["phase"]
+        self.t0 = spec.get("serieini", 0.0)
+        self.ramp_time = spec.get("ramptime", 0.0)
+        self.offset = float(np.sum(self.half_stroke * np.sin(self.omega * self.t0 + self.phase)))
+
+    def _series(self, tau: float):
+        a = self.omega * (tau + self.t0) + self.phase
+        return (float(np.dot(self.half_stroke, np.sin(a))) - self.offset,
+                float(np.dot(self.half_stroke * self.omega, np.cos(a))))
+
+    def elevation(self, x, t) -> np.ndarray:
+        """The linear progressive wave η(x, t) = Σ a_i cos(ω_i (τ + t0) + φ_i − k_i x) at a distance
+        ``x`` [m] in front of the paddle (along its stroke), without the ramp and the local
+        evanescent modes: what the paddle makes once the ramp is over and the waves have arrived."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        tau = t - self.start
+        a = np.outer(tau + self.t0, self.omega) + self.phase - self.k * float(x)
+        return np.cos(a) @ self.amp
+
+
 class MotionSet:
     """All imposed motions of a case: ``transforms(t)`` → {mkbound: Rigid}."""
 
     def __init__(self, motions: list, wavepaddles: list | None = None, g: float = 9.81):
         self.motions = {m["ref"]: m for m in motions}
-        self.paddles = {p["mkbound"]: WavePaddle(p, g) for p in (wavepaddles or [])}
+        self.paddles = {p["mkbound"]: (SpectrumPaddle(p, g) if p["type"].endswith("_spectrum") else WavePaddle(p, g))
+                        for p in (wavepaddles or [])}
 
     @property
     def mkbounds(self):

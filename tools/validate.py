@@ -15,6 +15,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S16M: S16 with mDBC on the box (dp 0.02, 0.01 and 0.005: 2, 25 and 107 min on 2 threads)
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
                                              # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
+                                             # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
     python tools/validate.py S16M --dp 0.02 --dp 0.01 --threads 2     # some of a case's resolutions
 
@@ -109,6 +110,11 @@ def score_accel_tank(outdir):
 def score_wave_flume(outdir):
     from sphdvi.validation.waveflume import wave_errors
     return wave_errors(outdir)
+
+
+def score_irregular_waves(outdir):
+    from sphdvi.validation.waveflume import irregular_errors
+    return irregular_errors(outdir)
 
 
 def score_flap_waves(outdir):
@@ -328,6 +334,15 @@ def cases() -> list:
              "impact times within 3 % (here of the roll period), peaks within 20-30 %", slow=True),
         _wave_flume_case("W1", "piston", "CaseWaveFlume2D_Def.xml"),
         _wave_flume_case("W2", "flap hinged at the bottom", "CaseWaveFlap2D_Def.xml"),
+        Case("W4", "irregular waves from a piston (<piston_spectrum>: JONSWAP Hs = 0.04 m, Tp = 1.4 s, d = 0.3 m)",
+             case_path("waveflume2d", "CaseWaveIrregular2D_Def.xml"),
+             [Resolution("Hs/dp 2", 0.02), Resolution("Hs/dp 4", 0.01)],
+             score_irregular_waves, [("corr WG1", "corr_WG1", "{:.3f}"), ("corr WG3", "corr_WG3", "{:.3f}"),
+                                     ("rms WG1 %", "rms_WG1", PCT), ("rms WG3 %", "rms_WG3", PCT),
+                                     ("lag WG1 s", "lag_WG1", "{:+.2f}"), ("lag WG3 s", "lag_WG3", "{:+.2f}")],
+             "rms_max", lambda e: e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15,
+             "surface elevation against the linear sum of the sea state's waves: correlation >= 0.9, rms "
+             "within 15 % (judgement, as W3)", slow=True),
         Case("W3", "waves from a measured flap motion (Hadzic et al. 2005 flume): wave probes",
              case_path("flapwaves2d", "CaseFlapWavesHadzic2D_Def.xml"),
              [Resolution("depth/dp 10", 0.04), Resolution("depth/dp 20", 0.02)],
@@ -413,7 +428,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 C3); default: all but the slow S4, S8, S16, S16M, S16O and S18")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 W4 C3); default: all but the slow S4, S8, S16, S16M, S16O, S18 and W4")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")

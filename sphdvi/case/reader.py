@@ -895,15 +895,22 @@ def read_gauges(reader, el) -> dict:
 
 def read_wavepaddles(reader, el) -> list:
     spec_common = {"mkbound": "int", "start": "num", "duration": "num", "depth": "num", "waveorder": "int",
-                   "waveheight": "num", "waveperiod": "num", "gainstroke": "num", "phase": "num",
-                   "ramp": "num", "savemotion": "raw", "awas_zsurf": "raw", "usefiledata": "raw"}
-    specs = {"piston": {**spec_common, "pistondir": "vec"},
-             "flap": {**spec_common, "variabledraft": "num", "flapaxis0": "vec", "flapaxis1": "vec"}}
+                   "waveheight": "num", "waveperiod": "num", "gainstroke": "num", "fixeddepth": "num",
+                   "savemotion": "raw", "awas_zsurf": "raw"}
+    spec_regular = {**spec_common, "phase": "num", "ramp": "num", "usefiledata": "raw"}
+    spec_spectrum = {**spec_common, "spectrum": "str", "discretization": "str", "peakcoef": "num", "waves": "int",
+                     "randomseed": "int", "serieini": "raw", "ramptime": "num", "saveserie": "raw",
+                     "saveseriewaves": "raw"}
+    flap_geometry = {"variabledraft": "num", "flapaxis0": "vec", "flapaxis1": "vec"}
+    specs = {"piston": {**spec_regular, "pistondir": "vec"}, "flap": {**spec_regular, **flap_geometry},
+             "piston_spectrum": {**spec_spectrum, "pistondir": "vec"},
+             "flap_spectrum": {**spec_spectrum, **flap_geometry}}
     out = []
     for c in reader.children(el):
         if c.tag not in specs:
             raise reader.error(c, f"<wavepaddles><{c.tag}> is not supported by sphdvi",
-                               "<piston> or <flap> (regular waves)")
+                               "<piston> or <flap> (regular waves), <piston_spectrum> or <flap_spectrum> (irregular)")
+        spectral = c.tag.endswith("_spectrum")
         d = {"type": c.tag, "line": c.sourceline}
         d.update(_value_children(reader, c, specs[c.tag], required=("mkbound", "depth", "waveheight", "waveperiod")))
         d.setdefault("waveorder", 1)
@@ -912,43 +919,91 @@ def read_wavepaddles(reader, el) -> list:
         for k in ("depth", "waveheight", "waveperiod"):
             if d[k] <= 0:
                 raise reader.error(reader.child(c, k), f"<{k}> must be positive", f"{k} > 0")
-        for k, what in (("start", "seconds"), ("duration", "seconds, 0: until the end"), ("ramp", "wave periods")):
+        for k, what in (("start", "seconds"), ("duration", "seconds, 0: until the end"), ("ramp", "wave periods"),
+                        ("ramptime", "seconds")):
             if d.get(k, 0.0) < 0:
                 raise reader.error(reader.child(c, k), f"<{k}> value={d[k]:g} is negative", f"{k} >= 0 ({what})")
-        if c.tag == "flap" and d["waveorder"] == 2:
+        if c.tag.startswith("flap") and d["waveorder"] == 2:
             raise reader.error(c, "second-order generation is not supported for flaps by sphdvi",
                                "waveorder 1 for a <flap> (a <piston> supports 2)")
-        if c.tag == "flap" and ("flapaxis0" not in d or "flapaxis1" not in d):
+        if spectral and d["waveorder"] == 2:
+            raise reader.error(reader.child(c, "waveorder"), "second-order generation of irregular waves is not "
+                               "implemented by sphdvi", "waveorder 1 (first order: the spectrum's linear waves)")
+        if c.tag.startswith("flap") and ("flapaxis0" not in d or "flapaxis1" not in d):
             raise reader.error(c, "missing <flapaxis0>/<flapaxis1>", "the two points of the hinge axis")
-        if c.tag == "flap" and d["flapaxis0"] == d["flapaxis1"]:
+        if c.tag.startswith("flap") and d["flapaxis0"] == d["flapaxis1"]:
             raise reader.error(reader.child(c, "flapaxis1"), f"<flapaxis0> and <flapaxis1> are the same point "
                                f"{d['flapaxis0']}, so they define no hinge axis", "two distinct points on the hinge axis")
-        if c.tag == "piston" and "pistondir" in d and not any(d["pistondir"]):
+        if c.tag.startswith("piston") and "pistondir" in d and not any(d["pistondir"]):
             raise reader.error(reader.child(c, "pistondir"), "<pistondir> is the zero vector",
                                "the direction of the piston's stroke, e.g. x=1 y=0 z=0")
+        if spectral:
+            _read_spectrum_options(reader, c, d)
         for k, what in (("awas_zsurf", "active wave absorption (AWAS) is not implemented by sphdvi: the paddle "
                                        "follows the theoretical stroke and absorbs no reflected waves"),
                         ("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
                                         "regular-wave theory"),
                         ("savemotion", "<savemotion> (the paddle motion written to a file) is not implemented "
-                                       "by sphdvi: no file is written")):
+                                       "by sphdvi: no file is written"),
+                        ("saveserie", "<saveserie> (the paddle's series written to a file) is not implemented "
+                                      "by sphdvi: no file is written"),
+                        ("saveseriewaves", "<saveseriewaves> (the series' waves written to a file) is not "
+                                           "implemented by sphdvi: no file is written")):
             if k in d:
                 reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
+        if d.get("fixeddepth", 0.0):
+            reader.warn(reader.child(c, "fixeddepth"), "<fixeddepth> (the fluid depth without the paddle) is not "
+                        "implemented by sphdvi: the stroke follows <depth>; <fixeddepth> is ignored")
         d.setdefault("start", 0.0)
         d.setdefault("duration", 0.0)
         d.setdefault("gainstroke", 1.0)
-        d.setdefault("phase", 0.0)
-        d.setdefault("ramp", 0.0)
-        if c.tag == "piston":
+        if not spectral:
+            d.setdefault("phase", 0.0)
+            d.setdefault("ramp", 0.0)
+        if c.tag.startswith("piston"):
             d.setdefault("pistondir", [1.0, 0.0, 0.0])
         try:       # the stroke from the wave theory: fails here, not at the first step of the run
-            from ..motion import WavePaddle
-            WavePaddle(d)
+            from ..motion import SpectrumPaddle, WavePaddle
+            (SpectrumPaddle if spectral else WavePaddle)(d)
         except (ArithmeticError, ValueError, CaseError) as exc:
             raise reader.error(c, f"cannot compute the paddle's stroke: {exc}",
                                "a wave period and depth of a real wave") from None
         out.append(d)
     return out
+
+
+def _read_spectrum_options(reader, c, d: dict) -> None:
+    """The irregular-wave options of a ``<piston_spectrum>``/``<flap_spectrum>`` (in place, with
+    DualSPHysics's defaults: stretched, γ 3.3, 50 waves; seed 0, serieini 0, ramptime 0)."""
+    from ..wavespectra import DISCRETISATIONS, SPECTRA
+    if "spectrum" not in d:
+        raise reader.error(c, "missing <spectrum>", "<spectrum value=\"jonswap\"/> or \"pierson-moskowitz\"")
+    d["spectrum"] = d["spectrum"].strip().lower()
+    if d["spectrum"] not in SPECTRA:
+        raise reader.error(reader.child(c, "spectrum"), f"unknown spectrum '{d['spectrum']}'", " or ".join(SPECTRA))
+    d["discretization"] = d.get("discretization", "stretched").strip().lower()
+    if d["discretization"] not in DISCRETISATIONS:
+        raise reader.error(reader.child(c, "discretization"), f"unknown discretization '{d['discretization']}'",
+                           ", ".join(DISCRETISATIONS))
+    d.setdefault("peakcoef", 3.3)
+    if d["peakcoef"] < 1:
+        raise reader.error(reader.child(c, "peakcoef"), f"<peakcoef> value={d['peakcoef']:g}",
+                           "a peak enhancement factor gamma >= 1 (1: Pierson-Moskowitz's shape)")
+    d.setdefault("waves", 50)
+    if d["waves"] < 1:
+        raise reader.error(reader.child(c, "waves"), f"<waves> value={d['waves']}", "at least 1 wave")
+    d.setdefault("randomseed", 0)
+    d.setdefault("ramptime", 0.0)
+    raw = d.pop("serieini", None)
+    d["serieini"] = 0.0
+    if raw is not None:
+        el = reader.child(c, "serieini")
+        d["serieini"] = reader.num(el, "value") if raw.get("value") is not None else 0.0
+        if d["serieini"] < 0:
+            raise reader.error(el, f"<serieini> value={d['serieini']:g} is negative", "a time >= 0 in the series [s]")
+        if str(raw.get("autofit", "false")).strip().lower() in ("true", "1"):
+            reader.warn(el, "<serieini autofit> is not needed by sphdvi: the paddle starts from where it is "
+                            "drawn (the series less its value at serieini) and ramps up; autofit is ignored")
 
 
 def read_damping(reader, el) -> list:

@@ -284,3 +284,56 @@ MOV
 <execution><parameters><parameter key="TimeMax" value="0.01"/><parameter key="TimeOut" value="0.01"/></parameters></execution>
 </case>
 """
+
+
+# -- irregular waves: <piston_spectrum> / <flap_spectrum> ---------------------------------
+def spectrum_paddles(tmp_path, inner, tag="piston_spectrum", spectrum='<spectrum value="jonswap"/>'):
+    return paddles(tmp_path, spectrum + inner, tag=tag)
+
+
+def test_spectrum_paddle_read_with_dualsphysics_defaults(tmp_path):
+    """As DesignSPHysics writes it: stretched, gamma 3.3, 50 waves by default; seed 0; the
+    serieini/ramptime of the case; <fixeddepth value="0"> accepted (also in a regular piston)."""
+    (p,), reader = spectrum_paddles(tmp_path, '<fixeddepth value="0"/><serieini value="1.5" autofit="false"/>'
+                                    '<ramptime value="2"/><pistondir x="1" y="0" z="0"/>')
+    assert list(reader.warnings) == []
+    assert (p["type"], p["spectrum"], p["discretization"], p["peakcoef"], p["waves"], p["randomseed"]) == \
+        ("piston_spectrum", "jonswap", "stretched", 3.3, 50, 0)
+    assert (p["serieini"], p["ramptime"], p["waveorder"]) == (1.5, 2.0, 1)
+    sets = MotionSet([], [p])
+    assert type(sets.paddles[1]).__name__ == "SpectrumPaddle" and sets.paddles[1].amp.size == 50
+    (q,), reader = paddles(tmp_path, '<fixeddepth value="0"/>')
+    assert q["type"] == "piston" and list(reader.warnings) == []
+    (f,), _ = spectrum_paddles(tmp_path, '<flapaxis0 x="0" y="-1" z="0"/><flapaxis1 x="0" y="1" z="0"/>'
+                               '<discretization value="Random"/><waves value="12"/>', tag="flap_spectrum",
+                               spectrum='<spectrum value="Pierson-Moskowitz"/>')
+    assert (f["spectrum"], f["discretization"], f["waves"]) == ("pierson-moskowitz", "random", 12)
+
+
+@pytest.mark.parametrize("inner, spectrum, message, element", [
+    ("", "", "missing <spectrum>", "piston_spectrum"),
+    ("", '<spectrum value="bretschneider"/>', "unknown spectrum 'bretschneider'", "spectrum"),
+    ('<discretization value="even"/>', None, "unknown discretization 'even'", "discretization"),
+    ('<waves value="0"/>', None, "<waves> value=0", "waves"),
+    ('<peakcoef value="0.5"/>', None, "<peakcoef> value=0.5", "peakcoef"),
+    ('<waveorder value="2"/>', None, "second-order generation of irregular waves", "waveorder"),
+    ('<serieini value="-1"/>', None, "<serieini> value=-1 is negative", "serieini"),
+    ('<ramptime value="-2"/>', None, "<ramptime> value=-2 is negative", "ramptime"),
+    ('<ramp value="2"/>', None, "unknown element <ramp> in <piston_spectrum>", "ramp"),
+])
+def test_bad_spectrum_options_are_case_errors(tmp_path, inner, spectrum, message, element):
+    kw = {} if spectrum is None else {"spectrum": spectrum}
+    with pytest.raises(CaseError, match=message) as e:
+        spectrum_paddles(tmp_path, inner, **kw)
+    assert e.value.element == element and e.value.line in (2, 3)
+
+
+def test_unimplemented_spectrum_options_warn(tmp_path):
+    inner = ('<serieini value="0" autofit="true"/>\n<saveserie timemin="0" timemax="100" timedt="0.05"/>\n'
+             '<saveseriewaves timemin="0" timemax="100" xpos="2"/>\n<fixeddepth value="0.2"/>')
+    _, reader = spectrum_paddles(tmp_path, inner)
+    text = "\n".join(reader.warnings)
+    assert len(reader.warnings) == 4
+    for tag, line in (("serieini", 3), ("saveserie", 4), ("saveseriewaves", 5), ("fixeddepth", 6)):
+        assert f"case.xml:{line}: warning: <{tag}>" in text
+    assert "autofit is ignored" in text

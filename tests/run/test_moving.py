@@ -9,7 +9,7 @@ from click.testing import CliRunner
 from sphdvi.cli import main
 from sphdvi.io.casefile import read_case_h5
 from sphdvi.io.vtkhdf import read_step, step_times
-from sphdvi.motion import WavePaddle
+from sphdvi.motion import MotionSet, WavePaddle
 
 TANK = """<?xml version="1.0" encoding="UTF-8" ?>
 <case>
@@ -106,6 +106,28 @@ def test_piston_wave_paddle_follows_stroke(tmp_path):
         xs = paddle.stroke_position(t)[0]
         assert np.allclose(x[:, 0] - p0[:, 0], xs, atol=1e-12)
     assert paddle.stroke_position(0.2)[0] == pytest.approx(0.5 * paddle.stroke * math.sin(2 * math.pi * 0.2))
+
+
+@pytest.mark.parametrize("tag, extra", [("piston_spectrum", ""),
+                                        ("flap_spectrum", '<flapaxis0 x="0" y="-1" z="0"/><flapaxis1 x="0" y="1" z="0"/>')])
+def test_spectrum_paddle_follows_its_series(tmp_path, tag, extra):
+    """An irregular-wave paddle moves its particles with SpectrumPaddle's stroke (a flap: turned
+    about its hinge by atan(X / depth)), velocities included, through the run."""
+    special = (f'<wavepaddles><{tag}><mkbound value="10"/><depth value="0.3"/><spectrum value="jonswap"/>'
+               f'<waveheight value="0.02"/><waveperiod value="1.0"/><waves value="20"/><randomseed value="4"/>'
+               f'{extra}</{tag}></wavepaddles>')
+    out = run_case(tmp_path, '<mvnull id="1" />', special)
+    p0, res = moving_positions(out)
+    from sphdvi.validation.runs import case_data
+    paddle = MotionSet([], case_data(out)["json"]["special"]["wavepaddles"]).paddles[10]
+    moved = 0.0
+    for t, x, v, _ in res:
+        rigid = paddle.transform(t)
+        expect = p0 @ rigid.R.T + rigid.d
+        assert np.allclose(x, expect, atol=1e-12)
+        assert np.allclose(v, rigid.V + np.cross(rigid.W, x - rigid.c), atol=1e-9)
+        moved = max(moved, float(np.abs(x - p0).max()))
+    assert moved > 1e-3
 
 
 def test_damping_zone_reduces_velocity():
