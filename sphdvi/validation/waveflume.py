@@ -35,9 +35,24 @@ def incident_reflected(x: np.ndarray, amp: np.ndarray, k: float) -> tuple[comple
     return complex(a[0]), complex(a[1])
 
 
+def fitted_wavenumber(x: np.ndarray, amp: np.ndarray, k0: float) -> float:
+    """The wave number k within ±30 % of ``k0`` for which amp(x) = A_i e^{−ikx} + A_r e^{ikx} fits
+    the gauges' complex amplitudes best (least squares; steps of 1e-4 k0): the wave's own k."""
+    ks = k0 * np.linspace(0.7, 1.3, 6001)
+    resid = []
+    for k in ks:
+        m = np.column_stack([np.exp(-1j * k * x), np.exp(1j * k * x)])
+        a = np.linalg.lstsq(m, amp, rcond=None)[0]
+        resid.append(np.linalg.norm(m @ a - amp))
+    return float(ks[int(np.argmin(resid))])
+
+
 def wave_errors(outdir: str) -> dict:
     """Incident height relative to H, the reflection coefficient, the height of the first
-    harmonic at each gauge (relative to H) and the mean level change."""
+    harmonic at each gauge (relative to H); ``celerity``: the phase speed ω/k of the wave the
+    gauges see (k from :func:`fitted_wavenumber`) over linear theory's, minus 1, and
+    ``reflection_fitted_k`` the reflection coefficient with that k (the split with the theory's k
+    takes a phase-speed error for reflection)."""
     from ..motion import wave_number
     k = wave_number(PERIOD, DEPTH)
     omega = 2 * math.pi / PERIOD
@@ -53,6 +68,10 @@ def wave_errors(outdir: str) -> dict:
     inc, ref = incident_reflected(np.asarray(xs), np.asarray(amps), k)
     out["H_incident"] = 2 * abs(inc) / H - 1.0
     out["reflection"] = abs(ref) / abs(inc)
+    k_wave = fitted_wavenumber(np.asarray(xs), np.asarray(amps), k)
+    out["celerity"] = k / k_wave - 1.0
+    inc, ref = incident_reflected(np.asarray(xs), np.asarray(amps), k_wave)
+    out["reflection_fitted_k"] = abs(ref) / abs(inc)
     return out
 
 

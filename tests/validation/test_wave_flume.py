@@ -65,3 +65,46 @@ def test_the_height_deficit_falls_with_dp(tmp_path):
     coarse, fine = run(tmp_path, 0.02), run(tmp_path, 0.01)
     print(coarse["H_incident"], fine["H_incident"])
     assert abs(fine["H_incident"]) < abs(coarse["H_incident"]) - 0.015
+
+
+IRREGULAR_CASE = REPO / "cases" / "waveflume2d" / "CaseWaveIrregular2D_Def.xml"
+
+
+@pytest.mark.slow
+def test_irregular_waves_follow_the_linear_sum_of_the_sea_state(tmp_path):
+    """W4 (about 5 minutes on 2 threads): a piston makes a JONSWAP sea (Hs 0.04 m, Tp 1.4 s, 50 waves)
+    in d = 0.3 m; at the three gauges the SPH surface is the linear sum of the sea state's waves
+    shifted in time: at the best shift it correlates 0.993 / 0.987 / 0.985 (measured at dp 0.02), and
+    the shift grows along the flume (−0.04 / −0.08 / −0.11 s at 0.6 / 1.2 / 1.8 m: the coarse SPH wave
+    runs ~9 % fast, as W1's regular wave, whose own k is 8 % short of the theory's), while its rms is
+    15–18 % below the theory's (W1: −13 % at H/dp 1.5). Against the judgement target of W3
+    (correlation ≥ 0.9 unshifted, rms within 15 %) dp 0.02 falls short at WG3: xfail below."""
+    out = run_case(tmp_path, 0.02, IRREGULAR_CASE)
+    from sphdvi.validation.waveflume import irregular_errors
+    e = irregular_errors(out)
+    print({k: round(v, 3) for k, v in e.items()})
+    lags = [e[f"lag_{g}"] for g in ("WG1", "WG2", "WG3")]
+    assert min(e[f"corr_lag_{g}"] for g in ("WG1", "WG2", "WG3")) >= 0.98
+    assert lags[0] < 0 and lags[0] > lags[1] > lags[2] >= -0.2          # early, more so along the flume
+    assert all(-0.25 < e[f"rms_{g}"] < 0.0 for g in ("WG1", "WG2", "WG3"))
+    if not (e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15):
+        pytest.xfail(f"W4 at Hs/dp 2: correlation {e['corr_min']:.3f} (>= 0.9), rms {e['rms_max']:.3f} (<= 0.15)")
+
+
+def test_fitted_wavenumber_recovers_the_waves_own_k():
+    """Three gauges' complex amplitudes of an incident and a 5 % reflected wave of k = 0.92 k0: the fit
+    finds k to its 1e-4 k0 step and, with it, the reflection; a lone incident wave of that k split
+    with the theory's k0 reads as a reflected one (W1 at dp 0.02: 7.5 % against 2.5 % with its own k)."""
+    import numpy as np
+    from sphdvi.validation.waveflume import GAUGES, fitted_wavenumber, incident_reflected
+    x = np.array(list(GAUGES.values()))
+    k = 0.92 * K
+    amp = 0.014 * np.exp(-1j * k * x) + 0.0007 * np.exp(1j * (k * x + 0.4))
+    assert fitted_wavenumber(x, amp, K) == pytest.approx(k, abs=1e-4 * K)
+    inc, ref = incident_reflected(x, amp, fitted_wavenumber(x, amp, K))
+    assert abs(ref) / abs(inc) == pytest.approx(0.05, abs=2e-3)
+    lone = 0.014 * np.exp(-1j * k * x)
+    inc, ref = incident_reflected(x, lone, fitted_wavenumber(x, lone, K))
+    assert abs(ref) / abs(inc) < 1e-3
+    inc0, ref0 = incident_reflected(x, lone, K)
+    assert abs(ref0) / abs(inc0) > 0.03
