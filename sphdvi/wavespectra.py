@@ -68,9 +68,12 @@ def spectrum(kind: str, f, hs: float, tp: float, gamma: float = 3.3) -> np.ndarr
 def _fine_grid(fmin: float, fmax: float, s) -> tuple[np.ndarray, np.ndarray]:
     """A fine frequency grid over [fmin, fmax] and the cumulative integral of S on it."""
     f = np.linspace(fmin, fmax, 20001)
-    sf = s(f)
-    cum = np.concatenate([[0.0], np.cumsum(0.5 * (sf[1:] + sf[:-1]) * np.diff(f))])
-    return f, cum
+    return f, _cumulative(f, s(f))
+
+
+def _cumulative(f: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The running trapezoidal integral of y over f, from 0 at f[0]."""
+    return np.concatenate([[0.0], np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(f))])
 
 
 def _edges(how: str, n: int, fmin: float, fp: float, fmax: float, s) -> np.ndarray:
@@ -113,8 +116,7 @@ def components(kind: str, hs: float, tp: float, n: int, discretization: str = "s
     if discretization == "stretched":
         # each bin's energy from the integral of S, its wave at the bin's energy centroid
         fine, cum = _fine_grid(fmin, fmax, s)
-        fs = fine * s(fine)
-        moment = np.concatenate([[0.0], np.cumsum(0.5 * (fs[1:] + fs[:-1]) * np.diff(fine))])
+        moment = _cumulative(fine, fine * s(fine))
         energy = np.diff(np.interp(edges, fine, cum))
         f = np.diff(np.interp(edges, fine, moment)) / energy
         raw = np.sqrt(2.0 * energy)
@@ -122,8 +124,7 @@ def components(kind: str, hs: float, tp: float, n: int, discretization: str = "s
         f = edges[:-1] + rng.random(n) * df if discretization == "random" else 0.5 * (edges[1:] + edges[:-1])
         raw = np.sqrt(2.0 * s(f) * df)
     phase = 2.0 * np.pi * rng.random(n)
-    m0 = 0.5 * float(np.sum(raw * raw))
-    scale = hs / (4.0 * math.sqrt(m0))
+    scale = hs / spectral_height(raw)
     return {"f": f, "df": df, "amp": raw * scale, "phase": phase, "scale": scale, "band": (fmin, fmax)}
 
 

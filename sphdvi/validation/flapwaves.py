@@ -44,11 +44,11 @@ def load_probe(reference_dir: str, probe: int) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(t), np.asarray(z)
 
 
-def gauge_elevation(outdir: str, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """(time, elevation above the still level) of the run-time gauge ``name``."""
+def gauge_elevation(outdir: str, name: str, still_until: float = STILL_UNTIL) -> tuple[np.ndarray, np.ndarray]:
+    """(time, elevation above the still level: the mean before ``still_until``) of the run-time gauge ``name``."""
     g = gauge_table(outdir, "SWL", name)
     t, z = g[:, 0], g[:, 3]
-    return t, z - z[t <= STILL_UNTIL].mean()
+    return t, z - z[t <= still_until].mean()
 
 
 def probe_scores(t_sph, z_sph, t_exp, z_exp) -> dict:

@@ -91,4 +91,3 @@ def slider_reactions(outdir: str, settle: float = 1.0, body: str = "box", link: 
     return {"fx_w": float(reac["fx"][late].mean() / weight), "fx_max_w": float(np.abs(reac["fx"][late]).max() / weight),
             "ty_wb": float(reac["ty"][late].mean() / (weight * width / 2)),
             "dx": float(np.abs(rows["x"] - rows["x"][0]).max()), "pitch_deg": float(np.abs(rows["pitch"]).max())}
-

@@ -98,33 +98,26 @@ def paddle_stroke(outdir: str, kind: str, mkbound: int = 10) -> float:
 IRREGULAR_GAUGES = {"WG1": 0.6, "WG2": 1.2, "WG3": 1.8}
 IRREGULAR_FROM = 6.0       # s: the 2 s ramp is over and its first waves have passed WG3
 STILL_UNTIL = 0.2          # s: the gauges' still-water reading, before the first waves arrive
-MAX_LAG = 0.3              # s: the lags searched for the best correlation
 
 
 def irregular_errors(outdir: str) -> dict:
-    """W4: at each gauge, over t ≥ IRREGULAR_FROM, the SPH surface elevation (the gauge's level
-    less its mean over t ≤ STILL_UNTIL) against the linear sum of the paddle's waves at the gauge
-    (:meth:`sphdvi.motion.SpectrumPaddle.elevation`): ``corr_<g>`` their correlation, ``rms_<g>`` the
-    SPH rms over the prediction's minus 1 (the ratio of the two spectral heights), ``lag_<g>`` the
-    shift (s, within ±MAX_LAG, 0.01 s steps) at which they correlate best (positive: the SPH wave is
-    late) and ``corr_lag_<g>`` that best correlation; ``corr_min``, ``rms_max`` (largest |rms_<g>|)."""
+    """W4: at each gauge, over t ≥ IRREGULAR_FROM, the SPH surface elevation (the gauge's level less
+    its mean over t ≤ STILL_UNTIL) against the linear sum of the paddle's waves at the gauge
+    (:meth:`sphdvi.motion.SpectrumPaddle.elevation`), scored as W3 scores its probes
+    (:func:`sphdvi.validation.flapwaves.probe_scores`): ``<g>_corr``, ``<g>_rms`` (rms ratio − 1),
+    ``<g>_lag`` (the best shift, s; positive: the SPH wave is late), ``<g>_corr_lag`` ...;
+    ``corr_min``, ``rms_max`` (largest |<g>_rms|)."""
     from ..motion import SpectrumPaddle
+    from .flapwaves import gauge_elevation, probe_scores
     from .runs import case_data
     spec = next(p for p in case_data(outdir)["json"]["special"]["wavepaddles"] if p["type"].endswith("_spectrum"))
     paddle = SpectrumPaddle(spec)
-    out = {}
+    out: dict = {}
     for name, x in IRREGULAR_GAUGES.items():
-        g = gauge_table(outdir, "SWL", name)
-        t, level = g[:, 0], g[:, 3]
-        eta = level - level[t <= STILL_UNTIL].mean()
-        sel = t >= IRREGULAR_FROM
-        pred = paddle.elevation(x, t[sel])
-        out[f"corr_{name}"] = float(np.corrcoef(eta[sel], pred)[0, 1])
-        out[f"rms_{name}"] = float(eta[sel].std() / pred.std() - 1.0)
-        lags = np.round(np.arange(-MAX_LAG, MAX_LAG + 1e-9, 0.01), 2)
-        corr = [np.corrcoef(eta[sel], paddle.elevation(x, t[sel] - lag))[0, 1] for lag in lags]
-        best = int(np.argmax(corr))
-        out[f"lag_{name}"], out[f"corr_lag_{name}"] = float(lags[best]), float(corr[best])
-    out["corr_min"] = min(out[f"corr_{n}"] for n in IRREGULAR_GAUGES)
-    out["rms_max"] = max(abs(out[f"rms_{n}"]) for n in IRREGULAR_GAUGES)
+        t, eta = gauge_elevation(outdir, name, STILL_UNTIL)
+        t_pred = t[t >= IRREGULAR_FROM]
+        s = probe_scores(t, eta, t_pred, paddle.elevation(x, t_pred))
+        out.update({f"{name}_{k}": v for k, v in s.items()})
+    out["corr_min"] = min(out[f"{n}_corr"] for n in IRREGULAR_GAUGES)
+    out["rms_max"] = max(abs(out[f"{n}_rms"]) for n in IRREGULAR_GAUGES)
     return out
