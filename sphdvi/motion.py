@@ -327,14 +327,34 @@ class _Paddle:
             return 1.0, 0.0
         return tau / self.ramp_time, 1.0 / self.ramp_time
 
-    def stroke_position(self, t: float):
-        """Paddle displacement at the free surface and its rate (m, m/s)."""
+    absorber = None     # a sphdvi.wave_absorption.PistonAbsorber when the piston absorbs (AWAS)
+
+    def theory_position(self, t: float):
+        """The wave theory's paddle displacement at the free surface and its rate (m, m/s)."""
         tau, moving = self._clock(t)
         if tau == 0.0:
             return 0.0, 0.0
         x, v = self._series(tau)
         r, dr = self._ramp(tau)
         return r * x, (r * v + dr * x) if moving else 0.0
+
+    def stroke_position(self, t: float):
+        """Paddle displacement at the free surface and its rate (m, m/s): the theory's, plus the
+        absorber's correction where the piston absorbs."""
+        x, v = self.theory_position(t)
+        if self.absorber is not None:
+            x += self.absorber.offset
+            v += self.absorber.velocity
+        return x, v
+
+    def target_elevation(self, x: float, t: float, order: int = 1) -> float:
+        """The free-surface elevation the paddle means to make at a distance ``x`` in front of it at
+        time t (:meth:`elevation` with the ramp; 0 before ``start`` and after ``duration``): the
+        target of an absorbing piston."""
+        tau, moving = self._clock(t)
+        if not moving:
+            return 0.0
+        return self._ramp(tau)[0] * float(np.asarray(self.elevation(x, t, order)).reshape(-1)[0])
 
     def transform(self, t: float) -> Rigid:
         x, v = self.stroke_position(t)
@@ -355,6 +375,7 @@ class WavePaddle(_Paddle):
         d, H, T = spec["depth"], spec["waveheight"], spec["waveperiod"]
         self.omega = 2 * math.pi / T
         self.k = wave_number(T, d, g)
+        self.height, self.depth = H, d
         self.phase = spec.get("phase", 0.0) * math.pi
         self.ramp_time = spec.get("ramp", 0.0) * T
         m1 = self._height_to_stroke(self.k, d)
@@ -368,6 +389,28 @@ class WavePaddle(_Paddle):
                 # DualSPHysics generates second-order waves with pistons only (Madsen 1971)
                 warnings.warn("flap mkbound=%s: waveorder=2 is implemented for pistons only; "
                               "the flap moves with first-order theory" % spec.get("mkbound"))
+
+    def elevation(self, x, t, order: int = 1) -> np.ndarray:
+        """The progressive wave η(x, t) = H/2 cos θ, θ = ω τ + φ − k x, at a distance ``x`` in front of
+        the paddle, without the ramp and the local evanescent modes (in phase with the paddle's
+        velocity at x = 0); ``order`` 2 adds Stokes's second-order bound harmonic
+        (π H²/8L) cosh kd (2 + cosh 2kd)/sinh³ kd cos 2θ (Dean & Dalrymple 1991 §11)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        theta = self.omega * (t - self.start) + self.phase - self.k * float(x)
+        H = self.height
+        eta = 0.5 * H * np.cos(theta)
+        if order == 2:
+            kd = self.k * self.depth
+            eta = eta + (H * H * self.k / 16.0) * (2.0 + math.cosh(2 * kd)) * _coth_over_sinh2(kd) * np.cos(2 * theta)
+        return eta
+
+    def stroke_amplitude(self) -> float:
+        """The theoretical stroke's amplitude S/2 (m)."""
+        return 0.5 * self.stroke
+
+    def max_acceleration(self) -> float:
+        """The peak acceleration of the theoretical stroke, (S/2) ω² + 4 ω² |second-order term| (m/s²)."""
+        return (0.5 * self.stroke + 4.0 * abs(self.second)) * self.omega ** 2
 
     def _series(self, tau: float):
         a = self.omega * tau + self.phase
@@ -407,10 +450,19 @@ class SpectrumPaddle(_Paddle):
         return (float(np.dot(self.half_stroke, np.sin(a))) - self.offset,
                 float(np.dot(self.half_stroke * self.omega, np.cos(a))))
 
-    def elevation(self, x, t) -> np.ndarray:
+    def stroke_amplitude(self) -> float:
+        """The stroke's significant amplitude 2σ, σ² = Σ (S_i/2)²/2 (as Hs/2 = 2σ of the elevation) (m)."""
+        return 2.0 * math.sqrt(0.5 * float(np.sum(self.half_stroke ** 2)))
+
+    def max_acceleration(self) -> float:
+        """A bound on the stroke's acceleration, Σ (S_i/2) ω_i² (m/s²)."""
+        return float(np.sum(self.half_stroke * self.omega ** 2))
+
+    def elevation(self, x, t, order: int = 1) -> np.ndarray:
         """The linear progressive wave η(x, t) = Σ a_i cos(ω_i (τ + t0) + φ_i − k_i x) at a distance
         ``x`` [m] in front of the paddle (along its stroke), without the ramp and the local
-        evanescent modes: what the paddle makes once the ramp is over and the waves have arrived."""
+        evanescent modes: what the paddle makes once the ramp is over and the waves have arrived
+        (first order: ``order`` is accepted for the regular paddle's signature)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         tau = t - self.start
         a = np.outer(tau + self.t0, self.omega) + self.phase - self.k * float(x)

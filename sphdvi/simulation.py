@@ -611,6 +611,8 @@ class SPHRun:
         self.bodies = self.floating.system if self.floating is not None else None
         self.body_names = self.floating.names if self.floating is not None else None
         self.damping = damping_zones(js.get("special", {}).get("damping", []))
+        from .wave_absorption import piston_absorbers
+        self.absorbers = piston_absorbers(motions, data, params) if self.moving is not None else []
         hook = self._hook if (self.moving is not None or self.floating is not None or self.damping) else None
         dt_table = None
         if str(params.get("DtFixedFile", "NONE")).upper() != "NONE":
@@ -624,6 +626,12 @@ class SPHRun:
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table,
                                 acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")))
+        for absorber in self.absorbers:
+            bias = absorber.calibrate(state)
+            if abs(bias) > float(c["dp"]):
+                warnings.warn(f"<awas_zsurf> of the piston mkbound={absorber.paddle.spec['mkbound']}: the still water "
+                              f"at its gauge is at z = {absorber.level0:.6g} m, {bias:+.3g} m from <swl> "
+                              f"{absorber.swl:g}; the absorber measures the elevation from the water's level")
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.excluded_limit = self.max_excluded()      # the parameters do not change in a run
         self.excluded_step_limit = max(MIN_EXCLUDED_PER_STEP, int(MAX_EXCLUDED_PER_STEP * self.n0_fluid))
@@ -650,7 +658,10 @@ class SPHRun:
         return normals
 
     def _hook(self, solver, t, dt):
-        """The end of each step: imposed motions, floating bodies, damping zones."""
+        """The end of each step: absorbing pistons' corrections, imposed motions, floating bodies,
+        damping zones."""
+        for absorber in self.absorbers:      # the gauge in front of the piston where it stands
+            absorber.update(t, dt, absorber.measure(solver.state, t - dt))
         if self.moving is not None:
             self.moving.apply(solver, t)
         if self.floating is not None:
@@ -722,6 +733,8 @@ class SPHRun:
                        "Mk": s.mk}
 
     def save_checkpoint(self, path: str, extra: dict) -> None:
+        if self.absorbers:
+            extra = dict(extra, awas=json.dumps([a.get_state() for a in self.absorbers]))
         save_sph_checkpoint(path, self.solver.get_checkpoint(),
                             dict(extra, dtmin_run=self.dtmin_run, dtmin_seen=self.dtmin_seen, **self.case_id),
                             self.bodies.get_state() if self.bodies is not None else None)
@@ -731,6 +744,12 @@ class SPHRun:
         self.excluded_seen = sum(self.solver.n_excluded.values())
         self.dtmin_run = int(extra["dtmin_run"])
         self.dtmin_seen = int(extra["dtmin_seen"])
+        if self.absorbers:
+            if "awas" not in extra:
+                raise InputError(f"{path}: the restart file has no state of the absorbing pistons (<awas_zsurf>); "
+                                 "it was written by a run without them: start the run again without --resume")
+            for absorber, state in zip(self.absorbers, json.loads(extra["awas"])):
+                absorber.set_state(state)
         return extra
 
 

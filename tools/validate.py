@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3, C3)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3, W5, C3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
@@ -120,6 +120,11 @@ def score_irregular_waves(outdir):
 def score_flap_waves(outdir):
     from sphdvi.validation.flapwaves import wave_scores
     return wave_scores(outdir, REFERENCE)
+
+
+def score_absorption(outdir):
+    from sphdvi.validation.waveflume import absorption_errors
+    return absorption_errors(outdir)
 
 
 def _wave_flume_case(name, paddle, xml):
@@ -335,6 +340,16 @@ def cases() -> list:
              "impact times within 3 % (here of the roll period), peaks within 20-30 %", slow=True),
         _wave_flume_case("W1", "piston", "CaseWaveFlume2D_Def.xml"),
         _wave_flume_case("W2", "flap hinged at the bottom", "CaseWaveFlap2D_Def.xml"),
+        Case("W5", "absorbing piston (<awas_zsurf>, DualSPHysics's AWAS) in the W1 flume closed by a wall",
+             case_path("waveflume2d", "CaseWaveAwas2D_Def.xml"),
+             [Resolution("H/dp 1.5", 0.02), Resolution("H/dp 3", 0.01)],
+             score_absorption, [("R paddle", "reflection", "{:.3f}"), ("R theory", "reflection_theory", "{:.3f}"),
+                                ("R spread", "reflection_spread", "{:.3f}"), ("H inc err %", "H_incident", PCT),
+                                ("H before %", "H_before", PCT), ("H back/H", "H_returning", "{:.2f}")],
+             "reflection", lambda e: abs(e["reflection"] - e["reflection_theory"]) <= 0.1
+             and abs(e["H_incident"]) <= 0.10,
+             "the paddle reflects what linear theory says its absorber should (within 0.1; a still piston: 1), "
+             "and the wave leaving it stays within 10 % of H (judgement)"),
         Case("W4", "irregular waves from a piston (<piston_spectrum>: JONSWAP Hs = 0.04 m, Tp = 1.4 s, d = 0.3 m)",
              case_path("waveflume2d", "CaseWaveIrregular2D_Def.xml"),
              [Resolution("Hs/dp 2", 0.02), Resolution("Hs/dp 4", 0.01)],
@@ -429,7 +444,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 W4 C3); default: all but the slow S4, S8, S16, S16M, S16O, S18 and W4")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 W4 W5 C3); default: all but the slow S4, S8, S16, S16M, S16O, S18 and W4")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")

@@ -939,9 +939,10 @@ def read_wavepaddles(reader, el) -> list:
                                "the direction of the piston's stroke, e.g. x=1 y=0 z=0")
         if spectral:
             _read_spectrum_options(reader, c, d)
-        for k, what in (("awas_zsurf", "active wave absorption (AWAS) is not implemented by sphdvi: the paddle "
-                                       "follows the theoretical stroke and absorbs no reflected waves"),
-                        ("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
+        if "awas_zsurf" in d:
+            d["awas"] = _read_awas(reader, reader.child(c, "awas_zsurf"), d)
+            del d["awas_zsurf"]
+        for k, what in (("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
                                         "regular-wave theory"),
                         ("savemotion", "<savemotion> (the paddle motion written to a file) is not implemented "
                                        "by sphdvi: no file is written"),
@@ -962,6 +963,8 @@ def read_wavepaddles(reader, el) -> list:
             d.setdefault("ramp", 0.0)
         if c.tag.startswith("piston"):
             d.setdefault("pistondir", [1.0, 0.0, 0.0])
+        if "awas" in d:
+            _check_awas_start(reader, c, d)
         try:       # the stroke from the wave theory: fails here, not at the first step of the run
             from ..motion import SpectrumPaddle, WavePaddle
             (SpectrumPaddle if spectral else WavePaddle)(d)
@@ -970,6 +973,85 @@ def read_wavepaddles(reader, el) -> list:
                                "a wave period and depth of a real wave") from None
         out.append(d)
     return out
+
+
+AWAS_SPEC = {"startawas": "num", "swl": "num", "elevation": "int", "gaugex": "raw", "gaugey": "num",
+             "gaugezmin": "num", "gaugezmax": "num", "gaugedp": "num", "coefmasslimit": "num", "savedata": "int",
+             "limitace": "num", "correction": "raw"}
+
+
+def _read_awas(reader, el, paddle: dict) -> dict:
+    """``<awas_zsurf>`` of a piston: active wave absorption (DualSPHysics's JWaveAwasZsurf; run by
+    :class:`sphdvi.wave_absorption.PistonAbsorber`). Options with DualSPHysics's defaults: ``startawas``
+    (the end of the ramp), ``swl`` (required), ``elevation`` 1 or 2 (2), ``gaugex`` value [m], valueh
+    [h] or valuedp [dp] from the piston's face (5 dp), ``gaugey`` (required), ``gaugezmin``/``gaugezmax``
+    (the domain's), ``gaugedp`` (0.1, in dp), ``coefmasslimit`` (the surface's kernel sum: 0.4 in 2D,
+    0.5 in 3D), ``limitace`` (2: the acceleration limit in peak theoretical accelerations, 0 none),
+    ``correction coefstroke coefperiod powerfunc`` (drift correction; off)."""
+    if paddle["type"].startswith("flap"):
+        raise reader.error(el, "active wave absorption (AWAS) is implemented for pistons only (as DualSPHysics)",
+                           "<awas_zsurf> in a <piston> or <piston_spectrum>")
+    direction = np.asarray(paddle.get("pistondir", [1.0, 0.0, 0.0]), float)
+    if not (direction[0] > 0 and direction[1] == 0 and direction[2] == 0):
+        raise reader.error(el, f"AWAS needs a piston moving along +x (pistondir {direction.tolist()})",
+                           '<pistondir x="1" y="0" z="0"/> (as DualSPHysics)')
+    a = _value_children(reader, el, AWAS_SPEC, required=("swl", "gaugey"))
+    a.setdefault("elevation", 2)
+    if a["elevation"] not in (1, 2):
+        raise reader.error(reader.child(el, "elevation"), f"<elevation> value={a['elevation']}",
+                           "1 (first-order) or 2 (second-order) target elevation")
+    gx = reader.child(el, "gaugex")
+    a["gaugex"] = {"unit": "dp", "value": 5.0}
+    if gx is not None:
+        given = [k for k in ("value", "valueh", "valuedp") if gx.get(k) is not None]
+        if len(given) != 1:
+            raise reader.error(gx, f"<gaugex> has {' and '.join(given) or 'no value'}",
+                               "exactly one of value (m), valueh (times h) or valuedp (times dp)")
+        a["gaugex"] = {"unit": {"value": "m", "valueh": "h", "valuedp": "dp"}[given[0]],
+                       "value": reader.num(gx, given[0], positive=True)}
+    a.setdefault("gaugedp", 0.1)
+    for k in ("gaugedp", "coefmasslimit"):
+        if k in a and not a[k] > 0:
+            raise reader.error(reader.child(el, k), f"<{k}> value={a[k]:g}", f"{k} > 0")
+    if "gaugezmin" in a and "gaugezmax" in a and not a["gaugezmax"] > a["gaugezmin"]:
+        raise reader.error(reader.child(el, "gaugezmax"), f"<gaugezmax> {a['gaugezmax']:g} is not above <gaugezmin> "
+                           f"{a['gaugezmin']:g}", "a vertical gauge line from gaugezmin up to gaugezmax")
+    a.setdefault("limitace", 2.0)
+    if a["limitace"] < 0:
+        raise reader.error(reader.child(el, "limitace"), f"<limitace> value={a['limitace']:g}",
+                           "a factor >= 0 of the peak theoretical acceleration (0: no limit)")
+    corr = reader.child(el, "correction")
+    a["correction"] = {"coefstroke": 0.0, "coefperiod": 0.0, "powerfunc": 1.0}
+    if corr is not None:
+        cc = {k: reader.num(corr, k, v) for k, v in a["correction"].items()}
+        if cc["powerfunc"] < 1:
+            raise reader.error(corr, f"powerfunc={cc['powerfunc']:g}", "powerfunc >= 1")
+        if cc["coefstroke"] or cc["coefperiod"]:
+            if cc["coefstroke"] < 1:
+                raise reader.error(corr, f"coefstroke={cc['coefstroke']:g}",
+                                   "coefstroke >= 1: the drift (in stroke amplitudes) that starts a correction")
+            if not cc["coefperiod"] > 0:
+                raise reader.error(corr, f"coefperiod={cc['coefperiod']:g}",
+                                   "coefperiod > 0: the correction's duration in wave periods")
+        a["correction"] = cc
+    if a.get("savedata", 0):
+        reader.warn(reader.child(el, "savedata"), "<savedata> (AWAS's CSV files) is not implemented by sphdvi: "
+                    "no file is written; measure the surface with a <gauges> swl gauge")
+    a.pop("savedata", None)
+    return a
+
+
+def _check_awas_start(reader, c, d: dict) -> None:
+    """AWAS starts at ``startawas``, by default (and at the earliest) where the ramp ends."""
+    ramp_end = d["start"] + (d.get("ramptime", 0.0) if d["type"].endswith("_spectrum")
+                             else d.get("ramp", 0.0) * d["waveperiod"])
+    a = d["awas"]
+    if a.get("startawas") is None:
+        a["startawas"] = ramp_end
+    elif a["startawas"] < ramp_end - 1e-12:
+        raise reader.error(reader.child(reader.child(c, "awas_zsurf"), "startawas"),
+                           f"<startawas> {a['startawas']:g} s is before the end of the ramp ({ramp_end:g} s)",
+                           f"startawas >= {ramp_end:g} s (as DualSPHysics: absorption begins after the ramp)")
 
 
 def _read_spectrum_options(reader, c, d: dict) -> None:

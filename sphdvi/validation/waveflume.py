@@ -121,3 +121,60 @@ def irregular_errors(outdir: str) -> dict:
     out["corr_min"] = min(out[f"{n}_corr"] for n in IRREGULAR_GAUGES)
     out["rms_max"] = max(abs(out[f"{n}_rms"]) for n in IRREGULAR_GAUGES)
     return out
+
+
+AWAS_BEFORE = 5.4          # s: the end of the window (2 periods) before the wall's wave reaches WG3
+AWAS_WINDOWS = 4           # windows of two periods, a period apart, at the end of the run
+
+
+def _split(outdir: str, t_end: float, k: float) -> tuple[complex, complex]:
+    """(incident, reflected) first-harmonic amplitudes at x = 0 over the two periods up to ``t_end``."""
+    omega = 2 * math.pi / PERIOD
+    xs, amps = [], []
+    for name, x in GAUGES.items():
+        g = gauge_table(outdir, "SWL", name)
+        sel = (g[:, 0] >= t_end - WINDOW * PERIOD - 1e-9) & (g[:, 0] <= t_end + 1e-9)
+        xs.append(x)
+        amps.append(first_harmonic(g[sel, 0], g[sel, 3], omega))
+    return incident_reflected(np.asarray(xs), np.asarray(amps), k)
+
+
+def awas_gauge_distance(outdir: str) -> float | None:
+    """How far in front of the piston its absorber's gauge stands (m), from the case (None: no
+    absorbing piston)."""
+    from .runs import case_data
+    data = case_data(outdir)
+    c = data["constants"]
+    for p in data["json"]["special"].get("wavepaddles", []):
+        if p.get("awas"):
+            gx = p["awas"]["gaugex"]
+            return float(gx["value"]) * {"m": 1.0, "h": float(c["h"]), "dp": float(c["dp"])}[gx["unit"]]
+    return None
+
+
+def absorption_errors(outdir: str, gauge_x: float | None = None) -> dict:
+    """W5, the flume closed by a wall with an absorbing piston (``CaseWaveAwas2D_Def.xml``): the wave
+    leaving the paddle before the wall's wave has come back (A0, ``H_before``) and over the last
+    periods (``H_incident``, relative to H), the wave coming back (``H_returning``), and the paddle's
+    reflection R = (A − A0)/B of the returning wave B (``reflection``: the mean |R| of the last
+    AWAS_WINDOWS windows, ``reflection_spread`` their range) against linear theory's
+    (:func:`sphdvi.wave_absorption.piston_reflection`, the gauge ``gauge_x`` in front of the piston:
+    ``reflection_theory``). A piston that does not absorb reflects R = 1. ``gauge_x`` defaults to the case's."""
+    from ..motion import wave_number
+    from ..wave_absorption import piston_reflection
+    k = wave_number(PERIOD, DEPTH)
+    t_last = gauge_table(outdir, "SWL", "WG1")[-1, 0]
+    a0, _ = _split(outdir, AWAS_BEFORE, k)
+    refl, inc, ret = [], [], []
+    for i in range(AWAS_WINDOWS):
+        a, b = _split(outdir, t_last - i * PERIOD, k)
+        refl.append(abs((a - a0) / b))
+        inc.append(2 * abs(a) / H - 1.0)
+        ret.append(2 * abs(b) / H)
+    out = {"H_before": 2 * abs(a0) / H - 1.0, "H_incident": inc[0], "H_incident_max": max(inc, key=abs),
+           "H_returning": ret[0], "reflection": float(np.mean(refl)),
+           "reflection_spread": float(max(refl) - min(refl))}
+    gauge_x = awas_gauge_distance(outdir) if gauge_x is None else gauge_x
+    if gauge_x is not None:
+        out["reflection_theory"] = abs(piston_reflection(k, DEPTH, 2 * math.pi / PERIOD, 9.81, gauge_x))
+    return out

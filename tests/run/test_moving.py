@@ -165,3 +165,65 @@ def test_resume_from_a_checkpoint_without_wall_acceleration(tmp_path):
     assert r.exit_code == 0, r.output
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "completed" and meta["physical_time"] >= 0.1
+
+
+AWAS_PISTON = ('<wavepaddles><piston><mkbound value="10"/><depth value="0.3"/><waveorder value="1"/>'
+               '<waveheight value="0.02"/><waveperiod value="1.0"/><ramp value="0"/>'
+               '<awas_zsurf><swl value="0.3"/><elevation value="1"/><gaugey value="0"/>'
+               '<gaugezmin value="0.1"/><gaugezmax value="0.5"/></awas_zsurf></piston></wavepaddles>')
+
+
+def test_absorbing_piston_moves_with_its_correction(tmp_path):
+    """With <awas_zsurf> the piston's particles move as the theory's stroke plus the absorber's
+    correction: at the start its gauge reads the still water where the target already has the
+    wave, so the correction is not zero; every particle keeps the rigid motion."""
+    out = run_case(tmp_path, '<mvnull id="1" />', AWAS_PISTON)
+    p0, res = moving_positions(out)
+    paddle = WavePaddle({"type": "piston", "mkbound": 10, "depth": 0.3, "waveheight": 0.02, "waveperiod": 1.0,
+                         "ramp": 0, "waveorder": 1})
+    offsets = []
+    for t, x, v, _ in res:
+        d = x - p0
+        assert np.ptp(d[:, 0]) < 1e-12 and np.abs(d[:, 1:]).max() == 0.0
+        offsets.append(d[0, 0] - paddle.stroke_position(t)[0])
+        assert np.ptp(v[:, 0]) < 1e-6
+    assert abs(offsets[0]) == 0.0 and max(abs(o) for o in offsets) > 1e-4
+
+
+def test_absorbing_piston_resumes_bitwise(tmp_path):
+    """The absorber's state is in restart.h5: a resumed run ends in the bitwise same state."""
+    import h5py
+
+    def final_state(outdir):
+        with h5py.File(outdir / "restart.h5", "r") as f:
+            o = np.argsort(f["state/idp"][...])
+            return {k: f["state"][k][...][o] for k in ("pos", "vel", "rhop")}, dict(f["scalars"].attrs)
+    case = tmp_path / "CaseMoving_Def.xml"
+    case.write_text(TANK.replace("MOTION", '<mvnull id="1" />').replace("SPECIAL", AWAS_PISTON))
+    common = ["--tout", "0.05", "--threads", "1", "-q"]
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert CliRunner().invoke(main, ["run", str(case), "-o", str(a), "--tmax", "0.2"] + common).exit_code == 0
+    assert CliRunner().invoke(main, ["run", str(case), "-o", str(b), "--tmax", "0.1"] + common).exit_code == 0
+    r = CliRunner().invoke(main, ["run", str(b), "--resume", "--tmax", "0.2"] + common)
+    assert r.exit_code == 0, r.output
+    sa, ka = final_state(a)
+    sb, kb = final_state(b)
+    assert ka["nstep"] == kb["nstep"] and ka["awas"] == kb["awas"]
+    for k in sa:
+        assert np.array_equal(sa[k], sb[k]), k
+
+
+def test_absorber_reads_the_still_water_and_warns_of_a_wrong_swl(tmp_path):
+    """The absorber's gauge reads the still water at the start (η is measured from that level); a
+    <swl> more than dp from it is warned, with the level found."""
+    case = tmp_path / "CaseMoving_Def.xml"
+    case.write_text(TANK.replace("MOTION", '<mvnull id="1" />')
+                    .replace("SPECIAL", AWAS_PISTON.replace('<swl value="0.3"/>', '<swl value="0.5"/>')))
+    with pytest.warns(UserWarning, match="mkbound=10") as rec:
+        r = CliRunner().invoke(main, ["run", str(case), "-o", str(tmp_path / "o"), "--tmax", "0.02", "--threads", "1",
+                                      "-q"])
+    assert r.exit_code == 0, r.output
+    text = next(str(w.message) for w in rec if "awas_zsurf" in str(w.message))
+    assert "from <swl> 0.5" in text
+    level = float(text.split("is at z = ")[1].split(" m")[0])
+    assert 0.3 < level < 0.32            # the water drawn up to z = 0.3 (particles every 0.02): its edge at 0.31
