@@ -971,7 +971,35 @@ def read_wavepaddles(reader, el) -> list:
         except (ArithmeticError, ValueError, CaseError) as exc:
             raise reader.error(c, f"cannot compute the paddle's stroke: {exc}",
                                "a wave period and depth of a real wave") from None
+        for message in wave_validity_warnings(d["waveheight"], d["waveperiod"], d["depth"], d["waveorder"],
+                                              "significant height Hs and peak period Tp" if spectral else ""):
+            reader.warn(c, message)
         out.append(d)
+    return out
+
+
+def wave_validity_warnings(height: float, period: float, depth: float, order: int = 1, of: str = "",
+                           g: float = 9.81) -> list:
+    """What DualSPHysics warns of a paddle's waves (L from the linear dispersion relation): they
+    break for their steepness, H/L > 0.142 tanh(kd) (Miche 1944), or for the depth, H/d > 0.78
+    (McCowan 1894); second-order generation stands outside its theory's range where the Ursell
+    number H L²/d³ ≥ 8π²/3 (Madsen 1971). ``of``: what H and T are (irregular waves)."""
+    import math
+    from ..motion import wave_number
+    k = wave_number(period, depth, g)
+    length = 2 * math.pi / k
+    what = f" (of the {of})" if of else ""
+    out = []
+    if height / length > 0.142 * math.tanh(k * depth):
+        out.append(f"the waves break for their steepness{what}: H/L = {height / length:.3g} > 0.142 tanh(kd) = "
+                   f"{0.142 * math.tanh(k * depth):.3g} (Miche 1944)")
+    if height / depth > 0.78:
+        out.append(f"the waves break for the depth{what}: H/d = {height / depth:.3g} > 0.78 (McCowan 1894)")
+    ursell = height * length ** 2 / depth ** 3
+    if order == 2 and ursell >= 8 * math.pi ** 2 / 3:
+        out.append(f"second-order generation outside its range{what}: the Ursell number H L^2/d^3 = {ursell:.3g} >= "
+                   f"8 pi^2/3 = {8 * math.pi ** 2 / 3:.3g} (Madsen 1971): the second-order term grows unphysical "
+                   "in shallow water")
     return out
 
 

@@ -336,3 +336,22 @@ def test_unimplemented_spectrum_options_warn(tmp_path):
     for tag, line in (("serieini", 3), ("saveserie", 4), ("saveseriewaves", 5), ("fixeddepth", 6)):
         assert f"case.xml:{line}: warning: <{tag}>" in text
     assert "autofit is ignored" in text
+
+
+@pytest.mark.parametrize("inner, expect", [
+    ('<depth value="1"/><waveheight value="0.1"/><waveperiod value="2"/>', []),
+    ('<depth value="1"/><waveheight value="0.5"/><waveperiod value="1"/>', ["Miche"]),
+    ('<depth value="0.1"/><waveheight value="0.08"/><waveperiod value="20"/>', ["McCowan"]),
+    ('<depth value="0.3"/><waveheight value="0.05"/><waveperiod value="4"/><waveorder value="2"/>', ["Madsen"]),
+    ('<depth value="0.3"/><waveheight value="0.05"/><waveperiod value="4"/>', []),
+])
+def test_breaking_and_second_order_range_are_warned(tmp_path, inner, expect):
+    """DualSPHysics's warnings on the waves asked for: steepness breaking (H/L > 0.142 tanh kd), depth
+    breaking (H/d > 0.78), second order past Madsen's Ursell limit (H L²/d³ >= 8π²/3)."""
+    xml = f'<wavepaddles>\n<piston><mkbound value="1"/>{inner}</piston></wavepaddles>'
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    read_wavepaddles(reader, etree.fromstring(xml))
+    text = "\n".join(reader.warnings)
+    assert len(reader.warnings) == len(expect)
+    for name in expect:
+        assert name in text and "case.xml:2: warning: <piston>" in text
