@@ -173,14 +173,21 @@ AWAS_PISTON = ('<wavepaddles><piston><mkbound value="10"/><depth value="0.3"/><w
                '<gaugezmin value="0.1"/><gaugezmax value="0.5"/></awas_zsurf></piston></wavepaddles>')
 
 
-def test_absorbing_piston_moves_with_its_correction(tmp_path):
+AWAS_SPECTRUM = AWAS_PISTON.replace("<piston>", "<piston_spectrum>").replace("</piston>", "</piston_spectrum>").replace(
+    '<waveorder value="1"/>', '<spectrum value="jonswap"/><waves value="20"/><randomseed value="3"/>').replace(
+    '<ramp value="0"/>', "")
+
+
+@pytest.mark.parametrize("special", [AWAS_PISTON, AWAS_SPECTRUM], ids=["regular", "irregular"])
+def test_absorbing_piston_moves_with_its_correction(tmp_path, special):
     """With <awas_zsurf> the piston's particles move as the theory's stroke plus the absorber's
     correction: at the start its gauge reads the still water where the target already has the
     wave, so the correction is not zero; every particle keeps the rigid motion."""
-    out = run_case(tmp_path, '<mvnull id="1" />', AWAS_PISTON)
+    from sphdvi.validation.runs import case_data
+    out = run_case(tmp_path, '<mvnull id="1" />', special)
     p0, res = moving_positions(out)
-    paddle = WavePaddle({"type": "piston", "mkbound": 10, "depth": 0.3, "waveheight": 0.02, "waveperiod": 1.0,
-                         "ramp": 0, "waveorder": 1})
+    paddle = MotionSet([], case_data(out)["json"]["special"]["wavepaddles"]).paddles[10]
+    assert paddle.absorber is None
     offsets = []
     for t, x, v, _ in res:
         d = x - p0
