@@ -73,10 +73,11 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
     from .errors import CaseError
     if not os.path.isfile(case_xml):
         raise CaseError("case file not found", file=case_xml, expected="an existing XML case file")
-    from .io.runfolder import check_new_run_folder, clear_earlier_results
+    from .io.runfolder import check_new_run_folder, check_other_case, clear_earlier_results
     if outdir is None:
         outdir = f"{case_name_from_path(case_xml)}_out"
     check_new_run_folder(outdir, overwrite, command="gencase")
+    check_other_case(outdir, case_name_from_path(case_xml), overwrite)
     result = build_case(case_xml, outdir, max_nodes=max_nodes, dp=dp)
     clear_earlier_results(outdir)
     files = write_outputs(result, outdir)
@@ -130,7 +131,7 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
 
 def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
     from .errors import InputError
-    from .io.runfolder import check_new_run_folder
+    from .io.runfolder import check_new_run_folder, check_other_case
     from .simulation import find_case_file, run as run_case
     drawn_dp = None      # --dp where no gencase runs: it must be the case's dp
     if os.path.isfile(source) and source.lower().endswith(".xml"):
@@ -142,6 +143,7 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
             drawn_dp = dp
         else:
             check_new_run_folder(outdir, overwrite)     # before gencase writes into it
+            check_other_case(outdir, case_name_from_path(source), overwrite)
             result = build_case(source, outdir, dp=dp)
             print_warnings(result.warnings)
             case_h5 = write_outputs(result, outdir)[0]

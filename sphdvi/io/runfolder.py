@@ -77,6 +77,43 @@ def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> 
                      "or into another -o folder")
 
 
+CASE_OUTPUT_SUFFIXES = (".h5", "_All.vtp", "_Normals.vtp")      # what gencase writes for a case
+
+
+def other_case_outputs(outdir: str, case_name: str) -> list[str]:
+    """The gencase outputs in ``outdir`` of cases other than ``case_name`` (a gencase HDF5 file,
+    ``format="sphdvi-case"``, and the .vtp files written beside it), sorted names."""
+    import h5py
+    if not os.path.isdir(outdir):
+        return []
+    out = []
+    for name in sorted(os.listdir(outdir)):
+        if not name.endswith(".h5") or name in (RESTART_FILE, f"{case_name}.h5"):
+            continue
+        with contextlib.suppress(OSError):
+            with h5py.File(os.path.join(outdir, name), "r") as f:
+                if f.attrs.get("format") != "sphdvi-case":
+                    continue
+            stem = name[:-3]
+            out += [stem + sfx for sfx in CASE_OUTPUT_SUFFIXES if os.path.isfile(os.path.join(outdir, stem + sfx))]
+    return out
+
+
+def check_other_case(outdir: str, case_name: str, overwrite: bool) -> list[str]:
+    """A gencase of ``case_name`` into ``outdir``: another case's gencase output there would leave the
+    folder with two cases, which ``run OUT``, ``--resume`` and ``measure`` cannot tell apart. Refused
+    (InputError) unless ``overwrite``, which deletes it; returns the names deleted."""
+    found = other_case_outputs(outdir, case_name)
+    if found and not overwrite:
+        raise InputError(f"{outdir} holds the gencase output of another case ({', '.join(found)}); a second case there "
+                         "leaves the folder ambiguous for 'sphdvi run OUT', --resume and 'sphdvi measure': use another "
+                         "-o folder, or --overwrite (deletes those files)")
+    for name in found:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(os.path.join(outdir, name))
+    return found
+
+
 def clear_earlier_results(outdir: str) -> list[str]:
     """Delete the files of an earlier run in ``outdir`` (a new run with --overwrite), so that
     nothing of it mixes with the new run's outputs: its own files and what `sphdvi export`

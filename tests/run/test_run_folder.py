@@ -83,6 +83,32 @@ def test_gencase_into_a_run_folder_is_refused_unless_overwrite(done, tmp_path):
     assert sorted(p.name for p in out.iterdir()) == [CASE_H5, "CaseDambreakVal2D_All.vtp"]
 
 
+def test_a_second_case_into_a_case_folder_is_refused_unless_overwrite(tmp_path):
+    """Another case's gencase output in OUT would leave two cases there, which `run OUT`, --resume
+    and `measure` cannot tell apart: gencase and `run CASE.xml` refuse (exit 2, the files named,
+    nothing changed); --overwrite deletes them (the user's other files stay)."""
+    g = tmp_path / "g"
+    assert invoke(["gencase", DAMBREAK, "-o", g, "--dp", "0.1", "-q"]).exit_code == 0
+    (g / "notes.txt").write_text("the user's")
+    other = tmp_path / "CaseOther_Def.xml"
+    other.write_text(DAMBREAK.read_text())
+    before = {p.name: p.read_bytes() for p in g.iterdir()}
+    for args in (["gencase", other, "-o", g, "--dp", "0.1", "-q"], ["run", other, "-o", g] + RUN):
+        r = invoke(args)
+        assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+        for text in ("gencase output of another case", CASE_H5, "CaseDambreakVal2D_All.vtp", "--overwrite"):
+            assert text in r.output, (text, r.output)
+        assert {p.name: p.read_bytes() for p in g.iterdir()} == before
+    r = invoke(["run", other, "-o", g, "--overwrite"] + RUN)
+    assert r.exit_code == 0, r.output
+    names = {p.name for p in g.iterdir()}
+    assert "CaseOther.h5" in names and "notes.txt" in names and not names & {CASE_H5, "CaseDambreakVal2D_All.vtp"}
+    assert invoke(["run", g, "--resume", "--tmax", "0.006"]).exit_code == 0
+    # the same case again needs no --overwrite for its own case file (a gencase output folder)
+    assert invoke(["gencase", other, "-o", tmp_path / "h", "--dp", "0.1", "-q"]).exit_code == 0
+    assert invoke(["gencase", other, "-o", tmp_path / "h", "--dp", "0.1", "-q"]).exit_code == 0
+
+
 def test_gencase_folder_runs_and_overwrite_starts_clean(done, tmp_path):
     # a gencase output folder (case files only) runs without --overwrite
     g = tmp_path / "g"
