@@ -394,10 +394,11 @@ class WavePaddle(_Paddle):
         """The progressive wave η(x, t) = H/2 cos θ, θ = ω τ + φ − k x, at a distance ``x`` in front of
         the paddle, without the ramp and the local evanescent modes (in phase with the paddle's
         velocity at x = 0); ``order`` 2 adds Stokes's second-order bound harmonic
-        (π H²/8L) cosh kd (2 + cosh 2kd)/sinh³ kd cos 2θ (Dean & Dalrymple 1991 §11)."""
+        (π H²/8L) cosh kd (2 + cosh 2kd)/sinh³ kd cos 2θ (Dean & Dalrymple 1991 §11). H is the height
+        the stroke makes: ``waveheight`` times ``gainstroke``, as the irregular paddle's."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         theta = self.omega * (t - self.start) + self.phase - self.k * float(x)
-        H = self.height
+        H = self.height * self.gain
         eta = 0.5 * H * np.cos(theta)
         if order == 2:
             kd = self.k * self.depth

@@ -280,3 +280,18 @@ def test_piston_reflection_with_its_gauge_in_front():
     dd = 0.01
     kk = wave_number(20.0, dd)
     assert abs(piston_reflection(kk, dd, 2 * math.pi / 20.0, G, 1e-6)) < 0.01
+
+
+def test_target_is_the_wave_the_stroke_makes_gain_included():
+    """gainstroke scales the stroke and the wave it makes alike (regular and irregular paddles), so
+    that an absorber does not work against the gain."""
+    base = {"type": "piston", "mkbound": 1, "depth": 0.3, "waveheight": 0.03, "waveperiod": 1.2, "ramp": 0}
+    p1, p2 = WavePaddle(base), WavePaddle({**base, "gainstroke": 1.3})
+    assert p2.stroke == pytest.approx(1.3 * p1.stroke)
+    assert np.allclose(p2.elevation(0.1, [0.3, 0.7]), 1.3 * p1.elevation(0.1, [0.3, 0.7]))
+    from sphdvi.motion import SpectrumPaddle
+    sbase = {"type": "piston_spectrum", "mkbound": 1, "depth": 0.3, "waveheight": 0.03, "waveperiod": 1.2,
+             "spectrum": "jonswap", "discretization": "stretched", "peakcoef": 3.3, "waves": 10, "randomseed": 1}
+    s1, s2 = SpectrumPaddle(sbase), SpectrumPaddle({**sbase, "gainstroke": 1.3})
+    assert np.allclose(s2.half_stroke, 1.3 * s1.half_stroke)
+    assert np.allclose(s2.elevation(0.1, [0.3, 0.7]), 1.3 * s1.elevation(0.1, [0.3, 0.7]))
