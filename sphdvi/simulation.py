@@ -661,7 +661,7 @@ class SPHRun:
         """The end of each step: absorbing pistons' corrections, imposed motions, floating bodies,
         damping zones."""
         for absorber in self.absorbers:      # the gauge in front of the piston where it stands
-            absorber.update(t, dt, absorber.measure(solver.state, t - dt))
+            absorber.update(t, dt, absorber.measure(solver.state, t - dt) if absorber.absorbs(t, dt) else math.nan)
         if self.moving is not None:
             self.moving.apply(solver, t)
         if self.floating is not None:

@@ -148,13 +148,18 @@ class PistonAbsorber:
         f = min(1.0, tau / self.corr_time) if self.corr_time > 0 else 1.0
         return self.corr_limit * (1.0 - (1.0 - f) ** self.corr_power)
 
+    def absorbs(self, t: float, dt: float) -> bool:
+        """Whether the step that ends at ``t`` corrects (it starts after ``startawas``): before it the
+        gauge need not be read."""
+        return t - dt > self.start
+
     def update(self, t: float, dt: float, surface_z: float) -> None:
         """Advance the correction over the step that ends at ``t`` (length ``dt``), ``surface_z`` the
         free surface measured at the gauge (NaN: no correction from it)."""
         x_old_theory = self.paddle.theory_position(t - dt)[0]
         x_theory = self.paddle.theory_position(t)[0]
         c_old = self.offset
-        active = t - dt > self.start
+        active = self.absorbs(t, dt)
         self.target = self.paddle.target_elevation(self.gauge_dx, t, self.order)
         self.eta = surface_z - (self.swl if math.isnan(self.level0) else self.level0)
         ur = 0.0
