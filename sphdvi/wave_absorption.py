@@ -79,6 +79,12 @@ def piston_reflection(k: float, depth: float, omega: float, g: float, gauge_x: f
                                                   + gain0 * evanescent)
 
 
+def gauge_distance(opts: dict, dp: float, h: float) -> float:
+    """How far in front of the piston's face its gauge stands (m): ``gaugex`` in m, h or dp (5 dp)."""
+    gx = opts.get("gaugex") or {"unit": "dp", "value": 5.0}
+    return float(gx["value"]) * {"m": 1.0, "h": h, "dp": dp}[gx["unit"]]
+
+
 class PistonAbsorber:
     """The AWAS correction of one piston (``paddle``: a :class:`sphdvi.motion.WavePaddle` or
     ``SpectrumPaddle``, ``opts``: the case's ``awas`` dict, see :func:`sphdvi.case.reader._read_awas`).
@@ -95,8 +101,7 @@ class PistonAbsorber:
         self.start = float(opts["startawas"])
         self.swl = float(opts["swl"])
         self.order = int(opts.get("elevation", 2))
-        gx = opts.get("gaugex") or {"unit": "dp", "value": 5.0}
-        self.gauge_dx = float(gx["value"]) * {"m": 1.0, "h": h, "dp": dp}[gx["unit"]]
+        self.gauge_dx = gauge_distance(opts, dp, h)
         self.gauge_y = float(opts.get("gaugey", 0.0))
         zmin = max(float(opts.get("gaugezmin", zlim[0])), zlim[0])
         zmax = min(float(opts.get("gaugezmax", zlim[1])), zlim[1])

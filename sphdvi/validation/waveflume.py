@@ -142,13 +142,13 @@ def _split(outdir: str, t_end: float, k: float) -> tuple[complex, complex]:
 def awas_gauge_distance(outdir: str) -> float | None:
     """How far in front of the piston its absorber's gauge stands (m), from the case (None: no
     absorbing piston)."""
+    from ..wave_absorption import gauge_distance
     from .runs import case_data
     data = case_data(outdir)
     c = data["constants"]
     for p in data["json"]["special"].get("wavepaddles", []):
         if p.get("awas"):
-            gx = p["awas"]["gaugex"]
-            return float(gx["value"]) * {"m": 1.0, "h": float(c["h"]), "dp": float(c["dp"])}[gx["unit"]]
+            return gauge_distance(p["awas"], float(c["dp"]), float(c["h"]))
     return None
 
 
