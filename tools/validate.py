@@ -18,6 +18,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
     python tools/validate.py S16M --dp 0.02 --dp 0.01 --threads 2     # some of a case's resolutions
+    python tools/validate.py S3 S7 --constant coefh=1.2                # the case files with another constant
 
 Not a test: the pytest suite asserts the same figures (tests/validation, tests/sph).
 """
@@ -32,7 +33,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -397,6 +398,54 @@ def cases() -> list:
 
 # ---- running ----
 
+# <constantsdef> entries that say the same thing: setting one removes the others
+_SMOOTHING_LENGTH = ("coefh", "hdp", "coefhdp", "h")
+
+
+def case_with_constants(path: str, constants: dict) -> str:
+    """A copy of the case file with ``<constantsdef>`` values replaced (``{"coefh": "1.2"}``),
+    written beside it so that its relative paths (motion files, meshes) still hold; the caller
+    deletes it. An entry that is missing is added; one with ``auto="true"`` is turned to the
+    given value; setting one way of giving h (coefh, hdp, coefhdp, h) removes the others."""
+    from lxml import etree
+    tree = etree.parse(path)
+    cdef = tree.find(".//casedef/constantsdef")
+    if cdef is None:
+        raise SystemExit(f"{path}: no <casedef><constantsdef> to set {', '.join(constants)} in")
+    for name, value in constants.items():
+        if name in _SMOOTHING_LENGTH:
+            for other in _SMOOTHING_LENGTH:
+                for el in cdef.findall(other) if other != name else []:
+                    cdef.remove(el)
+        el = cdef.find(name)
+        if el is None:
+            el = etree.SubElement(cdef, name)
+        el.set("value", value)
+        if "auto" in el.attrib:
+            el.set("auto", "false")
+    folder, base = os.path.split(path)
+    stem = base[:-len("_Def.xml")] if base.endswith("_Def.xml") else os.path.splitext(base)[0]
+    out = os.path.join(folder, f"{stem}_validate{os.getpid()}_Def.xml")
+    tree.write(out, xml_declaration=True, encoding="UTF-8")
+    return out
+
+
+def parse_constants(items: list | None, parser) -> dict:
+    """``NAME=VALUE`` options into a dict (names lower case, as <constantsdef> spells them)."""
+    from sphdvi.case.parameters import CONSTANTS
+    out = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        name = name.strip().lower()
+        if not sep or not value.strip():
+            parser.error(f"--constant {item}: expected NAME=VALUE, e.g. coefh=1.2")
+        if name not in CONSTANTS or name in ("gravity", "lattice"):
+            parser.error(f"--constant {item}: {name} is not a single-valued <constantsdef> entry "
+                         f"(one of {', '.join(sorted(CONSTANTS - {'gravity', 'lattice'}))})")
+        out[name] = value.strip()
+    return out
+
+
 def run_case(case: Case, res: Resolution, outdir: str, threads: int) -> dict:
     """Run one resolution through the CLI; return run.json's figures (status, particles, steps,
     runtime_s, us_per_particle_step, threads_used) and the wall time of the whole command."""
@@ -452,7 +501,11 @@ def main(argv=None) -> int:
                     help="only the resolutions of this dp (repeatable)")
     ap.add_argument("--keep", metavar="DIR", help="keep the run folders under DIR (default: a temporary folder)")
     ap.add_argument("--csv", metavar="FILE", help="also write every row to FILE")
+    ap.add_argument("--constant", action="append", metavar="NAME=VALUE",
+                    help="run the case files with this <constantsdef> value (repeatable; e.g. coefh=1.2): "
+                         "a copy of each file beside it, removed afterwards")
     args = ap.parse_args(argv)
+    constants = parse_constants(args.constant, ap)
     every = cases()
     known = {c.name: c for c in every}
     known["S2"] = known["S1"]                      # S1 and S2 are one run of the hydrostatic tank
@@ -475,7 +528,12 @@ def main(argv=None) -> int:
             resolutions = [r for r in resolutions if any(math.isclose(r.dp, d, rel_tol=1e-9) for d in args.dp)]
         for res in resolutions:
             outdir = os.path.join(base, f"{case.name}_{res.dp:g}")
-            run = run_case(case, res, outdir, args.threads)
+            copy = case_with_constants(case.case, constants) if constants else None
+            try:
+                run = run_case(replace(case, case=copy) if copy else case, res, outdir, args.threads)
+            finally:
+                if copy:
+                    os.remove(copy)
             errors = {}
             if run["rc"] == 0:
                 errors = case.score(outdir)

@@ -25,3 +25,47 @@ def test_validate_tool_scores_s9_and_reports_run_time(tmp_path):
     # the centre-line error of tests/validation/test_poiseuille_case.py at 20 across (+0.92 %)
     assert abs(float(row["centreline"]) - 0.0092) < 0.0005
     assert float(row["transient"]) < 0.02
+
+
+def _validate_module():
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("validate_tool", REPO / "tools" / "validate.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod                  # its dataclasses look their module up there
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_constant_option_writes_a_copy_beside_the_case_with_the_new_values(tmp_path):
+    """--constant coefh=1.2: the case file's copy, in its own folder (relative paths hold), with
+    coefh set and the other ways of giving h removed; an auto entry turned to the value; a
+    missing entry added; bad options exit 2."""
+    from lxml import etree
+
+    validate = _validate_module()
+    src = tmp_path / "CaseT_Def.xml"
+    src.write_text("""<?xml version="1.0" encoding="UTF-8" ?>
+<case><casedef><constantsdef>
+  <gravity x="0" y="0" z="-9.81" /><rhop0 value="1000" /><hdp value="2.0" />
+  <speedsystem value="0" auto="true" /><coefsound value="20" /><speedsound value="0" auto="true" />
+</constantsdef></casedef></case>""")
+    copy = validate.case_with_constants(str(src), {"coefh": "1.2", "speedsound": "50", "cflnumber": "0.1"})
+    try:
+        assert Path(copy).parent == tmp_path and Path(copy).name.endswith("_Def.xml") and Path(copy) != src
+        cdef = etree.parse(copy).find(".//constantsdef")
+        assert cdef.find("hdp") is None and cdef.find("coefh").get("value") == "1.2"
+        assert cdef.find("speedsound").attrib == {"value": "50", "auto": "false"}
+        assert cdef.find("speedsystem").get("auto") == "true"          # untouched
+        assert cdef.find("cflnumber").get("value") == "0.1"
+        assert "hdp" in src.read_text()                                 # the user's file unchanged
+    finally:
+        Path(copy).unlink()
+    ap = __import__("argparse").ArgumentParser()
+    assert validate.parse_constants(["CoefH=1.2"], ap) == {"coefh": "1.2"}
+    for bad in (["coefh"], ["Visco=0.1"], ["gravity=1"]):
+        try:
+            validate.parse_constants(bad, ap)
+        except SystemExit as e:
+            assert e.code == 2
+        else:
+            raise AssertionError(bad)
