@@ -29,6 +29,7 @@ import csv
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -506,6 +507,8 @@ def main(argv=None) -> int:
                          "a copy of each file beside it, removed afterwards")
     args = ap.parse_args(argv)
     constants = parse_constants(args.constant, ap)
+    # a kill runs the finally clauses that delete the case copies (--constant)
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     every = cases()
     known = {c.name: c for c in every}
     known["S2"] = known["S1"]                      # S1 and S2 are one run of the hydrostatic tank
