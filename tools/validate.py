@@ -415,9 +415,8 @@ def case_with_constants(path: str, constants: dict) -> str:
         raise SystemExit(f"{path}: no <casedef><constantsdef> to set {', '.join(constants)} in")
     for name, value in constants.items():
         if name in _SMOOTHING_LENGTH:
-            for other in _SMOOTHING_LENGTH:
-                for el in cdef.findall(other) if other != name else []:
-                    cdef.remove(el)
+            for el in [e for other in _SMOOTHING_LENGTH if other != name for e in cdef.findall(other)]:
+                cdef.remove(el)
         el = cdef.find(name)
         if el is None:
             el = etree.SubElement(cdef, name)
@@ -521,6 +520,8 @@ def main(argv=None) -> int:
     table, failed = [], 0
     for case in chosen:
         print(f"\n{case.name} {case.title}\n  target: {case.target_text}")
+        if constants:
+            print("  with " + ", ".join(f"<{k} value=\"{v}\">" for k, v in constants.items()) + " (--constant)")
         head = f"  {'resolution':<11}{'dp':>9}{'particles':>10}{'steps':>8}{'runtime_s':>10}{'µs/p-step':>10}{'thr':>4}"
         print(head + "".join(f"{h:>{max(len(h) + 2, 12)}}" for h, _, _ in case.columns) + "  target")
         rows = []
@@ -562,10 +563,12 @@ def main(argv=None) -> int:
                       - set(header))
         with open(args.csv, "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(header + ["target_applies"] + keys)
+            w.writerow(header + ["target_applies", "constants"] + keys)
+            given = " ".join(f"{k}={v}" for k, v in constants.items())      # --constant: not the case files' own
             for r in table:
                 w.writerow([r["case"], r["resolution"], r["dp"], r["particles"], r["steps"], r["runtime_s"], r["us"],
-                            r["threads_used"], r["status"], r["meets_target"], r["scored"]] + [r["errors"].get(k, "") for k in keys])
+                            r["threads_used"], r["status"], r["meets_target"], r["scored"], given]
+                           + [r["errors"].get(k, "") for k in keys])
     if args.keep:
         print(f"\nrun folders kept in {base}")
     else:

@@ -1,5 +1,6 @@
 """tools/validate.py (error against run time) runs a case file through `sphdvi run` and
 scores it: the S9 Poiseuille channel at its coarsest resolution (20 across, ~1 s of stepping)."""
+import argparse
 import csv
 import subprocess
 import sys
@@ -25,6 +26,7 @@ def test_validate_tool_scores_s9_and_reports_run_time(tmp_path):
     # the centre-line error of tests/validation/test_poiseuille_case.py at 20 across (+0.92 %)
     assert abs(float(row["centreline"]) - 0.0092) < 0.0005
     assert float(row["transient"]) < 0.02
+    assert row["constants"] == ""                       # the case file's own constants
 
 
 def _validate_module():
@@ -60,7 +62,7 @@ def test_constant_option_writes_a_copy_beside_the_case_with_the_new_values(tmp_p
         assert "hdp" in src.read_text()                                 # the user's file unchanged
     finally:
         Path(copy).unlink()
-    ap = __import__("argparse").ArgumentParser()
+    ap = argparse.ArgumentParser()
     assert validate.parse_constants(["CoefH=1.2"], ap) == {"coefh": "1.2"}
     for bad in (["coefh"], ["Visco=0.1"], ["gravity=1"]):
         try:
