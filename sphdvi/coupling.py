@@ -75,6 +75,7 @@ class FloatingBodies:
         mech = mechanism_from_case(data, motions)
         self.system, self.names = build_system(mech["bodies"], mech["links"], mech["materials"],
                                                **mech["system"])
+        self.mkbounds = [int(m) for m in mech["mkbounds"]]
         self.is2d = bool(data["constants"]["is2d"])
         self.normals0 = normals0
         self.ftpause = float(ftpause)

@@ -5,7 +5,9 @@ coupling ``sphdvi.coupling``) ≠ simulation (this loop: output schedule, diverg
 checks, when to checkpoint, resume) ≠ writers (``sphdvi.io``: particles.vtkhdf,
 restart.h5 in ``io.checkpoint``, the text outputs in ``io.runfiles``). Outputs in OUT:
 
-* ``particles.vtkhdf``: temporal VTKHDF PolyData, one step per TimeOut (live particles);
+* ``particles.vtkhdf``: temporal VTKHDF PolyData, one step per TimeOut (live particles;
+  those ``<special><outputparts>`` selects, :mod:`sphdvi.output_parts`);
+* ``DtInfo.csv`` (and ``DtAllInfo.csv``) with ``<special><savedt>`` (:mod:`sphdvi.io.dtinfo`);
 * ``run.json``: provenance and status, written at the start and at the end;
 * ``run.log`` / ``run.csv``: one line per output time (like Run.out and RunPARTs.csv);
 * ``restart.h5``: the complete solver state at the last output, written atomically;
@@ -40,8 +42,10 @@ from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
+from .io.dtinfo import DTINFO_FILE, DtLog
 from .io.runfolder import NORMALS_FILE, check_new_run_folder, clear_earlier_results, stored_overrides
 from .sph.damping import damping_zones
+from .output_parts import OutputParts
 from .output_schedule import OutputSchedule
 from .sph.clock import time_reached
 
@@ -369,6 +373,12 @@ def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quie
         run.resume()
     else:
         files.start()
+    for section in ("savedt", "outputparts"):
+        if js.get("special", {}).get(section):
+            line = (f"<special><{section}>: a body-only run (no fluid) has no SPH time step or particle output "
+                    f"to {'record' if section == 'savedt' else 'filter'}; ignored (its steps are DtFixed, {dt:g} s)")
+            files.log("WARNING: " + line)
+            warnings.warn(line)
     files.write_json(**meta, mode="bodies", status="running", message="", dt=dt, steps=run.step,
                      physical_time=float(run.system.time), runtime_s=run.runtime,
                      startup_s=_time.perf_counter() - t_start, bodies=len(names), links=len(system.links))
@@ -726,6 +736,12 @@ class SPHRun:
         return int(frac * self.n0_fluid)
 
     # -- snapshots and checkpoints ------------------------------------------------------
+    def body_centres(self) -> dict:
+        """mkbound -> centre of each floating body now (none without bodies)."""
+        if self.floating is None:
+            return {}
+        return {mkb: self.bodies.pos[i] for i, mkb in enumerate(self.floating.mkbounds)}
+
     def snapshot(self) -> tuple[np.ndarray, dict]:
         s = self.solver.state
         press = self.solver.press
@@ -812,6 +828,11 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     sph = SPHRun(data, params, outdir)
     sol = sph.solver
     tmax, tout = float(params["TimeMax"]), float(params["TimeOut"])
+    special = data["json"].get("special") or {}
+    sol.keep_dt_terms = bool(special.get("savedt"))
+    selection = (OutputParts(special["outputparts"], int(data["json"]["mkconfig"]["fluidcount"]))
+                 if special.get("outputparts") else None)
+    dtlog = None
     vtk_path = os.path.join(outdir, "particles.vtkhdf")
     ckpt = os.path.join(outdir, RESTART_FILE)
     part = 0
@@ -821,6 +842,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             raise InputError(f"--resume: no checkpoint {ckpt} in {outdir}")
         extra = sph.load_checkpoint(ckpt)
         part = int(extra["part"])
+        if sol.keep_dt_terms:
+            dtlog = _resumed_dtlog(outdir, special["savedt"], tout, extra.get("savedt"), sol, files)
         wall_prev = float(extra.get("runtime_s", 0.0))
         had_vtk = os.path.exists(vtk_path)
         writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS, append=True)
@@ -839,6 +862,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     else:
         writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS)
         files.start()
+        if sol.keep_dt_terms:
+            dtlog = DtLog(outdir, special["savedt"], tout)
         if sol.boundary == 2:                   # the normals mDBC starts from, for a look in ParaView
             from .io.vtkxml import write_normals_vtp
             st = sol.state
@@ -862,6 +887,11 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
 
     def write_part(k):
         pos, arrays = sph.snapshot()
+        written = ""
+        if selection is not None and selection.applies_to(k):
+            keep = selection.select(pos, arrays["Type"], arrays["Mk"], sph.body_centres())
+            pos, arrays = pos[keep], {name: a[keep] for name, a in arrays.items()}
+            written = f"  written={int(keep.sum())}"
         writer.append(sol.time, pos, arrays)
         excl = sum(sol.n_excluded.values())
         excl_lines = excl_warn.check(excl - excl_seen[0], sol.n_fluid, excl, sol.time, sol.nstep)
@@ -870,14 +900,19 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         files.csv(f"{k},{sol.time:.9g},{sol.nstep},{sol.state.n},{excl},"
                   f"{dt_lo if dt_lo < math.inf else 0:.6g},{dt_hi:.6g},{wall:.3f}")
         files.log(f"Part {k:04d}  t={sol.time:.6f} s  steps={sol.nstep}  particles={sol.state.n}  "
-                  f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s")
+                  f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s"
+                  + written)
         for line in excl_lines:
             files.log("WARNING: " + line)
             warnings.warn(line)
         excluded_log.record(sol.take_excluded())
         if body_log is not None:
             body_log.record()
-        sph.save_checkpoint(ckpt, {"part": k, "runtime_s": wall})
+        saved = {"part": k, "runtime_s": wall}
+        if dtlog is not None:
+            dtlog.flush()
+            saved["savedt"] = json.dumps({"log": dtlog.get_state(), "terms": list(sol.dt_terms)})
+        sph.save_checkpoint(ckpt, saved)
 
     excl_seen = [sum(sol.n_excluded.values())]
     excl_warn = ExclusionWarnings(int(params.get("WrnPartsOut", 1)) != 0, sph.n0_fluid,
@@ -896,8 +931,11 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             extra = float(extra) if body_log is not None and extra is not None and extra < tout else None
             next_extra = _next_multiple(sol.time, extra) if extra else 0.0
             while not time_reached(sol.time, tmax):
+                t_step = sol.time
                 sol.step()
                 dt_lo, dt_hi = min(dt_lo, sol.last_dt), max(dt_hi, sol.last_dt)
+                if dtlog is not None:
+                    dtlog.add(t_step, (sol.last_dt,) + sol.step_dt_terms)
                 sph.check(0)
                 if gauges is not None:
                     gauges.after_step(sol)
@@ -925,6 +963,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             runtime += _time.perf_counter() - t_loop
             if gauges is not None:
                 gauges.close()
+            if dtlog is not None:
+                dtlog.close()
             files.write_json(status=status, message=message, steps=int(sol.nstep),
                              physical_time=float(sol.time), runtime_s=runtime)
             writer.close()
@@ -933,6 +973,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     excluded_log.record(sol.take_excluded())       # those after the last output (a stopped run)
     if gauges is not None:
         gauges.close()
+    if dtlog is not None:
+        dtlog.close()
     progress.update(sol.time, sol.nstep, sol.state.n, force=True)
     progress.close()
     writer.close()
@@ -946,6 +988,20 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                      us_per_particle_step=(1e6 * (runtime - wall_prev)
                                            / max(1, sol.nstep - steps_at_start) / max(1, sol.state.n)))
     return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)
+
+
+def _resumed_dtlog(outdir, spec, tout, saved, sol, files) -> DtLog:
+    """The ``<savedt>`` files of a resumed run: cut back to the checkpoint, the interval in
+    progress and the solver's latest dt terms restored (anew when the checkpoint has none)."""
+    if saved is None:
+        line = (f"--resume: the checkpoint holds no <savedt> state (its run had none): {DTINFO_FILE} starts anew "
+                f"at t={sol.time:.6g} s")
+        files.log("WARNING: " + line)
+        warnings.warn(line)
+        return DtLog(outdir, spec, tout)
+    saved = json.loads(saved)
+    sol.dt_terms = tuple(float(v) for v in saved["terms"])
+    return DtLog(outdir, spec, tout, state=saved["log"])
 
 
 def _next_multiple(t: float, step: float) -> float:

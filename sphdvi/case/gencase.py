@@ -539,8 +539,10 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
         if missing:
             raise CaseError(f"<accinput> for mkfluid {missing[0]}, which has no particles", file=reader.file,
                             line=acc["line"], element="accinput", expected="an mkfluid drawn by the geometry")
-    known = bound_labels | fluid_labels
-    del known
+    if case.special.get("outputparts"):
+        from .outputs_xml import check_outputparts
+        check_outputparts(case.special["outputparts"], label, ptype, particles["mk"],
+                          {b.mkbound: list(map(float, b.center)) for b in bodies}, case.fluidcount, reader.file)
     for link in case.material_links:
         for mk in link.get("mkbound", []):
             if mk not in bound_labels:

@@ -18,6 +18,7 @@ from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
 from .normals_xml import read_initialize, read_normals, read_onlypos
+from .outputs_xml import read_outputparts, read_savedt
 from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
                          coerce, constant_hint, default_parameters, domain_from_deprecated, parameter_warnings)
 from .schema import validate_structure
@@ -26,10 +27,11 @@ from .xmldoc import CaseReader, load_xml, strip_disabled
 CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initials", "motion",
                     "properties", "normals", "patterns", "vres"}
 EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres"}
-SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout", "initialize"}
+SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout", "initialize",
+                     "savedt", "outputparts"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
     "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
-    "moorings", "forcepoints", "outputparts", "savedt", "inout", "vres"}
+    "moorings", "forcepoints", "inout", "vres"}
 
 
 def case_name_from_path(path: str) -> str:
@@ -1248,4 +1250,5 @@ def _acc_table(reader, c) -> np.ndarray:
 
 SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges": read_gauges,
                    "wavepaddles": read_wavepaddles, "damping": read_damping, "shifting": read_shifting,
-                   "timeout": read_timeout, "initialize": read_initialize}
+                   "timeout": read_timeout, "initialize": read_initialize, "savedt": read_savedt,
+                   "outputparts": read_outputparts}

@@ -15,7 +15,7 @@ from .checkpoint import RESTART_FILE
 # (<casename>.h5, <casename>_All.vtp) holds none of them
 NORMALS_FILE = "normals.vtp"            # with mDBC: the boundary normals at the start
 RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "run.csv", "bodies.csv", "links.csv",
-                    NORMALS_FILE, "excluded.csv")
+                    NORMALS_FILE, "excluded.csv", "DtInfo.csv", "DtAllInfo.csv")
 
 
 # what `sphdvi export` writes into a folder: the collection and its numbered parts

@@ -33,6 +33,7 @@ DtFixedFile is passed as ``dt_table`` (the case reader loads the file);
 DtAllParticles selects the particles whose speed limits dt.
 
 """
+import math
 import warnings
 
 from . import _env  # noqa: F401
@@ -191,6 +192,10 @@ class SPHSolver:
         self._reorder_next = False
         self._alloc()
         self.dt_pre = self.dtini
+        # <savedt>: the terms of the latest dt (dt_terms) and of the step just taken
+        # (step_dt_terms), kept only when asked for (keep_dt_terms)
+        self.keep_dt_terms = False
+        self.dt_terms = self.step_dt_terms = (math.nan,) * 5
 
     # ------------------------------------------------------------------ set-up
     def _setup_constants(self):
@@ -788,10 +793,15 @@ class SPHSolver:
     def _variable_dt(self, t):
         """The dt of a step starting at time t (eq. 10, or the imposed one)."""
         fixed = self._fixed_dt(t)
-        if fixed > 0.0 and self.dt_table is None:
+        if fixed > 0.0 and self.dt_table is None and not self.keep_dt_terms:
             return fixed
         a2, v2, cv = self.dtmax.max(axis=0)     # left by the interaction (dt_terms)
-        dt = _ts.variable_dt(a2, v2, cv, self.h, self.cs0, self.cfl)
+        dt1, dt2 = _ts.dt_conditions(a2, v2, cv, self.h, self.cs0)
+        if self.keep_dt_terms:                  # <savedt>: CFL dt1, CFL dt2, AceMax, ViscDtMax, VelMax
+            self.dt_terms = (self.cfl * dt1, self.cfl * dt2, math.sqrt(a2), float(cv), math.sqrt(v2))
+        if fixed > 0.0 and self.dt_table is None:
+            return fixed
+        dt = self.cfl * min(dt1, dt2)
         if fixed > 0.0:
             self.dt_error = max(self.dt_error, fixed - dt)
             return fixed
@@ -844,6 +854,7 @@ class SPHSolver:
             self.cst[20] = 1.0 / (self._fixed_dt(self.time) or self.last_dt or self.dt_pre)
         self.compute_rates()
         dt = self._variable_dt(self.time)
+        self.step_dt_terms = self.dt_terms
         self._set_ip(dt)
         euler = self._verlet_count >= self.verlet_steps
         self._verlet_count = 0 if euler else self._verlet_count + 1
@@ -857,6 +868,7 @@ class SPHSolver:
 
     def _step_symplectic(self):
         dt = self._fixed_dt(self.time) or self.dt_pre
+        self.step_dt_terms = self.dt_terms      # those of dt_pre, found at the end of the last step
         self._set_ip(dt)
         s = self.state
         if self.adv & 1:

@@ -37,9 +37,14 @@ def dt_terms(ace, vel, viscdt, ptype, vel_type=2):
     return amax, vmax, cmax
 
 
-def variable_dt(acemax2, velmax2, viscmax, h, cs0, cfl):
-    """CFL min(dt_f, dt_cv) (DualSPHysics ``DtVariable``)."""
+def dt_conditions(acemax2, velmax2, viscmax, h, cs0):
+    """(dt_f, dt_cv) of eq. 10 before the CFL factor (DualSPHysics ``DtVariable``'s dt1, dt2)."""
     acemax = math.sqrt(acemax2)
     dt1 = math.sqrt(h / acemax) if acemax > 0 else math.inf
     dt2 = h / (max(cs0, 10.0 * math.sqrt(velmax2)) + h * viscmax)
-    return cfl * min(dt1, dt2)
+    return dt1, dt2
+
+
+def variable_dt(acemax2, velmax2, viscmax, h, cs0, cfl):
+    """CFL min(dt_f, dt_cv) (DualSPHysics ``DtVariable``)."""
+    return cfl * min(dt_conditions(acemax2, velmax2, viscmax, h, cs0))

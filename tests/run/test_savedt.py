@@ -1,0 +1,125 @@
+"""``<special><savedt>`` (DualSPHysics's JSaveDt): DtInfo.csv and DtAllInfo.csv, their columns
+against the time-step formula (eq. 10), their window, and a resume that writes them bitwise as an
+uninterrupted run does."""
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+from sphdvi.io.dtinfo import dtinfo_header
+
+from run.test_run import small_case
+
+COMMON = ["--threads", "1", "-q"]
+
+
+def invoke(args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def savedt_case(tmp_path, body, params=""):
+    path = small_case(tmp_path, extra_params=params)
+    path.write_text(path.read_text().replace("<special>", f"<special><savedt>{body}</savedt>", 1))
+    return path
+
+
+def read_rows(path):
+    lines = path.read_text().splitlines()
+    return lines[0], [[float(v) if v.strip() else math.nan for v in line.split(";")] for line in lines[1:]]
+
+
+def run_steps(out):
+    return int((out / "run.csv").read_text().splitlines()[-1].split(",")[2])
+
+
+def test_each_step_row_obeys_the_time_step_formula(tmp_path):
+    """An interval shorter than a step gives a row per step: Dtf = min(Dt1, Dt2) (Verlet, dt
+    above DtMin), Dt1 = CFL sqrt(h/AceMax), Dt2 = CFL h/(max(c0, 10 VelMax) + h ViscDtMax);
+    DtAllInfo holds the same steps, their dt adding up to the run's time."""
+    case = savedt_case(tmp_path, '<interval value="1e-7"/><fullinfo value="1"/><alldt value="1"/>')
+    out = tmp_path / "o"
+    r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.005"] + COMMON)
+    assert r.exit_code == 0, r.output
+    head, rows = read_rows(out / "DtInfo.csv")
+    assert head == dtinfo_header(True)
+    assert head.startswith("Time;Values;Dtf_mean;Dtf_min;Dtf_max;Dt1_mean") and head.endswith("VelMax_max")
+    rows = np.array(rows)
+    steps = run_steps(out)
+    assert rows.shape == (steps, 20) and np.all(rows[:, 1] == 1)
+    t, dtf, dt1, dt2, ace, visc, vel = rows[:, 0], rows[:, 2], rows[:, 5], rows[:, 8], rows[:, 11], rows[:, 14], rows[:, 17]
+    assert np.all(np.diff(t) > 0) and t[0] == 0.0
+    np.testing.assert_allclose(t[1:], np.cumsum(dtf)[:-1], rtol=1e-9)
+    np.testing.assert_allclose(dtf, np.minimum(dt1, dt2), rtol=1e-11)
+    import json
+    meta = json.loads((out / "run.json").read_text())
+    from sphdvi.io.casefile import read_case_h5
+    c = read_case_h5(str(next(out.glob("*.h5")) if not (out / "restart.h5").exists() else
+                         next(p for p in out.glob("*.h5") if p.name != "restart.h5")))["constants"]
+    cfl, h, c0 = 0.2, float(c["h"]), float(c["cs0"])
+    np.testing.assert_allclose(dt1, cfl * np.sqrt(h / ace), rtol=1e-11)
+    np.testing.assert_allclose(dt2, cfl * h / (np.maximum(c0, 10 * vel) + h * visc), rtol=1e-11)
+    _, every = read_rows(out / "DtAllInfo.csv")
+    every = np.array(every)
+    assert (out / "DtAllInfo.csv").read_text().startswith("Time;Dtf\n")
+    np.testing.assert_array_equal(every, rows[:, [0, 2]])
+    assert every[:, 1].sum() == pytest.approx(meta["physical_time"], rel=1e-12)
+
+
+@pytest.mark.parametrize("algorithm", [1, 2])
+def test_intervals_window_and_bitwise_resume(tmp_path, algorithm):
+    """Rows every 0.003 s from 0.004 to 0.016 (an interval in progress at each output, 0.005
+    apart); the window holds every step that starts in it; a run stopped at 0.01 and resumed
+    writes both files byte for byte as the uninterrupted one."""
+    body = '<start value="0.004"/><finish value="0.016"/><interval value="0.003"/><alldt value="true"/>'
+    case = savedt_case(tmp_path, body, f'<parameter key="StepAlgorithm" value="{algorithm}"/>')
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert invoke(["run", case, "-o", a, "--tmax", "0.02", "--tout", "0.005"] + COMMON).exit_code == 0
+    head, rows = read_rows(a / "DtInfo.csv")
+    assert head == dtinfo_header(False)
+    rows = np.array(rows)
+    _, every = read_rows(a / "DtAllInfo.csv")
+    every = np.array(every)
+    assert every[0, 0] >= 0.004 and every[-1, 0] <= 0.016 and every[0, 0] - every[0, 1] < 0.004
+    assert rows[:, 1].sum() == len(every)               # every step of the window, once
+    k = np.floor((rows[:, 0] - 0.004) / 0.003)
+    assert list(k) == list(range(len(k)))                # a row per interval, in order
+    assert np.all(rows[:, 3] <= rows[:, 2]) and np.all(rows[:, 2] <= rows[:, 4])
+    if algorithm == 2:          # a Symplectic step's dt is the min of the terms found before it
+        np.testing.assert_allclose(rows[:, 3], np.minimum(rows[:, 6], rows[:, 9]), rtol=1e-11)
+    assert invoke(["run", case, "-o", b, "--tmax", "0.01", "--tout", "0.005"] + COMMON).exit_code == 0
+    r = invoke(["run", b, "--resume", "--tmax", "0.02"] + COMMON)
+    assert r.exit_code == 0, r.output
+    for name in ("DtInfo.csv", "DtAllInfo.csv"):
+        assert (b / name).read_bytes() == (a / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("body, message", [
+    ('<interval value="0"/>', "interval=0"),
+    ('<finish value="0.1"/><start value="0.2"/>', "is before start"),
+    ('<every value="1"/>', "unknown element <every>"),
+    ('<fullinfo value="maybe"/>', "is not a boolean"),
+])
+def test_bad_savedt_is_a_case_error(tmp_path, body, message):
+    case = savedt_case(tmp_path, body)
+    r = invoke(["gencase", case, "-o", tmp_path / "g"])
+    assert r.exit_code == 2, r.output
+    assert message in r.output and "CaseDB_Def.xml:" in r.output and "Traceback" not in r.output
+
+
+def test_a_body_only_run_says_it_has_no_dt_to_record(tmp_path):
+    from pathlib import Path
+    src = Path(__file__).resolve().parents[2] / "cases" / "pendulum"
+    xml = next(src.glob("*_Def.xml"))
+    for extra in src.iterdir():
+        if extra.is_file():
+            (tmp_path / extra.name).write_bytes(extra.read_bytes())
+    case = tmp_path / xml.name
+    case.write_text(xml.read_text().replace("<special>", "<special><savedt/>", 1))
+    out = tmp_path / "o"
+    with pytest.warns(UserWarning, match="body-only run"):
+        r = invoke(["run", case, "-o", out, "--tmax", "0.05", "-q"])
+    assert r.exit_code == 0, r.output
+    assert "<special><savedt>: a body-only run" in (out / "run.log").read_text()
+    assert not (out / "DtInfo.csv").exists()
