@@ -470,13 +470,131 @@ class SpectrumPaddle(_Paddle):
         return np.cos(a) @ self.amp
 
 
+SOLITARY_THEORIES = {1: "Rayleigh", 2: "Boussinesq", 3: "KdV"}
+GORING_THETA = 3.8        # Goring (1978): the motion spans tanh θ from -0.999 to 0.999
+
+
+def solitary_wave(theory: int, H: float, h: float, g: float = 9.81) -> tuple[float, float]:
+    """(κ, c) of the solitary wave η = H sech²(κ (x − c t)) in depth h: Rayleigh (Serre 1953)
+    κ = √(3H / (4h²(h + H))), c = √(g(h + H)); Boussinesq (Goring 1978) κ = √(3H/4h³),
+    c = √(g(h + H)); KdV κ = √(3H/4h³), c = √(gh) (1 + H/2h)."""
+    if theory == 1:
+        return math.sqrt(3 * H / (4 * h * h * (h + H))), math.sqrt(g * (h + H))
+    if theory == 2:
+        return math.sqrt(3 * H / (4 * h ** 3)), math.sqrt(g * (h + H))
+    if theory == 3:
+        return math.sqrt(3 * H / (4 * h ** 3)), math.sqrt(g * h) * (1 + H / (2 * h))
+    raise ValueError(f"solitary-wave theory {theory} (expected 1, 2 or 3)")
+
+
+class _SolitaryStroke:
+    """One solitary wave from a piston (Goring 1978): the piston moves with the wave's
+    depth-averaged velocity, dX/dt = c η/(h + η) at X. With η = H sech²θ, θ = κ(c t − X) − θ_e,
+    dX/dθ = η/(κh), so X(θ) = (H/κh)(tanh θ + tanh θ_e), t(θ) = (θ + θ_e + κ X(θ))/(κ c): exact for
+    each theory's κ and c. θ runs from −θ_e to θ_e, θ_e chosen so that the motion lasts
+    ``durationcoef`` times Goring's T = 2(3.8 + H/h)/(κc); t(θ) is inverted by Newton's method."""
+
+    def __init__(self, theory: int, H: float, h: float, durationcoef: float, start: float, g: float):
+        self.H, self.h, self.start = H, h, start
+        self.kappa, self.c = solitary_wave(theory, H, h, g)
+        self.duration = durationcoef * 2 * (GORING_THETA + H / h) / (self.kappa * self.c)
+        target, e = 0.5 * self.kappa * self.c * self.duration, GORING_THETA
+        for _ in range(50):             # θ_e + (H/h) tanh θ_e = κ c T / 2
+            step = (e + H / h * math.tanh(e) - target) / (1 + H / h / math.cosh(e) ** 2)
+            e -= step
+            if abs(step) < 1e-14 * max(1.0, e):
+                break
+        self.theta_e = e
+        self.amp = H / (self.kappa * h)
+        self.stroke = self.amp * 2 * math.tanh(e)
+
+    def _theta(self, tau: float) -> float:
+        """θ at the time τ since this wave's start (Newton on κcτ = θ + θ_e + κX(θ))."""
+        target = self.kappa * self.c * tau - self.theta_e - self.kappa * self.amp * math.tanh(self.theta_e)
+        th = min(max(target, -self.theta_e), self.theta_e)
+        r = self.H / self.h
+        for _ in range(60):
+            step = (th + r * math.tanh(th) - target) / (1 + r / math.cosh(th) ** 2)
+            th -= step
+            if abs(step) < 1e-15 * max(1.0, abs(th)):
+                break
+        return th
+
+    def position(self, t: float) -> tuple[float, float]:
+        """Displacement and velocity of the piston at time t (0 before the start, the stroke after)."""
+        tau = t - self.start
+        if tau <= 0:
+            return 0.0, 0.0
+        if tau >= self.duration:
+            return self.stroke, 0.0
+        th = self._theta(tau)
+        eta = self.H / math.cosh(th) ** 2
+        return self.amp * (math.tanh(th) + math.tanh(self.theta_e)), self.c * eta / (self.h + eta)
+
+    def crest(self) -> tuple[float, float]:
+        """Where (from the piston's rest position) and when the crest leaves the piston (θ = 0)."""
+        x = self.amp * math.tanh(self.theta_e)
+        return x, self.start + (self.theta_e + self.kappa * x) / (self.kappa * self.c)
+
+
+class SolitaryPaddle(_Paddle):
+    """Solitary waves from a piston (``<piston_solitary>``): ``waves`` strokes of
+    :class:`_SolitaryStroke`, each starting ``startcoef`` times the previous one's duration
+    after it; their displacements add up.  Theories 1 Rayleigh, 2 Boussinesq (Goring's, the
+    default), 3 KdV (:func:`solitary_wave`)."""
+
+    def __init__(self, spec: dict, g: float = 9.81):
+        self._set_geometry(spec)
+        self.ramp_time = 0.0
+        self.duration = 0.0                 # each stroke stops by itself
+        self.depth = spec["depth"]
+        self.strokes = []
+        start = 0.0
+        for w in spec["solitary"]:
+            if self.strokes:
+                start += w["startcoef"] * self.strokes[-1].duration
+            self.strokes.append(_SolitaryStroke(int(spec.get("theory", 2)), w["waveheight"], self.depth,
+                                                w["durationcoef"], start, g))
+
+    def _series(self, tau: float):
+        x = v = 0.0
+        for s in self.strokes:
+            dx, dv = s.position(tau)
+            x, v = x + dx, v + dv
+        return x, v
+
+    def elevation(self, x, t, order: int = 1) -> np.ndarray:
+        """The solitary waves' η(x, t) = Σ H sech²(κ(x − x_c − c(τ − τ_c))) at a distance ``x`` in
+        front of the piston's rest position, each crest leaving the piston at x_c, τ_c
+        (:meth:`_SolitaryStroke.crest`); no interaction between the waves."""
+        tau = np.atleast_1d(np.asarray(t, dtype=float)) - self.start
+        eta = np.zeros_like(tau)
+        for s in self.strokes:
+            xc, tc = s.crest()
+            eta += s.H / np.cosh(s.kappa * (float(x) - xc - s.c * (tau - tc))) ** 2
+        return eta
+
+    def stroke_amplitude(self) -> float:
+        return 0.5 * sum(s.stroke for s in self.strokes)
+
+    def max_acceleration(self) -> float:
+        """A bound on the stroke's acceleration: Σ c² κ H/h (|d/dt of c η/(h + η)|)."""
+        return sum(s.c ** 2 * s.kappa * s.H / s.h for s in self.strokes)
+
+
+def make_paddle(spec: dict, g: float = 9.81) -> _Paddle:
+    """The paddle of a ``<wavepaddles>`` entry."""
+    if spec["type"] == "piston_solitary":
+        return SolitaryPaddle(spec, g)
+    return SpectrumPaddle(spec, g) if spec["type"].endswith("_spectrum") else WavePaddle(spec, g)
+
+
 class MotionSet:
     """All imposed motions of a case: ``transforms(t)`` → {mkbound: Rigid}."""
 
     def __init__(self, motions: list, wavepaddles: list | None = None, g: float = 9.81):
         self.motions = {m["ref"]: m for m in motions}
-        self.paddles = {p["mkbound"]: (SpectrumPaddle(p, g) if p["type"].endswith("_spectrum") else WavePaddle(p, g))
-                        for p in (wavepaddles or [])}
+        self.paddles = {p["mkbound"]: make_paddle(p, g) for p in (wavepaddles or [])}
 
     @property
     def mkbounds(self):

@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3, W5, C3)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3, W5, W6, C3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.005 took 1 h 52 min on 2 threads);
@@ -127,6 +127,11 @@ def score_flap_waves(outdir):
 def score_absorption(outdir):
     from sphdvi.validation.waveflume import absorption_errors
     return absorption_errors(outdir)
+
+
+def score_solitary(outdir):
+    from sphdvi.validation.solitary import solitary_errors
+    return solitary_errors(outdir)
 
 
 def _wave_flume_case(name, paddle, xml):
@@ -352,6 +357,15 @@ def cases() -> list:
              and abs(e["H_incident"]) <= 0.10,
              "the paddle reflects what linear theory says its absorber should (within 0.1; a still piston: 1), "
              "and the wave leaving it stays within 10 % of H (judgement)"),
+        Case("W6", "solitary wave from a piston (<piston_solitary>, Goring 1978: H = 0.02 m in h = 0.1 m)",
+             case_path("waveflume2d", "CaseWaveSolitary2D_Def.xml"),
+             [Resolution("h/dp 10", 0.01), Resolution("h/dp 20", 0.005)],
+             score_solitary, [("H max|err| %", "H_max", PCT), ("H WG1 %", "H_WG1", PCT), ("H WG3 %", "H_WG3", PCT),
+                              ("celerity %", "celerity", PCT), ("arrival WG1 s", "arrival_WG1", "{:+.3f}"),
+                              ("arrival WG3 s", "arrival_WG3", "{:+.3f}"), ("rms max %H", "rms_max", PCT)],
+             "H_max", lambda e: e["H_max"] <= 0.10 and abs(e["celerity"]) <= 0.03,
+             "crest height within 10 % of H at the three gauges and crest speed within 3 % of sqrt(g(h + H)) "
+             "(judgement, as W1)"),
         Case("W4", "irregular waves from a piston (<piston_spectrum>: JONSWAP Hs = 0.04 m, Tp = 1.4 s, d = 0.3 m)",
              case_path("waveflume2d", "CaseWaveIrregular2D_Def.xml"),
              [Resolution("Hs/dp 2", 0.02), Resolution("Hs/dp 4", 0.01)],
@@ -493,7 +507,7 @@ def fmt(spec: str, value) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 W4 W5 C3); default: all but the slow S4, S8, S16, S16M, S16O, S18 and W4")
+    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 W4 W5 W6 C3); default: all but the slow S4, S8, S16, S16M, S16O, S18 and W4")
     ap.add_argument("--all", action="store_true", help="every case, S4 included")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")

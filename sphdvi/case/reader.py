@@ -909,9 +909,13 @@ def read_wavepaddles(reader, el) -> list:
              "flap_spectrum": {**spec_spectrum, **flap_geometry}}
     out = []
     for c in reader.children(el):
+        if c.tag == "piston_solitary":
+            out.append(read_piston_solitary(reader, c))
+            continue
         if c.tag not in specs:
             raise reader.error(c, f"<wavepaddles><{c.tag}> is not supported by sphdvi",
-                               "<piston> or <flap> (regular waves), <piston_spectrum> or <flap_spectrum> (irregular)")
+                               "<piston> or <flap> (regular waves), <piston_spectrum> or <flap_spectrum> "
+                               "(irregular), <piston_solitary> (solitary waves)")
         spectral = c.tag.endswith("_spectrum")
         d = {"type": c.tag, "line": c.sourceline}
         d.update(_value_children(reader, c, specs[c.tag], required=("mkbound", "depth", "waveheight", "waveperiod")))
@@ -1116,6 +1120,68 @@ def _read_spectrum_options(reader, c, d: dict) -> None:
         if str(raw.get("autofit", "false")).strip().lower() in ("true", "1"):
             reader.warn(el, "<serieini autofit> is not needed by sphdvi: the paddle starts from where it is "
                             "drawn (the series less its value at serieini) and ramps up; autofit is ignored")
+
+
+def read_piston_solitary(reader, c) -> dict:
+    """``<piston_solitary>``: ``waves`` solitary waves (DualSPHysics's JWavePaddles format):
+    ``theory`` (1 Rayleigh, 2 Boussinesq, 3 KdV; 2), ``start``, ``depth``, ``pistondir``,
+    ``waveheight``, ``durationcoef`` (1) and for the n-th wave ``waveheightN``,
+    ``durationcoefN`` and ``startcoefN`` (its start after the previous wave's, in that wave's
+    durations), each defaulting to the previous wave's (startcoef2: 1)."""
+    base = {"mkbound": "int", "theory": "int", "start": "num", "depth": "num", "pistondir": "vec",
+            "durationcoef": "num", "waveheight": "num", "waves": "int", "savemotion": "raw"}
+    allowed = set(base)
+    n = 1
+    wel = reader.child(c, "waves")
+    if wel is not None:
+        n = reader.integer(wel, "value", lo=1, hi=100)
+    for k in range(2, n + 1):
+        allowed |= {f"startcoef{k}", f"durationcoef{k}", f"waveheight{k}"}
+    for e in reader.children(c):
+        if e.tag not in allowed:
+            hint = (f" (the case has <waves value=\"{n}\">)" if e.tag[-1:].isdigit() else "")
+            raise reader.error(e, f"unknown element <{e.tag}> in <piston_solitary>{hint}",
+                               "one of " + ", ".join(f"<{k}>" for k in sorted(base)) +
+                               ", and <startcoefN>, <durationcoefN>, <waveheightN> for N = 2..waves")
+    spec = dict(base)
+    spec.update({k: "num" for k in allowed - set(base)})
+    d = {"type": "piston_solitary", "line": c.sourceline}
+    d.update(_value_children(reader, c, spec, required=("mkbound", "depth", "waveheight")))
+    d.setdefault("theory", 2)
+    if d["theory"] not in (1, 2, 3):
+        raise reader.error(reader.child(c, "theory"), f"theory {d['theory']}",
+                           "1 (Rayleigh), 2 (Boussinesq, Goring 1978) or 3 (KdV)")
+    d.setdefault("start", 0.0)
+    if d["start"] < 0:
+        raise reader.error(reader.child(c, "start"), f"<start> value={d['start']:g} is negative", "start >= 0 [s]")
+    if d["depth"] <= 0:
+        raise reader.error(reader.child(c, "depth"), "<depth> must be positive", "depth > 0")
+    d.setdefault("pistondir", [1.0, 0.0, 0.0])
+    if not any(d["pistondir"]):
+        raise reader.error(reader.child(c, "pistondir"), "<pistondir> is the zero vector",
+                           "the direction of the piston's stroke, e.g. x=1 y=0 z=0")
+    waves, prev = [], {"waveheight": d["waveheight"], "durationcoef": d.get("durationcoef", 1.0), "startcoef": 1.0}
+    for k in range(1, n + 1):
+        w = {key: d.pop(f"{key}{k}" if k > 1 else key, prev[key]) for key in ("waveheight", "durationcoef", "startcoef")}
+        tag = lambda key: reader.child(c, f"{key}{k}" if k > 1 else key)   # noqa: E731
+        if not w["waveheight"] > 0:
+            raise reader.error(tag("waveheight"), f"wave height {w['waveheight']:g}", "a height > 0 [m]")
+        if w["waveheight"] > 0.78 * d["depth"]:
+            raise reader.error(tag("waveheight"), f"wave height {w['waveheight']:g} m in {d['depth']:g} m of water "
+                               "breaks (H/h > 0.78)", "H/h below 0.78 (a solitary wave's limit)")
+        if not w["durationcoef"] > 0:
+            raise reader.error(tag("durationcoef"), f"duration coefficient {w['durationcoef']:g}", "a coefficient > 0")
+        if k > 1 and not w["startcoef"] >= 0:
+            raise reader.error(tag("startcoef"), f"start coefficient {w['startcoef']:g}", "a coefficient >= 0")
+        waves.append(w)
+        prev = w
+    d["solitary"] = waves
+    d["waves"] = n
+    if "savemotion" in d:
+        reader.warn(reader.child(c, "savemotion"), "<savemotion> (the paddle motion written to a file) is not "
+                    "implemented by sphdvi: no file is written; <savemotion> is ignored")
+    d["duration"], d["gainstroke"] = 0.0, 1.0
+    return d
 
 
 def read_damping(reader, el) -> list:
