@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,6 +67,12 @@ class RunOutput:
         self.fluidcount = int((self.data["json"].get("mkconfig") or {}).get("fluidcount", 0))
         self.mass_by_idp[idp] = self._run_masses(p)
         self.vtk_path = os.path.join(outdir, "particles.vtkhdf")
+        selection = (self.data["json"].get("special") or {}).get("outputparts")
+        if selection:
+            every = int(selection.get("ignore") or 0)
+            warnings.warn(f"{self.vtk_path} holds only the particles the case's <special><outputparts> selects"
+                          + (f" (outputs 0, {every}, {2 * every}, ... whole)" if every > 0 else "")
+                          + ": what is measured from it sees those alone")
 
     def _run_masses(self, p) -> np.ndarray:
         """The particle masses the run used: the case's, but rho0 dp^d for the floating

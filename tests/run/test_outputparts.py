@@ -144,6 +144,9 @@ def test_a_run_writes_the_selected_particles_of_the_full_output(tmp_path):
         assert 0 < keep.sum()
         for name in ("Idp", "points", "Vel", "Rhop", "Type", "Mk"):
             np.testing.assert_array_equal(b[name], a[name][keep], err_msg=f"{name} at output {k}")
+    from sphdvi.measure.post import RunOutput
+    with pytest.warns(UserWarning, match=r"holds only the particles .* \(outputs 0, 3, 6, \.\.\. whole\)"):
+        RunOutput(str(part))
 
 
 @pytest.mark.parametrize("section, message", [
