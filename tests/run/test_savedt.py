@@ -123,3 +123,22 @@ def test_a_body_only_run_says_it_has_no_dt_to_record(tmp_path):
     assert r.exit_code == 0, r.output
     assert "<special><savedt>: a body-only run" in (out / "run.log").read_text()
     assert not (out / "DtInfo.csv").exists()
+
+
+def test_a_diverged_run_keeps_the_dt_of_every_step_it_took(tmp_path):
+    """DtFixed far above the CFL limit blows up (exit 3); DtInfo.csv and DtAllInfo.csv hold every step,
+    the last one's included, and show the force condition Dt1 collapsing under the imposed dt."""
+    import json
+    case = savedt_case(tmp_path, '<interval value="0.002"/><alldt value="1"/>')
+    out = tmp_path / "o"
+    r = invoke(["run", case, "-o", out, "--tmax", "0.5", "--tout", "0.01", "--set", "DtFixed=0.004"] + COMMON)
+    assert r.exit_code == 3, r.output
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "diverged"
+    _, every = read_rows(out / "DtAllInfo.csv")
+    _, rows = read_rows(out / "DtInfo.csv")
+    rows = np.array(rows)
+    assert len(every) == meta["steps"] == rows[:, 1].sum()
+    assert np.all(np.array(every)[:, 1] == 0.004)
+    # Dt1 = CFL sqrt(h/|a|max): below the imposed 0.004 s from the first step, a tenth of it by the last
+    assert rows[-1, 6] < 0.1 * rows[0, 6] and rows[0, 6] < 0.004
