@@ -8,7 +8,7 @@ from sphdvi.cli import main
 from sphdvi.io.vtkhdf import read_step, step_times
 from sphdvi.output_parts import OutputParts
 
-from run.test_run import small_case
+from run.test_run import assert_gencase_error, small_case
 
 COMMON = ["--threads", "1", "-q"]
 FLUIDCOUNT = 9
@@ -165,7 +165,4 @@ def test_a_run_writes_the_selected_particles_of_the_full_output(tmp_path):
     ('<outputparts preselection="all"><filtercube operation="add"/></outputparts>', "unknown element <filtercube>"),
 ])
 def test_bad_outputparts_is_a_case_error(tmp_path, section, message):
-    case = with_special(tmp_path, section)
-    r = invoke(["gencase", case, "-o", tmp_path / "g"])
-    assert r.exit_code == 2, r.output
-    assert message in r.output and "CaseDB_Def.xml:" in r.output and "Traceback" not in r.output
+    assert_gencase_error(with_special(tmp_path, section), tmp_path / "g", message)

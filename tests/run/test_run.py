@@ -34,6 +34,14 @@ def invoke(args):
     return CliRunner().invoke(main, [str(a) for a in args])
 
 
+def assert_gencase_error(case, outdir, message):
+    """gencase of ``case`` fails with exit code 2 and a message naming the case file and line, without a
+    traceback."""
+    r = invoke(["gencase", case, "-o", outdir])
+    assert r.exit_code == 2, r.output
+    assert message in r.output and f"{os.path.basename(str(case))}:" in r.output and "Traceback" not in r.output
+
+
 def final_state(outdir):
     with h5py.File(os.path.join(outdir, "restart.h5"), "r") as f:
         idp = f["state/idp"][...]

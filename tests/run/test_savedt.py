@@ -10,7 +10,7 @@ from click.testing import CliRunner
 from sphdvi.cli import main
 from sphdvi.io.dtinfo import dtinfo_header
 
-from run.test_run import small_case
+from run.test_run import assert_gencase_error, small_case
 
 COMMON = ["--threads", "1", "-q"]
 
@@ -102,10 +102,7 @@ def test_intervals_window_and_bitwise_resume(tmp_path, algorithm):
     ('<fullinfo value="maybe"/>', "is not a boolean"),
 ])
 def test_bad_savedt_is_a_case_error(tmp_path, body, message):
-    case = savedt_case(tmp_path, body)
-    r = invoke(["gencase", case, "-o", tmp_path / "g"])
-    assert r.exit_code == 2, r.output
-    assert message in r.output and "CaseDB_Def.xml:" in r.output and "Traceback" not in r.output
+    assert_gencase_error(savedt_case(tmp_path, body), tmp_path / "g", message)
 
 
 def test_a_body_only_run_says_it_has_no_dt_to_record(tmp_path):
