@@ -115,7 +115,9 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
     \b
     Outputs in OUT: particles.vtkhdf (one temporal VTKHDF file), run.json,
     run.log, run.csv, restart.h5; cases with bodies write bodies.csv and links.csv,
-    runs that exclude fluid particles excluded.csv (one row per particle).
+    runs that exclude fluid particles excluded.csv (one row per particle),
+    cases with <special><savedt> DtInfo.csv (and DtAllInfo.csv); <special>
+    <outputparts> chooses the particles particles.vtkhdf holds.
     A new run into an OUT holding an earlier run's results needs --overwrite.
     Exit codes: 0 completed, 1 failed or interrupted, 2 bad input, 3 diverged.
     """
