@@ -545,6 +545,7 @@ class SolitaryPaddle(_Paddle):
 
     def __init__(self, spec: dict, g: float = 9.81):
         self._set_geometry(spec)
+        self.g = g
         self.ramp_time = 0.0
         self.duration = 0.0                 # each stroke stops by itself
         self.depth = spec["depth"]
