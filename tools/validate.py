@@ -141,7 +141,8 @@ def _wave_flume_case(name, paddle, xml):
                 [Resolution("H/dp 1.5", 0.02), Resolution("H/dp 3", 0.01)],
                 score_wave_flume, [("H inc err %", "H_incident", PCT), ("refl %", "reflection", "{:.1f} %"),
                                    ("H WG1 %", "H_WG1", PCT), ("H WG3 %", "H_WG3", PCT),
-                                   ("celerity %", "celerity", PCT), ("refl (own k) %", "reflection_fitted_k", "{:.1f} %")],
+                                   ("celerity %", "celerity", PCT), ("vs still depth %", "celerity_still_depth", PCT),
+                                   ("refl (own k) %", "reflection_fitted_k", "{:.1f} %")],
                 "H_incident", lambda e: abs(e["H_incident"]) <= 0.10,
                 "incident wave height within 10 % of the target (judgement; DualSPHysics advises H/dp >= 10)")
 

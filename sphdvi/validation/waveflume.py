@@ -18,6 +18,7 @@ PERIOD = 1.2               # s
 DEPTH = 0.3                # m
 GAUGES = {"WG1": 0.3, "WG2": 0.6, "WG3": 0.9}
 WINDOW = 2                 # periods, at the end of the run
+STILL_BEFORE = 0.1         # s: the gauges read the still water before the first wave reaches WG1
 
 
 def first_harmonic(t: np.ndarray, eta: np.ndarray, omega: float) -> complex:
@@ -52,14 +53,18 @@ def wave_errors(outdir: str) -> dict:
     harmonic at each gauge (relative to H); ``celerity``: the phase speed ω/k of the wave the
     gauges see (k from :func:`fitted_wavenumber`) over linear theory's, minus 1, and
     ``reflection_fitted_k`` the reflection coefficient with that k (the split with the theory's k
-    takes a phase-speed error for reflection)."""
+    takes a phase-speed error for reflection).  ``celerity_still_depth``: the same phase speed against
+    linear theory's in the depth the gauges read in the still water (before the first wave arrives,
+    from the bottom wall's particle centres at z = 0 to the kernel-sum surface, which stands above
+    the top fluid particles), ``still_depth``."""
     from ..motion import wave_number
     k = wave_number(PERIOD, DEPTH)
     omega = 2 * math.pi / PERIOD
-    xs, amps, out = [], [], {}
+    xs, amps, out, still = [], [], {}, []
     for name, x in GAUGES.items():
         g = gauge_table(outdir, "SWL", name)
         t, eta = g[:, 0], g[:, 3]
+        still.append(float(np.mean(eta[t <= STILL_BEFORE])))
         sel = t >= t[-1] - WINDOW * PERIOD - 1e-9
         a = first_harmonic(t[sel], eta[sel], omega)
         xs.append(x)
@@ -70,6 +75,8 @@ def wave_errors(outdir: str) -> dict:
     out["reflection"] = abs(ref) / abs(inc)
     k_wave = fitted_wavenumber(np.asarray(xs), np.asarray(amps), k)
     out["celerity"] = k / k_wave - 1.0
+    out["still_depth"] = float(np.mean(still))
+    out["celerity_still_depth"] = wave_number(PERIOD, out["still_depth"]) / k_wave - 1.0
     inc, ref = incident_reflected(np.asarray(xs), np.asarray(amps), k_wave)
     out["reflection_fitted_k"] = abs(ref) / abs(inc)
     return out
