@@ -112,6 +112,28 @@ def test_fitted_wavenumber_recovers_the_waves_own_k():
     assert abs(ref0) / abs(inc0) > 0.03
 
 
+def test_a_wave_in_deeper_still_water_is_fast_for_the_case_depth_and_right_for_its_own(tmp_path):
+    """Gauge files of a linear wave H in 0.307 m of still water (the kernel-sum surface 0.7 dp above the
+    top particles at dp 0.01): wave_errors reads the still depth from the first 0.1 s, finds the wave's
+    k, the phase speed k(d)/k(0.307) − 1 = +0.78 % against the case's d = 0.3 m and 0 against the still
+    depth."""
+    import numpy as np
+    from sphdvi.validation.waveflume import GAUGES, STILL_BEFORE
+    d = 0.307
+    k = wave_number(PERIOD, d)
+    omega = 2 * np.pi / PERIOD
+    t = np.arange(0.0, 8.4 + 1e-9, 0.01)
+    for name, x in GAUGES.items():
+        eta = np.where(t > STILL_BEFORE, 0.5 * H * np.cos(omega * t - k * x), 0.0)
+        rows = "".join(f"{ti:.15g};0;0;{d + e:.12g};0;0;0;0;0;0\n" for ti, e in zip(t, eta))
+        (tmp_path / f"GaugesSWL_{name}.csv").write_text("time [s];a;b;swlz [m];c;d;e;f;g;h\n" + rows)
+    e = wave_errors(str(tmp_path))
+    assert e["still_depth"] == pytest.approx(d, abs=1e-12)
+    assert e["celerity"] == pytest.approx(K / k - 1, abs=2e-4) and 0.0075 < e["celerity"] < 0.0081
+    assert abs(e["celerity_still_depth"]) < 2e-4
+    assert abs(e["H_incident"]) < 1e-3 and e["reflection"] < 1e-2
+
+
 AWAS_CASE = REPO / "cases" / "waveflume2d" / "CaseWaveAwas2D_Def.xml"
 
 
