@@ -875,6 +875,9 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     if stopped is not None:
         writer.close()
         return stopped
+    # the run-time gauges measure the initial state here, so that their first JIT compilation
+    # counts in startup_s, not in runtime_s
+    gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
     startup = _time.perf_counter() - t_start
     files.write_json(**meta, mode="sph", numba=numba.__version__, threading_layer=_threading_layer(),
                      status="running", message="", steps=int(sol.nstep), physical_time=float(sol.time),
@@ -917,7 +920,6 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     excl_seen = [sum(sol.n_excluded.values())]
     excl_warn = ExclusionWarnings(int(params.get("WrnPartsOut", 1)) != 0, sph.n0_fluid,
                                   int(data["particles"]["type"].size))
-    gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
     excluded_log = ExcludedLog(outdir, float(sol.time) if resume else None)
     body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None)
                 if sph.bodies is not None else None)
