@@ -103,7 +103,8 @@ def test_the_case_format_and_its_defaults(tmp_path):
 
 @pytest.mark.parametrize("body, message", [
     ('<theory value="4"/>', "theory 4"),
-    ('<startcoef2 value="0.5"/>', "unknown element <startcoef2> in <piston_solitary> (the case has <waves value=\"1\">)"),
+    ('<startcoef2 value="0.5"/>',
+     "unknown element <startcoef2> in <piston_solitary> (the case has <waves value=\"1\">)"),
     ('<waves value="2"/><waveheight2 value="0.09"/>', "breaks (H/h > 0.78)"),
     ('<durationcoef value="0"/>', "duration coefficient 0"),
     ('<pistondir x="0" y="0" z="0"/>', "<pistondir> is the zero vector"),

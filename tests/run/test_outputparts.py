@@ -8,7 +8,7 @@ from sphdvi.cli import main
 from sphdvi.io.vtkhdf import read_step, step_times
 from sphdvi.output_parts import OutputParts
 
-from run.test_run import assert_gencase_error, small_case
+from run.test_run import REPO, assert_gencase_error, small_case
 
 COMMON = ["--threads", "1", "-q"]
 FLUIDCOUNT = 9
@@ -166,3 +166,38 @@ def test_a_run_writes_the_selected_particles_of_the_full_output(tmp_path):
 ])
 def test_bad_outputparts_is_a_case_error(tmp_path, section, message):
     assert_gencase_error(with_special(tmp_path, section), tmp_path / "g", message)
+
+
+def test_a_filter_follows_the_floating_body_in_a_run(tmp_path):
+    """A sphere of 0.1537 m (no lattice distance) about the floating box's centre (no <centre>: the
+    body's), the box launched at 1 m/s: each output holds exactly the particles of the full run within
+    its radius of the centre bodies.csv gives at that time."""
+    src = REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
+    text = src.read_text().replace('<floating mkbound="5" rhopbody="500" />',
+                                   '<floating mkbound="5" rhopbody="500"><linearvelini x="1" y="0" z="0" />'
+                                   '</floating>')
+    assert "linearvelini" in text
+    plain, follow = tmp_path / "CasePlain_Def.xml", tmp_path / "CaseFollow_Def.xml"
+    plain.write_text(text)
+    section = ('<outputparts preselection="none"><filtersphere operation="add"><ftfollow mkbound="5"/>'
+               '<radius v="0.1537"/></filtersphere></outputparts>')
+    follow.write_text(text.replace("<special>", "<special>" + section, 1) if "<special>" in text else
+                      text.replace("<execution>", "<execution><special>" + section + "</special>", 1))
+    common = ["--dp", "0.02", "--tmax", "0.04", "--tout", "0.01", "--threads", "1", "-q", "--set", "FtPause=0"]
+    for case, out in ((plain, tmp_path / "a"), (follow, tmp_path / "b")):
+        r = invoke(["run", case, "-o", out] + common)
+        assert r.exit_code == 0, r.output
+    from sphdvi.validation.runs import body_log
+    bodies = body_log(str(tmp_path / "b"))
+    moved = 0.0
+    for k, t in enumerate(step_times(str(tmp_path / "b" / "particles.vtkhdf"))):
+        row = bodies[np.isclose(bodies["time"], t, rtol=0, atol=1e-9)][0]
+        centre = np.array([row["x"], row["y"], row["z"]])
+        if k == 0:
+            centre0 = centre
+        moved = max(moved, abs(centre[0] - centre0[0]))
+        a = read_step(str(tmp_path / "a" / "particles.vtkhdf"), k)
+        b = read_step(str(tmp_path / "b" / "particles.vtkhdf"), k)
+        keep = np.einsum("ij,ij->i", a["points"] - centre, a["points"] - centre) <= 0.1537 ** 2
+        np.testing.assert_array_equal(b["Idp"], a["Idp"][keep], err_msg=f"output {k}")
+    assert moved > 0.02            # the box has moved by more than a particle: the sphere went with it
