@@ -797,11 +797,14 @@ class _Stop:
 
 
 def _warm_up(sph: "SPHRun") -> float:
-    """Compile (or load from cache) the kernels on a throw-away copy of the solver."""
+    """Compile (or load from cache) the kernels on a throw-away copy of the solver: two steps, the
+    first of which moves the particles into cell order and the second does not (its kernels compiled
+    inside the loop otherwise: 0.6 s of a 0.03 s run on an empty cache)."""
     import copy
     t0 = _time.perf_counter()
     clone = copy.deepcopy(sph.solver)
     clone.motion_hook = None
+    clone.step()
     clone.step()
     return _time.perf_counter() - t0
 
