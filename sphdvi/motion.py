@@ -575,13 +575,6 @@ class SolitaryPaddle(_Paddle):
             eta += s.H / np.cosh(s.kappa * (float(x) - xc - s.c * (tau - tc))) ** 2
         return eta
 
-    def stroke_amplitude(self) -> float:
-        return 0.5 * sum(s.stroke for s in self.strokes)
-
-    def max_acceleration(self) -> float:
-        """A bound on the stroke's acceleration: Σ c² κ H/h (|d/dt of c η/(h + η)|)."""
-        return sum(s.c ** 2 * s.kappa * s.H / s.h for s in self.strokes)
-
 
 def make_paddle(spec: dict, g: float = 9.81) -> _Paddle:
     """The paddle of a ``<wavepaddles>`` entry."""

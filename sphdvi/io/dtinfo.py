@@ -54,8 +54,7 @@ class DtLog:
         self.header = dtinfo_header(self.fullinfo)
         self.rows: list[str] = []            # complete rows not yet written
         self.all_rows: list[str] = []
-        self.k = None                        # the interval in progress, its first step's time and count
-        self.t0 = 0.0
+        self.t0 = 0.0                        # the interval in progress: its first step's time and count
         self.count = 0
         self.acc: list = []                  # per term [n, mean, min, max]
         self.written, self.all_written = 0, 0
@@ -74,11 +73,10 @@ class DtLog:
             if t > self.finish and self.count:
                 self._close_interval()
             return
-        k = int(math.floor((t - self.start) / self.interval))
-        if k != self.k and self.count:
+        if self.count and self._interval(t) != self._interval(self.t0):
             self._close_interval()
         if not self.count:
-            self.k, self.t0 = k, t
+            self.t0 = t
             self.acc = [[0, 0.0, math.inf, -math.inf] for _ in range(self.nterms)]
         self.count += 1
         for a, v in zip(self.acc, terms[:self.nterms]):
@@ -95,7 +93,10 @@ class DtLog:
         for n, mean, lo, hi in self.acc:
             cols += [_fmt(mean), _fmt(lo), _fmt(hi)] if n else ["", "", ""]
         self.rows.append(";".join(cols) + "\n")
-        self.count, self.k = 0, None
+        self.count = 0
+
+    def _interval(self, t: float) -> int:
+        return int(math.floor((t - self.start) / self.interval))
 
     # -- the files -----------------------------------------------------------------------
     def flush(self) -> None:
@@ -118,13 +119,13 @@ class DtLog:
     # -- resume --------------------------------------------------------------------------
     def get_state(self) -> str:
         """What a resumed run needs (JSON): the rows written and the interval in progress."""
-        return json.dumps({"written": self.written, "all_written": self.all_written, "k": self.k, "t0": self.t0,
+        return json.dumps({"written": self.written, "all_written": self.all_written, "t0": self.t0,
                            "count": self.count, "acc": self.acc})
 
     def _resume(self, text: str) -> None:
         st = json.loads(text)
         self.written, self.all_written = int(st["written"]), int(st["all_written"])
-        self.k, self.t0, self.count, self.acc = st["k"], float(st["t0"]), int(st["count"]), st["acc"]
+        self.t0, self.count, self.acc = float(st["t0"]), int(st["count"]), st["acc"]
         for path, header, n in ((self.path, self.header, self.written),
                                 (self.all_path, "Time;Dtf", self.all_written)):
             if path is None:

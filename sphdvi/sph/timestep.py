@@ -43,8 +43,3 @@ def dt_conditions(acemax2, velmax2, viscmax, h, cs0):
     dt1 = math.sqrt(h / acemax) if acemax > 0 else math.inf
     dt2 = h / (max(cs0, 10.0 * math.sqrt(velmax2)) + h * viscmax)
     return dt1, dt2
-
-
-def variable_dt(acemax2, velmax2, viscmax, h, cs0, cfl):
-    """CFL min(dt_f, dt_cv) (DualSPHysics ``DtVariable``)."""
-    return cfl * min(dt_conditions(acemax2, velmax2, viscmax, h, cs0))
