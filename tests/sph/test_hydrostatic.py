@@ -44,9 +44,10 @@ PROBE_Z = np.linspace(0.025, 0.175, 7)
 _RUNS = {}
 
 
-def run_tank(dp, coefh=1.0, coefsound=20.0, layers=3):
-    """Run (cached per setting) and return a dict of measurements."""
-    key = (dp, coefh, coefsound, layers)
+def run_tank(dp, coefh=1.0, coefsound=20.0, layers=3, periods=10.0):
+    """Run to ``periods`` sqrt(H/g) (cached per setting) and return a dict of measurements
+    averaged over the last 30 % of the run."""
+    key = (dp, coefh, coefsound, layers, periods)
     if key in _RUNS:
         return _RUNS[key]
     st, c = tank_2d(W, H + 4 * dp, W, H, dp, layers=layers, bound_hydrostatic=True, coefh=coefh,
@@ -57,7 +58,7 @@ def run_tank(dp, coefh=1.0, coefsound=20.0, layers=3):
     top = st.pos[fl, 2].max() + 0.5 * dp
     zcm0 = st.pos[fl, 2].mean()
     nfluid0 = int(fl.sum())
-    T = 10.0 * math.sqrt(H / G)
+    T = periods * math.sqrt(H / G)
     zs = PROBE_Z
     probes = np.stack([np.full_like(zs, W / 2), 0 * zs, zs], 1)
     acc = np.zeros(len(zs))
@@ -88,7 +89,8 @@ def run_tank(dp, coefh=1.0, coefsound=20.0, layers=3):
         "nfluid": int(fl.sum()), "nfluid0": nfluid0, "mass": float(sol.state.mass[fl].sum()),
         "steps": sol.nstep,
     }
-    print("S1/S2 dp=%g coefh=%g c0=%g sqrt(gH) layers=%d: %s" % (dp, coefh, coefsound, layers, res))
+    print("S1/S2 dp=%g coefh=%g c0=%g sqrt(gH) layers=%d T=%g sqrt(H/g): %s"
+          % (dp, coefh, coefsound, layers, periods, res))
     _RUNS[key] = res
     return res
 
@@ -126,6 +128,10 @@ def test_s2_still_water():
 # dp/h -> 0 (Quinlan et al. 2006) and the Mach number -> 0.  Here h ~ dp^(1/2) and
 # c0 ~ dp^(-1/2) (Mach^2 ~ dp), wall layers covering the kernel support 2h.
 MACH_PATH = [(0.01, 1.0, 20.0, 3), (0.005, math.sqrt(2), 20 * math.sqrt(2), 4), (0.0025, 2.0, 40.0, 6)]
+# The initial state is hydrostatic, so these runs are settled early: the errors averaged over
+# [2.1, 3] sqrt(H/g) are those over [7, 10] sqrt(H/g) within 1 % (dp 0.005: 0.289 % against
+# 0.292 % of rho0 g H, every probe within 3e-5), at 30 % of the cost.
+MACH_PERIODS = 3.0
 
 
 def test_s1_converges_when_h_over_dp_and_c0_grow():
@@ -142,7 +148,7 @@ def test_s1_converges_when_h_over_dp_and_c0_grow():
     the integrator nor the run length changes it (0.49-0.52 %); c0 = 40 sqrt(gH) gives 0.19 %.
     Along the path where the Mach number falls too, the error converges: 1.15 % (dp 0.01,
     h/dp 1.41, c0 20) -> 0.29 % (dp 0.005, h/dp 2, c0 28.3), observed order 2.0."""
-    coarse, mid = (run_tank(*k) for k in MACH_PATH[:2])
+    coarse, mid = (run_tank(*k, periods=MACH_PERIODS) for k in MACH_PATH[:2])
     order = math.log2(coarse["einf"] / mid["einf"])
     print("S1 along h ~ dp^1/2, c0 ~ dp^-1/2: max |p - p_ref| / (rho g H) %.4f -> %.4f, observed order %.2f"
           % (coarse["einf"], mid["einf"], order))
@@ -170,7 +176,7 @@ def test_s1_mach_path_three_resolutions():
     orders 2.0, 0.9; the third point, dp 0.0025, h/dp 2.83, c0 40 sqrt(gH), six wall layers,
     is predicted at 0.15 % by the compressibility and lattice terms).  With only three wall
     layers there (2h = 5.7 dp) the deepest probe reads 0.25 %."""
-    errs = [run_tank(*k)["einf"] for k in MACH_PATH]
+    errs = [run_tank(*k, periods=MACH_PERIODS)["einf"] for k in MACH_PATH]
     orders = [math.log2(errs[k] / errs[k + 1]) for k in range(2)]
     print("S1 Mach path: max |p - p_ref| / (rho g H)", errs, "observed orders", orders)
     assert errs[0] > errs[1] > errs[2]
