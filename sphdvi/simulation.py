@@ -796,6 +796,41 @@ class _Stop:
             signal.signal(sig, old)
 
 
+#: seconds of start-up compilation after which the user is told that kernels are being compiled
+COMPILE_NOTICE_AFTER_S = 3.0
+
+
+class _CompileNotice:
+    """A line on ``stream`` (None: quiet) when the start-up's compilation lasts longer than
+    COMPILE_NOTICE_AFTER_S, and another when it is done.  A first run with a case's options
+    compiles its kernels (10-30 s before any output); a warm cache loads them in under a second,
+    and then nothing is said."""
+
+    def __init__(self, stream):
+        import threading
+        self.stream = stream
+        self.t0 = _time.perf_counter()
+        self.said = threading.Event()
+        self.timer = None
+        if stream is not None:
+            self.timer = threading.Timer(COMPILE_NOTICE_AFTER_S, self._say)
+            self.timer.daemon = True
+            self.timer.start()
+
+    def _say(self):
+        self.said.set()
+        self.stream.write("compiling the kernels for this case's options (a first run with them; later runs "
+                          "load them from numba's cache) ...\n")
+        self.stream.flush()
+
+    def done(self):
+        if self.timer is not None:
+            self.timer.cancel()
+        if self.said.is_set():
+            self.stream.write(f"kernels ready after {_time.perf_counter() - self.t0:.1f} s\n")
+            self.stream.flush()
+
+
 def _warm_up(sph: "SPHRun") -> float:
     """Compile (or load from cache) the kernels on a throw-away copy of the solver: two steps, the
     first of which moves the particles into cell order and the second does not (its kernels compiled
@@ -872,15 +907,20 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             st = sol.state
             write_normals_vtp(os.path.join(outdir, NORMALS_FILE), st.pos, st.ptype, st.mk, sol.normals)
     stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
-    if stopped is None:
-        jit_s = _warm_up(sph)
-        stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
+    notice = _CompileNotice(None if quiet else sys.stderr)
+    try:
+        if stopped is None:
+            jit_s = _warm_up(sph)
+            stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
+        if stopped is None:
+            # the run-time gauges measure the initial state here, so that their first JIT
+            # compilation counts in startup_s, not in runtime_s
+            gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
+    finally:
+        notice.done()
     if stopped is not None:
         writer.close()
         return stopped
-    # the run-time gauges measure the initial state here, so that their first JIT compilation
-    # counts in startup_s, not in runtime_s
-    gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
     startup = _time.perf_counter() - t_start
     files.write_json(**meta, mode="sph", numba=numba.__version__, threading_layer=_threading_layer(),
                      status="running", message="", steps=int(sol.nstep), physical_time=float(sol.time),

@@ -1,6 +1,7 @@
 """sphdvi run: outputs, resume (bitwise on 1 thread), divergence, body-only runs."""
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -699,3 +700,30 @@ def test_timeoutextra_floating_rows_between_outputs_and_resume(tmp_path):
     assert len(rows) == 1 + nbody * 9 and times.size == 9          # t = 0, 0.005, ..., 0.04
     assert np.all(times - np.arange(9) * 0.005 >= -1e-12) and np.all(times - np.arange(9) * 0.005 < 2e-4)
     assert (a / "bodies.csv").read_text() == (b / "bodies.csv").read_text()
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_a_slow_start_says_that_it_compiles(tmp_path, monkeypatch, quiet):
+    """A first run with a case's options compiles its kernels before any output (10-30 s): past
+    COMPILE_NOTICE_AFTER_S a line says so and another when they are ready; ``-q`` says nothing.
+    Here the threshold is 0 and the warm-up made 0.3 s slower, so the notice must come."""
+    import sphdvi.simulation as simulation
+    warm_up = simulation._warm_up
+
+    def slow_warm_up(sph):
+        time.sleep(0.3)
+        return warm_up(sph)
+
+    monkeypatch.setattr(simulation, "COMPILE_NOTICE_AFTER_S", 0.0)
+    monkeypatch.setattr(simulation, "_warm_up", slow_warm_up)
+    args = ["run", small_case(tmp_path), "-o", tmp_path / "out", "--tmax", "0.01", "--threads", "1"]
+    r = invoke(args + (["-q"] if quiet else []))
+    assert r.exit_code == 0, r.output
+    said = "compiling the kernels for this case's options" in r.stderr
+    ready = re.search(r"kernels ready after (\d+\.\d) s", r.stderr)
+    if quiet:
+        assert not said and ready is None and r.stderr == ""
+    else:
+        assert said and ready is not None and float(ready.group(1)) >= 0.3
+        # the notice comes before the first progress line
+        assert r.stderr.index("kernels ready") < r.stderr.index("progress:")
