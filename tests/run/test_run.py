@@ -727,3 +727,34 @@ def test_a_slow_start_says_that_it_compiles(tmp_path, monkeypatch, quiet):
         assert said and ready is not None and float(ready.group(1)) >= 0.3
         # the notice comes before the first progress line
         assert r.stderr.index("kernels ready") < r.stderr.index("progress:")
+
+
+def test_warm_up_steps_a_copy_of_the_coupled_run(tmp_path, monkeypatch):
+    """The start-up's two warm-up steps run on a copy of the whole run, whose end-of-step hook
+    steps the copy's floating bodies (so that the multibody kernels compile before the loop's
+    clock): the copy's bodies take exactly those two steps, the run's own take every step of the
+    run from t = 0, and the run's state is that of a run without the warm-up."""
+    import sphdvi.coupling as coupling
+    import sphdvi.simulation as simulation
+    calls = []
+    step = coupling.FloatingBodies.step
+
+    def spy(self, solver, dt):
+        calls.append((id(self), float(solver.time)))
+        return step(self, solver, dt)
+
+    monkeypatch.setattr(coupling.FloatingBodies, "step", spy)
+    case = REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
+    common = ["--dp", "0.02", "--tmax", "0.01", "--tout", "0.01", "--threads", "1", "-q", "--set", "FtPause=0"]
+    assert invoke(["run", case, "-o", tmp_path / "a"] + common).exit_code == 0
+    owners = list(dict.fromkeys(i for i, _ in calls))
+    assert len(owners) == 2
+    copy_calls = [t for i, t in calls if i == owners[0]]
+    run_calls = [t for i, t in calls if i == owners[1]]
+    assert len(copy_calls) == 2 and len(run_calls) > 2 and run_calls[0] == copy_calls[0]
+    state = final_state(tmp_path / "a")[0]
+    monkeypatch.setattr(simulation, "_warm_up", lambda sph: 0.0)
+    assert invoke(["run", case, "-o", tmp_path / "b"] + common).exit_code == 0
+    for k, v in final_state(tmp_path / "b")[0].items():
+        assert np.array_equal(state[k], v), k
+    assert (tmp_path / "a" / "bodies.csv").read_text() == (tmp_path / "b" / "bodies.csv").read_text()
