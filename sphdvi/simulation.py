@@ -384,6 +384,9 @@ def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quie
         jit_s = _warm_up_bodies(system, dt)
     finally:
         notice.done()
+    stopped = _stopped_at_startup(stop, files, meta, outdir, resume)     # a signal during the JIT
+    if stopped is not None:
+        return stopped
     files.write_json(**meta, mode="bodies", status="running", message="", dt=dt, steps=run.step,
                      physical_time=float(run.system.time), runtime_s=run.runtime,
                      startup_s=_time.perf_counter() - t_start, jit_s=jit_s, bodies=len(names),

@@ -322,3 +322,19 @@ def test_warm_up_steps_a_copy_and_says_when_it_compiles(tmp_path, monkeypatch):
     assert r.exit_code == 0, r.output
     for name in ("bodies.csv", "links.csv"):
         assert (tmp_path / "warm" / name).read_bytes() == (tmp_path / "cold" / name).read_bytes()
+
+
+def test_sigterm_during_the_warm_up_ends_interrupted(tmp_path, monkeypatch):
+    """A signal that comes while the multibody kernels compile ends the run before its loop:
+    exit 1, run.json 'interrupted' during start-up, no step taken."""
+    def warm_up(system, dt):
+        os.kill(os.getpid(), signal.SIGTERM)
+        return 0.0
+
+    monkeypatch.setattr(simulation, "_warm_up_bodies", warm_up)
+    out = tmp_path / "out"
+    r = invoke(["run", case_file(tmp_path), "-o", out, "-q"])
+    assert r.exit_code == 1, r.output
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "interrupted" and "during start-up" in meta["message"]
+    assert meta.get("steps", 0) == 0
