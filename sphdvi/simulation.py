@@ -855,16 +855,17 @@ class _CompileNotice:
 def _warm_up(sph: "SPHRun") -> float:
     """Compile (or load from cache) the kernels on a throw-away copy of the run: two steps, the
     first of which moves the particles into cell order and the second does not (its kernels compiled
-    inside the loop otherwise: 0.6 s of a 0.03 s run on an empty cache).  The copy is the whole
-    SPHRun, so that its solver's end-of-step hook is the copy's: imposed motions, the floating
+    inside the loop otherwise: 0.6 s of a 0.03 s run on an empty cache).  With an end-of-step hook
+    the copy is the whole SPHRun, so that its solver's hook is the copy's: imposed motions, the floating
     bodies' multibody step (31 s of JIT inside a 31.2 s hinged-flap run before) and the damping
     zones compile too, and nothing of the run itself moves.  Kernels of events that come later (a
     first contact between bodies) still compile when they come."""
     import copy
     t0 = _time.perf_counter()
-    clone = copy.deepcopy(sph)
-    clone.solver.step()
-    clone.solver.step()
+    # without a hook the solver alone (a copy of the run would copy the case's arrays too)
+    clone = copy.deepcopy(sph).solver if sph.solver.motion_hook is not None else copy.deepcopy(sph.solver)
+    clone.step()
+    clone.step()
     return _time.perf_counter() - t0
 
 
