@@ -21,6 +21,7 @@ def run(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_free_surface_settles_at_slope_a_over_g(run):
     e = slope_errors(run)
     print(f"steady slope (t = 4.5-7 s, first mode fitted out) {100 * e['slope_mean']:+.2f} % from a/g, swing {100 * e['slope_swing']:.1f} %")

@@ -50,6 +50,7 @@ def test_probe_scores_of_a_shifted_and_scaled_record():
     assert probe_scores(t, -z, t[::7], z[::7])["corr"] == pytest.approx(-1.0, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_flap_waves_follow_the_measured_probes_at_depth_over_dp_10(tmp_path):
     out = run_case(tmp_path, 0.04)
     e = wave_scores(out, str(REFERENCE))
