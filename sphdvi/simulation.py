@@ -847,6 +847,7 @@ class _CompileNotice:
     def done(self):
         if self.timer is not None:
             self.timer.cancel()
+            self.timer.join()          # a notice being written ends before the "ready" line
         if self.said.is_set():
             self.stream.write(f"kernels ready after {_time.perf_counter() - self.t0:.1f} s\n")
             self.stream.flush()
