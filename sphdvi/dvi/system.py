@@ -774,6 +774,36 @@ class System:
         self.n_contacts = nc
         return nc
 
+    def compile_contact_kernels(self):
+        """Compile (or load from numba's cache) the kernels that only a contact calls: the pair
+        materials, the contact rows, their warm start and the SMC forces.  Called on zero
+        contacts (the argument types are those of :meth:`step`), so that a first contact later in
+        a run compiles nothing inside the time loop.  Meant for a warm-up's copy: it may allocate
+        the System's row arrays, and moves nothing."""
+        if self.sh_type.shape[0] < 2:
+            return
+        if not self._packed:
+            self._pack()
+        nb, nc = self.nb, 0
+        c = dict(a=np.empty(1, np.int32), b=np.empty(1, np.int32), sa=np.empty(1, np.int32),
+                 sb=np.empty(1, np.int32), pt=np.empty((1, 3)), n=np.empty((1, 3)),
+                 gap=np.empty(1), key=np.empty(1, np.int64))
+        R = body_rotations(self.quat)
+        if self.contactmethod.lower() == "smc":
+            col.smc_forces(nc, c["a"], c["b"], c["sa"], c["sb"], c["pt"], c["n"], c["gap"],
+                           self.sh_mat, self.sh_rad, self.mat_mu, self.mat_e, self.mat_E,
+                           self.mat_nu, self.pos, R, self.vel, self.omega_b, self.inv_mass,
+                           np.zeros((nb, 3)), np.zeros((nb, 3)), True)
+            return
+        c_mu, c_e, c_row = np.empty(nc), np.empty(nc), np.empty(nc, np.int64)
+        col.contact_materials(nc, c["sa"], c["sb"], self.sh_mat, self.mat_mu, self.mat_e, c_mu, c_e)
+        self._ensure_rows(self._max_link_rows())
+        rw.build_contact_rows(0, 1.0, self.recovery_speed, self.min_bounce_speed, self.pos, R,
+                              np.zeros((nb, 6)), nc, c["a"], c["b"], c["pt"], c["n"], c["gap"],
+                              c_mu, c_e, c_row, *self._row_args())
+        col.match_warm_start(nc, c["key"], np.zeros(0, np.int64), np.zeros((0, 3)),
+                             np.zeros((nc, 3)))
+
     # ---------------------------------------------------------------- step
     def step(self, dt, forces=None, torques=None):
         """Advance the system by ``dt``.
