@@ -73,12 +73,14 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
     from .errors import CaseError
     if not os.path.isfile(case_xml):
         raise CaseError("case file not found", file=case_xml, expected="an existing XML case file")
-    from .io.runfolder import check_new_run_folder, check_other_case, clear_earlier_results
+    from .io.runfolder import check_new_run_folder, check_other_case, clear_earlier_results, delete_files
     if outdir is None:
         outdir = f"{case_name_from_path(case_xml)}_out"
     check_new_run_folder(outdir, overwrite, command="gencase")
-    check_other_case(outdir, case_name_from_path(case_xml), overwrite)
+    others = check_other_case(outdir, case_name_from_path(case_xml), overwrite)
     result = build_case(case_xml, outdir, max_nodes=max_nodes, dp=dp)
+    # what --overwrite replaces goes only once the case is built (bad input deletes nothing)
+    delete_files(outdir, others)
     clear_earlier_results(outdir)
     files = write_outputs(result, outdir)
     print_warnings(result.warnings)
@@ -133,9 +135,11 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
 
 def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
     from .errors import InputError
-    from .io.runfolder import check_new_run_folder, check_other_case
+    from .io.runfolder import (SetAside, case_outputs, check_new_run_folder, check_other_case, earlier_exports,
+                               earlier_results, restored_on_bad_input)
     from .simulation import find_case_file, run as run_case
     drawn_dp = None      # --dp where no gencase runs: it must be the case's dp
+    set_aside = None     # with --overwrite: what the new gencase and run replace, put back on bad input
     if os.path.isfile(source) and source.lower().endswith(".xml"):
         from .case.gencase import build_case, write_outputs
         from .case.reader import case_name_from_path
@@ -145,8 +149,12 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
             drawn_dp = dp
         else:
             check_new_run_folder(outdir, overwrite)     # before gencase writes into it
-            check_other_case(outdir, case_name_from_path(source), overwrite)
-            result = build_case(source, outdir, dp=dp)
+            name = case_name_from_path(source)
+            replaced = check_other_case(outdir, name, overwrite) + earlier_results(outdir) + earlier_exports(outdir)
+            if os.path.isdir(outdir):
+                set_aside = SetAside(outdir, replaced + (case_outputs(outdir, name) if replaced else []))
+            with restored_on_bad_input(set_aside):
+                result = build_case(source, outdir, dp=dp)
             print_warnings(result.warnings)
             case_h5 = write_outputs(result, outdir)[0]
     elif os.path.isdir(source):
@@ -156,7 +164,7 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
     else:
         raise InputError(f"{source}: not a case XML file or a gencase output folder")
     result = run_case(case_h5, outdir, tmax=tmax, tout=tout, threads=threads, sets=sets, resume=resume,
-                      quiet=quiet, expect_dp=drawn_dp, overwrite=overwrite, stop=stop)
+                      quiet=quiet, expect_dp=drawn_dp, overwrite=overwrite, stop=stop, set_aside=set_aside)
     if result.status != "completed":
         click.echo(f"{result.status}: {result.message}", err=True)
     elif not quiet:

@@ -43,7 +43,8 @@ from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint,
 from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
 from .io.dtinfo import DTINFO_FILE, DtLog
-from .io.runfolder import NORMALS_FILE, check_new_run_folder, clear_earlier_results, stored_overrides
+from .io.runfolder import (NORMALS_FILE, SetAside, check_new_run_folder, earlier_exports, earlier_results,
+                           restored_on_bad_input, stored_overrides)
 from .sph.damping import damping_zones
 from .output_parts import OutputParts
 from .output_schedule import OutputSchedule
@@ -238,12 +239,14 @@ def _same_value(a, b) -> bool:
 
 
 def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(), resume=False,
-        quiet=False, expect_dp=None, overwrite=False, stop=None) -> RunResult:
+        quiet=False, expect_dp=None, overwrite=False, stop=None, set_aside=None) -> RunResult:
     """Run a gencase output: body-only cases go to the multibody engine, the rest to SPH.
 
     ``expect_dp``: a dp the user gave where no gencase runs (a gencase folder, --resume);
     it must be the case's, else InputError.  A new run into a folder with an earlier run's
-    results is refused unless ``overwrite`` (they are deleted first); ``--resume`` reuses the
+    results is refused unless ``overwrite``: they are set aside (:class:`SetAside`; the caller's
+    ``set_aside`` when it made one), put back if the run stops on bad input before its start-up
+    is through, deleted once it is; ``--resume`` reuses the
     --tmax/--tout/--set of the interrupted run.  ``stop``: a :class:`_Stop` the caller
     installed before its own start-up work (a signal then interrupts the run cleanly)."""
     from .io.casefile import read_case_h5
@@ -264,16 +267,19 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
         check_new_run_folder(outdir, overwrite)
     os.makedirs(outdir, exist_ok=True)
     remove_leftover_temporaries(outdir)
-    if not resume:
-        clear_earlier_results(outdir)
+    if not resume and set_aside is None:
+        set_aside = SetAside(outdir, earlier_results(outdir) + earlier_exports(outdir))
     files = RunFiles(outdir)
+    if set_aside is not None:
+        files.on_start = set_aside.discard     # the new run's start-up passed its checks
     base_meta = {
         "version": __version__, "case": data["casename"], "case_file": os.path.abspath(case_h5),
         "parameters": params, "overrides": {"tmax": tmax, "tout": tout, "set": list(sets or ())},
         "threads": threads, "particles": int(data["particles"]["type"].size),
         "fluid_particles": nfluid, "python": sys.version.split()[0], "numpy": np.__version__,
     }
-    with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
+    with restored_on_bad_input(set_aside), \
+            (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
         if nfluid == 0:
             return _run_bodies_only(data, params, out_times, outdir, files, base_meta, t_start, quiet, resume, stop)
         return _run_sph(data, params, out_times, outdir, files, base_meta, threads, resume, quiet, t_start, stop)

@@ -35,6 +35,7 @@ class RunFiles:
         self.log_path = os.path.join(outdir, "run.log")
         self.csv_path = os.path.join(outdir, "run.csv")
         self.meta: dict = {}
+        self.on_start = None     # called once by start(): --overwrite deletes the earlier run's files then
 
     def write_json(self, **updates) -> None:
         self.meta.update(updates)
@@ -52,6 +53,9 @@ class RunFiles:
         """A new run: empty run.log and run.csv (header only)."""
         write_text_atomic(self.log_path, "")
         write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
+        if self.on_start is not None:
+            self.on_start()
+            self.on_start = None
 
     def load_existing(self, nparts: int) -> None:
         """On resume: keep the log (without a torn last line), and the CSV rows of the first

@@ -102,16 +102,82 @@ def other_case_outputs(outdir: str, case_name: str) -> list[str]:
 def check_other_case(outdir: str, case_name: str, overwrite: bool) -> list[str]:
     """A gencase of ``case_name`` into ``outdir``: another case's gencase output there would leave the
     folder with two cases, which ``run OUT``, ``--resume`` and ``measure`` cannot tell apart. Refused
-    (InputError) unless ``overwrite``, which deletes it; returns the names deleted."""
+    (InputError) unless ``overwrite``; returns the names found (for :class:`SetAside`)."""
     found = other_case_outputs(outdir, case_name)
     if found and not overwrite:
         raise InputError(f"{outdir} holds the gencase output of another case ({', '.join(found)}); a second case there "
                          "leaves the folder ambiguous for 'sphdvi run OUT', --resume and 'sphdvi measure': use another "
                          "-o folder, or --overwrite (deletes those files)")
-    for name in found:
+    return found
+
+
+def case_outputs(outdir: str, case_name: str) -> list[str]:
+    """The gencase outputs of ``case_name`` in ``outdir`` (names), which a new gencase replaces."""
+    return [case_name + sfx for sfx in CASE_OUTPUT_SUFFIXES if os.path.isfile(os.path.join(outdir, case_name + sfx))]
+
+
+OVERWRITTEN_DIR = ".sphdvi-overwritten"
+
+
+class SetAside:
+    """``--overwrite`` as one transaction, so that a command that fails on bad input (exit 2)
+    loses nothing: the files it replaces (``names``, relative to OUT: an earlier run's results,
+    what `sphdvi export` made of them, gencase outputs) move into OUT/.sphdvi-overwritten
+    (renames, on the same file system); :meth:`restore` puts them back and deletes the run and
+    gencase outputs the failed command wrote; :meth:`discard` deletes them, once the new run's
+    start-up has passed its checks.  A folder left by a killed command is replaced."""
+
+    def __init__(self, outdir: str, names):
+        self.outdir = outdir
+        self.dir = os.path.join(outdir, OVERWRITTEN_DIR)
+        self.moved: list[str] = []
+        names = sorted(set(names))
+        if not names:
+            return
+        import shutil
+        shutil.rmtree(self.dir, ignore_errors=True)
+        for name in names:
+            src, dst = os.path.join(outdir, name), os.path.join(self.dir, name)
+            if not os.path.isfile(src):
+                continue
+            os.makedirs(os.path.dirname(dst), exist_ok=True)
+            os.replace(src, dst)
+            self.moved.append(name)
+        for folder in sorted({os.path.dirname(n) for n in self.moved if os.path.dirname(n)}):
+            with contextlib.suppress(OSError):
+                os.rmdir(os.path.join(outdir, folder))        # only when empty
+        self._before = set(os.listdir(outdir))
+
+    def restore(self) -> None:
+        """Put the files back; the run and gencase outputs written since are deleted first."""
+        if not self.moved:
+            return
+        import shutil
+        for name in set(os.listdir(self.outdir)) - self._before:
+            if name in RUN_OUTPUT_FILES or name.endswith(CASE_OUTPUT_SUFFIXES) or \
+                    (name.startswith("Gauges") and name.endswith(".csv")):
+                with contextlib.suppress(OSError):
+                    os.unlink(os.path.join(self.outdir, name))
+        for name in self.moved:
+            dst = os.path.join(self.outdir, name)
+            os.makedirs(os.path.dirname(dst), exist_ok=True)
+            os.replace(os.path.join(self.dir, name), dst)
+        self.moved = []
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def discard(self) -> None:
+        """Delete the files set aside (the new run has started)."""
+        if self.moved:
+            import shutil
+            shutil.rmtree(self.dir, ignore_errors=True)
+            self.moved = []
+
+
+def delete_files(outdir: str, names) -> None:
+    """Delete ``names`` (relative to ``outdir``) where they exist."""
+    for name in names:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(os.path.join(outdir, name))
-    return found
 
 
 def clear_earlier_results(outdir: str) -> list[str]:
@@ -121,9 +187,7 @@ def clear_earlier_results(outdir: str) -> list[str]:
     stays).  Returns their names, relative to OUT."""
     found = earlier_results(outdir)
     exports = earlier_exports(outdir)
-    for name in found + exports:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(os.path.join(outdir, name))
+    delete_files(outdir, found + exports)
     for folder in sorted({os.path.dirname(name) for name in exports}):
         with contextlib.suppress(OSError):
             os.rmdir(os.path.join(outdir, folder))        # only when empty
@@ -140,3 +204,15 @@ def stored_overrides(outdir: str):
         return None
     stored = meta.get("overrides") if isinstance(meta, dict) else None
     return stored if isinstance(stored, dict) else None
+
+
+@contextlib.contextmanager
+def restored_on_bad_input(set_aside: "SetAside | None"):
+    """Put ``set_aside``'s files back when the block raises a bad-input error (exit 2)."""
+    try:
+        yield
+    except Exception as exc:
+        from ..errors import EXIT_INPUT
+        if set_aside is not None and getattr(exc, "exit_code", None) == EXIT_INPUT:
+            set_aside.restore()
+        raise

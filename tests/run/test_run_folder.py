@@ -154,6 +154,39 @@ def test_overwrite_deletes_the_earlier_exports_and_nothing_else(done, tmp_path):
     assert (out / "mine" / "Part_0007.vtp").read_text() == "not an export"
 
 
+def tree(folder):
+    """Every file under ``folder`` (hidden ones too): relative path -> bytes."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in Path(folder).rglob("*") if p.is_file()}
+
+
+def test_overwrite_that_fails_on_bad_input_loses_nothing(done, tmp_path):
+    """--overwrite sets the earlier files aside and deletes them only once the new run's start-up
+    has passed its checks: a command that stops on bad input (exit 2) after gencase, or in the
+    run's start-up (a DtFixedFile that is not there), leaves OUT byte for byte as it was, the
+    exports and another case's gencase output included, and no new case beside them."""
+    out = copy_run(done, tmp_path / "o")
+    assert invoke(["export", out]).exit_code == 0
+    before = tree(out)
+    bad_dp = tmp_path / "CaseBad_Def.xml"
+    bad_dp.write_text(DAMBREAK.read_text().replace('<definition dp="', '<definition dp="-'))
+    other = tmp_path / "CaseOther_Def.xml"
+    other.write_text(DAMBREAK.read_text())
+    missing = ["--set", f"DtFixedFile={tmp_path / 'missing.csv'}"]
+    for args in (["run", out, "--overwrite"] + missing + RUN,
+                 ["run", DAMBREAK, "-o", out, "--overwrite"] + missing + RUN,
+                 ["run", other, "-o", out, "--overwrite"] + missing + RUN,
+                 ["run", bad_dp, "-o", out, "--overwrite"] + RUN[2:],
+                 ["gencase", bad_dp, "-o", out, "--overwrite", "-q"]):
+        r = invoke(args)
+        assert r.exit_code == 2 and "Traceback" not in r.output, (args, r.output)
+        assert tree(out) == before, args
+    # a good run with --overwrite then replaces them, and leaves nothing aside
+    r = invoke(["run", out, "--overwrite", "--tmax", "0.002", "--tout", "0.002", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    assert not (out / ".sphdvi-overwritten").exists() and not (out / "vtp").exists()
+    assert nsteps(out / "particles.vtkhdf") == 2
+
+
 def test_export_again_drops_the_parts_of_a_longer_earlier_export(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     assert invoke(["export", out]).exit_code == 0
