@@ -258,6 +258,7 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
     if resume:
         tmax, tout, sets = resume_overrides(base, outdir, tmax, tout, sets)
     params = apply_overrides(base, sets, tmax, tout)
+    _check_rigid_algorithm(data, params, sets)
     out_times = output_schedule(data, params, tout)
     threads = _usable_threads(threads)
     nfluid = int(np.count_nonzero(data["particles"]["type"] == 3))
@@ -332,6 +333,16 @@ def _usable_threads(threads) -> int:
                           f"using {limit}")
         wanted = limit
     return wanted
+
+
+def _check_rigid_algorithm(data: dict, params: dict, sets) -> None:
+    """RigidAlgorithm 3 (Chrono) needs the case's <special><chrono> section, as gencase checks for
+    the XML's value: a ``--set RigidAlgorithm=3`` on a case without one is refused."""
+    if params.get("RigidAlgorithm") == 3 and not data["json"].get("chrono"):
+        given = any(str(s).split("=", 1)[0].strip() == "RigidAlgorithm" for s in sets or ())
+        raise InputError(("--set RigidAlgorithm=3" if given else "RigidAlgorithm=3") +
+                         ": Chrono needs an <execution><special><chrono> section, which this case has not; "
+                         "expected RigidAlgorithm 0 or 1, or a <chrono> section in the case file (then gencase again)")
 
 
 def _check_dtfixed(dt: float, params: dict, what: str = "DtFixed") -> None:

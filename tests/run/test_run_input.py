@@ -117,6 +117,16 @@ def test_set_of_a_constant_and_of_dem():
         apply_overrides({"TimeOut": 0.1}, ["Visc=1"])
 
 
+def test_set_rigid_algorithm_3_needs_a_chrono_section(done, tmp_path):
+    """gencase refuses RigidAlgorithm=3 without a <chrono> section; --set RigidAlgorithm=3 on
+    such a case is refused as well (it was recorded and run before), nothing written."""
+    out = copy_run(done, tmp_path / "o")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    r = invoke(["run", out, "--overwrite", "--set", "RigidAlgorithm=3", "--tmax", "0.002", "--threads", "1"])
+    assert_input_error(r, "--set RigidAlgorithm=3", "<execution><special><chrono>", "expected RigidAlgorithm 0 or 1")
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
 def test_dualsphysics_keys_in_a_case_file(tmp_path):
     """SavePosDouble=2 (DualSPHysics reads != 0) and BoundaryMethod (not a DualSPHysics key,
     ignored by it) are accepted with a warning naming the line; RigidAlgorithm=2 (DEM) is an error."""
