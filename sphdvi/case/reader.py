@@ -50,7 +50,7 @@ def open_case(path: str, warnings=None):
     Returns ``(root, reader, source_text)``.
     """
     root, text = load_xml(path)
-    strip_disabled(root)
+    strip_disabled(root, path)
     validate_structure(root, path)
     reader = CaseReader(path, warnings=warnings)
     reader.mark(root)
@@ -545,7 +545,7 @@ def read_properties(reader, casedef):
 
 def _read_property_file(reader, el, path, section):
     sub_root, _ = load_xml_any(path, reader)
-    strip_disabled(sub_root)
+    strip_disabled(sub_root, path)
     node = sub_root
     parts = [p for p in section.split(".") if p]
     if parts and parts[0] == sub_root.tag:

@@ -131,8 +131,9 @@ def load_xml(path: str) -> tuple[etree._Element, str]:
     return root, text
 
 
-def strip_disabled(root: etree._Element) -> None:
-    """Remove ``_``-prefixed elements and elements with ``active="false"`` (and their children)."""
+def strip_disabled(root: etree._Element, file: str | None = None) -> None:
+    """Remove ``_``-prefixed elements and elements with ``active="false"`` (and their children);
+    an ``active`` that is not a boolean (nor a ``#`` expression) is a CaseError naming ``file``."""
     doomed = []
     for el in root.iter():
         if not isinstance(el.tag, str):
@@ -142,8 +143,14 @@ def strip_disabled(root: etree._Element) -> None:
             doomed.append(el)
             continue
         active = el.get("active")
-        if active is not None and active.strip().lower() in _FALSE:
+        if active is None:
+            continue
+        text = active.strip().lower()
+        if text in _FALSE:
             doomed.append(el)
+        elif text not in _TRUE and not text.startswith("#"):
+            raise CaseError(f"active={active!r} is not a boolean", file=file, line=el.sourceline,
+                            element=el.tag, expected="true/false or 1/0")
     for el in doomed:
         parent = el.getparent()
         if parent is not None:

@@ -345,6 +345,12 @@ def test_disabled_elements_removed():
     root = parse_xml_text('<case><_a/><b active="false"><c/></b><d active="true"/><e active="0"/></case>', "f")
     strip_disabled(root)
     assert [c.tag for c in root] == ["d"]
+    # an `active` that is not a boolean is an error, not a drawing (it drew the box before)
+    for value in ("maybe", "fals"):
+        root = parse_xml_text(f'<case>\n<drawbox active="{value}"/></case>', "f.xml")
+        with pytest.raises(CaseError, match=rf"f.xml:2: <drawbox>: active='{value}' is not a boolean; "
+                                            "expected true/false or 1/0"):
+            strip_disabled(root, "f.xml")
 
 
 def test_unknown_attribute_warns(tmp_path):
