@@ -286,8 +286,9 @@ class CaseReader:
         return value
 
     # -- composite values ----------------------------------------------------
-    def vec3(self, el, default=REQUIRED, names=("x", "y", "z"), missing=0.0) -> np.ndarray:
-        """A 3-vector from attributes x, y, z (a missing component is ``missing``)."""
+    def vec3(self, el, default=REQUIRED, names=("x", "y", "z"), missing=REQUIRED) -> np.ndarray:
+        """A 3-vector from attributes x, y, z; a missing component is an error (as in DualSPHysics's
+        reader: ``<size x="1" y="2"/>`` drew nothing, z being 0) unless ``missing`` gives its value."""
         if el is None:
             if default is REQUIRED:
                 raise CaseError("missing 3-vector element", file=self.file)

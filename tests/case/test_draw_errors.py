@@ -88,27 +88,30 @@ def test_drawing_without_mk(tmp_path):
     ('<setmkbound mk="0"/><drawbox><point x="0" y="0" z="0"/><size x="1"/><endpoint x="1"/>'
      '</drawbox>', "exactly one"),
     ('<setmkbound mk="0"/><drawbox><size x="1"/></drawbox>', "<point>"),
-    ('<setmkbound mk="0"/><drawsphere radius="-1"><point x="1"/></drawsphere>', "not positive"),
+    # a missing component is an error, as DualSPHysics's reader (it was 0: the box drew nothing)
+    ('<setmkbound mk="0"/><drawbox><point x="0" y="0" z="0"/><size x="1" y="2"/></drawbox>',
+     r"<size>: missing attribute 'z'; expected a number"),
+    ('<setmkbound mk="0"/><drawsphere radius="-1"><point x="1" y="0" z="0"/></drawsphere>', "not positive"),
     ('<setmkbound mk="0"/><drawsphere radius="1"/>', "exactly 1"),
-    ('<setmkbound mk="0"/><drawcylinder radius="1"><point x="1"/><point x="1"/></drawcylinder>',
+    ('<setmkbound mk="0"/><drawcylinder radius="1"><point x="1" y="0" z="0"/><point x="1" y="0" z="0"/></drawcylinder>',
      "coincide"),
-    ('<setmkbound mk="0"/><drawcylinder radius="1" mask="top"><point x="1"/><point x="2"/>'
+    ('<setmkbound mk="0"/><drawcylinder radius="1" mask="top"><point x="1" y="0" z="0"/><point x="2" y="0" z="0"/>'
      '</drawcylinder>', "mask"),
-    ('<setmkbound mk="0"/><drawellipsoid radius="0.5"><point x="0"/><point x="3"/>'
+    ('<setmkbound mk="0"/><drawellipsoid radius="0.5"><point x="0" y="0" z="0"/><point x="3" y="0" z="0"/>'
      '</drawellipsoid>', "radius"),
-    ('<setmkbound mk="0"/><drawprism><point x="0"/><point x="1"/><point y="1"/><point z="1"/>'
-     '<point x="1" z="1"/><point y="1" z="1"/><point z="3"/></drawprism>', "at least 6|even"),
-    ('<setmkbound mk="0"/><drawpolygon><point x="0"/><point x="1"/><point x="2"/></drawpolygon>',
+    ('<setmkbound mk="0"/><drawprism><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/><point x="0" y="1" z="0"/><point x="0" y="0" z="1"/>'
+     '<point x="1" y="0" z="1"/><point x="0" y="1" z="1"/><point x="0" y="0" z="3"/></drawprism>', "at least 6|even"),
+    ('<setmkbound mk="0"/><drawpolygon><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/><point x="2" y="0" z="0"/></drawpolygon>',
      "no area"),
-    ('<setmkbound mk="0"/><drawtriangles><points><point x="0"/><point x="1"/><point y="1"/>'
+    ('<setmkbound mk="0"/><drawtriangles><points><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/><point x="0" y="1" z="0"/>'
      '</points><triangles><triangle x="0" y="1" z="5"/></triangles></drawtriangles>', "above 2"),
-    ('<setmkbound mk="0"/><drawline><point x="0"/></drawline>', "exactly 2"),
+    ('<setmkbound mk="0"/><drawline><point x="0" y="0" z="0"/></drawline>', "exactly 2"),
     ('<setmkbound mk="0"/><drawlineto x="1"/>', "no line start"),
     ('<setmkbound mk="0"/><drawpoint x="#nosuchvar"/>', "unknown variable"),
     ('<scale x="0" y="1" z="1"/>', "scale factor is 0"),
     ('<scale/>', "missing scale"),
     ('<rotate ang="10" x="0" y="0" z="0"/>', "axis"),
-    ('<rotateline ang="10"><point x="1"/><point x="1"/></rotateline>', "coincide"),
+    ('<rotateline ang="10"><point x="1" y="0" z="0"/><point x="1" y="0" z="0"/></rotateline>', "coincide"),
     ('<matrixload/>', "no matrix saved"),
     ('<stateload/>', "no state saved"),
     ('<mkload/>', "no mk saved"),
@@ -163,10 +166,10 @@ def test_fill_seed_outside_warns(tmp_path):
 
 @pytest.mark.parametrize("attr", ['x="1e308"', 'x="-1e308"', 'radius="1e308"'])
 def test_huge_coordinates_no_crash(tmp_path, attr):
-    body = ('<setmkbound mk="0"/><drawsphere radius="1"><point x="1"/></drawsphere>'
+    body = ('<setmkbound mk="0"/><drawsphere radius="1"><point x="1" y="0" z="0"/></drawsphere>'
             .replace('radius="1"', attr if "radius" in attr else 'radius="1"')
-            .replace('<point x="1"/>', f'<point {attr}/>' if "radius" not in attr
-                     else '<point x="1"/>'))
+            .replace('<point x="1" y="0" z="0"/>', f'<point {attr} y="0" z="0"/>' if "radius" not in attr
+                     else '<point x="1" y="0" z="0"/>'))
     try:
         draw(tmp_path, body)
     except CaseError:

@@ -318,7 +318,7 @@ def test_motion_chain(tmp_path):
 
 def test_motion_next_missing(tmp_path):
     motion = ('<motion><objreal ref="0"><begin mov="1"/><mvrect id="1" duration="1" next="7">'
-              '<vel x="1"/></mvrect></objreal></motion>')
+              '<vel x="1" y="0" z="0"/></mvrect></objreal></motion>')
     with pytest.raises(CaseError, match="next=7, which does not exist"):
         build(tmp_path, casedef_extra=motion)
 

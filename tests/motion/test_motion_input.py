@@ -143,9 +143,9 @@ def test_cli_bad_motion_file_is_exit_2(tmp_path):
 
 # -- loops that would never advance time ------------------------------------------------
 @pytest.mark.parametrize("body,ids", [
-    ('<mvrect id="1" duration="0" next="1"><vel x="1"/></mvrect>', "1 -> 1"),
-    ('<mvrect id="1" duration="0" next="2"><vel x="1"/></mvrect><wait id="2" duration="0" next="1"/>', "1 -> 2 -> 1"),
-    ('<wait id="1" duration="1" next="2"/><mvrect id="2" duration="0" next="3"><vel x="1"/></mvrect>'
+    ('<mvrect id="1" duration="0" next="1"><vel x="1" y="0" z="0"/></mvrect>', "1 -> 1"),
+    ('<mvrect id="1" duration="0" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0" next="1"/>', "1 -> 2 -> 1"),
+    ('<wait id="1" duration="1" next="2"/><mvrect id="2" duration="0" next="3"><vel x="1" y="0" z="0"/></mvrect>'
      '<wait id="3" duration="0" next="2"/>', "2 -> 3 -> 2"),
 ])
 def test_zero_duration_loop_is_an_error(tmp_path, body, ids):
@@ -155,9 +155,9 @@ def test_zero_duration_loop_is_an_error(tmp_path, body, ids):
 
 
 @pytest.mark.parametrize("body", [
-    '<mvrect id="1" duration="0.5" next="2"><vel x="1"/></mvrect><wait id="2" duration="0" next="1"/>',
-    '<mvrect id="1" duration="-1" next="1"><vel x="1"/></mvrect>',              # forever: never loops
-    '<mvrect id="1" duration="0" next="2"><vel x="1"/></mvrect><wait id="2" duration="0"/>',   # ends
+    '<mvrect id="1" duration="0.5" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0" next="1"/>',
+    '<mvrect id="1" duration="-1" next="1"><vel x="1" y="0" z="0"/></mvrect>',              # forever: never loops
+    '<mvrect id="1" duration="0" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0"/>',   # ends
 ])
 def test_loops_that_advance_are_accepted(tmp_path, body):
     (m,), _ = read(tmp_path, body)
@@ -172,7 +172,7 @@ def test_zero_loop_at_run_time_is_a_case_error():
 
 
 def test_begin_finish(tmp_path):
-    body = '<mvrect id="1" duration="-1"><vel x="1"/></mvrect>'
+    body = '<mvrect id="1" duration="-1"><vel x="1" y="0" z="0"/></mvrect>'
     (m,), _ = read(tmp_path, body, begin='<begin mov="1" start="0.5" finish="-1"/>')
     assert m["begin"]["finish"] is None      # DualSPHysics: -1 = no end
     with pytest.raises(CaseError, match="finish=0.2 comes before start=0.5") as e:
