@@ -147,6 +147,9 @@ def read_sections(case: Case, root, reader: CaseReader) -> None:
     case.initials = read_initials(reader, casedef)
     case.motions = read_motion(reader, casedef)
     case.materials, case.material_links = read_properties(reader, casedef)
+    for fd in case.floatings:
+        if fd.property is not None:
+            _check_property_names(reader, fd.property, case.materials, fd.line, "floating")
     case.normals = read_normals(reader, casedef)
     execution = root.find("execution")
     params, set_keys, domain = read_parameters(reader, execution)
@@ -476,6 +479,17 @@ MATERIAL_KEYS = {"Young_Modulus": "young", "PoissonRatio": "poisson",
                  "Restitution_Coefficient": "restitution", "Kfric": "kfric", "Sfric": "sfric"}
 
 
+def _warn_near_material_key(reader, el, key: str) -> None:
+    """A property value sphdvi does not read, spelt like one it does (``Kfrik``): warned, as it
+    would leave the contact with the default value.  Other keys (a user's own) pass silently."""
+    import difflib
+    known = list(MATERIAL_KEYS) + [k + "_User" for k in MATERIAL_KEYS]
+    hint = difflib.get_close_matches(key, known, n=1, cutoff=0.75)
+    if hint:
+        reader.warn(el, f"property value '{key}' is not read (did you mean '{hint[0]}'?); the contact uses "
+                        f"the default for it")
+
+
 def _read_material(reader, el) -> Material:
     """A ``<property>``: values as child elements (``<Kfric value="0.3"/>``) or attributes
     (``Restitution_Coefficient_User="0.65"``); as in DualSPHysics, a ``*_User`` value
@@ -487,6 +501,7 @@ def _read_material(reader, el) -> Material:
         if key in MATERIAL_KEYS:
             (user if c.tag.endswith("_User") else plain)[MATERIAL_KEYS[key]] = reader.num(c, "value", nonnegative=True)
         else:
+            _warn_near_material_key(reader, c, c.tag)
             mat.extra[c.tag] = {k: c.get(k) for k in c.keys()}
             reader.mark(c, *c.keys())
     for k in el.keys():
@@ -496,6 +511,7 @@ def _read_material(reader, el) -> Material:
         if key in MATERIAL_KEYS:
             (user if k.endswith("_User") else plain)[MATERIAL_KEYS[key]] = reader.num(el, k, nonnegative=True)
         else:
+            _warn_near_material_key(reader, el, k)
             mat.extra[k] = el.get(k)
             reader.mark(el, k)
     for attr, value in {**plain, **user}.items():
@@ -535,12 +551,18 @@ def read_properties(reader, casedef):
         else:
             raise reader.error(c, f"unknown element <{c.tag}> in <properties>", "property, propertyfile, links")
     for d in links:
-        for name in d["property"].split("+"):
-            if name.strip() not in materials:
-                raise CaseError(f"property '{name.strip()}' is not defined", file=reader.file, line=d["line"],
-                                element="link", expected="a <property name> defined in <properties> or its propertyfile"
-                                + (f" (defined: {', '.join(sorted(materials))})" if materials else ""))
+        _check_property_names(reader, d["property"], materials, d["line"], "link")
     return materials, links
+
+
+def _check_property_names(reader, combo: str, materials: dict, line: int, element: str) -> None:
+    """Each name of a property (or a combination "A + B") of a <link> or a <floating> is defined
+    (a floating's misspelt property fell back to the default material before)."""
+    for name in combo.split("+"):
+        if name.strip() not in materials:
+            raise CaseError(f"property '{name.strip()}' is not defined", file=reader.file, line=line,
+                            element=element, expected="a <property name> defined in <properties> or its propertyfile"
+                            + (f" (defined: {', '.join(sorted(materials))})" if materials else ""))
 
 
 def _read_property_file(reader, el, path, section):

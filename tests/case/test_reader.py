@@ -282,6 +282,23 @@ def test_unknown_material(tmp_path):
     props = '<properties><links><link mkbound="0" property="wood"/></links></properties>'
     with pytest.raises(CaseError, match="property 'wood' is not defined"):
         build(tmp_path, casedef_extra=props)
+    # a floating's property as a link's (the default material was used silently before)
+    for prop in ("stel", "steel + wood"):
+        with pytest.raises(CaseError, match=rf"Case_Def.xml:\d+: <floating>: property '{prop.split()[-1]}' is not "
+                                            r"defined; expected .* \(defined: steel\)"):
+            build(tmp_path, commands=TANK_2D + CHRONO_BODIES, special=chrono(),
+                  casedef_extra=FLOATINGS.replace('"steel"', f'"{prop}"') + PROPS)
+
+
+def test_misspelt_property_value_is_warned(tmp_path):
+    """A property value spelt like one sphdvi reads (Kfrik) is warned (the contact would take the
+    default friction); a user's own key (colour) is not."""
+    props = PROPS.replace("<Kfric", '<Kfrik').replace('name="steel"', 'name="steel" colour="red"')
+    r = build(tmp_path, commands=TANK_2D + CHRONO_BODIES, casedef_extra=FLOATINGS + props, special=chrono())
+    assert [w for w in r.warnings if "property value" in w] == [
+        w for w in r.warnings if "'Kfrik' is not read (did you mean 'Kfric'?)" in w and "<Kfrik>" in w]
+    assert len([w for w in r.warnings if "property value" in w]) == 1
+    assert r.case.materials["steel"].kfric is None
 
 
 def test_gauges_wavepaddles_damping(tmp_path):
