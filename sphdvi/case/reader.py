@@ -765,6 +765,21 @@ def read_special(reader, execution) -> dict:
     return out
 
 
+def _check_modelfile(reader, el, modelfile: str, body_id: str) -> None:
+    """A chrono body's collision ``modelfile``: GenCase's own shapes (AutoActual, AutoDp, a
+    ``*_Actual.vtk`` / ``*_Dp.vtk`` it wrote) pass; a mesh file must exist, as DualSPHysics loads
+    it, and is warned about: sphdvi builds every collision shape from the body's particles."""
+    low = modelfile.strip().lower()
+    if low in ("autoactual", "autodp") or low.endswith(("_actual.vtk", "_dp.vtk")):
+        return
+    path = os.path.normpath(os.path.join(reader.base_dir, modelfile))
+    if not os.path.isfile(path):
+        raise reader.error(el, f"modelfile '{modelfile}' not found (looked for {path})",
+                           "an existing .obj/.vtk file, or AutoActual / AutoDp (the shape GenCase drew)")
+    reader.warn(el, f"modelfile '{modelfile}': sphdvi does not read collision meshes; body '{body_id}' collides "
+                    "through spheres at its boundary particles, as with AutoActual")
+
+
 def read_chrono(reader, el) -> dict:
     allowed = {"savedata", "schemescale", "ompthreads", "collision", "bodyfixed", "bodyfloating",
                "bodymoving", "link_hinge", "link_spheric", "link_pointline", "link_linearspring",
@@ -815,6 +830,8 @@ def read_chrono(reader, el) -> dict:
                     "imposefric": reader.boolean(b, "imposefric", False)}
             if kind == "moving":
                 body["massbody"] = reader.num(b, "massbody", positive=True)
+            if out["collision"]["activate"] and body["modelfile"]:
+                _check_modelfile(reader, b, body["modelfile"], name)
             out["bodies"].append(body)
     for ln in reader.children(el):
         if not ln.tag.startswith("link_"):

@@ -290,6 +290,25 @@ def test_unknown_material(tmp_path):
                   casedef_extra=FLOATINGS.replace('"steel"', f'"{prop}"') + PROPS)
 
 
+def test_collision_modelfile(tmp_path):
+    """With collision on, a modelfile that is not there is an error (DualSPHysics loads it; it
+    passed silently before); one that is there is warned about (sphdvi collides through the
+    body's particles); GenCase's own shapes pass silently."""
+    def case(modelfile):
+        return dict(commands=TANK_2D + CHRONO_BODIES, casedef_extra=FLOATINGS + PROPS,
+                    special=chrono().replace('<bodyfloating id="box" mkbound="50" modelfile="AutoActual"/>',
+                             f'<bodyfloating id="box" mkbound="50" modelfile="{modelfile}"/>'))
+    with pytest.raises(CaseError, match=r"<bodyfloating>: modelfile 'nofile.obj' not found .*; expected an existing "
+                                        r"\.obj/\.vtk file, or AutoActual / AutoDp"):
+        build(tmp_path, **case("nofile.obj"))
+    (tmp_path / "box.obj").write_text("v 0 0 0\n")
+    r = build(tmp_path, **case("box.obj"))
+    assert any("modelfile 'box.obj': sphdvi does not read collision meshes; body 'box'" in w for w in r.warnings)
+    for auto in ("AutoDp", "Case_Mkb0050_Actual.vtk"):
+        r = build(tmp_path, **case(auto))
+        assert not any("modelfile '" in w for w in r.warnings), list(r.warnings)
+
+
 def test_misspelt_property_value_is_warned(tmp_path):
     """A property value spelt like one sphdvi reads (Kfrik) is warned (the contact would take the
     default friction); a user's own key (colour) is not."""
