@@ -946,6 +946,10 @@ def _read_definition(reader, geometry_el):
                                     f"{pmin.tolist()}", "pointmax >= pointmin on every axis")
     if not np.all(np.isfinite((pmax - pmin) / dp)):
         raise reader.error(d, "domain size / dp is not finite", "a finite number of nodes")
+    width = float(pmax[1] - pmin[1])
+    if 0 < width < dp:
+        reader.warn(pmax_el, f"the domain is {width:g} m deep in y, less than dp ({dp:g} m): a 3D case one particle "
+                             "layer thick; for a 2D case give pointmin and pointmax the same y")
     return d, dp, pmin, pmax, pref
 
 
