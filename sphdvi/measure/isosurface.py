@@ -17,15 +17,28 @@ import numpy as np
 from ..errors import InputError
 
 
+# the isosurface's grid at most: 5e7 nodes take ~3 GB with their positions and sums
+MAX_GRID_NODES = 50_000_000
+
+
 def kernel_sum_grid(grid, spec, spacing):
     """(origin, dims, values) of the kernel sum on a grid covering the fluid plus 2h."""
     from .core import kernel_sum
     lo = grid.pos.min(axis=0) - 2.0 * spec.h
     hi = grid.pos.max(axis=0) + 2.0 * spec.h
-    dims = np.floor((hi - lo) / spacing).astype(int) + 1
+    dims = np.floor((hi - lo) / spacing).astype(np.int64) + 1
     if spec.is2d:
         lo[1] = grid.pos[0, 1]
         dims[1] = 1
+    nodes = float(np.prod(dims.astype(np.float64)))
+    if nodes > MAX_GRID_NODES:
+        # the spacing that gives MAX_GRID_NODES nodes over the same box
+        box = np.where(dims > 1, hi - lo, 1.0)
+        need = (float(np.prod(box[dims > 1])) / MAX_GRID_NODES) ** (1.0 / max(1, int((dims > 1).sum())))
+        raise InputError(f"--iso-spacing {spacing:g}: {nodes:.3g} grid nodes over the fluid "
+                         f"({' x '.join(f'{e:.3g}' for e, n in zip(hi - lo, dims) if n > 1)} m); at most "
+                         f"{MAX_GRID_NODES:.0e}: expected a spacing >= {need:.3g} m (the default is dp/2, "
+                         f"{0.5 * spec.dp:g} m)")
     axes = [lo[k] + spacing * np.arange(dims[k]) for k in range(3)]
     z, y, x = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")      # x fastest (VTK order)
     nodes = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)

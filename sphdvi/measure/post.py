@@ -374,6 +374,10 @@ def elevation_step(grid: core.ParticleGrid, bound_pos, xy, zlo, zhi, spec, thres
     return surf, bottom
 
 
+# samples along one vertical of `measure elevation` at most (--dz 1e-9 ran out of memory)
+MAX_LINE_SAMPLES = 1_000_000
+
+
 def measure_elevation(run: RunOutput, xy, threshold=None, dz=None, first=0, last=None, every=1):
     """Free-surface elevation and water depth at each (x, y) at every output time."""
     spec = run.spec
@@ -397,6 +401,10 @@ def measure_elevation(run: RunOutput, xy, threshold=None, dz=None, first=0, last
             zhi = float(grid.pos[:, 2].max()) + 2 * spec.h
         else:
             zlo, zhi = 0.0, 1.0
+        if (zhi - zlo) / dz > MAX_LINE_SAMPLES:
+            raise InputError(f"--dz {dz:g}: {(zhi - zlo) / dz:.3g} samples along each vertical ({zhi - zlo:.3g} m, "
+                             f"the fluid's height and 2h either side); at most {MAX_LINE_SAMPLES:.0e}: expected "
+                             f"--dz >= {(zhi - zlo) / MAX_LINE_SAMPLES:.3g} m (the default is dp/4, {0.25 * spec.dp:g} m)")
         surf, bottom = elevation_step(grid, bound, xy, zlo, zhi, spec, threshold, dz)
         rows.append(np.column_stack([surf, surf - bottom]).reshape(-1))
         times.append(snap.time)

@@ -129,6 +129,8 @@ def test_cli_bad_options_exit_2_before_any_output(tank2d, tmp_path):
         (["elevation", "--at", "0.3", "--first", "10"], "--first 10: "),
         (["elevation", "--at", "0.3", "--first", "1", "--last", "0"], "--last 0 is before --first 1"),
         (["elevation", "--at", "0.2,0,1"], "expected x or x,y"),
+        # a step that would sample beyond memory (it ran ~70 s, then exit 1 "out of memory")
+        (["elevation", "--at", "0.3", "--dz", "1e-9"], "samples along each vertical"),
         (["points", "--points", "nonexist.txt"], "nonexist.txt: file not found"),
         (["points", "--points", str(tmp_path / "nope.csv")], "nope.csv: file not found"),
     ]

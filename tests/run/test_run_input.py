@@ -317,3 +317,5 @@ def test_export_dir_is_used_as_given(done, tmp_path):
     assert_input_error(r, "run.csv exists and is not a folder")
     r = invoke(["export", out, "--isosurface", "--iso-spacing", "nan"])
     assert_input_error(r, "Invalid value for '--iso-spacing'")
+    r = invoke(["export", out, "--isosurface", "--iso-spacing", "1e-7"])     # out of memory before
+    assert_input_error(r, "--iso-spacing 1e-07: ", "grid nodes over the fluid", "expected a spacing >= ")
