@@ -49,6 +49,21 @@ class OutputSchedule:
             nxt = min(nxt, self.rows[i + 1][0])
         return nxt
 
+    def first_after(self, t: float, tolerance: float = 0.0) -> float:
+        """The first output time after the clock time ``t`` (a resumed run's next output after
+        its last one, which may be off the schedule: a run ended at a TimeMax between two outputs
+        and extended).  A ``t`` within ``tolerance`` of a scheduled time counts as that time."""
+        if self.uniform:
+            tout = self.rows[0][1]
+            k = math.floor(t / tout)
+            if t >= (k + 1) * tout - tolerance:      # at the next scheduled time, to round-off
+                k += 1
+            return (k + 1) * tout
+        s = 0.0
+        while s <= t + tolerance:
+            s = self.after(s)
+        return s
+
     def nth(self, k: int) -> float:
         """The time of output ``k`` (0: the start)."""
         if self.uniform:

@@ -48,7 +48,7 @@ from .io.runfolder import (NORMALS_FILE, SetAside, check_new_run_folder, earlier
 from .sph.damping import damping_zones
 from .output_parts import OutputParts
 from .output_schedule import OutputSchedule
-from .sph.clock import time_reached
+from .sph.clock import TIME_TOLERANCE, time_reached
 
 POINT_ARRAYS = {"Idp": (np.int64, 1), "Vel": (np.float32, 3), "Rhop": (np.float32, 1),
                 "Press": (np.float32, 1), "Type": (np.uint8, 1), "Mk": (np.int32, 1)}
@@ -1021,7 +1021,10 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         try:
             if not resume:
                 write_part(0)
-            next_out = out_times.after(out_times.nth(part))
+            # on resume, the first output after the last one written: that one may be off the
+            # schedule (a TimeMax between two outputs, extended by --resume --tmax)
+            next_out = (out_times.first_after(float(sol.time), TIME_TOLERANCE * max(1.0, out_times.smallest))
+                        if resume else out_times.after(out_times.nth(part)))
             extra = params.get("TimeOutExtra")
             extra = float(extra) if body_log is not None and extra is not None and extra < tout else None
             next_extra = _next_multiple(sol.time, extra) if extra else 0.0

@@ -237,6 +237,36 @@ def test_resume_reuses_the_run_options(done, tmp_path):
     assert len(csv_rows(out / "run.csv")) == 5
 
 
+def test_extending_a_run_that_ended_between_outputs_keeps_the_schedule(tmp_path):
+    """A run to a TimeMax between two outputs ends with an output there; extended with --resume
+    --tmax, its next output is the schedule's next one (0.003 was skipped before: after an output
+    at 0.0025 the next came at 0.004), and its times are those of an uninterrupted run besides."""
+    whole, ext = tmp_path / "whole", tmp_path / "ext"
+    opts = ["--dp", "0.1", "--tout", "0.001", "--threads", "1", "-q"]
+    assert invoke(["run", DAMBREAK, "-o", whole, "--tmax", "0.005"] + opts).exit_code == 0
+    assert invoke(["run", DAMBREAK, "-o", ext, "--tmax", "0.0025"] + opts).exit_code == 0
+    r = invoke(["run", ext, "--resume", "--tmax", "0.005", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+
+    def times(out):
+        return [float(row.split(",")[1]) for row in csv_rows(out / "run.csv")]
+    assert len(times(whole)) == 6
+    assert times(ext) == sorted(times(whole) + [times(ext)[3]])     # the same steps; one output more
+    assert 0.0025 <= times(ext)[3] < times(whole)[3] and times(whole)[3] >= 0.003
+
+
+def test_first_output_after_a_clock_time():
+    from sphdvi.output_schedule import OutputSchedule
+    every = OutputSchedule.every(0.05)
+    assert every.first_after(0.125) == pytest.approx(0.15)
+    assert every.first_after(0.1000000000001, 1e-12) == pytest.approx(0.15)
+    assert every.first_after(0.15 - 1e-14, 1e-12) == pytest.approx(0.2)       # at 0.15 to round-off
+    rows = OutputSchedule([(0.0, 0.1), (0.25, 0.01)])
+    assert rows.first_after(0.12) == pytest.approx(0.2)
+    assert rows.first_after(0.2) == pytest.approx(0.25)
+    assert rows.first_after(0.253) == pytest.approx(0.26)
+
+
 def test_leftover_temporaries_go_at_start(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     (out / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
