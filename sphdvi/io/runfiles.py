@@ -58,9 +58,10 @@ class RunFiles:
             self.on_start = None
 
     def load_existing(self, nparts: int) -> None:
-        """On resume: keep the log (without a torn last line), and the CSV rows of the first
-        ``nparts`` outputs."""
-        write_text_atomic(self.log_path, "".join(line + "\n" for line in complete_lines(self.log_path)))
+        """On resume: the log and the CSV rows of the first ``nparts`` outputs, without what was
+        written after the restart output (the run goes on from there and writes it again)."""
+        lines = log_to_part(complete_lines(self.log_path), nparts - 1)
+        write_text_atomic(self.log_path, "".join(line + "\n" for line in lines))
         rows = complete_lines(self.csv_path)[1:nparts + 1]
         write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n" + "".join(r + "\n" for r in rows))
         if os.path.exists(self.json_path):
@@ -69,6 +70,19 @@ class RunFiles:
                     self.meta = json.load(fh)
                 except json.JSONDecodeError:
                     self.meta = {}
+
+
+def log_to_part(lines: list[str], part: int) -> list[str]:
+    """run.log's lines up to output ``part``'s "Part NNNN" line and the WARNING lines written with
+    it; all of them where that line is missing (a log of an older run)."""
+    tag = f"Part {part:04d} "
+    ends = [i for i, line in enumerate(lines) if line.startswith(tag)]
+    if not ends:
+        return lines
+    end = ends[-1] + 1
+    while end < len(lines) and lines[end].startswith("WARNING:"):
+        end += 1
+    return lines[:end]
 
 
 def _jsonable(obj):

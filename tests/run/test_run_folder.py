@@ -267,6 +267,30 @@ def test_first_output_after_a_clock_time():
     assert rows.first_after(0.253) == pytest.approx(0.26)
 
 
+def test_resume_cuts_run_log_back_to_the_restart_output(done, tmp_path):
+    """A run killed after an output's log line but before its checkpoint (a body-only run
+    checkpoints at most once a second) resumes from the earlier output: the log lines written
+    after it go, so that each Part line is there once (they were written twice before)."""
+    out = copy_run(done, tmp_path / "o")              # restart.h5 at part 2
+    log = out / "run.log"
+    kept = log.read_text().split("completed:")[0]     # the lines up to the restart output's
+    log.write_text(kept + "Part 0003  t=0.006000 s  steps=99  (written before the kill)\nWARNING: lost\n")
+    r = invoke(["run", out, "--resume", "--tmax", "0.008", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    text = log.read_text()
+    assert text.startswith(kept) and "before the kill" not in text and "lost" not in text
+    parts = [line.split()[1] for line in text.splitlines() if line.startswith("Part ")]
+    assert parts == ["0000", "0001", "0002", "0003", "0004"]
+
+
+def test_log_to_part():
+    from sphdvi.io.runfiles import log_to_part
+    lines = ["Part 0000  t=0", "Part 0001  t=1", "WARNING: excluded", "a step's note", "Part 0002  t=2"]
+    assert log_to_part(lines, 1) == lines[:3]
+    assert log_to_part(lines, 2) == lines
+    assert log_to_part(["resumed"], 3) == ["resumed"]
+
+
 def test_leftover_temporaries_go_at_start(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     (out / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
