@@ -1004,7 +1004,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         excluded_log.record(sol.take_excluded())
         if body_log is not None:
             body_log.record()
-        saved = {"part": k, "runtime_s": wall}
+        saved = {"part": k, "runtime_s": wall, "excl_part_pct": excl_warn.part_pct,
+                 "excl_total_pct": excl_warn.total_pct}
         if dtlog is not None:
             dtlog.flush()
             saved["savedt"] = json.dumps({"log": dtlog.get_state(), "terms": list(sol.dt_terms)})
@@ -1013,6 +1014,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     excl_seen = [sum(sol.n_excluded.values())]
     excl_warn = ExclusionWarnings(int(params.get("WrnPartsOut", 1)) != 0, sph.n0_fluid,
                                   int(data["particles"]["type"].size))
+    if resume and "excl_part_pct" in extra:         # the levels already warned about (each warns once)
+        excl_warn.part_pct, excl_warn.total_pct = int(extra["excl_part_pct"]), int(extra["excl_total_pct"])
     excluded_log = ExcludedLog(outdir, float(sol.time) if resume else None)
     body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None)
                 if sph.bodies is not None else None)

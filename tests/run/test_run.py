@@ -647,6 +647,22 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
         log = (out / "run.log").read_text()
         assert ("WARNING: more than 1% of the fluid particles were excluded" in log) == expect
         assert any("more than 1%" in str(c.message) for c in caught) == expect
+    # the levels warned about travel in restart.h5, so that a resumed run does not warn again
+    # at a level it has passed (they started again at 1 % and 10 % before)
+    out = tmp_path / "levels"
+    r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.01", "--threads", "1", "-q",
+                "--set", "RhopOutMax=1002.0"])
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "restart.h5", "r") as f:
+        levels = int(f["scalars"].attrs["excl_part_pct"]), int(f["scalars"].attrs["excl_total_pct"])
+    assert levels == (2, 20)          # 252 of 1,501 particles went by 0.01 s: 1 % and 10 % warned
+    with h5py.File(out / "restart.h5", "r+") as f:        # as if the next levels had been passed
+        f["scalars"].attrs["excl_part_pct"], f["scalars"].attrs["excl_total_pct"] = 200, 200
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert invoke(["run", out, "--resume", "--tmax", "0.03", "--threads", "1", "-q"]).exit_code == 0
+    with h5py.File(out / "restart.h5", "r") as f:
+        assert int(f["scalars"].attrs["excl_part_pct"]) == 200
 
 
 def test_excluded_particles_file_and_resume(tmp_path):
