@@ -38,7 +38,7 @@ import numpy as np
 
 from ._version import __version__
 from .errors import DivergenceError, InputError
-from .io.checkpoint import (RESTART_FILE, case_identity, load_bodies_checkpoint, load_sph_checkpoint,
+from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_bodies_checkpoint, load_sph_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import remove_leftover_temporaries
 from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
@@ -229,6 +229,21 @@ def resume_overrides(base: dict, outdir: str, tmax, tout, sets):
     return (old_tmax if tmax is None else tmax), old_tout, old_sets
 
 
+def _check_resume_tmax(tmax: float, outdir: str) -> None:
+    """``--resume --tmax`` below the time the run has reached is refused (the run was marked
+    completed at a time past its TimeMax, and a later --resume kept that TimeMax), unless it is
+    the TimeMax the run already had (a completed run resumed again: nothing to do)."""
+    reached = checkpoint_time(os.path.join(outdir, RESTART_FILE))
+    if reached is None or tmax >= reached * (1 - 1e-9):
+        return
+    with contextlib.suppress(OSError, ValueError, KeyError, TypeError):
+        with open(os.path.join(outdir, "run.json")) as fh:
+            if _same_value(float(json.load(fh)["parameters"]["TimeMax"]), tmax):
+                return
+    raise InputError(f"--tmax {tmax:g}: the run in {outdir} has reached t={reached:.6g} s (its last output): "
+                     f"expected a --tmax beyond it to go on, or --resume without --tmax")
+
+
 def _same_value(a, b) -> bool:
     if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
         return True
@@ -256,6 +271,8 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
         _check_dp(expect_dp, data, case_h5, resume)
     base = special_parameters(data)
     if resume:
+        if tmax is not None:
+            _check_resume_tmax(float(tmax), outdir)
         tmax, tout, sets = resume_overrides(base, outdir, tmax, tout, sets)
     params = apply_overrides(base, sets, tmax, tout)
     _check_rigid_algorithm(data, params, sets)
@@ -451,7 +468,7 @@ class BodiesOnlyRun:
 
     def resume(self) -> None:
         """Continue from the last output: the System's state from restart.h5 (into the System
-        the case builds), run.csv cut back to that output (run.log kept); bodies.csv/links.csv
+        the case builds), run.csv and run.log cut back to that output; bodies.csv/links.csv
         are cut when the run starts."""
         if not os.path.exists(self.ckpt):
             raise InputError(f"--resume: no checkpoint {self.ckpt} in {self.outdir}")

@@ -165,6 +165,19 @@ def load_sph_checkpoint(path: str, solver, system=None, case_id: dict | None = N
     return sc
 
 
+def checkpoint_time(path: str) -> float | None:
+    """The simulated time of a restart.h5 (an SPH or a body-only run's); None when it cannot
+    be read (the resume itself then says why)."""
+    import h5py
+    try:
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("format") == BODIES_RESTART_FORMAT:
+                return float(json.loads(f["bodies"].attrs["scalars"])["time"])
+            return float(f["scalars"].attrs["time"])
+    except (OSError, KeyError, ValueError, TypeError):
+        return None
+
+
 def save_bodies_checkpoint(path: str, state: dict, **extra) -> None:
     """Write the state of a body-only run to ``path`` atomically: a System's dynamic state
     (``System.get_state()``, in the layout of an SPH run's restart.h5) and the scalars

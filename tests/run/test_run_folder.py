@@ -291,6 +291,25 @@ def test_log_to_part():
     assert log_to_part(["resumed"], 3) == ["resumed"]
 
 
+def test_resume_with_a_tmax_below_the_time_reached_is_refused(done, tmp_path):
+    """--resume --tmax below the run's time (t = 0.0042 after TimeMax 0.004) is refused, nothing
+    touched (the run was marked completed at TimeMax 0.002 before, and kept it); the run's own
+    TimeMax again is accepted (nothing to do), as in a body-only run."""
+    out = copy_run(done, tmp_path / "o")
+    before = tree(out)
+    r = invoke(["run", out, "--resume", "--tmax", "0.002", "--threads", "1", "-q"])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert "--tmax 0.002: the run in" in r.output and "has reached t=0.00424" in r.output
+    assert "expected a --tmax beyond it" in r.output
+    assert tree(out) == before
+    assert invoke(["run", out, "--resume", "--tmax", "0.004", "--threads", "1", "-q"]).exit_code == 0
+    pend = tmp_path / "pend"
+    assert invoke(["run", REPO / "cases" / "pendulum" / "CasePendulum_Def.xml", "-o", pend, "--tmax", "0.05",
+                   "-q"]).exit_code == 0
+    r = invoke(["run", pend, "--resume", "--tmax", "0.01", "-q"])
+    assert r.exit_code == 2 and "has reached t=0.05" in r.output, r.output
+
+
 def test_leftover_temporaries_go_at_start(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     (out / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
