@@ -146,6 +146,7 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
         outdir = outdir or f"{case_name_from_path(source)}_out"
         if resume:
             case_h5 = find_case_file(outdir)
+            _check_resume_source(source, case_h5, outdir)
             drawn_dp = dp
         else:
             check_new_run_folder(outdir, overwrite)     # before gencase writes into it
@@ -171,6 +172,26 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
         click.echo(f"completed: t = {result.physical_time:.6g} s, {result.steps} steps, "
                    f"{result.runtime_s:.2f} s of time stepping -> {outdir}", err=True)
     sys.exit(result.exit_code)
+
+
+def _check_resume_source(case_xml: str, case_h5: str, outdir: str) -> None:
+    """``run CASE.xml --resume -o OUT``: the run in OUT goes on with the case gencase drew then, so
+    CASE.xml must be that case's file as it was (another case, or an edited file, resumed silently
+    with the old case before)."""
+    from .case.reader import case_name_from_path
+    from .errors import InputError
+    from .io.casefile import read_case_h5
+    name = case_name_from_path(case_xml)
+    drawn = os.path.basename(case_h5)[:-3]
+    if drawn != name:
+        raise InputError(f"--resume: {outdir} holds a run of the case '{drawn}' ({case_h5}), not of {case_xml} "
+                         f"('{name}'); expected that case's file, or 'sphdvi run {outdir} --resume'")
+    with open(case_xml, "rb") as fh:
+        text = fh.read().decode("utf-8", errors="replace")
+    if read_case_h5(case_h5)["source_xml"].strip() != text.strip():
+        raise InputError(f"--resume: {case_xml} has changed since gencase drew the case in {outdir}, and a resumed "
+                         f"run goes on with the case as drawn then; expected 'sphdvi run {outdir} --resume' to go on "
+                         "with it, or a new run of the edited case with --overwrite or another -o")
 
 
 @main.command(context_settings=CONTEXT)

@@ -310,6 +310,24 @@ def test_resume_with_a_tmax_below_the_time_reached_is_refused(done, tmp_path):
     assert r.exit_code == 2 and "has reached t=0.05" in r.output, r.output
 
 
+def test_resume_with_a_case_xml_checks_it_is_the_runs(done, tmp_path):
+    """`run CASE.xml --resume -o OUT` goes on with the case drawn in OUT: its own file is accepted;
+    another case's file, or the same file edited since, is refused naming what to do (either
+    resumed the old case silently before), nothing touched."""
+    out = copy_run(done, tmp_path / "o")
+    before = tree(out)
+    other = tmp_path / "CaseOther_Def.xml"
+    other.write_text(DAMBREAK.read_text())
+    edited = tmp_path / "CaseDambreakVal2D_Def.xml"
+    edited.write_text(DAMBREAK.read_text().replace("<parameters>", '<parameters><parameter key="Visco" value="0.5"/>'))
+    for xml, text in ((other, "holds a run of the case 'CaseDambreakVal2D'"), (edited, "has changed since gencase")):
+        r = invoke(["run", xml, "-o", out, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
+        assert r.exit_code == 2 and text in r.output and f"'sphdvi run {out} --resume'" in r.output, r.output
+        assert tree(out) == before
+    r = invoke(["run", DAMBREAK, "-o", out, "--resume", "--tmax", "0.006", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+
+
 def test_leftover_temporaries_go_at_start(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     (out / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
