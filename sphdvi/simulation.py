@@ -161,11 +161,28 @@ def find_case_file(folder: str) -> str:
         raise InputError(f"{folder}: no readable gencase output: {'; '.join(unreadable)} cannot be read as HDF5 "
                          "(truncated or corrupt?); run 'sphdvi gencase' again")
     if not found:
+        elsewhere = _case_file_of_run(folder)
+        if elsewhere is not None:
+            return elsewhere
         raise InputError(f"{folder}: no gencase output (<casename>.h5) found; run 'sphdvi gencase' first "
                          "or give the case XML")
     if len(found) > 1:
         raise InputError(f"{folder}: several case files ({', '.join(os.path.basename(f) for f in found)})")
     return found[0]
+
+
+def _case_file_of_run(folder: str) -> str | None:
+    """The gencase output a run in ``folder`` read, by its run.json's ``case_file``: a run of a
+    gencase folder into another -o (``sphdvi run G -o OUT``) leaves OUT without one.  None when
+    there is no such run.json or the file is no longer a gencase output."""
+    import h5py
+    try:
+        with open(os.path.join(folder, "run.json")) as fh:
+            path = json.load(fh)["case_file"]
+        with h5py.File(path, "r") as f:
+            return path if f.attrs.get("format") == "sphdvi-case" else None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
 
 
 def periodic_axes(data: dict, params: dict) -> list[str]:

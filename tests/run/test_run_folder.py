@@ -328,6 +328,19 @@ def test_resume_with_a_case_xml_checks_it_is_the_runs(done, tmp_path):
     assert r.exit_code == 0, r.output
 
 
+def test_a_run_of_a_gencase_folder_into_another_folder_resumes_and_measures_there(tmp_path):
+    """`sphdvi run G -o OUT` leaves OUT without a case file: `run OUT --resume` (what its message
+    says) and `measure ... OUT` find it by run.json's case_file (both said "no gencase output")."""
+    g, out = tmp_path / "g", tmp_path / "out"
+    assert invoke(["gencase", DAMBREAK, "-o", g, "--dp", "0.1", "-q"]).exit_code == 0
+    assert invoke(["run", g, "-o", out, "--tmax", "0.002", "--tout", "0.002", "--threads", "1", "-q"]).exit_code == 0
+    r = invoke(["run", out, "--resume", "--tmax", "0.004", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    assert nsteps(out / "particles.vtkhdf") == 3
+    r = invoke(["measure", "elevation", out, "--at", "0.2"])
+    assert r.exit_code == 0 and len(r.stdout.splitlines()) == 4, r.output
+
+
 def test_leftover_temporaries_go_at_start(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     (out / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
