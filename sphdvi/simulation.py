@@ -982,7 +982,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             files.log("WARNING: " + line)
             warnings.warn(line)
     else:
-        writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS)
+        writer = VTKHDFParticleWriter(vtk_path, POINT_ARRAYS, points_per_step=int(data["particles"]["type"].size))
         files.start()
         if sol.keep_dt_terms:
             dtlog = DtLog(outdir, special["savedt"], tout)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
 from sphdvi.cli import main
+from sphdvi.simulation import POINT_ARRAYS
 
 DAMBREAK = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
 
@@ -76,6 +77,10 @@ def test_run_outputs(tmp_path):
     r = invoke(["export", out])
     assert r.exit_code == 0 and (out / "vtp" / "particles.pvd").is_file()
     assert len(list((out / "vtp").glob("Part_*.vtp"))) == 5
+    # the file is about its data: 5 steps of 1,501 particles, 53 bytes each (0.4 MB), take under
+    # 1 MB (14.3 MB for one step before, the chunks of 2^16 rows of every per-step array)
+    data = 5 * 1501 * sum(np.dtype(d).itemsize * n for d, n in POINT_ARRAYS.values()) + 5 * 1501 * 24
+    assert (out / "particles.vtkhdf").stat().st_size < max(1 << 20, 2 * data)
 
 
 def test_run_restores_the_callers_thread_count(tmp_path):
