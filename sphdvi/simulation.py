@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._version import __version__
-from .errors import DivergenceError, InputError
+from .errors import DivergenceError, InputError, SphdviError
 from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_bodies_checkpoint, load_sph_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import remove_leftover_temporaries
@@ -552,9 +552,11 @@ class BodiesOnlyRun:
                 status, code, message = "diverged", 3, str(exc)
             except BaseException as exc:
                 self.runtime = wall_prev + (_time.perf_counter() - t_loop)
-                self._checkpoint()
-                files.write_json(status="failed", message=f"{type(exc).__name__}: {exc}", steps=self.step,
-                                 physical_time=float(s.time), runtime_s=self.runtime)
+                _clean_up_after_failure(
+                    self._checkpoint,
+                    lambda: files.write_json(status="failed", message=f"{type(exc).__name__}: {exc}",
+                                             steps=self.step, physical_time=float(s.time), runtime_s=self.runtime))
+                _raise_if_disk_full(exc, self.outdir, float(s.time), self.step, self.part)
                 raise
         self._checkpoint()           # the latest output, if the throttle held it back
         self.runtime = wall_prev + (_time.perf_counter() - t_loop)
@@ -842,6 +844,54 @@ class SPHRun:
         return extra
 
 
+def _clean_up_after_failure(*steps) -> None:
+    """Run each step (None: skipped) of a failed run's clean-up, whatever the others raise: on a
+    full disk they fail too, and a particle file left open crashed the interpreter at exit
+    (segmentation fault, exit 139, run.json still 'running')."""
+    for step in steps:
+        if step is not None:
+            with contextlib.suppress(Exception):
+                step()
+
+
+def _disk_full(what: str, outdir: str, t: float, step: int, part: int) -> SphdviError:
+    return SphdviError(f"{what} in {outdir} at t={t:.6g} s, step {step}: the outputs up to part {part} are intact; "
+                       f"free some space and go on with 'sphdvi run {outdir} --resume'")
+
+
+def _raise_if_disk_full(exc: BaseException, outdir: str, t: float, step: int, part: int) -> None:
+    """A write that failed for want of space (ENOSPC, EDQUOT; HDF5 says it in a RuntimeError's
+    text) ends the run with a message that says so and what to do, instead of a bare
+    '[Errno 28] No space left on device' or an HDF5 error."""
+    import errno
+    if isinstance(exc, OSError) and exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        where = f" (writing {exc.filename})" if exc.filename else ""
+        raise _disk_full(os.strerror(exc.errno).lower() + where, outdir, t, step, part) from None
+    if isinstance(exc, RuntimeError) and ("errno = 28" in str(exc) or "No space left" in str(exc)):
+        raise _disk_full("no space left on device (HDF5 write)", outdir, t, step, part) from None
+
+
+# room an output needs besides its own bytes (logs, gauges, run.json)
+OUTPUT_SPACE_MARGIN = 1 << 20
+
+
+def _check_output_space(outdir: str, step_bytes: int, t: float, step: int, part: int) -> None:
+    """Before an output: the free space of OUT's device holds the particle step and a new
+    restart.h5 beside the old one (an atomic write), else the run stops here, cleanly: a write
+    that fails inside HDF5 leaves the file library in a state that crashed the interpreter at exit."""
+    try:
+        st = os.statvfs(outdir)
+    except (OSError, AttributeError):
+        return
+    free = st.f_bavail * st.f_frsize
+    ckpt = os.path.join(outdir, RESTART_FILE)
+    ckpt_bytes = os.path.getsize(ckpt) if os.path.exists(ckpt) else 4 * step_bytes
+    need = step_bytes + ckpt_bytes + OUTPUT_SPACE_MARGIN
+    if free < need:
+        raise _disk_full(f"too little space left on the device ({free / 2**20:.1f} MiB free, an output needs "
+                         f"about {need / 2**20:.1f} MiB)", outdir, t, step, part)
+
+
 def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(x):.5g}" for x in v) + ")"
 
@@ -1017,6 +1067,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
 
     def write_part(k):
         pos, arrays = sph.snapshot()
+        _check_output_space(outdir, pos.nbytes + sum(a.nbytes for a in arrays.values()), float(sol.time),
+                            int(sol.nstep), k - 1)
         written = ""
         if selection is not None and selection.applies_to(k):
             keep = selection.select(pos, arrays["Type"], arrays["Mk"], sph.body_centres())
@@ -1093,16 +1145,17 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         except DivergenceError as exc:
             status, code, message = "diverged", 3, str(exc)
         except BaseException as exc:
-            status, code, message = "failed", 1, f"{type(exc).__name__}: {exc}"
-            excluded_log.record(sol.take_excluded())
+            status, code = "failed", 1
+            message = str(exc) if isinstance(exc, SphdviError) else f"{type(exc).__name__}: {exc}"
             runtime += _time.perf_counter() - t_loop
-            if gauges is not None:
-                gauges.close()
-            if dtlog is not None:
-                dtlog.close()
-            files.write_json(status=status, message=message, steps=int(sol.nstep),
-                             physical_time=float(sol.time), runtime_s=runtime)
-            writer.close()
+            _clean_up_after_failure(
+                lambda: excluded_log.record(sol.take_excluded()),
+                gauges.close if gauges is not None else None,
+                dtlog.close if dtlog is not None else None,
+                lambda: files.write_json(status=status, message=message, steps=int(sol.nstep),
+                                         physical_time=float(sol.time), runtime_s=runtime),
+                writer.close)
+            _raise_if_disk_full(exc, outdir, float(sol.time), int(sol.nstep), part)
             raise
     runtime += _time.perf_counter() - t_loop
     excluded_log.record(sol.take_excluded())       # those after the last output (a stopped run)

@@ -199,6 +199,38 @@ def test_sigterm_stops_cleanly(tmp_path):
     assert meta["status"] == "interrupted" and "--resume" in meta["message"]
 
 
+def test_a_full_disk_stops_the_run_cleanly_and_it_resumes(tmp_path, monkeypatch):
+    """Before each output the run checks that its device holds it (a write failing inside HDF5
+    crashed the interpreter at exit, exit 139, run.json left 'running'): with too little space
+    it stops with exit 1 and a message saying so and how to go on, run.json 'failed', the outputs
+    before intact; once there is room, --resume ends bitwise as an uninterrupted run."""
+    import os as _os
+    from collections import namedtuple
+    case = small_case(tmp_path)
+    opts = ["--tmax", "0.02", "--tout", "0.005", "--threads", "1", "-q"]
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    assert invoke(["run", case, "-o", ref] + opts).exit_code == 0
+    real, calls = _os.statvfs, []
+    Vfs = namedtuple("Vfs", "f_bavail f_frsize")
+
+    def statvfs(path):                     # room for three outputs
+        calls.append(path)
+        return Vfs(10 if len(calls) > 3 else real(path).f_bavail, 4096)
+    monkeypatch.setattr(_os, "statvfs", statvfs)
+    r = invoke(["run", case, "-o", out] + opts)
+    assert r.exit_code == 1, r.output
+    assert "too little space left on the device" in r.output and "outputs up to part 2 are intact" in r.output
+    assert f"'sphdvi run {out} --resume'" in r.output
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "failed" and meta["message"].startswith("too little space")
+    assert len((out / "run.csv").read_text().splitlines()) == 1 + 3
+    monkeypatch.setattr(_os, "statvfs", real)
+    assert invoke(["run", out, "--resume", "--threads", "1", "-q"]).exit_code == 0
+    from sphdvi.io.vtkhdf import read_step
+    a, b = read_step(str(ref / "particles.vtkhdf"), -1), read_step(str(out / "particles.vtkhdf"), -1)
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+
+
 def test_divergence_exit_3(tmp_path):
     """A time step far above the CFL limit blows up: exit 3 naming time, step, particle and cause."""
     case = small_case(tmp_path)
