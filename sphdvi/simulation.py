@@ -897,14 +897,16 @@ def _fmt(v) -> str:
 
 
 class _Stop:
-    """SIGTERM/SIGINT turn into a clean stop at the next step boundary."""
+    """SIGTERM/SIGINT/SIGHUP (a closed terminal) turn into a clean stop at the next step boundary."""
 
     def __init__(self):
         self.signal = None
         self._old = {}
 
     def __enter__(self):
-        for sig in (signal.SIGTERM, signal.SIGINT):
+        for sig in (signal.SIGTERM, signal.SIGINT, getattr(signal, "SIGHUP", None)):
+            if sig is None or (sig != signal.SIGINT and signal.getsignal(sig) == signal.SIG_IGN):
+                continue                # nohup's ignored SIGHUP stays ignored
             try:
                 self._old[sig] = signal.signal(sig, self._handle)
             except ValueError:  # not in the main thread

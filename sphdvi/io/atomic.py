@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import tempfile
 
 # the process's umask, read once (os.umask can only be read by setting it): atomically
@@ -32,6 +33,11 @@ def atomic_path(path: str):
         raise
 
 
+# what atomic_path's mkstemp names: "." + name + "." + 8 characters of [a-z0-9_] + ".tmp" (any
+# ".X.Y.tmp" went before: a user's ".my.backup.tmp" too)
+_TEMPORARY = re.compile(r"\..+\.[a-z0-9_]{8}\.tmp")
+
+
 def remove_leftover_temporaries(folder: str) -> list[str]:
     """Delete the temporary files :func:`atomic_path` leaves when its process is killed
     (SIGKILL) between creating and renaming one: ``.NAME.XXXXXXXX.tmp``.  Returns their names.
@@ -40,7 +46,7 @@ def remove_leftover_temporaries(folder: str) -> list[str]:
     with contextlib.suppress(FileNotFoundError):
         for entry in os.scandir(folder):
             name = entry.name
-            if name.startswith(".") and name.endswith(".tmp") and name.count(".") >= 3 and entry.is_file():
+            if _TEMPORARY.fullmatch(name) and entry.is_file():
                 with contextlib.suppress(OSError):
                     os.unlink(entry.path)
                     removed.append(name)

@@ -36,6 +36,9 @@ def export_vtp(outdir: str, subdir: str = "vtp") -> list[str]:
     beyond this run's steps are deleted; returns the files (.pvd last)."""
     src = os.path.join(outdir, "particles.vtkhdf")
     if not os.path.isfile(src):
+        if os.path.isfile(os.path.join(outdir, "bodies.csv")) and os.path.isfile(os.path.join(outdir, "run.json")):
+            raise InputError(f"{outdir} holds a body-only run (no fluid): it writes no particles.vtkhdf to export; "
+                             "its results are bodies.csv and links.csv")
         raise InputError(f"{src} not found: run 'sphdvi run' first")
     dest = export_dir(outdir, subdir)
     times = step_times(src)

@@ -64,10 +64,15 @@ def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> 
     if not found or overwrite:
         return
     status = ""
-    with contextlib.suppress(OSError, ValueError, AttributeError):
+    with contextlib.suppress(OSError, ValueError, AttributeError, KeyError, TypeError):
         with open(os.path.join(outdir, "run.json")) as fh:
             meta = json.load(fh)
         status = f", status '{meta['status']}' at t={float(meta['physical_time']):.6g} s"
+        if meta["status"] == "running":      # run.json is written at the start and the end only
+            status = ", status 'running': it still runs, or it was killed"
+            last = last_output_time(outdir)
+            if last is not None:
+                status += f"; its last output at t={last:.6g} s"
     if command == "gencase":
         raise InputError(f"{outdir} holds the results of a run ({', '.join(found)}{status}); a new case there would "
                          "leave them beside a case they do not belong to: use another -o folder, or --overwrite "
@@ -75,6 +80,16 @@ def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> 
     raise InputError(f"{outdir} holds the results of an earlier run ({', '.join(found)}{status}); continue it with "
                      f"'sphdvi run {outdir} --resume', or start again with --overwrite (deletes those files) "
                      "or into another -o folder")
+
+
+def last_output_time(outdir: str) -> float | None:
+    """The time of the last complete row of OUT's run.csv (None: no such row)."""
+    try:
+        with open(os.path.join(outdir, "run.csv")) as fh:
+            rows = [line for line in fh.read().split("\n")[1:-1] if line]
+        return float(rows[-1].split(",")[1]) if rows else None
+    except (OSError, ValueError, IndexError):
+        return None
 
 
 CASE_OUTPUT_SUFFIXES = (".h5", "_All.vtp", "_Normals.vtp")      # what gencase writes for a case

@@ -23,7 +23,11 @@ _LAYOUT = ("VTKHDF/Points", "VTKHDF/NumberOfPoints", "VTKHDF/PointData", "VTKHDF
 
 
 def _bad_file(path: str, exc: BaseException) -> InputError:
-    return InputError(f"{path} is not a readable particle file ({h5_reason(exc)}; truncated or corrupt?)")
+    reason = h5_reason(exc)
+    if "unable to lock file" in reason or getattr(exc, "errno", None) == 11:
+        return InputError(f"{path} is locked by the run writing it (HDF5 file locking): read it once that run has "
+                          "ended or been stopped (a stopped run goes on with --resume)")
+    return InputError(f"{path} is not a readable particle file ({reason}; truncated or corrupt?)")
 
 
 def _check_layout(f, path: str) -> None:

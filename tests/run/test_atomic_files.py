@@ -33,6 +33,13 @@ def test_leftover_temporaries_are_removed(tmp_path):
     from sphdvi.io.atomic import remove_leftover_temporaries
     (tmp_path / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
     (tmp_path / ".notes.tmp").write_text("the user's")
+    (tmp_path / ".my.backup.tmp").write_text("the user's (went before: any .X.Y.tmp was taken for one)")
     (tmp_path / "run.csv").write_text("x")
     assert remove_leftover_temporaries(str(tmp_path)) == [".restart.h5.k3j_x9a1.tmp"]
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".notes.tmp", "run.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".my.backup.tmp", ".notes.tmp", "run.csv"]
+    # what atomic_path makes is what it removes
+    import os
+    import tempfile
+    fd, made = tempfile.mkstemp(prefix=".run.json.", suffix=".tmp", dir=tmp_path)
+    os.close(fd)
+    assert remove_leftover_temporaries(str(tmp_path)) == [os.path.basename(made)]

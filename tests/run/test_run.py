@@ -182,7 +182,10 @@ def test_sigkill_then_resume(tmp_path):
     assert "99,0.0" not in (killed / "run.log").read_text()
 
 
-def test_sigterm_stops_cleanly(tmp_path):
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP"])
+def test_sigterm_stops_cleanly(tmp_path, sig):
+    """SIGTERM, and SIGHUP (a closed terminal: exit 129 and run.json left 'running' before), end
+    the run as interrupted, resumable."""
     case = small_case(tmp_path)
     out = tmp_path / "o"
     proc = subprocess.Popen([sys.executable, "-m", "sphdvi", "run", str(case), "-o", str(out), "--tmax", "5",
@@ -192,11 +195,26 @@ def test_sigterm_stops_cleanly(tmp_path):
     while time.time() < deadline and not ((out / "run.csv").exists()
                                           and (out / "run.csv").read_text().count("\n") >= 3):
         time.sleep(0.05)
-    proc.send_signal(signal.SIGTERM)
+    proc.send_signal(getattr(signal, sig))
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 1 and "Traceback" not in err
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "interrupted" and "--resume" in meta["message"]
+
+
+def test_an_ignored_sighup_stays_ignored():
+    """Under nohup SIGHUP is ignored: the run's signal handling keeps it so."""
+    from sphdvi.simulation import _Stop
+    old = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        with _Stop():
+            assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN
+            assert signal.getsignal(signal.SIGTERM) not in (signal.SIG_IGN, signal.SIG_DFL)
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
+        with _Stop():
+            assert signal.getsignal(signal.SIGHUP) not in (signal.SIG_IGN, signal.SIG_DFL)
+    finally:
+        signal.signal(signal.SIGHUP, old)
 
 
 def test_a_full_disk_stops_the_run_cleanly_and_it_resumes(tmp_path, monkeypatch):

@@ -68,6 +68,19 @@ def test_new_run_into_earlier_results_is_refused_and_changes_nothing(done, tmp_p
     assert r.exit_code == 2 and "give one" in r.output
 
 
+def test_refusal_of_a_killed_run_names_its_last_output(done, tmp_path):
+    """run.json of a killed run still says 'running' at t = 0 (it is written at the start and the
+    end): the refusal says it still runs or was killed, with run.csv's last output time."""
+    out = copy_run(done, tmp_path / "o")
+    meta = json.loads((out / "run.json").read_text())
+    meta.update(status="running", physical_time=0.0)
+    (out / "run.json").write_text(json.dumps(meta))
+    r = invoke(["run", out] + RUN)
+    assert r.exit_code == 2, r.output
+    assert "status 'running': it still runs, or it was killed; its last output at t=0.00" in r.output
+    assert "at t=0 s" not in r.output
+
+
 def test_gencase_into_a_run_folder_is_refused_unless_overwrite(done, tmp_path):
     """A new case drawn into a folder holding a run's results would leave them beside a case
     they do not belong to: refused, nothing changed; with --overwrite the results go."""

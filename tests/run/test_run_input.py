@@ -319,3 +319,35 @@ def test_export_dir_is_used_as_given(done, tmp_path):
     assert_input_error(r, "Invalid value for '--iso-spacing'")
     r = invoke(["export", out, "--isosurface", "--iso-spacing", "1e-7"])     # out of memory before
     assert_input_error(r, "--iso-spacing 1e-07: ", "grid nodes over the fluid", "expected a spacing >= ")
+
+
+def test_export_of_a_body_only_run_says_it_has_no_particles(tmp_path):
+    out = tmp_path / "pend"
+    assert invoke(["run", PENDULUM, "-o", out, "--tmax", "0.01", "-q"]).exit_code == 0
+    r = invoke(["export", out])
+    assert_input_error(r, "holds a body-only run (no fluid)", "bodies.csv and links.csv")
+    assert "run 'sphdvi run' first" not in r.output
+
+
+def test_a_particle_file_locked_by_its_run_is_named_as_such(done, tmp_path):
+    """While a run writes particles.vtkhdf, HDF5's lock keeps readers out: measure and export say
+    so (they called the file 'truncated or corrupt?' before)."""
+    import os
+    import subprocess
+    import sys
+    if os.environ.get("HDF5_USE_FILE_LOCKING", "").upper() == "FALSE":
+        pytest.skip("HDF5 file locking is off here")
+    out = copy_run(done, tmp_path / "o")
+    path = out / "particles.vtkhdf"
+    holder = subprocess.Popen([sys.executable, "-c", "import h5py, sys, time; f = h5py.File(sys.argv[1], 'a'); "
+                               "print('open', flush=True); time.sleep(60)", str(path)],
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "open"
+        for args in (["export", out], ["measure", "elevation", out, "--at", "0.2"]):
+            r = invoke(args)
+            assert_input_error(r, "is locked by the run writing it", "--resume")
+            assert "corrupt" not in r.output
+    finally:
+        holder.kill()
+        holder.wait()
