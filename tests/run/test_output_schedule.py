@@ -50,6 +50,9 @@ def test_body_only_step_schedule_puts_each_output_at_its_nearest_step():
     assert np.allclose(np.array(steps) * 5e-4, EXPECTED[1:])
     plain = StepSchedule(0.01, 0.004, 1e-3)
     assert [k for k in range(1, 11) if plain.is_row(k)] == [4, 8, 10]
+    # a TimeMax between two steps takes the step after it, as an SPH run (round() stopped short)
+    assert StepSchedule(1.0125, 0.1, 1e-3).nsteps == 1013
+    assert StepSchedule(0.3, 0.1, 0.1).nsteps == 3             # 0.3 / 0.1 = 2.9999999999999996
 
 
 def invoke(args):
