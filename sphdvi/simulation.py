@@ -40,7 +40,7 @@ from ._version import __version__
 from .errors import DivergenceError, InputError, SphdviError
 from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_bodies_checkpoint, load_sph_checkpoint,
                             save_bodies_checkpoint, save_sph_checkpoint)
-from .io.atomic import remove_leftover_temporaries
+from .io.atomic import make_folder, remove_leftover_temporaries
 from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
 from .io.dtinfo import DTINFO_FILE, DtLog
 from .io.runfolder import (NORMALS_FILE, SetAside, check_new_run_folder, earlier_exports, earlier_results,
@@ -300,7 +300,7 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
         _check_dtfixed(float(params.get("DtFixed") or 0.0), params)
     if not resume:
         check_new_run_folder(outdir, overwrite)
-    os.makedirs(outdir, exist_ok=True)
+    make_folder(outdir)
     remove_leftover_temporaries(outdir)
     if not resume and set_aside is None:
         set_aside = SetAside(outdir, earlier_results(outdir) + earlier_exports(outdir))

@@ -20,6 +20,7 @@ from .._version import __version__
 from ..errors import CaseError, Warnings
 from .constants import hydrostatic_density, resolve_constants
 from .model import Body, Case, Constants
+from ..io.atomic import make_folder
 from .reader import (case_name_from_path, open_case, parse_domain_spec, read_constantsdef,
                      read_mkconfig, read_sections)
 
@@ -78,7 +79,7 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
             raise CaseError(f"--dp {dp} is not a positive number", file=path)
         definition.set("dp", repr(float(dp)))
     if outdir is not None:
-        os.makedirs(outdir, exist_ok=True)
+        make_folder(outdir)
     casename = case_name_from_path(path)
     casedef = root.find("casedef")
     cdef = read_constantsdef(reader, casedef)
@@ -597,7 +598,7 @@ def write_outputs(result: GenCaseResult, outdir: str) -> list[str]:
     ``<casename>_Normals.vtp`` into ``outdir``."""
     from ..io.casefile import write_case_h5
     from ..io.vtkxml import write_normals_vtp, write_vtp_points
-    os.makedirs(outdir, exist_ok=True)
+    make_folder(outdir)
     case, consts, p = result.case, result.constants, result.particles
     h5 = os.path.join(outdir, f"{case.name}.h5")
     chrono = case.special.get("chrono") or {}

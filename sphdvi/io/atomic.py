@@ -19,6 +19,9 @@ def atomic_path(path: str):
     On an exception the temporary file is removed and ``path`` is left untouched.
     """
     folder = os.path.dirname(os.path.abspath(path)) or "."
+    if os.path.isdir(path):
+        from ..errors import InputError
+        raise InputError(f"{path} is a folder, where a file is to be written; move the folder away")
     fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
     try:
         os.fchmod(fd, 0o666 & ~_UMASK)
@@ -85,3 +88,19 @@ def complete_lines(path: str) -> list[str]:
         text = fh.read()
     lines = text.split("\n")
     return lines[:-1]          # the part after the last newline is '' or a torn line
+
+
+def make_folder(path: str, option: str = "-o") -> None:
+    """Create the output folder ``path`` (and its parents) for ``option``: a path that cannot
+    be a folder (a file on the way, no permission, a read-only file system) is an InputError
+    (exit 2) naming the option; it was exit 1 with a bare 'Not a directory'."""
+    from ..errors import InputError
+    try:
+        os.makedirs(path, exist_ok=True)
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+        raise InputError(f"{option} {path}: the folder cannot be made ({why}"
+                         + (f": {exc.filename}" if exc.filename and exc.filename != path else "")
+                         + "); expected a folder that exists or can be created") from None
+    if not os.path.isdir(path):
+        raise InputError(f"{option} {path}: exists and is not a folder; expected a folder")

@@ -4,6 +4,7 @@ from __future__ import annotations
 import os
 
 from ..errors import InputError
+from .atomic import make_folder
 from .vtkhdf import read_step, step_times
 from .vtkxml import write_pvd, write_vtp_points
 
@@ -42,7 +43,7 @@ def export_vtp(outdir: str, subdir: str = "vtp") -> list[str]:
         raise InputError(f"{src} not found: run 'sphdvi run' first")
     dest = export_dir(outdir, subdir)
     times = step_times(src)
-    os.makedirs(dest, exist_ok=True)
+    make_folder(dest, "--dir")
     files, entries = [], []
     for k, t in enumerate(times):
         step = read_step(src, k)

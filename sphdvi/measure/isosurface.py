@@ -15,6 +15,7 @@ import os
 import numpy as np
 
 from ..errors import InputError
+from ..io.atomic import make_folder
 
 
 # the isosurface's grid at most: 5e7 nodes take ~3 GB with their positions and sums
@@ -82,7 +83,7 @@ def export_isosurface(outdir: str, subdir: str = "iso", spacing: float | None = 
     level = spec.surface_threshold if threshold is None else float(threshold)
     from ..io.export import export_dir
     dest = export_dir(outdir, subdir or "iso")      # as `export --dir`: relative to OUTDIR, absolute as given
-    os.makedirs(dest, exist_ok=True)
+    make_folder(dest, "--dir")
     files, entries = [], []
     for snap in run.snapshots(arrays=("Rhop",), first=first, last=last):
         from .core import ParticleGrid, FLUID

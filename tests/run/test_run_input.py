@@ -351,3 +351,19 @@ def test_a_particle_file_locked_by_its_run_is_named_as_such(done, tmp_path):
     finally:
         holder.kill()
         holder.wait()
+
+
+def test_output_folders_that_cannot_be_made_are_bad_input(done, tmp_path):
+    """-o / --dir below a file, or a case file's name taken by a folder: exit 2 naming the option
+    and the path (exit 1 with a bare 'Not a directory' or a temporary file's name before)."""
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    xml = case_xml(tmp_path)
+    for args in (["gencase", xml, "-o", afile / "sub", "--dp", "0.1", "-q"],
+                 ["run", xml, "-o", afile / "sub", "--dp", "0.1", "--tmax", "0.002", "-q"]):
+        assert_input_error(invoke(args), f"-o {afile / 'sub'}: the folder cannot be made (Not a directory)")
+    assert_input_error(invoke(["export", done, "--dir", afile / "sub"]), "--dir ", "the folder cannot be made")
+    taken = tmp_path / "taken"
+    (taken / CASE_H5).mkdir(parents=True)
+    assert_input_error(invoke(["gencase", xml, "-o", taken, "--dp", "0.1", "-q"]),
+                       f"{CASE_H5} is a folder, where a file is to be written")
