@@ -665,7 +665,9 @@ def _expected_for(key):
     if spec.choices:
         return "one of " + ", ".join(str(c) for c in spec.choices)
     rng = []
-    if spec.lo is not None:
+    if spec.positive:
+        rng.append("> 0")
+    elif spec.lo is not None:
         rng.append(f">= {spec.lo:g}")
     if spec.hi is not None:
         rng.append(f"<= {spec.hi:g}")

@@ -17,6 +17,26 @@ def case_schema() -> etree.XMLSchema:
         return etree.XMLSchema(etree.parse(str(p)))
 
 
+# what an attribute of each of the XSD's simple types holds (a pattern error names only the
+# pattern it tried last: every attribute was said to expect a number)
+EXPECTED_BY_TYPE = {"number": "a finite number or a #expression",
+                    "boolean": "true/false or 1/0 (or a #expression)",
+                    "mklist": "an mk number, a range or a list of them (5, 1-3 or 1-3,7)"}
+
+
+@functools.lru_cache(maxsize=1)
+def _attribute_types() -> dict:
+    """Attribute name -> its simple type in the XSD, where every declaration agrees."""
+    path = resources.files("sphdvi").joinpath("schemas/case.xsd")
+    with resources.as_file(path) as p:
+        doc = etree.parse(str(p))
+    seen: dict = {}
+    for a in doc.iter("{http://www.w3.org/2001/XMLSchema}attribute"):
+        if a.get("name") and a.get("type"):
+            seen.setdefault(a.get("name"), set()).add(a.get("type").split(":")[-1])
+    return {name: next(iter(types)) for name, types in seen.items() if len(types) == 1}
+
+
 _ELEMENT = re.compile(r"^Element '([^']+)'(?:, attribute '([^']+)')?: (.*)$", re.S)
 
 
@@ -39,5 +59,6 @@ def validate_structure(root, file: str) -> None:
                      r"the value '\1' is not valid", message)
     expected = None
     if "number" in message or "is not valid" in message:
-        expected = "a finite number or a #expression"
+        kind = _attribute_types().get(m.group(2)) if m and m.group(2) else None
+        expected = EXPECTED_BY_TYPE.get(kind, EXPECTED_BY_TYPE["number"])
     raise CaseError(message.strip(), file=file, line=err.line, element=element, expected=expected)

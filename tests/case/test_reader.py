@@ -99,6 +99,7 @@ def test_parameters_defaults_and_values(tmp_path):
     ('<parameter key="StepAlgorithm" value="1.5"/>', "is not an integer"),
     ('<parameter key="TimeMax" value="abc"/>', "is not a number"),
     ('<parameter key="TimeOut" value="-1"/>', "below"),
+    ('<parameter key="TimeOut" value="0"/>', "0.0 is not > 0 (TimeOut must be positive); expected a number > 0 and"),
     ('<parameter key="RhopOutMin" value="1400"/>', "RhopOutMin (1400.0) >= RhopOutMax"),
     ('<parameter key="VerletSteps" value="-1"/>', "VerletSteps: -1 is below 0"),
     ('<parameter key="CFLnumber" value="0.2"/>', "'CFLnumber' is a constant of the case"),
@@ -126,6 +127,19 @@ def test_a_domain_thinner_than_dp_in_y_is_warned(tmp_path):
     assert any("the domain is 0.001 m deep in y, less than dp (0.02 m): a 3D case one particle layer thick; "
                "for a 2D case give pointmin and pointmax the same y" in w and "<pointmax>" in w for w in r.warnings)
     assert not any("deep in y" in w for w in build(tmp_path / "b").warnings)
+
+
+def test_schema_errors_say_what_the_attribute_holds(tmp_path):
+    """An XSD pattern error names only the last pattern tried: the expected form comes from the
+    attribute's type (a boolean and an mk list were both said to expect a number)."""
+    from casetext import TANK_2D
+    with pytest.raises(CaseError, match=r"attribute 'auto': the value 'yes please' is not valid; expected "
+                                        r"true/false or 1/0"):
+        build(tmp_path / "a", constants=CONSTANTS.replace('<hswl value="0" auto="true"',
+                                                         '<hswl value="0" auto="yes please"'))
+    with pytest.raises(CaseError, match=r"attribute 'mkbound': the value '5-' is not valid; expected an mk number, "
+                                        r"a range or a list"):
+        build(tmp_path / "b", commands=TANK_2D, casedef_extra='<floatings><floating mkbound="5-"/></floatings>')
 
 
 def test_verlet_steps_zero_is_accepted(tmp_path):
