@@ -38,6 +38,8 @@ def _check_outputs(csv_path, plot):
     for path, hint in ((csv_path, "'--csv'"), (plot, "'--plot'")):
         if path:
             folder = os.path.dirname(os.path.abspath(path))
+            if os.path.exists(folder) and not os.path.isdir(folder):
+                raise click.BadParameter(f"{path}: {folder} is a file, not a folder", param_hint=hint)
             if not os.path.isdir(folder):
                 raise click.BadParameter(f"{path}: the folder {folder} does not exist; create it first",
                                          param_hint=hint)

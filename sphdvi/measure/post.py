@@ -169,6 +169,8 @@ def parse_points(text: str, is2d: bool | None = None, ncoord: int = 3) -> np.nda
     if os.path.isfile(text):
         with open(text, encoding="utf-8") as fh:
             return _points_from_lines(fh.read().splitlines(), ncoord, source=text)
+    if os.path.isdir(text):
+        raise ValueError(f"{text} is a folder; expected a points file or a list of numbers")
     if _looks_like_a_file_name(text):
         raise ValueError(f"{text}: file not found (and not a list of numbers)")
     items = [s for s in text.replace("\n", ";").split(";") if s.strip()]
@@ -423,14 +425,19 @@ def parse_mk_list(text: str):
         part = part.strip()
         if not part:
             continue
-        if "-" in part[1:]:
-            a, b = part.split("-", 1)
-            lo, hi = int(a), int(b)
-            if hi < lo:
-                raise ValueError(f"empty mk range '{part}'")
-            out.extend(range(lo, hi + 1))
-        else:
-            out.append(int(part))
+        try:
+            if "-" in part[1:]:
+                a, b = part.split("-", 1)
+                lo, hi = int(a), int(b)
+                if hi < lo:
+                    raise ValueError(f"empty mk range '{part}'")
+                out.extend(range(lo, hi + 1))
+            else:
+                out.append(int(part))
+        except ValueError as exc:
+            if "empty mk range" in str(exc):
+                raise
+            raise ValueError(f"'{part}' is not an mk; expected mk numbers or ranges like 11,12 or 11-14") from None
     if not out:
         raise ValueError("no mk given")
     return out

@@ -119,6 +119,7 @@ def test_cli_bad_options_exit_2_before_any_output(tank2d, tmp_path):
     name, --csv and --plot an existing folder (never created), --kclimit/--threshold finite and
     in range, --first an existing output, --at no z; a missing points file is named."""
     tank, out = tank2d
+    (tmp_path / "afile").write_text("x")
     cases = [
         (["points", "--points", "0.5,0,0.1", "--plot", tmp_path / "x.txt"], "expected an image file name"),
         (["points", "--points", "0.5,0,0.1", "--csv", tmp_path / "no" / "dir" / "x.csv"], "does not exist"),
@@ -132,6 +133,11 @@ def test_cli_bad_options_exit_2_before_any_output(tank2d, tmp_path):
         # a step that would sample beyond memory (it ran ~70 s, then exit 1 "out of memory")
         (["elevation", "--at", "0.3", "--dz", "1e-9"], "samples along each vertical"),
         (["points", "--points", "nonexist.txt"], "nonexist.txt: file not found"),
+        # what was wrong, not Python's words ("invalid literal for int()", "file not found" for a folder)
+        (["forces", "--mkbound", "abc"], "'abc' is not an mk; expected mk numbers or ranges"),
+        (["points", "--points", "0.5,0,0.1", "--trackmk", "1,x"], "'x' is not an mk"),
+        (["points", "--points", str(tmp_path)], "is a folder; expected a points file"),
+        (["points", "--points", "0.5,0,0.1", "--csv", tmp_path / "afile" / "x.csv"], "afile is a file, not a folder"),
         (["points", "--points", str(tmp_path / "nope.csv")], "nope.csv: file not found"),
     ]
     for args, text in cases:
