@@ -150,16 +150,17 @@ def assemble_particles(case: Case, drawing, consts: Constants, reader):
     bad = label[is_fluid & (label >= case.fluidcount)]
     if bad.size:
         raise CaseError(f"mkfluid {int(bad.max())} is not below fluidcount={case.fluidcount}", file=reader.file,
-                        element="mkconfig", expected="mkfluid < fluidcount (raise fluidcount in <mkconfig>)")
+                        line=reader.line_of("casedef/mkconfig"), element="mkconfig", expected="mkfluid < fluidcount (raise fluidcount in <mkconfig>)")
     bad = label[~is_fluid & (label >= case.boundcount)]
     if bad.size:
         raise CaseError(f"mkbound {int(bad.max())} is not below boundcount={case.boundcount}", file=reader.file,
-                        element="mkconfig", expected="mkbound < boundcount (raise boundcount in <mkconfig>)")
+                        line=reader.line_of("casedef/mkconfig"), element="mkconfig",
+                        expected="mkbound < boundcount (raise boundcount in <mkconfig>)")
     floating, moving = bound_roles(case)
     both = floating & moving
     if both:
         raise CaseError(f"mkbound {sorted(both)} is both floating and moving", file=reader.file,
-                        element="motion", expected="a floating body or an imposed motion, not both")
+                        line=next((m["line"] for m in case.motions if m["ref"] in both), None), element="motion", expected="a floating body or an imposed motion, not both")
     ptype = np.full(label.shape, TYPE_FIXED, dtype=np.uint8)
     ptype[is_fluid] = TYPE_FLUID
     if floating:
@@ -476,7 +477,8 @@ def resolve_domain(case: Case, particles: dict, consts: Constants, reader) -> di
         posmin[1] = posmax[1] = consts.posy2d
     if np.any(posmax < posmin):
         raise CaseError(f"simulation domain is empty: posmin {posmin.tolist()} > posmax {posmax.tolist()}",
-                        file=reader.file, element="simulationdomain", expected="posmin <= posmax")
+                        file=reader.file, line=reader.line_of("execution/parameters/simulationdomain"),
+                        element="simulationdomain", expected="posmin <= posmax")
     return {"posmin": posmin.tolist(), "posmax": posmax.tolist()}
 
 
@@ -490,7 +492,8 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
     if outside.any():
         i = int(np.flatnonzero(outside)[0])
         raise CaseError(f"{int(outside.sum())} fluid particles lie outside the simulation domain "
-                        f"(first at {pos[i].tolist()})", file=reader.file, element="simulationdomain",
+                        f"(first at {pos[i].tolist()})", file=reader.file,
+                        line=reader.line_of("execution/parameters/simulationdomain"), element="simulationdomain",
                         expected=f"posmin {lo.tolist()} <= fluid positions <= posmax {hi.tolist()}")
     bound_labels = set(np.unique(label[ptype != TYPE_FLUID]).tolist())
     for m in case.motions:
@@ -519,7 +522,8 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
                         f"{case.parameters.get('RigidAlgorithm')}; sphdvi uses the DVI engine for the chrono bodies")
     elif case.parameters.get("RigidAlgorithm") == 3:
         raise CaseError("RigidAlgorithm=3 (Chrono) needs an <execution><special><chrono> section",
-                        file=reader.file, element="parameter", expected="a <chrono> section or RigidAlgorithm 1")
+                        file=reader.file, line=reader.line_of("execution/parameters/parameter[@key='RigidAlgorithm']"),
+                        element="parameter", expected="a <chrono> section or RigidAlgorithm 1")
     gauges = case.special.get("gauges")
     if gauges:
         for g in gauges["items"]:

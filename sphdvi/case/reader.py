@@ -53,6 +53,7 @@ def open_case(path: str, warnings=None):
     strip_disabled(root, path)
     validate_structure(root, path)
     reader = CaseReader(path, warnings=warnings)
+    reader.root = root            # for the lines of checks made after reading (gencase's)
     reader.mark(root)
     casedef = root.find("casedef")
     if casedef is None:

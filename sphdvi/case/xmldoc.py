@@ -173,6 +173,7 @@ class CaseReader:
         self.vars = variables if variables is not None else Variables()
         self.warnings = warnings if warnings is not None else Warnings()
         self.base_dir = base_dir if base_dir is not None else os.path.dirname(os.path.abspath(file))
+        self.root = None          # the document, where the reader was made for one
         self._read: dict[etree._Element, set[str]] = {}
 
     # -- errors ------------------------------------------------------------
@@ -180,6 +181,11 @@ class CaseReader:
         line = getattr(el, "sourceline", None) if el is not None else None
         tag = el.tag if el is not None and isinstance(getattr(el, "tag", None), str) else None
         return CaseError(message, file=self.file, line=line, element=tag, expected=expected)
+
+    def line_of(self, path: str) -> int | None:
+        """The line of the element at ``path`` (an ElementPath from the document's root), or None."""
+        el = self.root.find(path) if self.root is not None else None
+        return getattr(el, "sourceline", None)
 
     def warn(self, el, message: str) -> None:
         line = getattr(el, "sourceline", None) if el is not None else None

@@ -156,6 +156,23 @@ def test_simulation_domain(tmp_path):
     assert r.domain["posmax"][2] == pytest.approx(4.5)
 
 
+def test_checks_after_reading_name_the_line(tmp_path):
+    """Errors gencase finds once the case is drawn name the element's line too (they gave the
+    file and element only)."""
+    import re as _re
+    cases = [(dict(mkconfig='<mkconfig boundcount="240" fluidcount="1" />',
+                   commands=TANK_2D.replace('<setmkfluid mk="0"', '<setmkfluid mk="3"')), "mkconfig",
+              "mkfluid 3 is not below fluidcount=1"),
+             (dict(parameters='<parameter key="RigidAlgorithm" value="3"/>'), "parameter", "RigidAlgorithm=3"),
+             (dict(parameters='<simulationdomain><posmin z="5"/><posmax z="4"/></simulationdomain>'),
+              "simulationdomain", "simulation domain is empty")]
+    for i, (kw, element, text) in enumerate(cases):
+        with pytest.raises(CaseError) as info:
+            build(tmp_path / str(i), **kw)
+        msg = str(info.value)
+        assert _re.search(rf"Case_Def\.xml:\d+: <{element}>: ", msg) and text in msg, msg
+
+
 def test_deprecated_domain_keys_as_dualsphysics(tmp_path):
     """IncZ v raises the top by v times the height (= posmax z "default + 100 v %"), DomainFixed
     fixes all six limits and DomainFixedXmin ... one each (DualSPHysics v5.4 still applies them,
