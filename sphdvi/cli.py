@@ -145,6 +145,9 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
         from .case.reader import case_name_from_path
         outdir = outdir or f"{case_name_from_path(source)}_out"
         if resume:
+            if not os.path.isdir(outdir):
+                raise InputError(f"--resume: {outdir} does not exist: there is no run to continue; start one "
+                                 "without --resume")
             case_h5 = find_case_file(outdir)
             _check_resume_source(source, case_h5, outdir)
             drawn_dp = dp

@@ -287,6 +287,11 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
     if expect_dp is not None:
         _check_dp(expect_dp, data, case_h5, resume)
     base = special_parameters(data)
+    if resume and not os.path.exists(os.path.join(outdir, RESTART_FILE)):
+        started = os.path.exists(os.path.join(outdir, "run.json"))
+        raise InputError(f"--resume: {outdir} holds no run to continue (no {RESTART_FILE}"
+                         + ("; its run stopped before its first output" if started else "") + "); start it with "
+                         f"'sphdvi run {outdir}'" + (" --overwrite" if started else ""))
     if resume:
         if tmax is not None:
             _check_resume_tmax(float(tmax), outdir)

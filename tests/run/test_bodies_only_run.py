@@ -232,7 +232,7 @@ def test_resume_without_checkpoint_is_input_error(tmp_path):
     assert invoke(["run", case_file(tmp_path), "-o", out, "-q", "--tmax", "0.01"]).exit_code == 0
     os.unlink(out / simulation.RESTART_FILE)
     r = invoke(["run", out, "--resume"])
-    assert r.exit_code == 2 and "no checkpoint" in r.output
+    assert r.exit_code == 2 and "holds no run to continue (no restart.h5" in r.output, r.output
 
 
 def _mechanism():

@@ -354,6 +354,20 @@ def test_a_run_of_a_gencase_folder_into_another_folder_resumes_and_measures_ther
     assert r.exit_code == 0 and len(r.stdout.splitlines()) == 4, r.output
 
 
+def test_resume_of_what_never_ran(tmp_path):
+    """--resume of a gencase folder that never ran says so, without a warning about run.json
+    first; of a folder that is not there, says that (it said 'not a folder or case file')."""
+    g = tmp_path / "g"
+    assert invoke(["gencase", DAMBREAK, "-o", g, "--dp", "0.1", "-q"]).exit_code == 0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = invoke(["run", g, "--resume"])
+    assert r.exit_code == 2 and f"{g} holds no run to continue (no restart.h5); start it with" in r.output
+    assert not [w for w in caught if "run.json" in str(w.message)]
+    r = invoke(["run", DAMBREAK, "--resume", "-o", tmp_path / "missing"])
+    assert r.exit_code == 2 and "missing does not exist: there is no run to continue" in r.output, r.output
+
+
 def test_leftover_temporaries_go_at_start(done, tmp_path):
     out = copy_run(done, tmp_path / "o")
     (out / ".restart.h5.k3j_x9a1.tmp").write_bytes(b"half a checkpoint")
