@@ -585,13 +585,18 @@ def warn_gauges_outside(gauges, domain, is2d: bool, reader) -> None:
     axes = [0, 2] if is2d else [0, 1, 2]
     tol = 1e-9 * max(1.0, float(np.abs(np.r_[lo, hi]).max()))
     for g in gauges["items"]:
-        for pt in gauge_extent_points(g):
-            p = np.asarray(pt, float)
-            if np.any(p[axes] < lo[axes] - tol) or np.any(p[axes] > hi[axes] + tol):
-                reader.warnings.add(f"{g['type']} gauge '{g['name']}': point {np.round(p, 9).tolist()} lies outside "
-                                    f"the simulation domain {lo.tolist()} .. {hi.tolist()}; it records no fluid there",
-                                    file=reader.file, line=g.get("line"), element=g["type"])
-                break
+        pts = np.asarray(gauge_extent_points(g), float).reshape(-1, 3)
+        if not pts.size:
+            continue
+        # a line or a mesh that reaches into the domain records there (a swl line from z = 0 at
+        # a dp whose floor particles sit above 0 was warned about); one wholly outside, not
+        pmin, pmax = pts.min(axis=0), pts.max(axis=0)
+        if np.any(pmax[axes] < lo[axes] - tol) or np.any(pmin[axes] > hi[axes] + tol):
+            what = (f"point {np.round(pts[0], 9).tolist()} lies" if len(pts) == 1 else
+                    f"points {np.round(pmin, 9).tolist()} .. {np.round(pmax, 9).tolist()} lie")
+            reader.warnings.add(f"{g['type']} gauge '{g['name']}': {what} outside the simulation domain "
+                                f"{lo.tolist()} .. {hi.tolist()}; it records no fluid there",
+                                file=reader.file, line=g.get("line"), element=g["type"])
 
 
 # ---------------------------------------------------------------------------

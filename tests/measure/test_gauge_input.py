@@ -235,10 +235,16 @@ def test_run_of_old_case_file_with_invalid_gauge_is_exit_2(tmp_path):
 
 @pytest.mark.parametrize("gauge, outside", [
     ('<velocity name="far">\n<point x="9" y="0" z="0.5" />\n</velocity>', True),
-    ('<swl name="far">\n<point0 x="0.2" y="0" z="0" />\n<point2 x="0.2" y="0" z="9" />\n</swl>', True),
-    ('<maxz name="far">\n<point0 x="0.5" y="0" z="0" />\n<height value="20" />\n</maxz>', True),
-    ('<mesh name="far">\n<point x="0.2" y="0" z="0.2" />\n<vec1 x="1" y="0" z="0" />\n<size1 value="40" />\n</mesh>',
+    ('<swl name="far">\n<point0 x="9" y="0" z="0" />\n<point2 x="9" y="0" z="9" />\n</swl>', True),
+    ('<maxz name="far">\n<point0 x="9.5" y="0" z="0" />\n<height value="20" />\n</maxz>', True),
+    ('<mesh name="far">\n<point x="9.2" y="0" z="0.2" />\n<vec1 x="1" y="0" z="0" />\n<size1 value="40" />\n</mesh>',
      True),
+    # lines and meshes reaching into the domain record there: not warned (a swl line from z = 0,
+    # below the floor particles at a coarse dp, was)
+    ('<swl name="part">\n<point0 x="0.2" y="0" z="-0.01" />\n<point2 x="0.2" y="0" z="9" />\n</swl>', False),
+    ('<maxz name="part">\n<point0 x="0.5" y="0" z="0" />\n<height value="20" />\n</maxz>', False),
+    ('<mesh name="part">\n<point x="0.2" y="0" z="0.2" />\n<vec1 x="1" y="0" z="0" />\n<size1 value="40" />\n</mesh>',
+     False),
     (f'<velocity name="near">\n{VPOINT}\n</velocity>', False),
     # 2D: y is not compared (the particles lie on y = 0)
     ('<velocity name="y2d">\n<point x="0.5" y="3" z="0.5" />\n</velocity>', False),
