@@ -443,14 +443,25 @@ def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody)
             p1, p2 = np.asarray(par["point1"], float), np.asarray(par["point2"], float)
             length = float(np.linalg.norm(p2 - p1))
             if is2d:
-                return None
-            volume = math.pi * r * r * length
-            axis = (p2 - p1) / length
-            if not np.allclose(np.abs(axis), np.round(np.abs(axis))):
-                return None
-            ia = r * r / 2.0
-            it = (3 * r * r + length * length) / 12.0
-            diag = np.where(np.abs(axis) > 0.5, ia, it)
+                axis = (p2 - p1) / max(length, 1e-300)
+                if abs(abs(axis[1]) - 1.0) < 1e-9:      # across the plane: a disc, as a 2D sphere
+                    volume = math.pi * r * r
+                    diag = np.array([0.25, 0.5, 0.25]) * r * r
+                elif abs(axis[1]) < 1e-9 and np.allclose(np.abs(axis), np.round(np.abs(axis))):
+                    # along x or z: a rectangle of the length by the diameter in the x-z plane
+                    sx, sz = (length, 2 * r) if abs(axis[0]) > 0.5 else (2 * r, length)
+                    volume = sx * sz
+                    diag = np.array([sz * sz, sx * sx + sz * sz, sx * sx]) / 12.0
+                else:
+                    return None
+            else:
+                volume = math.pi * r * r * length
+                axis = (p2 - p1) / length
+                if not np.allclose(np.abs(axis), np.round(np.abs(axis))):
+                    return None
+                ia = r * r / 2.0
+                it = (3 * r * r + length * length) / 12.0
+                diag = np.where(np.abs(axis) > 0.5, ia, it)
         else:
             return None
     except (KeyError, TypeError, ValueError):

@@ -532,6 +532,26 @@ def test_analytic_inertia_of_rotated_box(tmp_path):
     assert b.center == pytest.approx([0.5, 0.5, 0.5], abs=0.011)
 
 
+@pytest.mark.parametrize("p2, mass, diag", [
+    # across the plane (y): a disc of radius 0.1, as a 2D sphere: I_yy = m r²/2
+    (("0.5", "1", "0.5"), 500 * math.pi * 0.01, np.array([0.25, 0.5, 0.25]) * 500 * math.pi * 0.01 * 0.01),
+    # along x: a 0.3 × 0.2 rectangle in the x-z plane
+    (("0.8", "0", "0.5"), 500 * 0.06, np.array([0.04, 0.09 + 0.04, 0.09]) * 500 * 0.06 / 12),
+])
+def test_analytic_mass_of_a_2d_cylinder(tmp_path, p2, mass, diag):
+    """In 2D a drawcylinder is a disc (axis along y) or a rectangle (axis along x or z): its
+    analytic mass and inertia are printed beside the particle values (none were in 2D)."""
+    commands = f"""
+        <setmkbound mk="3" />
+        <drawcylinder radius="0.1"><point x="0.5" y="0" z="0.5" /><point x="{p2[0]}" y="{p2[1]}" z="{p2[2]}" />
+        </drawcylinder>"""
+    r = build(tmp_path, dp="0.01", pointmin=("0", "0", "0"), pointmax=("1", "0", "1"), commands=commands,
+              casedef_extra='<floatings><floating mkbound="3" rhopbody="500"/></floatings>')
+    (b,) = r.bodies
+    assert b.analytic["mass"] == pytest.approx(mass)
+    assert np.allclose(np.diag(b.analytic["inertia"]), diag, rtol=1e-12)
+
+
 def test_second_order_flap_is_refused(tmp_path):
     special = ('<wavepaddles><flap><mkbound value="0"/><depth value="1"/><waveorder value="2"/>'
                '<waveheight value="0.1"/><waveperiod value="1"/><flapaxis0 x="0" y="0" z="0"/>'
