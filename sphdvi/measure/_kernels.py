@@ -316,6 +316,24 @@ def column_top_below(points, zlim, pos, radius, is2d, out):
 
 
 @njit(cache=True)
+def column_lowest(points, pos, radius, is2d, out):
+    """Lowest particle z (of ``pos``) within horizontal distance ``radius`` of each point;
+    NaN when there is none."""
+    r2 = radius * radius
+    for p in range(points.shape[0]):
+        best = np.inf
+        for j in range(pos.shape[0]):
+            dx = pos[j, 0] - points[p, 0]
+            d2 = dx * dx
+            if not is2d:
+                dy = pos[j, 1] - points[p, 1]
+                d2 += dy * dy
+            if d2 <= r2 and pos[j, 2] < best:
+                best = pos[j, 2]
+        out[p] = best if best < np.inf else np.nan
+
+
+@njit(cache=True)
 def column_max_z(points, zhi, pos, radius, is2d, out, idx):
     """Highest particle (of ``pos``) within horizontal distance ``radius`` of each
     point with point_z <= z <= zhi[p] (the maxz gauge); NaN / -1 when none."""

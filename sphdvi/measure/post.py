@@ -350,8 +350,10 @@ def elevation_step(grid: core.ParticleGrid, bound_pos, xy, zlo, zhi, spec, thres
 
     Elevation: first drop of the kernel sum below ``threshold`` going up the
     vertical from ``zlo`` (MeasureTool -elevation).  Bottom: the top of the
-    boundary below the surface (highest boundary particle within dp
-    horizontally) plus dp/2, its half spacing (the wall face).
+    boundary below the water's lowest particle there (highest boundary particle within dp
+    horizontally) plus dp/2, its half spacing (the wall face).  Below the lowest water, not
+    below the surface: at a side wall the wall's own particles reach up to the surface
+    (the depth there read 6 mm, then negative, in water 0.5 m deep).
     """
     from . import _kernels as K
     xy = np.asarray(xy, np.float64).reshape(-1, 3)
@@ -363,6 +365,10 @@ def elevation_step(grid: core.ParticleGrid, bound_pos, xy, zlo, zhi, spec, thres
     bottom = np.full(xy.shape[0], np.nan)
     if bound_pos.shape[0]:
         zlim = np.where(np.isfinite(surf), surf, zhi)
+        if grid.n:
+            lowest = np.empty(xy.shape[0])
+            K.column_lowest(xy, np.ascontiguousarray(grid.pos, dtype=np.float64), spec.dp * 1.0001, spec.is2d, lowest)
+            zlim = np.where(np.isfinite(lowest), np.minimum(zlim, lowest), zlim)
         K.column_top_below(xy, np.ascontiguousarray(zlim, dtype=np.float64),
                            np.ascontiguousarray(bound_pos, dtype=np.float64), 0.5 * spec.dp * 1.0001 + 1e-12,
                            spec.is2d, bottom)
