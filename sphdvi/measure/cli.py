@@ -65,6 +65,24 @@ def _warn_y_in_2d(run, pts, option):
                    f"ignored (point {i}: y = {float(pts[i][1]):g})", err=True)
 
 
+def _warn_outside_domain(run, pts, option, axes=(0, 1, 2)):
+    """A point outside the case's simulation domain reads no fluid (an empty column): say so, as
+    gencase says of its gauges.  ``axes``: the coordinates compared (x, y for --at); y not in 2D."""
+    import numpy as np
+    dom = run.data.get("domain") or {}
+    if "posmin" not in dom:
+        return
+    lo, hi = np.asarray(dom["posmin"], float), np.asarray(dom["posmax"], float)
+    axes = [a for a in axes if not (run.spec.is2d and a == 1)]
+    p = np.asarray(pts, float).reshape(-1, 3)
+    tol = 1e-9 * max(1.0, float(np.abs(np.r_[lo, hi]).max()))
+    out = np.flatnonzero(np.any((p[:, axes] < lo[axes] - tol) | (p[:, axes] > hi[axes] + tol), axis=1))
+    if out.size:
+        i = int(out[0])
+        click.echo(f"warning: {option}: {out.size} point(s) outside the simulation domain {lo.tolist()} .. "
+                   f"{hi.tolist()} read no fluid (point {i}: {np.round(p[i], 9).tolist()})", err=True)
+
+
 def _emit(table, csv_path, sep, plot):
     from .tables import plot_table, write_table
     write_table(table, csv_path, sep=sep)
@@ -152,13 +170,15 @@ def points(outdir, points, variables, kclimit, correction, trackmk, trackmkbound
                                      else "'--trackmkbound'") from None
     pts = _points_option(points, "'--points'")
     from .post import UNITS, measure_points
-    names = [v.strip().lower() for v in variables.split(",") if v.strip()]
+    names = list(dict.fromkeys(v.strip().lower() for v in variables.split(",") if v.strip()))   # once each
     bad = [v for v in names if v not in UNITS]
     if bad or not names:
         raise click.BadParameter(f"unknown variable(s) {', '.join(bad) or '(none)'}; expected some of "
                                  f"{', '.join(UNITS)}", param_hint="'--vars'")
     run = _run(outdir)
     _warn_y_in_2d(run, pts, "--points")
+    if track is None:                  # tracked points move with their particles
+        _warn_outside_domain(run, pts, "--points")
     table, near = measure_points(run, pts, names, kclimit=kclimit, order=1 if correction == "linear" else 0,
                                  first=first, last=last, every=every, track=track)
     for i, d, t in near:
@@ -191,6 +211,7 @@ def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot
     from .post import measure_elevation
     run = _run(outdir)
     _warn_y_in_2d(run, xy, "--at")
+    _warn_outside_domain(run, xy, "--at", axes=(0, 1))
     _emit(measure_elevation(run, xy, threshold=threshold, dz=dz, first=first, last=last, every=every),
           csv_path, sep, plot)
 

@@ -170,6 +170,21 @@ def test_cli_2d_points_off_the_plane_are_warned(tank2d):
     assert r.exit_code == 0 and "the case is 2D" in r.stderr, r.output
 
 
+def test_cli_points_outside_the_domain_are_warned_and_variables_counted_once(tank2d):
+    """A point or vertical outside the case's domain reads nothing: warned (empty columns came
+    silently); a variable named twice gives its columns once."""
+    tank, out = tank2d
+    r = invoke("measure", "points", out, "--points", "0.5,0,0.2;100,0,100", "--vars", "vel,press,vel")
+    assert r.exit_code == 0, r.output
+    assert "--points: 1 point(s) outside the simulation domain" in r.stderr and "point 1" in r.stderr
+    header = r.stdout.splitlines()[0]
+    assert header.count("velx_0") == 1 and header.count("press_1") == 1
+    r = invoke("measure", "elevation", out, "--at", "0.3;50")
+    assert r.exit_code == 0 and "--at: 1 point(s) outside the simulation domain" in r.stderr, r.output
+    r = invoke("measure", "elevation", out, "--at", "0.3")
+    assert "outside" not in r.stderr
+
+
 def test_csv_round_trip(tmp_path):
     rng = np.random.default_rng(3)
     data = rng.normal(size=(4, 3)) * 1e3
