@@ -705,8 +705,9 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
     # the levels warned about travel in restart.h5, so that a resumed run does not warn again
     # at a level it has passed (they started again at 1 % and 10 % before)
     out = tmp_path / "levels"
-    r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.01", "--threads", "1", "-q",
-                "--set", "RhopOutMax=1002.0"])
+    with pytest.warns(UserWarning, match="more than 10% of the particles were excluded"):
+        r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.01", "--threads", "1", "-q",
+                    "--set", "RhopOutMax=1002.0"])
     assert r.exit_code == 0, r.output
     with h5py.File(out / "restart.h5", "r") as f:
         levels = int(f["scalars"].attrs["excl_part_pct"]), int(f["scalars"].attrs["excl_total_pct"])
@@ -716,6 +717,7 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         assert invoke(["run", out, "--resume", "--tmax", "0.03", "--threads", "1", "-q"]).exit_code == 0
+    assert not [w for w in caught if "were excluded" in str(w.message)]
     with h5py.File(out / "restart.h5", "r") as f:
         assert int(f["scalars"].attrs["excl_part_pct"]) == 200
 
