@@ -297,6 +297,17 @@ def first_drop_below(values, nsample, threshold, out_frac):
         out_frac[l] = res
 
 
+@njit(cache=True, inline="always")
+def _horizontal_d2(pos, j, points, p, is2d):
+    """Squared horizontal distance of particle ``j`` from point ``p`` (x only in 2D)."""
+    dx = pos[j, 0] - points[p, 0]
+    d2 = dx * dx
+    if not is2d:
+        dy = pos[j, 1] - points[p, 1]
+        d2 += dy * dy
+    return d2
+
+
 @njit(cache=True)
 def column_top_below(points, zlim, pos, radius, is2d, out):
     """Highest particle z (of ``pos``) within horizontal distance ``radius`` of each
@@ -305,12 +316,7 @@ def column_top_below(points, zlim, pos, radius, is2d, out):
     for p in range(points.shape[0]):
         best = -np.inf
         for j in range(pos.shape[0]):
-            dx = pos[j, 0] - points[p, 0]
-            d2 = dx * dx
-            if not is2d:
-                dy = pos[j, 1] - points[p, 1]
-                d2 += dy * dy
-            if d2 <= r2 and pos[j, 2] < zlim[p] and pos[j, 2] > best:
+            if _horizontal_d2(pos, j, points, p, is2d) <= r2 and pos[j, 2] < zlim[p] and pos[j, 2] > best:
                 best = pos[j, 2]
         out[p] = best if best > -np.inf else np.nan
 
@@ -323,12 +329,7 @@ def column_lowest(points, pos, radius, is2d, out):
     for p in range(points.shape[0]):
         best = np.inf
         for j in range(pos.shape[0]):
-            dx = pos[j, 0] - points[p, 0]
-            d2 = dx * dx
-            if not is2d:
-                dy = pos[j, 1] - points[p, 1]
-                d2 += dy * dy
-            if d2 <= r2 and pos[j, 2] < best:
+            if _horizontal_d2(pos, j, points, p, is2d) <= r2 and pos[j, 2] < best:
                 best = pos[j, 2]
         out[p] = best if best < np.inf else np.nan
 
@@ -345,12 +346,7 @@ def column_max_z(points, zhi, pos, radius, is2d, out, idx):
             z = pos[j, 2]
             if z < points[p, 2] or z > zhi[p] or z <= best:
                 continue
-            dx = pos[j, 0] - points[p, 0]
-            d2 = dx * dx
-            if not is2d:
-                dy = pos[j, 1] - points[p, 1]
-                d2 += dy * dy
-            if d2 <= r2:
+            if _horizontal_d2(pos, j, points, p, is2d) <= r2:
                 best = z
                 bi = j
         out[p] = best if bi >= 0 else np.nan
