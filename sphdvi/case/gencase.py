@@ -516,6 +516,7 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
             raise CaseError(f"wave paddle mkbound {wp['mkbound']} has no <motion> object", file=reader.file,
                             line=wp["line"], element=wp["type"],
                             expected=f'<motion><objreal ref="{wp["mkbound"]}"> with an <mvnull>')
+        _warn_paddle_depth(wp, pos, ptype, label, reader)
     chrono = case.special.get("chrono")
     floating_labels = {b.mkbound for b in bodies}
     if chrono:
@@ -584,6 +585,29 @@ def gauge_extent_points(g: dict) -> list:
                 far += g.get(f"size{k}", 0.0) * v / n
         return [g["point"], far]
     return []
+
+
+def _warn_paddle_depth(wp: dict, pos, ptype, label, reader) -> None:
+    """A wave paddle's <depth> sets the waves' theory (the stroke for a height and period); the
+    water the case draws in front of the paddle (its top face minus its bottom face, within 10 dp
+    of the paddle in x) differing by more than 10 % (and 2 dp) is warned about: the waves come
+    out of another height than asked (a <depth> of 3 m in water 0.3 m deep passed silently)."""
+    depth = wp.get("depth")
+    paddle = pos[(ptype != TYPE_FLUID) & (label == wp["mkbound"])]
+    fluid = pos[ptype == TYPE_FLUID]
+    if depth is None or not paddle.size or not fluid.size:
+        return
+    dp = float(reader.vars.values.get("Dp", 0.0)) or 0.0
+    if not dp > 0:
+        return
+    near = fluid[(fluid[:, 0] >= paddle[:, 0].min() - 10 * dp) & (fluid[:, 0] <= paddle[:, 0].max() + 10 * dp)]
+    if not near.size:
+        return
+    drawn = float(near[:, 2].max() - near[:, 2].min()) + dp
+    if abs(depth - drawn) > max(0.1 * drawn, 2 * dp):
+        reader.warnings.add(f"<depth> {depth:g} m of the wave paddle (mkbound {wp['mkbound']}) differs from the water "
+                            f"drawn in front of it, {drawn:.4g} m deep: the waves are made for the <depth> given",
+                            file=reader.file, line=wp.get("line"), element=wp["type"])
 
 
 def warn_gauges_outside(gauges, domain, is2d: bool, reader) -> None:

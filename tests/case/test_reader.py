@@ -558,3 +558,19 @@ def test_second_order_flap_is_refused(tmp_path):
                '<flapaxis1 x="0" y="1" z="0"/></flap></wavepaddles>')
     with pytest.raises(CaseError, match="second-order generation is not supported for flaps"):
         build(tmp_path, special=special)
+
+
+def test_a_wave_paddles_depth_unlike_the_water_drawn_is_warned(tmp_path):
+    """<depth> 3 m for the 0.3 m of water drawn in front of the piston is warned (the waves are
+    made for the depth given; it passed silently); the case's own 0.3 m is not."""
+    from pathlib import Path
+    flume = Path(__file__).resolve().parents[2] / "cases" / "waveflume2d" / "CaseWaveFlume2D_Def.xml"
+    for depth, warned in (("0.3", False), ("3", True)):
+        case = tmp_path / f"d{depth}" / "CaseWaveFlume2D_Def.xml"
+        case.parent.mkdir()
+        case.write_text(flume.read_text().replace('<depth value="0.3" />', f'<depth value="{depth}" />'))
+        r = build_case(str(case), None, dp=0.02)
+        found = [w for w in r.warnings if "differs from the water drawn in front of it" in w]
+        assert bool(found) == warned, list(r.warnings)
+        if warned:
+            assert "<depth> 3 m of the wave paddle" in found[0] and "0.3 m deep" in found[0]
