@@ -692,6 +692,7 @@ class SPHRun:
                               "with two or three layers 1-2, DBC 0); draw it with <layers vdp=\"0,1,2\"> (the kernel "
                               f"reaches 2h = {2 * float(c['h']) / float(c['dp']):.1f} dp), or keep it DBC (MdbcMkbound)")
             state.mass[mdbc_floating_mask(p["type"], labels, params, normals0)] = float(c["massbound"])
+            _warn_undamped_mdbc(params, p, normals0, c)
         # the solids that move boundary particles, and the damping zones: each only when
         # the case has it
         self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)
@@ -847,6 +848,30 @@ class SPHRun:
             for absorber, state in zip(self.absorbers, json.loads(extra["awas"])):
                 absorber.set_state(state)
         return extra
+
+
+# the share of the fluid within 2h of mDBC walls above which DensityDT 2 with SlipMode 1 is warned about
+UNDAMPED_MDBC_SHARE = 0.5
+
+
+def _warn_undamped_mdbc(params: dict, p: dict, normals, c: dict) -> None:
+    """mDBC SlipMode 1 extrapolates the walls' density along the gradient measured at their ghost
+    nodes, which feeds a pressure mode across a narrow tank (the wall values of a cos(pi y/W) mode
+    come out x1.04 / 1.32 / 1.82 by layer at W = 10 dp), and DensityDT 2 (Fourtakas, as DualSPHysics)
+    is off for a fluid particle with a boundary particle within 2h, so that nothing damps it: a 3D
+    tank 10 dp across grew a 50 Hz mode to a wall force of 140 N on 130 N of water by 0.75 s (still
+    with DensityDT 3 or 1, or SlipMode 2).  Warned when more than half the fluid lies within 2h of
+    mDBC walls."""
+    if int(params.get("SlipMode", 1)) != 1 or int(params.get("DensityDT", 0)) != 2:
+        return
+    walls = (p["type"] != 3) & np.any(normals != 0.0, axis=1)
+    from .sph.cells import share_within
+    share = share_within(p["pos"][p["type"] == 3], p["pos"][walls], 2.0 * float(c["h"]), bool(c["is2d"]))
+    if share > UNDAMPED_MDBC_SHARE:
+        warnings.warn(f"mDBC SlipMode 1 with DensityDT 2: {100 * share:.0f} % of the fluid lies within 2h of mDBC "
+                      "walls, where DensityDT 2 (Fourtakas) is off, as in DualSPHysics; an acoustic mode across a "
+                      "narrow tank can then grow undamped (a 3D tank 10 dp across: wall forces as large as the "
+                      "water's weight). Prefer DensityDT 3 (or 1), SlipMode 2 or 3, or more particles across")
 
 
 def _clean_up_after_failure(*steps) -> None:

@@ -228,3 +228,52 @@ class CellList:
     def sorted_cells(self):
         """Cell of each particle in sorted order."""
         return self.cell[self.order]
+
+
+@njit(cache=True, error_model="numpy")
+def _near_any(points, others, order, cell_start, pmin, inv_cell, ncx, ncy, ncz, is2d, radius, out):
+    r2 = radius * radius
+    for i in range(points.shape[0]):
+        cx = min(max(int((points[i, 0] - pmin[0]) * inv_cell), 0), ncx - 1)
+        cy = 0 if is2d else min(max(int((points[i, 1] - pmin[1]) * inv_cell), 0), ncy - 1)
+        cz = min(max(int((points[i, 2] - pmin[2]) * inv_cell), 0), ncz - 1)
+        found = False
+        for z in range(max(cz - 1, 0), min(cz + 2, ncz)):
+            for y in range(max(cy - 1, 0), min(cy + 2, ncy)):
+                for x in range(max(cx - 1, 0), min(cx + 2, ncx)):
+                    c = (z * ncy + y) * ncx + x
+                    for k in range(cell_start[c], cell_start[c + 1]):
+                        j = order[k]
+                        d2 = 0.0
+                        for a in range(3):
+                            if not (is2d and a == 1):
+                                d = points[i, a] - others[j, a]
+                                d2 += d * d
+                        if d2 <= r2:
+                            found = True
+                            break
+                    if found:
+                        break
+                if found:
+                    break
+            if found:
+                break
+        out[i] = found
+
+
+def share_within(points, others, radius: float, is2d: bool) -> float:
+    """Share of ``points`` that have a particle of ``others`` within ``radius`` (x-z in 2D)."""
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
+    others = np.ascontiguousarray(others, dtype=np.float64).reshape(-1, 3)
+    if not points.shape[0] or not others.shape[0]:
+        return 0.0
+    lo = np.minimum(points.min(axis=0), others.min(axis=0))
+    hi = np.maximum(points.max(axis=0), others.max(axis=0))
+    ncx, ncy, ncz = grid_shape(lo, hi, radius, is2d)
+    cell = np.empty(others.shape[0], np.int64)
+    order = np.empty(others.shape[0], np.int64)
+    cell_start = np.empty(ncx * ncy * ncz + 1, np.int64)
+    counting_sort_cells(others, lo, 1.0 / radius, ncx, ncy, ncz, is2d, cell, order, cell_start)
+    near = np.empty(points.shape[0], np.bool_)
+    _near_any(points, others, order, cell_start, lo, 1.0 / radius, ncx, ncy, ncz, is2d, radius, near)
+    return float(near.mean())

@@ -619,6 +619,39 @@ def test_mdbc_on_one_layer_walls_is_warned(tmp_path):
     assert one_layer_mkbounds(n, np.array([0, 0, 1, 0, 2]), np.array([0, 0, 3, 4, 5]), 0.1) == [3]
 
 
+def test_undamped_mdbc_mode_is_warned():
+    """mDBC SlipMode 1 with DensityDT 2 where most of the fluid is within 2h of mDBC walls (a 3D
+    tank 10 dp across grew an acoustic mode across it to wall forces of the water's weight) is
+    warned about, naming the share and the remedies; DensityDT 3, SlipMode 2, or a wide tank not."""
+    from sphdvi.simulation import _warn_undamped_mdbc
+    from sphdvi.sph.cells import share_within
+    dp, h = 0.02, 0.02 * 2 ** 0.5
+    xs = (np.arange(10) + 0.5) * dp
+    fluid = np.array([[x, 0.0, z] for x in xs for z in xs])              # 10 x 10, in 2D
+    walls = np.array([[x, 0.0, -0.5 * dp - k * dp] for x in xs for k in range(3)] +
+                     [[-0.5 * dp - k * dp, 0.0, z] for z in xs for k in range(3)] +
+                     [[10 * dp + 0.5 * dp + k * dp, 0.0, z] for z in xs for k in range(3)])
+    p = {"pos": np.r_[walls, fluid], "type": np.r_[np.zeros(len(walls), int), np.full(len(fluid), 3)]}
+    normals = np.r_[np.full((len(walls), 3), 0.01), np.zeros((len(fluid), 3))]
+    c = {"h": h, "is2d": True}
+    # within 2h = 2.83 dp of a wall particle: the two rows over the floor and the two columns by
+    # each side wall (their nearest wall particles dp and 2 dp away); 8 x 6 of the 100 are not
+    assert share_within(fluid, walls, 2 * h, True) == pytest.approx(0.52)
+    for params, warned in (({"SlipMode": 1, "DensityDT": 2}, True), ({"SlipMode": 1, "DensityDT": 3}, False),
+                           ({"SlipMode": 2, "DensityDT": 2}, False)):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            _warn_undamped_mdbc(params, p, normals, c)
+        msgs = [str(w.message) for w in caught]
+        assert bool(msgs) == warned, msgs
+        if warned:
+            assert "52 % of the fluid lies within 2h of mDBC walls" in msgs[0] and "DensityDT 3" in msgs[0]
+    with warnings.catch_warnings(record=True) as caught:     # DBC walls (no normal): not counted
+        warnings.simplefilter("always")
+        _warn_undamped_mdbc({"SlipMode": 1, "DensityDT": 2}, p, np.zeros_like(normals), c)
+    assert not caught
+
+
 def test_mdbc_floating_mask():
     """The floating particles mDBC corrects, whose mass the fluid takes as rho0 dp^d: Boundary 2
     with any SlipMode, of the MdbcMkbound list when there is one."""
