@@ -246,6 +246,16 @@ def resume_overrides(base: dict, outdir: str, tmax, tout, sets):
     return (old_tmax if tmax is None else tmax), old_tout, old_sets
 
 
+def _warn_set_aside_left(outdir: str) -> None:
+    """A command killed between setting an earlier run's files aside (--overwrite) and deleting
+    them leaves them in OUT/.sphdvi-overwritten: say so, as they are out of sight there."""
+    from .io.runfolder import OVERWRITTEN_DIR
+    left = os.path.join(outdir, OVERWRITTEN_DIR)
+    if os.path.isdir(left):
+        warnings.warn(f"{left} holds the files of a run that an interrupted --overwrite set aside; move them back "
+                      "into the folder to keep that run, or delete it")
+
+
 def _check_resume_tmax(tmax: float, outdir: str) -> None:
     """``--resume --tmax`` below the time the run has reached is refused (the run was marked
     completed at a time past its TimeMax, and a later --resume kept that TimeMax), unless it is
@@ -307,6 +317,8 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
         check_new_run_folder(outdir, overwrite)
     make_folder(outdir)
     remove_leftover_temporaries(outdir)
+    if not overwrite:                  # with --overwrite a new set-aside replaces it
+        _warn_set_aside_left(outdir)
     if not resume and set_aside is None:
         set_aside = SetAside(outdir, earlier_results(outdir) + earlier_exports(outdir))
     files = RunFiles(outdir)

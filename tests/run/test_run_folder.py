@@ -193,6 +193,12 @@ def test_overwrite_that_fails_on_bad_input_loses_nothing(done, tmp_path):
         r = invoke(args)
         assert r.exit_code == 2 and "Traceback" not in r.output, (args, r.output)
         assert tree(out) == before, args
+    # what a killed --overwrite left aside is pointed out by the next run
+    left = out / ".sphdvi-overwritten"
+    left.mkdir()
+    (left / "run.csv").write_text("an earlier run's")
+    with pytest.warns(UserWarning, match="holds the files of a run that an interrupted --overwrite set aside"):
+        invoke(["run", out, "--resume", "--tmax", "0.004", "--threads", "1", "-q"])
     # a good run with --overwrite then replaces them, and leaves nothing aside
     r = invoke(["run", out, "--overwrite", "--tmax", "0.002", "--tout", "0.002", "--threads", "1", "-q"])
     assert r.exit_code == 0, r.output
