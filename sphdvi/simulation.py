@@ -38,8 +38,8 @@ import numpy as np
 
 from ._version import __version__
 from .errors import DivergenceError, InputError, SphdviError
-from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_bodies_checkpoint, load_sph_checkpoint,
-                            save_bodies_checkpoint, save_sph_checkpoint)
+from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_bodies_checkpoint,
+                            load_sph_checkpoint, save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import make_folder, remove_leftover_temporaries
 from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
 from .io.dtinfo import DTINFO_FILE, DtLog

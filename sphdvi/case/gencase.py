@@ -150,7 +150,8 @@ def assemble_particles(case: Case, drawing, consts: Constants, reader):
     bad = label[is_fluid & (label >= case.fluidcount)]
     if bad.size:
         raise CaseError(f"mkfluid {int(bad.max())} is not below fluidcount={case.fluidcount}", file=reader.file,
-                        line=reader.line_of("casedef/mkconfig"), element="mkconfig", expected="mkfluid < fluidcount (raise fluidcount in <mkconfig>)")
+                        line=reader.line_of("casedef/mkconfig"), element="mkconfig",
+                        expected="mkfluid < fluidcount (raise fluidcount in <mkconfig>)")
     bad = label[~is_fluid & (label >= case.boundcount)]
     if bad.size:
         raise CaseError(f"mkbound {int(bad.max())} is not below boundcount={case.boundcount}", file=reader.file,
@@ -160,7 +161,8 @@ def assemble_particles(case: Case, drawing, consts: Constants, reader):
     both = floating & moving
     if both:
         raise CaseError(f"mkbound {sorted(both)} is both floating and moving", file=reader.file,
-                        line=next((m["line"] for m in case.motions if m["ref"] in both), None), element="motion", expected="a floating body or an imposed motion, not both")
+                        line=next((m["line"] for m in case.motions if m["ref"] in both), None), element="motion",
+                        expected="a floating body or an imposed motion, not both")
     ptype = np.full(label.shape, TYPE_FIXED, dtype=np.uint8)
     ptype[is_fluid] = TYPE_FLUID
     if floating:

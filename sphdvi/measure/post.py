@@ -412,7 +412,8 @@ def measure_elevation(run: RunOutput, xy, threshold=None, dz=None, first=0, last
         if (zhi - zlo) / dz > MAX_LINE_SAMPLES:
             raise InputError(f"--dz {dz:g}: {(zhi - zlo) / dz:.3g} samples along each vertical ({zhi - zlo:.3g} m, "
                              f"the fluid's height and 2h either side); at most {MAX_LINE_SAMPLES:.0e}: expected "
-                             f"--dz >= {(zhi - zlo) / MAX_LINE_SAMPLES:.3g} m (the default is dp/4, {0.25 * spec.dp:g} m)")
+                             f"--dz >= {(zhi - zlo) / MAX_LINE_SAMPLES:.3g} m (the default is dp/4, "
+                             f"{0.25 * spec.dp:g} m)")
         surf, bottom = elevation_step(grid, bound, xy, zlo, zhi, spec, threshold, dz)
         rows.append(np.column_stack([surf, surf - bottom]).reshape(-1))
         times.append(snap.time)

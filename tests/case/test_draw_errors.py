@@ -99,11 +99,14 @@ def test_drawing_without_mk(tmp_path):
      '</drawcylinder>', "mask"),
     ('<setmkbound mk="0"/><drawellipsoid radius="0.5"><point x="0" y="0" z="0"/><point x="3" y="0" z="0"/>'
      '</drawellipsoid>', "radius"),
-    ('<setmkbound mk="0"/><drawprism><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/><point x="0" y="1" z="0"/><point x="0" y="0" z="1"/>'
+    ('<setmkbound mk="0"/><drawprism><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/>'
+     '<point x="0" y="1" z="0"/><point x="0" y="0" z="1"/>'
      '<point x="1" y="0" z="1"/><point x="0" y="1" z="1"/><point x="0" y="0" z="3"/></drawprism>', "at least 6|even"),
-    ('<setmkbound mk="0"/><drawpolygon><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/><point x="2" y="0" z="0"/></drawpolygon>',
+    ('<setmkbound mk="0"/><drawpolygon><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/>'
+     '<point x="2" y="0" z="0"/></drawpolygon>',
      "no area"),
-    ('<setmkbound mk="0"/><drawtriangles><points><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/><point x="0" y="1" z="0"/>'
+    ('<setmkbound mk="0"/><drawtriangles><points><point x="0" y="0" z="0"/><point x="1" y="0" z="0"/>'
+     '<point x="0" y="1" z="0"/>'
      '</points><triangles><triangle x="0" y="1" z="5"/></triangles></drawtriangles>', "above 2"),
     ('<setmkbound mk="0"/><drawline><point x="0" y="0" z="0"/></drawline>', "exactly 2"),
     ('<setmkbound mk="0"/><drawlineto x="1"/>', "no line start"),
