@@ -190,7 +190,11 @@ def _check_resume_source(case_xml: str, case_h5: str, outdir: str) -> None:
         raise InputError(f"--resume: {outdir} holds a run of the case '{drawn}' ({case_h5}), not of {case_xml} "
                          f"('{name}'); expected that case's file, or 'sphdvi run {outdir} --resume'")
     with open(case_xml, "rb") as fh:
-        text = fh.read().decode("utf-8", errors="replace")
+        raw = fh.read()
+    try:                                   # decoded as gencase reads it
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")
     if read_case_h5(case_h5)["source_xml"].strip() != text.strip():
         raise InputError(f"--resume: {case_xml} has changed since gencase drew the case in {outdir}, and a resumed "
                          f"run goes on with the case as drawn then; expected 'sphdvi run {outdir} --resume' to go on "
