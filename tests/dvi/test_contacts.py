@@ -325,45 +325,42 @@ def test_variable_time_step_resting_contact():
     assert abs(s.pos[b, 2] - z0) < 1e-6
 
 
-_FIRST_CONTACT_SCRIPT = r"""
-import copy, json, sys
-from sphdvi.dvi import System, collision as col, rows as rw
-method = sys.argv[1]
-s = System(gravity=(0, 0, -9.81), contactmethod=method, envelope=0.01)
-m = s.add_material("m", friction=0.3, restitution=0.5, young=1e7, poisson=0.3)
-s.add_plane(material=m)
-b = s.add_body(1.0, (0.004,) * 3, pos=(0, 0, 0.15))
-s.add_sphere(b, 0.1, material=m)
-kernels = dict(smc_forces=col.smc_forces, contact_materials=col.contact_materials,
-               build_contact_rows=rw.build_contact_rows, match_warm_start=col.match_warm_start)
-clone = copy.deepcopy(s)
-clone.step(1e-3)
-clone.compile_contact_kernels()
-before = {k: [str(t) for t in f.signatures] for k, f in kernels.items()}
-contacts = 0
-for _ in range(300):
-    s.step(1e-3)
-    contacts = max(contacts, s.n_contacts)
-after = {k: [str(t) for t in f.signatures] for k, f in kernels.items()}
-print(json.dumps(dict(before=before, after=after, contacts=contacts, z=float(s.pos[b, 2]))))
-"""
-
-
 @pytest.mark.parametrize("method", ["nsc", "smc"])
-def test_contact_kernels_compile_before_the_first_contact(method):
-    """A warm-up's ``compile_contact_kernels`` (on zero contacts) compiles exactly the kernel
-    signatures that a first contact calls, so that none compiles inside the time loop.  A fresh
-    process, so that no other test has compiled them before."""
-    import json
-    import subprocess
-    import sys
-    out = subprocess.run([sys.executable, "-c", _FIRST_CONTACT_SCRIPT, method], check=True,
-                         capture_output=True, text=True).stdout
-    r = json.loads(out.strip().splitlines()[-1])
-    assert r["contacts"] >= 1                       # the sphere did land on the plane
-    assert abs(r["z"] - 0.1) < 2e-3                 # and rests there
-    used = ["smc_forces"] if method == "smc" else ["contact_materials", "build_contact_rows",
-                                                   "match_warm_start"]
-    for k in used:
-        assert len(r["before"][k]) == 1, k          # compiled by the warm-up ...
-        assert r["after"][k] == r["before"][k], k   # ... and no new signature at the contact
+def test_contact_kernels_compile_before_the_first_contact(method, monkeypatch):
+    """A warm-up's ``compile_contact_kernels`` (on zero contacts) calls the kernels that a first
+    contact calls with the same argument types, so that numba compiles them then, not inside the
+    time loop: the types of every call at the landing of a sphere were among the warm-up's."""
+    import copy
+    from sphdvi.dvi import collision as col
+    from sphdvi.dvi import rows as rw
+    names = ["smc_forces"] if method == "smc" else ["contact_materials", "match_warm_start"]
+    kernels = [(col, n) for n in names] + ([] if method == "smc" else [(rw, "build_contact_rows")])
+    calls = {}
+
+    def recording(module, name):
+        fn = getattr(module, name)
+
+        def wrapper(*args):
+            calls.setdefault(phase[0], set()).add((name, tuple(fn.typeof_pyval(a) for a in args)))
+            return fn(*args)
+        return wrapper
+    for module, name in kernels:
+        monkeypatch.setattr(module, name, recording(module, name))
+    s = System(gravity=(0, 0, -G), contactmethod=method, envelope=0.01)
+    m = s.add_material("m", friction=0.3, restitution=0.5, young=1e7, poisson=0.3)
+    s.add_plane(material=m)
+    b = s.add_body(1.0, (0.004,) * 3, pos=(0, 0, 0.15))
+    s.add_sphere(b, 0.1, material=m)
+    phase = ["warm-up"]
+    clone = copy.deepcopy(s)
+    clone.step(1e-3)
+    clone.compile_contact_kernels()
+    phase[0] = "run"
+    contacts = 0
+    for _ in range(300):
+        s.step(1e-3)
+        contacts = max(contacts, s.n_contacts)
+    assert contacts >= 1 and abs(s.pos[b, 2] - 0.1) < 2e-3        # the sphere landed and rests
+    warm, run = calls.get("warm-up", set()), calls.get("run", set())
+    assert {n for n, _ in run} == {n for _, n in kernels}           # every contact kernel was called
+    assert run <= warm, run - warm                                  # with types the warm-up compiled
