@@ -694,15 +694,12 @@ class SPHRun:
                 normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
                                             Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
             normals0 = self._mdbc_only_on(normals0, p, fluidcount, str(params.get("MdbcMkbound") or "").strip())
-            from .case.normals import mdbc_floating_mask, one_layer_mkbounds
+            from .case.normals import layers_needed, mdbc_floating_mask, thin_wall_mkbounds
             from .coupling import body_labels
             labels = body_labels(p["mk"], fluidcount)
-            thin = one_layer_mkbounds(normals0, p["type"], labels, float(c["dp"]))
-            if thin:
-                warnings.warn(f"mDBC on mkbound {', '.join(map(str, thin))}: a wall one particle thick, through which "
-                              "the fluid leaks (S3's dam break at dp 0.02: 200-210 of 5,501 particles out by 0.72 s; "
-                              "with two or three layers 1-2, DBC 0); draw it with <layers vdp=\"0,1,2\"> (the kernel "
-                              f"reaches 2h = {2 * float(c['h']) / float(c['dp']):.1f} dp), or keep it DBC (MdbcMkbound)")
+            _warn_thin_mdbc_walls(thin_wall_mkbounds(p["pos"], normals0, p["type"], labels, float(c["dp"]),
+                                                     float(c["h"])), layers_needed(float(c["h"]), float(c["dp"])),
+                                  float(c["h"]) / float(c["dp"]))
             state.mass[mdbc_floating_mask(p["type"], labels, params, normals0)] = float(c["massbound"])
             _warn_undamped_mdbc(params, p, normals0, c)
         # the solids that move boundary particles, and the damping zones: each only when
@@ -860,6 +857,25 @@ class SPHRun:
             for absorber, state in zip(self.absorbers, json.loads(extra["awas"])):
                 absorber.set_state(state)
         return extra
+
+
+def _warn_thin_mdbc_walls(thin: dict, need: int, h_dp: float) -> None:
+    """mDBC on walls thinner than the kernel's reach leaks (:func:`~sphdvi.case.normals.thin_wall_mkbounds`)."""
+    if not thin:
+        return
+    vdp = ",".join(str(k) for k in range(need))
+    one = sorted(mk for mk, (fewest, _) in thin.items() if fewest == 1)
+    more = {mk: v for mk, v in thin.items() if v[0] > 1}
+    if one:
+        warnings.warn(f"mDBC on mkbound {', '.join(map(str, one))}: a wall one particle thick, through which "
+                      "the fluid leaks (S3's dam break at dp 0.02: 200-210 of 5,501 particles out by 0.72 s; "
+                      f"with two or three layers 1-2, DBC 0); draw it with <layers vdp=\"{vdp}\"> (the kernel "
+                      f"reaches 2h = {2 * h_dp:.1f} dp), or keep it DBC (MdbcMkbound)")
+    for mk, (fewest, count) in sorted(more.items()):
+        warnings.warn(f"mDBC on mkbound {mk}: the wall is {fewest} particles thick behind {count} of its face "
+                      f"particles, where the kernel reaches {need} layers (2h = {2 * h_dp:.2f} dp); the fluid leaks "
+                      "through it (a 3D tank with 2 layers on two sides: 35 particles through by 1 s at low "
+                      f"viscosity); draw it {need} layers thick (<layers vdp=\"{vdp}\">, or a larger solid box)")
 
 
 # the share of the fluid within 2h of mDBC walls above which DensityDT 2 with SlipMode 1 is warned about

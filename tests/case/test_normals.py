@@ -194,12 +194,14 @@ def test_curved_wall_normals(layers, inner_mean, inner_max):
     assert np.all((n * inward).sum(axis=1) > 0)                 # every one towards the water
 
 
-@pytest.mark.parametrize("layers, thin", [(1, [0]), (2, [])])
-def test_one_layer_walls_are_found_in_3d(layers, thin):
-    """A 3D tank one particle thick is a one-layer wall though its corner particles' normals are
-    dp sqrt(3)/2 long; with two layers the second layer's are 1.5 dp."""
-    from sphdvi.case.normals import one_layer_mkbounds
+@pytest.mark.parametrize("layers, thin", [(1, {0: 1}), (2, {0: 2}), (3, {})])
+def test_thin_walls_are_found_in_3d(layers, thin):
+    """A 3D tank whose walls are thinner than the kernel's reach (3 layers at coefh 1: 2h =
+    3.46 dp) is found, with the fewest layers behind a face particle, though its corner
+    particles' normals are longer than dp; with three layers it is not."""
+    from sphdvi.case.normals import layers_needed, thin_wall_mkbounds
     dp = 0.05
+    h = dp * np.sqrt(3)
     k = np.arange(-(layers - 1), 9 + layers)
     g = np.stack(np.meshgrid(k, k, np.arange(-(layers - 1), 8), indexing="ij"), axis=-1).reshape(-1, 3)
     wall = (g[:, 0] <= 0) | (g[:, 0] >= 9) | (g[:, 1] <= 0) | (g[:, 1] >= 9) | (g[:, 2] <= 0)
@@ -208,4 +210,6 @@ def test_one_layer_walls_are_found_in_3d(layers, thin):
     ptype = np.r_[np.zeros(wall.sum(), int), np.full(water.sum(), 3)]
     n = boundary_normals(pos, ptype, dp, False)
     assert np.linalg.norm(n[ptype == 0], axis=1).max() == pytest.approx(dp * (layers - 0.5) * np.sqrt(3))
-    assert one_layer_mkbounds(n, ptype, np.zeros(len(pos), int), dp) == thin
+    found = thin_wall_mkbounds(pos, n, ptype, np.zeros(len(pos), int), dp, h)
+    assert {mk: fewest for mk, (fewest, _) in found.items()} == thin
+    assert layers_needed(h, dp) == 3 and layers_needed(dp * np.sqrt(2), dp) == 2      # 3D and 2D, coefh 1

@@ -602,7 +602,7 @@ def test_mdbc_on_one_layer_walls_is_warned(tmp_path):
     layers to draw; with three layers it does not."""
     case = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
     args = ["--dp", "0.1", "--tmax", "0.002", "-q", "--threads", "1", "--set", "Boundary=2"]
-    with pytest.warns(UserWarning, match=r'mDBC on mkbound 0: a wall one particle thick.*<layers vdp="0,1,2">'):
+    with pytest.warns(UserWarning, match=r'mDBC on mkbound 0: a wall one particle thick.*<layers vdp="0,1">'):
         r = invoke(["run", case, "-o", tmp_path / "one", *args])
     assert r.exit_code == 0
     thick = tmp_path / "CaseThick_Def.xml"
@@ -613,10 +613,13 @@ def test_mdbc_on_one_layer_walls_is_warned(tmp_path):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         r = invoke(["run", thick, "-o", tmp_path / "three", *args])
-    assert r.exit_code == 0 and not any("one particle thick" in str(w.message) for w in caught)
-    from sphdvi.case.normals import one_layer_mkbounds
-    n = np.array([[0, 0, 0.05], [0, 0, 0.15], [0.05, 0, 0], [0, 0, 0], [0, 0, 0.05]])
-    assert one_layer_mkbounds(n, np.array([0, 0, 1, 0, 2]), np.array([0, 0, 3, 4, 5]), 0.1) == [3]
+    assert r.exit_code == 0 and not any("particle thick" in str(w.message) or "particles thick" in str(w.message)
+                                        for w in caught)
+    # a wall thicker than one layer but thinner than the kernel's reach (2 layers where it reaches 3)
+    from sphdvi.simulation import _warn_thin_mdbc_walls
+    with pytest.warns(UserWarning, match=r"mDBC on mkbound 4: the wall is 2 particles thick behind 120 of its face "
+                                         r'particles, where the kernel reaches 3 layers.*<layers vdp="0,1,2">'):
+        _warn_thin_mdbc_walls({4: (2, 120)}, 3, 3 ** 0.5)
 
 
 def test_undamped_mdbc_mode_is_warned():
