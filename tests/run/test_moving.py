@@ -144,6 +144,7 @@ def test_damping_zone_reduces_velocity():
     assert st.vel[4] == pytest.approx([1, 1, 1])                  # boundary particle untouched
 
 
+@pytest.mark.filterwarnings("ignore:mDBC on mkbound 0. a wall one particle thick")     # the tank's one-layer floor
 def test_resume_from_a_checkpoint_without_wall_acceleration(tmp_path):
     """mDBC SlipMode 2 with a moving wall keeps the wall acceleration (pressure cloning)
     in the checkpoint; a checkpoint written before that array existed still resumes,
