@@ -7,11 +7,13 @@ Positions are always placed by the exact transform (no accumulated drift).
 Movements (DualSPHysics ``JMotion``; times τ measured from the start of the movement):
 
 * ``wait``, ``mvnull``: no motion;
-* ``mvrect``: d = v τ;  ``mvrectace``: d = v0 τ + a τ²/2 (v0 defaults to the previous speed);
+* ``mvrect``: d = v τ;  ``mvrectace``: d = v0 τ + a τ²/2 (v0 defaults to the previous movement's
+  final speed, 0 after one that is not rectilinear, as DualSPHysics);
 * ``mvrot``: rotation by ω τ about the axis through p1 and p2, in DualSPHysics's sense (a
   positive angle turns right-handed about p2→p1: :func:`_rotational`); ``mvrotace``: ω0 τ + α τ²/2;
 * ``mvcir``: the object translates along the circle that ``ref`` describes when rotated about the axis;
-* ``mvrectsinu``: d = A [sin(2π f τ + φ) − sin φ] per component;
+* ``mvrectsinu``: d = A [sin(2π f τ + φ) − sin φ] per component (φ defaults to the phase a
+  previous sinusoidal movement of the chain reached, 0 after any other);
   ``mvrotsinu``: angle A [sin(2π f τ + φ) − sin φ]; ``mvcirsinu`` likewise on a circle;
 * ``mvrectfile`` (alias ``mvfile``, ``mvpredef``)/``mvrotfile``: positions or angles
   interpolated linearly from a file of ``fields`` columns; ``fieldtime``, ``fieldx``...
@@ -76,11 +78,18 @@ def _angle_units(m) -> float:
 
 
 def _segment(m: dict, tau: float, state: dict) -> Rigid:
-    """Transform and velocity of one movement ``tau`` seconds after it started."""
+    """Transform and velocity of one movement ``tau`` seconds after it started.
+
+    ``state`` carries what DualSPHysics's active movement carries into the next one of the chain
+    (JMotionMovActive::NextMov) at the end of this one: the linear speed of a rectilinear movement
+    (``v``), the angular speed of a rotation or circular one (``w``), the advanced phases of a
+    sinusoidal one (``phase3``: mvrectsinu; ``phase``: mvrotsinu, mvcirsinu); every other one is
+    zero there (a mvrectace without <velini> after a rotation starts from rest, not from the last
+    rectilinear speed; a mvrectsinu without <phase> after another goes on from its phase)."""
     kind = m["type"]
+    carried = {"v": np.zeros(3), "w": 0.0, "phase3": np.zeros(3), "phase": 0.0}
     if kind in ("wait", "mvnull"):
-        state["v"] = np.zeros(3)
-        state["w"] = 0.0
+        state.update(carried)
         return Rigid()
     if kind in ("mvrect", "mvrectace"):
         if kind == "mvrect":
@@ -90,7 +99,7 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
             a = np.asarray(m["ace"], float)
         d = v0 * tau + 0.5 * a * tau * tau
         v = v0 + a * tau
-        state["v"] = v
+        state.update(carried, v=v)
         return Rigid(d=d, V=v)
     if kind in ("mvrot", "mvrotace", "mvcir", "mvcirace"):
         u = _angle_units(m)
@@ -101,22 +110,27 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
             al = m["ace"] * u
         angle = w0 * tau + 0.5 * al * tau * tau
         w = w0 + al * tau
-        state["w"] = w
+        state.update(carried, w=w)
         return _rotational(m, angle, w, circular=kind.startswith("mvcir"))
     if kind == "mvrectsinu":
         f, A = np.asarray(m["freq"], float), np.asarray(m["ampl"], float)
-        ph = np.asarray(m.get("phase", [0.0, 0.0, 0.0]), float) * _angle_units(m)
+        ph = (np.asarray(m["phase"], float) * _angle_units(m) if "phase" in m
+              else np.asarray(state.get("phase3", np.zeros(3)), float))
         arg = 2 * math.pi * f * tau + ph
         d = A * (np.sin(arg) - np.sin(ph))
+        state.update(carried, phase3=np.where(A != 0.0, arg, ph))     # DualSPHysics advances moving axes only
         return Rigid(d=d, V=A * 2 * math.pi * f * np.cos(arg))
     if kind in ("mvrotsinu", "mvcirsinu"):
         u = _angle_units(m)
-        f, A, ph = m["freq"], m["ampl"] * u, m.get("phase", 0.0) * u
+        f, A = m["freq"], m["ampl"] * u
+        ph = m["phase"] * u if "phase" in m else state.get("phase", 0.0)
         arg = 2 * math.pi * f * tau + ph
         angle = A * (math.sin(arg) - math.sin(ph))
         w = A * 2 * math.pi * f * math.cos(arg)
+        state.update(carried, phase=arg)
         return _rotational(m, angle, w, circular=kind == "mvcirsinu")
     if kind in ("mvrectfile", "mvrotfile"):
+        state.update(carried)
         return _from_file(m, tau)
     raise ValueError(f"unsupported movement {kind}")
 

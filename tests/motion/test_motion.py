@@ -38,6 +38,28 @@ def test_rectace_continues_speed():
     assert x[0, 0] == pytest.approx(1.0 + 0.5 + 0.5 * 2 * 0.25) and v[0, 0] == pytest.approx(2.0)
 
 
+def test_what_a_movement_carries_into_the_next_is_dualsphysics_s():
+    """As JMotionMovActive::NextMov: a mvrectace without <velini> takes the previous movement's
+    final speed only when that one is rectilinear (after a rotation it starts from rest: it took
+    the last rectilinear speed before); a mvrectsinu without <phase> goes on from the phase the
+    previous mvrectsinu reached (it restarted at 0, the velocity jumping), so that two halves of
+    a sinusoid chained are the whole one."""
+    rot = {"type": "mvrot", "id": 2, "duration": 1.0, "next": 3, "vel": 10.0, "anglesunits": "degrees",
+           "axisp1": [0, 0, 0], "axisp2": [0, 1, 0]}
+    ace = {"type": "mvrectace", "id": 3, "duration": 1.0, "next": None, "ace": [0, 0, 0]}
+    before = chain_transform(chain([rect(1, 1.0, [1, 0, 0], 2), rot, ace]), 2.0).apply(np.zeros((1, 3)))[0]
+    after = chain_transform(chain([rect(1, 1.0, [1, 0, 0], 2), rot, ace]), 3.0).apply(np.zeros((1, 3)))
+    assert after[0] == pytest.approx(before, abs=1e-12) and after[1] == pytest.approx(np.zeros((1, 3)), abs=1e-12)
+    sinu = {"type": "mvrectsinu", "freq": [1, 0, 0], "ampl": [0.1, 0, 0], "anglesunits": "degrees"}
+    halves = chain([dict(sinu, id=1, duration=0.3, next=2), dict(sinu, id=2, duration=-1, next=None)])
+    whole = chain([dict(sinu, id=1, duration=-1, next=None)])
+    for t in (0.2, 0.45, 0.8):
+        xh, vh = chain_transform(halves, t).apply(np.zeros((1, 3)))
+        xw, vw = chain_transform(whole, t).apply(np.zeros((1, 3)))
+        assert xh == pytest.approx(xw, abs=1e-12) and vh == pytest.approx(vw, abs=1e-12)
+        assert xw[0, 0] == pytest.approx(0.1 * math.sin(2 * math.pi * t), abs=1e-12)
+
+
 def test_rotation_quarter_turn_about_axis():
     m = {"type": "mvrot", "id": 1, "duration": -1, "next": None, "vel": 90.0, "anglesunits": "degrees",
          "axisp1": [1, 0, 0], "axisp2": [1, 1, 0]}
