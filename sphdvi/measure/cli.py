@@ -207,6 +207,10 @@ def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot
     particle below the surface, plus dp/2).
     """
     _check_outputs(csv_path, plot)
+    if threshold is not None and threshold >= 1.0:
+        # inside the water the kernel sum is about 1: a level at or above it is never crossed
+        click.echo(f"warning: --threshold {threshold:g}: the kernel sum inside the water is about 1, so the surface "
+                   "is found only below that (default 0.4 in 2D, 0.5 in 3D); expect empty columns", err=True)
     xy = _points_option(at, "'--at'", ncoord=2)
     from .post import measure_elevation
     run = _run(outdir)

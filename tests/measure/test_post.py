@@ -183,6 +183,8 @@ def test_cli_points_outside_the_domain_are_warned_and_variables_counted_once(tan
     assert r.exit_code == 0 and "--at: 1 point(s) outside the simulation domain" in r.stderr, r.output
     r = invoke("measure", "elevation", out, "--at", "0.3")
     assert "outside" not in r.stderr
+    r = invoke("measure", "elevation", out, "--at", "0.3", "--threshold", "5")     # never crossed
+    assert r.exit_code == 0 and "--threshold 5: the kernel sum inside the water is about 1" in r.stderr
 
 
 def test_csv_round_trip(tmp_path):
