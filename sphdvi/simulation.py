@@ -43,8 +43,8 @@ from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_b
 from .io.atomic import make_folder, remove_leftover_temporaries
 from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
 from .io.dtinfo import DTINFO_FILE, DtLog
-from .io.runfolder import (NORMALS_FILE, SetAside, check_new_run_folder, earlier_exports, earlier_results,
-                           restored_on_bad_input, stored_overrides)
+from .io.runfolder import (NORMALS_FILE, OVERWRITTEN_DIR, SetAside, check_new_run_folder, earlier_exports,
+                           earlier_results, restored_on_bad_input, stored_overrides)
 from .sph.damping import damping_zones
 from .output_parts import OutputParts
 from .output_schedule import OutputSchedule
@@ -249,7 +249,6 @@ def resume_overrides(base: dict, outdir: str, tmax, tout, sets):
 def _warn_set_aside_left(outdir: str) -> None:
     """A command killed between setting an earlier run's files aside (--overwrite) and deleting
     them leaves them in OUT/.sphdvi-overwritten: say so, as they are out of sight there."""
-    from .io.runfolder import OVERWRITTEN_DIR
     left = os.path.join(outdir, OVERWRITTEN_DIR)
     if os.path.isdir(left):
         warnings.warn(f"{left} holds the files of a run that an interrupted --overwrite set aside; move them back "

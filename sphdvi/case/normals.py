@@ -486,25 +486,36 @@ def thin_wall_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, 
     wall = (np.asarray(ptype) <= 1) & (length > 0)
     if need < 2 or not wall.any():
         return {}
+    # face particles with an axis-aligned normal (an edge or a corner is counted by its faces)
+    face = np.flatnonzero(wall & (np.abs(length - 0.5 * dp) < 0.1 * dp))
+    u = normals[face] / length[face, None]
+    axis = np.argmax(np.abs(u), axis=1)
+    along = np.abs(np.abs(u[np.arange(face.size), axis]) - 1.0) <= 1e-6
+    face, u, axis = face[along], u[along], axis[along]
+    if not face.size:
+        return {}
+    # the boundary particles as lattice cells, one integer code each, looked up layer by layer
     origin = pos[wall].min(axis=0)
-    keys = {tuple(k) for k in np.round((pos[np.asarray(ptype) != 3] - origin) / dp).astype(np.int64)}
-    face = wall & (np.abs(length - 0.5 * dp) < 0.1 * dp)
+    cells = np.round((pos[np.asarray(ptype) != 3] - origin) / dp).astype(np.int64)
+    lo = cells.min(axis=0) - need
+    span = cells.max(axis=0) + need - lo + 1
+
+    def code(k):
+        return ((k[:, 2] - lo[2]) * span[1] + (k[:, 1] - lo[1])) * span[0] + (k[:, 0] - lo[0])
+    occupied = np.unique(code(cells))
+    k0 = np.round((pos[face] - origin) / dp).astype(np.int64)
+    step = np.zeros_like(k0)
+    step[np.arange(face.size), axis] = -np.sign(u[np.arange(face.size), axis]).astype(np.int64)   # into the wall
+    layers = np.ones(face.size, np.int64)
+    going = np.ones(face.size, bool)
+    for k in range(1, need):
+        going &= np.isin(code(k0 + k * step), occupied, assume_unique=False)
+        layers += going
+    thin = layers < need
     out = {}
-    for i in np.flatnonzero(face):
-        u = normals[i] / length[i]
-        axis = int(np.argmax(np.abs(u)))
-        if abs(abs(u[axis]) - 1.0) > 1e-6:
-            continue                               # an edge or a corner: counted by its faces
-        step = np.zeros(3, np.int64)
-        step[axis] = -int(np.sign(u[axis]))        # into the wall
-        k0 = np.round((pos[i] - origin) / dp).astype(np.int64)
-        layers = 1
-        while layers < need and tuple(k0 + layers * step) in keys:
-            layers += 1
-        if layers < need:
-            mk = int(mkbound[i])
-            fewest, count = out.get(mk, (need, 0))
-            out[mk] = (min(fewest, layers), count + 1)
+    for mk in np.unique(mkbound[face[thin]]):
+        sel = thin & (mkbound[face] == mk)
+        out[int(mk)] = (int(layers[sel].min()), int(sel.sum()))
     return out
 
 

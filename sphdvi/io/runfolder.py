@@ -7,6 +7,7 @@ import contextlib
 import json
 import os
 import re
+import shutil
 
 from ..errors import InputError
 from .checkpoint import RESTART_FILE
@@ -149,7 +150,6 @@ class SetAside:
         names = sorted(set(names))
         if not names:
             return
-        import shutil
         shutil.rmtree(self.dir, ignore_errors=True)
         for name in names:
             src, dst = os.path.join(outdir, name), os.path.join(self.dir, name)
@@ -167,7 +167,6 @@ class SetAside:
         """Put the files back; the run and gencase outputs written since are deleted first."""
         if not self.moved:
             return
-        import shutil
         for name in set(os.listdir(self.outdir)) - self._before:
             if name in RUN_OUTPUT_FILES or name.endswith(CASE_OUTPUT_SUFFIXES) or \
                     (name.startswith("Gauges") and name.endswith(".csv")):
@@ -183,7 +182,6 @@ class SetAside:
     def discard(self) -> None:
         """Delete the files set aside (the new run has started)."""
         if self.moved:
-            import shutil
             shutil.rmtree(self.dir, ignore_errors=True)
             self.moved = []
 
