@@ -13,13 +13,23 @@ Two kinds, as in DualSPHysics:
   gravity: the multibody system adds m g to each body); the particles then take the
   body's rigid-body motion, v_k = V + Omega x (r_k - R) (``FtPartsUpdate``), their
   positions by the exact rigid transform of their body-frame offsets rather than by
-  dt times their old velocity.
+  dt times their old velocity.  With Symplectic, as DualSPHysics's ComputeStep_Sym, the
+  bodies first go to the half step under the predictor's loads (their particles there for
+  the corrector's interaction; the multibody state then put back) and then by the whole step
+  from the step's start under the corrector's loads (:meth:`FloatingBodies.predict`,
+  :meth:`FloatingBodies.step`); mDBC normals turn with the body at the half step too
+  (DualSPHysics keeps them at t^n until the corrector's update).  With periodic boundaries the particles are kept in
+  the periodic box while the body's centre is not wrapped: r_k - R is taken as its
+  shortest periodic image (DualSPHysics's FtPeriodicDist).
 
 The fluid side is the solver's arrays; nothing here writes files.
 """
 from __future__ import annotations
 
 import numpy as np
+
+from .errors import DivergenceError
+from .sph.clock import time_reached
 
 
 def quat_matrix(q) -> np.ndarray:
@@ -101,37 +111,106 @@ class FloatingBodies:
         F = np.zeros((nb, 3))
         T = np.zeros((nb, 3))
         np.add.at(F, body, f)
-        np.add.at(T, body, np.cross(s.pos[sel] - self.system.pos[body], f))
+        arm = s.pos[sel] - self.system.pos[body]
+        per = getattr(solver, "periodicity", None)
+        if per is not None:
+            # the body's particles are wrapped at the periodic ends, its centre is not: the
+            # lever arm is the shortest periodic image (DualSPHysics's FtPeriodicDist)
+            per.min_image(arm)
+        np.add.at(T, body, np.cross(arm, f))
         if self.is2d:
             F[:, 1] = 0.0
             T[:, 0] = T[:, 2] = 0.0
         return F, T
 
+    def paused(self, t_start: float) -> bool:
+        """FtPause holds the bodies in a step that starts before it (DualSPHysics's RunFloating:
+        ``ftpaused = TimeStep < FtPause``, TimeStep the step's start time; to round-off)."""
+        return not time_reached(t_start, self.ftpause)
+
     def step(self, solver, dt: float) -> None:
         """Advance the bodies by ``dt`` under this step's loads and carry their particles
-        (``solver.ace`` holds this step's accelerations; a floating particle's has no gravity)."""
+        (``solver.ace`` holds this step's accelerations; a floating particle's has no gravity;
+        ``solver.time`` is the step's end).  With Symplectic the step starts again from the
+        state :meth:`predict` left the bodies in, the one at the step's start."""
         s = solver.state
         sel = np.flatnonzero(s.ptype == 2)
         body = self.body_of_idp[s.idp[sel]]
         F, T = self.loads(solver, sel, body)
-        if solver.time <= self.ftpause:
+        if self.paused(solver.time - dt):
             self.system.time = solver.time     # frozen bodies (FtPause): the clock still runs
+            self.hold(F, T)
             return
         self.system.step(dt, F, T)
         self.carry_particles(solver, sel, body)
+        self.check_in_domain(solver, sel, body)
+
+    def predict(self, solver, dt_half: float) -> None:
+        """Symplectic predictor (DualSPHysics's ComputeStep_Sym: RunFloating(dt/2, predictor)):
+        the bodies advance by ``dt_half`` under the predictor's loads and carry their particles
+        there, for the corrector's interaction; the multibody state is then put back
+        (System.get_state / set_state), so that :meth:`step` advances from the step's start
+        with the corrector's loads.  ``solver.time`` is the step's start."""
+        if self.paused(solver.time):
+            return
+        s = solver.state
+        sel = np.flatnonzero(s.ptype == 2)
+        body = self.body_of_idp[s.idp[sel]]
+        F, T = self.loads(solver, sel, body)
+        saved = self.system.get_state()
+        self.system.step(dt_half, F, T)
+        self.carry_particles(solver, sel, body)
+        self.system.set_state(saved)
+
+    def hold(self, F: np.ndarray, T: np.ndarray) -> None:
+        """During FtPause, the loads on each held floating body for bodies.csv: its weight plus
+        the fluid's force (``F``) as total_force, the fluid's moment (``T``, the torque columns),
+        as DualSPHysics keeps computing them for its output while paused."""
+        from .dvi.system import FLOATING
+        sys_ = self.system
+        fl = (sys_.kind == FLOATING)[:, None]
+        sys_.total_force = np.where(fl, F + sys_.mass[:, None] * sys_.gravity[None, :], sys_.total_force)
+        sys_.total_torque = np.where(fl, T, sys_.total_torque)
+
+    def check_in_domain(self, solver, sel: np.ndarray, body: np.ndarray) -> None:
+        """Stop the run (DivergenceError, exit 3) when a floating particle has left the simulation
+        domain, naming the body, the time and the position: DualSPHysics excludes such a
+        particle and aborts (JSph::AbortBoundOut, "Fixed, moving or floating particles were
+        excluded")."""
+        dom = getattr(solver, "_domain", None)
+        if dom is None or sel.size == 0:
+            return
+        pos = solver.state.pos[sel]
+        out = np.any((pos < dom[0]) | (pos > dom[1]), axis=1)
+        if not out.any():
+            return
+        k = int(np.flatnonzero(out)[0])
+        i = int(body[k])
+        nout = int(np.count_nonzero(out & (body == i)))
+        fmt = lambda v: "(" + ", ".join(f"{float(x):.5g}" for x in v) + ")"     # noqa: E731
+        raise DivergenceError(
+            f"t={solver.time:.6g} s, step {solver.nstep}: floating body mkbound {self.mkbounds[i]} "
+            f"('{self.names[i]}', centre {fmt(self.system.pos[i])}) left the simulation domain: its particle "
+            f"{int(solver.state.idp[sel[k]])} is at {fmt(pos[k])}, outside {fmt(dom[0])} - {fmt(dom[1])} "
+            f"({nout} of its particles out); DualSPHysics stops too (\"Fixed, moving or floating particles "
+            f"were excluded\"); check the body's loads and contacts (RigidAlgorithm 1: the walls hold it through "
+            f"the SPH terms; 0: it meets no wall) or enlarge the domain")
 
     def carry_particles(self, solver, sel: np.ndarray, body: np.ndarray) -> None:
         """Rigid-body position and velocity of each floating particle (and its mDBC normal)."""
         s = solver.state
         sys_ = self.system
         pos, quat, vel, omega = sys_.pos, sys_.quat, sys_.vel, sys_.omega_world
+        per = getattr(solver, "periodicity", None)
         for i, (idp, local) in enumerate(self.particles):
             rows = sel[body == i]
             if rows.size == 0:
                 continue
             R = quat_matrix(quat[i])
             x = pos[i] + local[np.searchsorted(idp, s.idp[rows])] @ R.T
-            s.pos[rows] = x
             s.vel[rows] = vel[i] + np.cross(omega[i], x - pos[i])
+            if per is not None:
+                per.wrap(x)         # into the periodic box, as the fluid
+            s.pos[rows] = x
             if self.normals0 is not None:
                 solver.normals[rows] = self.normals0[s.idp[rows]] @ (R @ self.R0[i].T).T

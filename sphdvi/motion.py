@@ -16,8 +16,10 @@ Movements (DualSPHysics ``JMotion``; times τ measured from the start of the mov
   previous sinusoidal movement of the chain reached, 0 after any other);
   ``mvrotsinu``: angle A [sin(2π f τ + φ) − sin φ]; ``mvcirsinu`` likewise on a circle;
 * ``mvrectfile`` (alias ``mvfile``, ``mvpredef``)/``mvrotfile``: positions or angles
-  interpolated linearly from a file of ``fields`` columns; ``fieldtime``, ``fieldx``...
-  are 0-based column indices (DualSPHysics's JMotionDataFile).
+  interpolated linearly from a file of ``fields`` columns, its first row played at the movement's
+  start and the displacement measured from it, the velocity the slope of the rows' segment (0
+  outside the file's times); ``fieldtime``, ``fieldx``... are 0-based column indices
+  (DualSPHysics's JMotionDataFile).
 
 A movement ends after ``duration`` (−1: never) and continues with ``next``; the
 chain starts at ``begin start`` and stops at ``finish``. Movements of enclosing
@@ -25,8 +27,10 @@ chain starts at ``begin start`` and stops at ``finish``. Movements of enclosing
 
 Wave paddles (regular waves, Biesel transfer functions, Dean & Dalrymple 1991 §6):
 piston H/S = 2 (cosh 2kd − 1)/(sinh 2kd + 2kd); flap H/S = 4 sinh kd/kd ·
-(1 − cosh kd + kd sinh kd)/(sinh 2kd + 2kd); second-order piston term of
-Madsen (1971). A linear ramp over ``ramp`` periods starts the motion.
+(1 − cosh kd + kd sinh kd)/(sinh 2kd + 2kd) hinged at the bottom, from linear wavemaker
+theory with its hinge ``variabledraft`` below it (:func:`flap_height_to_stroke`); second-order
+piston term of Madsen (1971). A linear ramp r over ``ramp`` periods starts the motion from rest,
+X = r S/2 sin(ωτ + φ); without a ramp X = S/2 [sin(ωτ + φ) − sin φ] starts it without a jump.
 """
 from __future__ import annotations
 
@@ -175,42 +179,63 @@ def file_columns(m) -> tuple[int, dict]:
 
 
 def _load_table(m):
-    """(times, {field: (values, d values/dt)}) of a file movement, read once per file; the
-    rates are computed here, not at every time step."""
+    """(times, {field: values}) of a file movement, read once per file."""
     ncols, cols = file_columns(m)
     key = (m["file"], ncols, tuple(sorted(cols.items())))
     if key not in _FILE_CACHE:
         from .case.datafiles import read_motion_table
         data = read_motion_table(m["file"], ncols, cols, f"<{m['type']}> file")
-        t = data[:, cols["fieldtime"]]
-        _FILE_CACHE[key] = (t, {name: (data[:, c], np.gradient(data[:, c], t))
-                                for name, c in cols.items() if name != "fieldtime"})
+        _FILE_CACHE[key] = (data[:, cols["fieldtime"]],
+                            {name: data[:, c] for name, c in cols.items() if name != "fieldtime"})
     return _FILE_CACHE[key]
 
 
+def _file_value(t: np.ndarray, col: np.ndarray, tau: float) -> tuple[float, float]:
+    """A file column's displacement from its first row and its rate ``tau`` seconds into the
+    movement, as DualSPHysics's JMotionMovActive::DfGetNewPos/DfGetNewAng with JMotionObj::ProcesTime:
+    the file's first row plays at the movement's start (its time looked up is τ + t_0), the
+    value is interpolated linearly between rows and held at the last row; the rate is the step's
+    displacement over dt there: the slope of the row segment that holds τ, 0 before the first
+    row and from the last row on (strictly rising times: the reader checks them)."""
+    tf = tau + t[0]
+    value = float(np.interp(tf, t, col)) - col[0]
+    i = int(np.searchsorted(t, tf, side="right")) - 1
+    if i < 0 or i >= t.size - 1:
+        return value, 0.0
+    return value, float((col[i + 1] - col[i]) / (t[i + 1] - t[i]))
+
+
 def _from_file(m, tau) -> Rigid:
+    """The transform of an ``mvrectfile`` (displacement per axis given in the file) or an
+    ``mvrotfile`` (angle about its axis) ``tau`` seconds after it started (:func:`_file_value`)."""
     t, fields = _load_table(m)
     if m["type"] == "mvrectfile":
         d = np.zeros(3)
         v = np.zeros(3)
         for k, name in enumerate(("fieldx", "fieldy", "fieldz")):
             if name in fields:
-                col, rate = fields[name]
-                d[k] = np.interp(tau, t, col) - col[0]
-                v[k] = np.interp(tau, t, rate)
+                d[k], v[k] = _file_value(t, fields[name], tau)
         return Rigid(d=d, V=v)
-    col, rate = fields["fieldang"]
     units = _angle_units(m)
-    angle = (np.interp(tau, t, col) - col[0]) * units
-    w = np.interp(tau, t, rate) * units
-    return _rotational(m, angle, w, circular=False)
+    angle, w = _file_value(t, fields["fieldang"], tau)
+    return _rotational(m, angle * units, w * units, circular=False)
 
 
 def chain_transform(chain: dict, t: float) -> Rigid:
-    """Accumulated transform of a movement chain at time t."""
-    begin = chain.get("begin")
-    if not begin:
-        return Rigid()
+    """Accumulated transform of an object's movements at time t: each of its events (``<begin>``,
+    DualSPHysics's JMotionEvent) runs its own chain (:func:`_event_transform`), and their transforms
+    compose in order of their start (the reader admits several events only where that is
+    DualSPHysics's motion: times that do not overlap, or overlapping translations)."""
+    events = chain.get("events") or ([chain["begin"]] if chain.get("begin") else [])
+    total = Rigid()
+    for begin in sorted(events, key=lambda e: e["start"]):
+        total = total.then(_event_transform(chain, begin, t))
+    return total
+
+
+def _event_transform(chain: dict, begin: dict, t: float) -> Rigid:
+    """Transform of the chain of movements that the event ``begin`` (mov, start, finish) starts, at
+    time t (JMotionObj::ProcesTime for one active movement and those that follow it by next=)."""
     movs = {m["id"]: m for m in chain["movements"]}
     start, finish = begin["start"], begin.get("finish")
     if t <= start:
@@ -286,13 +311,26 @@ def piston_height_to_stroke(k: float, d: float) -> float:
     return 2 * math.expm1(-2 * x) ** 2 / (-math.expm1(-4 * x) + 4 * x * e)
 
 
-def flap_height_to_stroke(k: float, d: float) -> float:
-    """Biesel transfer function of a flap hinged at the bottom: H/S (S at the free surface),
-    4 sinh kd/kd · (1 − cosh kd + kd sinh kd)/(sinh 2kd + 2kd)."""
+def flap_height_to_stroke(k: float, d: float, draft: float = 0.0) -> float:
+    """Transfer function H/S (S the stroke at the free surface) of a flap hinged ``draft`` below
+    the bottom (DualSPHysics's ``<variabledraft>``: < 0 above it), from linear wavemaker theory
+    (Dean & Dalrymple 1991 §6.2): H/S = 4 sinh kd/(sinh 2kd + 2kd) · k ∫ X(z)/S cosh k(d+z) dz over
+    the water column, X(z)/S = (z + D)/D above the hinge (D = d + draft its depth) and 0 below it:
+
+        H/S = 4 sinh kd/(sinh 2kd + 2kd) · [sinh kd − (cosh kd − cosh k u_b)/(k D)],  u_b = max(0, −draft),
+
+    Biesel's 4 sinh kd/kd · (1 − cosh kd + kd sinh kd)/(sinh 2kd + 2kd) for a hinge at the bottom.
+    Written with q = exp(−kd), the brackets' cosh kd − cosh k u_b = expm1(k u_b − kd) expm1(−k u_b − kd)/(2q),
+    so that it holds without overflow in deep water."""
+    depth = d + draft
+    if not depth > 0:
+        raise ValueError(f"the flap's hinge ({draft:g} m below the bottom) must lie below the still water "
+                         f"(depth {d:g} m)")
     x = k * d
+    xb = k * max(0.0, -draft)
     a = -math.expm1(-2 * x)          # 1 - q²
-    b = -math.expm1(-x)              # 1 - q
-    return 2 * a * (x * a - b * b) / (x * (-math.expm1(-4 * x) + 4 * x * math.exp(-2 * x)))
+    b2 = math.expm1(xb - x) * math.expm1(-xb - x)
+    return 2 * a * (a - b2 / (k * depth)) / (-math.expm1(-4 * x) + 4 * x * math.exp(-2 * x))
 
 
 def _coth_over_sinh2(x: float) -> float:
@@ -323,8 +361,11 @@ class _Paddle:
             self.p0, self.axis = p0, _unit(p1 - p0, f"flap mkbound={mk}: <flapaxis0> and <flapaxis1>")
 
     def _height_to_stroke(self, k: float, d: float) -> float:
-        """Biesel's H/S of this paddle for the wave number k in depth d."""
-        return piston_height_to_stroke(k, d) if self.kind == "piston" else flap_height_to_stroke(k, d)
+        """Biesel's H/S of this paddle for the wave number k in depth d (a flap's with its hinge
+        ``variabledraft`` below the bottom)."""
+        if self.kind == "piston":
+            return piston_height_to_stroke(k, d)
+        return flap_height_to_stroke(k, d, self.spec.get("variabledraft", 0.0))
 
     def _clock(self, t: float) -> tuple[float, bool]:
         """(τ, moving): the time since ``start`` held within [0, duration], and whether the
@@ -342,6 +383,10 @@ class _Paddle:
         return tau / self.ramp_time, 1.0 / self.ramp_time
 
     absorber = None     # a sphdvi.wave_absorption.PistonAbsorber when the piston absorbs (AWAS)
+
+    def mean_position(self) -> float:
+        """The theory's mean displacement once the ramp is over (m), about which the paddle moves."""
+        return 0.0
 
     def theory_position(self, t: float):
         """The wave theory's paddle displacement at the free surface and its rate (m, m/s)."""
@@ -392,6 +437,7 @@ class WavePaddle(_Paddle):
         self.height, self.depth = H, d
         self.phase = spec.get("phase", 0.0) * math.pi
         self.ramp_time = spec.get("ramp", 0.0) * T
+        self.shift = self.ramp_time <= 0      # no ramp: the series starts from its value at τ = 0
         m1 = self._height_to_stroke(self.k, d)
         self.stroke = H / m1 * self.gain
         self.second = 0.0
@@ -427,22 +473,30 @@ class WavePaddle(_Paddle):
         """The peak acceleration of the theoretical stroke, (S/2) ω² + 4 ω² |second-order term| (m/s²)."""
         return (0.5 * self.stroke + 4.0 * abs(self.second)) * self.omega ** 2
 
+    def mean_position(self) -> float:
+        """The theory's mean displacement once the ramp is over (m): 0 with a ramp, which starts the
+        paddle from rest; without one −(S/2 sin φ + X2 sin 2φ), the series less its start value."""
+        if not self.shift:
+            return 0.0
+        return -(0.5 * self.stroke * math.sin(self.phase) + self.second * math.sin(2 * self.phase))
+
     def _series(self, tau: float):
+        """S/2 sin(ω τ + φ) + X2 sin 2(ω τ + φ) (φ ``phase`` π, X2 the second-order amplitude), plus
+        :meth:`mean_position` (without a ramp the paddle starts where it is drawn, not with a jump)."""
         a = self.omega * tau + self.phase
-        x1 = 0.5 * self.stroke * (math.sin(a) - math.sin(self.phase))
-        v1 = 0.5 * self.stroke * self.omega * math.cos(a)
-        x2 = self.second * (math.sin(2 * a) - math.sin(2 * self.phase))
-        v2 = self.second * 2 * self.omega * math.cos(2 * a)
-        return x1 + x2, v1 + v2
+        x = 0.5 * self.stroke * math.sin(a) + self.second * math.sin(2 * a) + self.mean_position()
+        v = 0.5 * self.stroke * self.omega * math.cos(a) + self.second * 2 * self.omega * math.cos(2 * a)
+        return x, v
 
 
 class SpectrumPaddle(_Paddle):
     """Irregular long-crested waves from a piston or flap (``<piston_spectrum>``/``<flap_spectrum>``),
     first order: the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: amplitude
     a_i, frequency f_i, phase φ_i) each made by Biesel's stroke S_i = 2 a_i / (H/S)(k_i d), so that
-    X(τ) = r(τ) Σ S_i/2 [sin(ω_i (τ + t0) + φ_i) − sin(ω_i t0 + φ_i)] (times ``gainstroke``), t0 =
-    ``serieini``, r a linear ramp over ``ramptime`` seconds. The linear wave it makes at a
-    distance x from the paddle is :meth:`elevation`."""
+    X(τ) = r(τ) [Σ S_i/2 sin(ω_i (τ + t0) + φ_i) − X_0] (times ``gainstroke``), t0 = ``serieini``, r a
+    linear ramp over ``ramptime`` seconds; X_0 = Σ S_i/2 sin(ω_i t0 + φ_i) without a ramp (the paddle
+    starts where it is drawn), 0 with one (it starts from rest and moves about its rest position).
+    The linear wave it makes at a distance x from the paddle is :meth:`elevation`."""
 
     def __init__(self, spec: dict, g: float = 9.81):
         from .wavespectra import components
@@ -458,7 +512,15 @@ class SpectrumPaddle(_Paddle):
         self.phase = comp["phase"]
         self.t0 = spec.get("serieini", 0.0)
         self.ramp_time = spec.get("ramptime", 0.0)
-        self.offset = float(np.sum(self.half_stroke * np.sin(self.omega * self.t0 + self.phase)))
+        # without a ramp the series is shifted by its start value so that the paddle starts from
+        # where it is drawn; with one (r(0) = 0) it moves about its rest position
+        self.offset = (float(np.sum(self.half_stroke * np.sin(self.omega * self.t0 + self.phase)))
+                       if self.ramp_time <= 0 else 0.0)
+
+    def mean_position(self) -> float:
+        """The theory's mean displacement once the ramp is over (m): −(the series' value at serieini)
+        without a ramp, 0 with one."""
+        return -self.offset
 
     def _series(self, tau: float):
         a = self.omega * (tau + self.t0) + self.phase

@@ -186,27 +186,62 @@ def _case_file_of_run(folder: str) -> str | None:
 
 
 def periodic_axes(data: dict, params: dict) -> list[str]:
-    """Periodic axes: DualSPHysics switches an axis on when one of its ``*PeriodicInc*``
-    keys is written in the case (even with value 0), or with XYPeriodic/XZPeriodic/YZPeriodic = 1."""
-    written = set(data["json"].get("parameters_set", []))
-    axes = set()
-    for axis in "XYZ":
-        if any(k.startswith(f"{axis}PeriodicInc") for k in written):
-            axes.add(axis.lower())
-    for pair in ("XY", "XZ", "YZ"):
-        if int(params.get(f"{pair}Periodic", 0) or 0) == 1:
-            axes.update(pair.lower())
-    return sorted(axes)
+    """Periodic axes as DualSPHysics switches them on (:func:`sphdvi.sph.periodic.periodic_config`:
+    a written ``*PeriodicInc*`` key, or a written XYPeriodic/XZPeriodic/YZPeriodic, whatever its
+    value); a periodic y in a 2D case is an InputError."""
+    return _periodic_config(data, params)[0]
+
+
+def periodic_params(data: dict, params: dict) -> dict:
+    """``params`` with the periodic keys as DualSPHysics applies them: the increments of the
+    periodic axes (all 0 after XYPeriodic/XZPeriodic/YZPeriodic) and no pair key left, for
+    the solver, which then takes the axes it is given."""
+    incs = _periodic_config(data, params)[1]
+    out = {k: v for k, v in params.items() if k not in PERIODIC_PARAM_KEYS}
+    out.update(incs)
+    return out
+
+
+PERIODIC_PARAM_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ", "ZPeriodicIncX",
+                       "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
+
+
+def _periodic_config(data: dict, params: dict):
+    from .sph.periodic import periodic_config
+    # the keys the case writes, and any given a value (--set XZPeriodic=1 is not in the case's list)
+    written = set(data["json"].get("parameters_set", [])) | {k for k in PERIODIC_PARAM_KEYS if params.get(k)}
+    try:
+        return periodic_config(written, params, bool(data["constants"]["is2d"]))
+    except ValueError as exc:
+        raise InputError(f"case {data.get('casename') or ''}: <execution><parameters> {exc}; "
+                         "expected x and/or z periodicity only in a 2D case") from None
 
 
 def special_parameters(data: dict) -> dict:
-    """Parameters with ``<special><shifting>`` applied (it overrides Shifting, ShiftCoef, ShiftTFS)."""
+    """Parameters with ``<special><shifting>`` applied: its mode, coefficient and fsthreshold set
+    Shifting, ShiftCoef and ShiftTFS (the case reader refuses it together with a Shifting parameter,
+    as DualSPHysics); its zones go to the solver (:func:`shift_zones`)."""
     params = dict(data["parameters"])
     shifting = (data["json"].get("special") or {}).get("shifting") or {}
     for key, name in (("mode", "Shifting"), ("coefficient", "ShiftCoef"), ("fsthreshold", "ShiftTFS")):
         if key in shifting:
             params[name] = shifting[key]
     return params
+
+
+def shift_zones(data: dict) -> list:
+    """The ``<shiftingzone>`` boxes of ``<special><shifting>`` as posref and edge vectors
+    (rows); a gencase output of an older sphdvi kept them as written (size or vecx/vecy/vecz)."""
+    zones = []
+    for z in ((data["json"].get("special") or {}).get("shifting") or {}).get("zones") or []:
+        if "vecs" not in z:
+            if z.get("rotateaxis"):
+                raise InputError("<shiftingzone> with <rotateaxis> in a gencase output of an older sphdvi: "
+                                 "run 'sphdvi gencase' again")
+            vecs = (np.diag(z["size"]) if "size" in z else [z["vecx"], z["vecy"], z["vecz"]])
+            z = {"posref": z["posref"], "vecs": np.asarray(vecs, float).tolist()}
+        zones.append(z)
+    return zones
 
 
 def output_schedule(data: dict, params: dict, tout=None) -> OutputSchedule:
@@ -653,7 +688,7 @@ class ExclusionWarnings:
 class SPHRun:
     """One SPH run: the solver, its motion/body hook, the output schedule and the checks."""
 
-    def __init__(self, data: dict, params: dict, outdir: str):
+    def __init__(self, data: dict, params: dict, outdir: str, resume: bool = False):
         from .motion import MotionSet
         from .sph.solver import SPHSolver
         from .coupling import FloatingBodies, ImposedMotions
@@ -675,6 +710,8 @@ class SPHRun:
             domain[0][1] -= c["h"]
             domain[1][1] += c["h"]
         periodic = periodic_axes(data, params)
+        if periodic:
+            params = periodic_params(data, params)      # DualSPHysics's increments (reset by XZPeriodic...)
         for k in periodic:
             i = "xyz".index(k)
             domain[1][i] += c["dp"]
@@ -682,7 +719,7 @@ class SPHRun:
         if int(params.get("Boundary", 1)) == 2:
             from .case.normals import boundary_normals
             from .sph.periodic import Periodicity
-            axes = [k for k in periodic if not (c["is2d"] and k == "y")]
+            axes = periodic
             if data.get("normals") is not None:       # the case's own (<normals>, <initialize>)
                 normals0 = np.array(data["normals"], dtype=np.float64)
                 if not np.any(normals0[p["type"] != 3]):
@@ -724,7 +761,10 @@ class SPHRun:
         from .sph.accinput import acc_inputs
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table,
-                                acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")))
+                                acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")),
+                                shift_zones=shift_zones(data))
+        if self.floating is not None:       # Symplectic: the bodies at the half step for the corrector
+            self.solver.half_step_hook = self.floating.predict
         for absorber in self.absorbers:
             bias = absorber.calibrate(state)
             if abs(bias) > float(c["dp"]):
@@ -734,10 +774,15 @@ class SPHRun:
         self.n0_fluid = int(np.count_nonzero(p["type"] == 3))
         self.excluded_limit = self.max_excluded()      # the parameters do not change in a run
         self.excluded_step_limit = max(MIN_EXCLUDED_PER_STEP, int(MAX_EXCLUDED_PER_STEP * self.n0_fluid))
+        self.npf_minimum = min_fluid(params, self.n0_fluid)
         self.excluded_seen = 0
         self.case_id = case_identity(p, c)             # written into restart.h5; --resume checks it
         self.dtmin_run = 0
         self.dtmin_seen = 0
+        self.dtmin_warn_at = 1          # the next count of DtMin steps warned about (1, 10, 100, ...)
+        self.step_warnings = []         # lines for run.log (and stderr) found by check()
+        # the initial state's densities (a resumed run starts from its restart output instead)
+        self.rhop_window_excludes = None if resume else _warn_initial_density(p["rhop"][p["type"] == 3], params)
 
     @staticmethod
     def _mdbc_only_on(normals, p, fluidcount: int, mkbound_list: str):
@@ -784,6 +829,7 @@ class SPHRun:
         if sol.n_dtmin > self.dtmin_seen:
             self.dtmin_run += sol.n_dtmin - self.dtmin_seen
             self.dtmin_seen = sol.n_dtmin
+            self._warn_dtmin()
             if self.dtmin_run >= DTMIN_STUCK_STEPS:
                 i = int(np.argmax(np.einsum("ij,ij->i", sol.ace, sol.ace)))
                 raise DivergenceError(
@@ -799,30 +845,78 @@ class SPHRun:
             raise DivergenceError(
                 f"t={sol.time:.6g} s, step {sol.nstep}: {new} of {self.n0_fluid} fluid particles excluded in one "
                 f"step (more than {MAX_EXCLUDED_PER_STEP:.0%} at once; dt {sol.last_dt:.3g} s); last: particle "
-                f"{int(ev['idp'][0])} at {_fmt(ev['pos'][0])}, reason {ev['reason'][0]}; cause: the time step is far "
-                f"too large for the flow (DtFixed?) or the solution blew up")
+                f"{int(ev['idp'][0])} at {_fmt(ev['pos'][0])}, reason {ev['reason'][0]}; "
+                + self._exclusion_cause(ev, "the time step is far too large for the flow (DtFixed?) or the "
+                                            "solution blew up"))
         limit = self.excluded_limit
         if excluded > limit:
             ev = sol.excluded[-1]
+            cause = self._exclusion_cause(ev, "")
             raise DivergenceError(
                 f"t={sol.time:.6g} s, step {sol.nstep}: {excluded} of {self.n0_fluid} fluid particles excluded "
                 f"(limit {limit}); last: particle {int(ev['idp'][0])} at {_fmt(ev['pos'][0])}, "
-                f"reason {ev['reason'][0]}")
+                f"reason {ev['reason'][0]}" + (f"; {cause}" if cause else ""))
         if not np.isfinite(sol.last_dt) or sol.last_dt <= 0:
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: time step {sol.last_dt} is not valid")
         if self.bodies is not None and not (np.isfinite(self.bodies.pos).all() and np.isfinite(self.bodies.vel).all()):
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: a floating body state is not finite")
 
     def max_excluded(self) -> int:
-        """Excluded fluid particles beyond which the run stops: PartsOutMax (when the case
-        sets it below 1, else half the fluid), at most 1 - MinFluidStop of the fluid."""
+        """Excluded fluid particles beyond which the run stops as diverged: PartsOutMax (when
+        the case sets it below 1), else half the fluid; no such limit when the case gives
+        MinFluidStop instead (its own end of the run, a normal one: :meth:`min_fluid_reached`)."""
         p = self.params
         frac = DEFAULT_MAX_EXCLUDED_FRACTION
+        if float(p.get("MinFluidStop") or 0.0) > 0:
+            frac = 1.0
         if "PartsOutMax" in self.data["json"].get("parameters_set", []) and p.get("PartsOutMax", 1.0) < 1.0:
             frac = float(p["PartsOutMax"])
-        if p.get("MinFluidStop", 0.0) > 0:
-            frac = min(frac, 1.0 - float(p["MinFluidStop"]))
         return int(frac * self.n0_fluid)
+
+    def min_fluid_reached(self) -> str:
+        """MinFluidStop: a message when fewer fluid particles remain than NpfMinimum (DualSPHysics's
+        JSphCpuSingle::Run, ``npfnormal < NpfMinimum || !Np``, then a normal end), else ''."""
+        if not self.npf_minimum:
+            return ""
+        sol = self.solver
+        left = self.n0_fluid - sum(sol.n_excluded.values())
+        if left >= self.npf_minimum and sol.state.n:
+            return ""
+        return (f"The minimum number of fluid particles ({self.npf_minimum}) was reached: {left} of {self.n0_fluid} "
+                f"left at t={sol.time:.6g} s, step {sol.nstep} (MinFluidStop {float(self.params['MinFluidStop']):g})")
+
+    def _exclusion_cause(self, ev: dict, default: str) -> str:
+        """The likely cause of a mass exclusion (event ``ev``) for the divergence messages: a
+        density window that excludes the initial fluid, dt raised to DtMin in the steps before,
+        or ``default``."""
+        sol = self.solver
+        win = self.rhop_window_excludes
+        if win is not None and "rhop" in ev["reason"]:
+            lo, hi, rmin, rmax, _ = win
+            return (f"cause: RhopOutMin/RhopOutMax [{rmin:g}, {rmax:g}] exclude the initial fluid (its densities "
+                    f"span [{lo:.6g}, {hi:.6g}] kg/m3): widen them")
+        if self.dtmin_run > 0:
+            return (f"cause: dt was raised to DtMin ({sol.dtmin:.3g} s) in the last {self.dtmin_run} step(s), "
+                    f"above what the CFL and force conditions allowed: DtMin is too large for this flow, or the "
+                    f"flow blew up")
+        return f"cause: {default}" if default else ""
+
+    def _warn_dtmin(self) -> None:
+        """DualSPHysics's DtVariable warning "N DTs adjusted to DtMin (t:..., nstep:...)" at 1, 10,
+        100, ... steps whose dt was raised to DtMin (t and nstep of the step that found it)."""
+        sol = self.solver
+        if sol.n_dtmin < self.dtmin_warn_at:
+            return
+        while self.dtmin_warn_at <= sol.n_dtmin:
+            self.dtmin_warn_at *= 10
+        self.step_warnings.append(
+            f"{sol.n_dtmin} DTs adjusted to DtMin (t:{sol.time - sol.last_dt:g}, nstep:{sol.nstep - 1}); "
+            f"DtMin {sol.dtmin:.4g} s is above the dt the CFL and force conditions ask for")
+
+    def take_step_warnings(self) -> list:
+        """The warning lines :meth:`check` found since the last call."""
+        lines, self.step_warnings = self.step_warnings, []
+        return lines
 
     # -- snapshots and checkpoints ------------------------------------------------------
     def body_centres(self) -> dict:
@@ -849,6 +943,9 @@ class SPHRun:
         self.excluded_seen = sum(self.solver.n_excluded.values())
         self.dtmin_run = int(extra["dtmin_run"])
         self.dtmin_seen = int(extra["dtmin_seen"])
+        self.dtmin_warn_at = 1              # the levels already warned about follow from the count
+        while self.dtmin_warn_at <= self.solver.n_dtmin:
+            self.dtmin_warn_at *= 10
         if self.absorbers:
             if "awas" not in extra:
                 raise InputError(f"{path}: the restart file has no state of the absorbing pistons (<awas_zsurf>); "
@@ -856,6 +953,32 @@ class SPHRun:
             for absorber, state in zip(self.absorbers, json.loads(extra["awas"])):
                 absorber.set_state(state)
         return extra
+
+
+def min_fluid(params: dict, n0_fluid: int) -> int:
+    """DualSPHysics's NpfMinimum = unsigned(MinFluidStop*CaseNfluid), a float product (its
+    MinFluidStop is a float); 0 without MinFluidStop."""
+    mfs = float(params.get("MinFluidStop") or 0.0)
+    if mfs <= 0:
+        return 0
+    return int(np.float32(mfs) * np.float32(n0_fluid))
+
+
+def _warn_initial_density(rhop_fluid: np.ndarray, params: dict):
+    """Warn when initial fluid densities lie outside [RhopOutMin, RhopOutMax] (those particles
+    leave the run in its first steps); returns (min, max, RhopOutMin, RhopOutMax, count) then,
+    else None."""
+    if rhop_fluid.size == 0:
+        return None
+    rmin, rmax = float(params.get("RhopOutMin", 700.0)), float(params.get("RhopOutMax", 1300.0))
+    out = int(np.count_nonzero((rhop_fluid < rmin) | (rhop_fluid > rmax)))
+    if not out:
+        return None
+    lo, hi = float(rhop_fluid.min()), float(rhop_fluid.max())
+    warnings.warn(f"{out} of {rhop_fluid.size} fluid particles start with a density outside RhopOutMin/RhopOutMax "
+                  f"[{rmin:g}, {rmax:g}] (the initial fluid densities span [{lo:.6g}, {hi:.6g}] kg/m3): they are "
+                  "excluded as soon as the run starts, as DualSPHysics would; widen RhopOutMin/RhopOutMax")
+    return lo, hi, rmin, rmax, out
 
 
 def _warn_thin_mdbc_walls(thin: dict, need: int, h_dp: float) -> None:
@@ -1056,7 +1179,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     stopped = _stopped_at_startup(stop, files, meta, outdir, resume)
     if stopped is not None:
         return stopped
-    sph = SPHRun(data, params, outdir)
+    sph = SPHRun(data, params, outdir, resume=resume)
     sol = sph.solver
     tmax, tout = float(params["TimeMax"]), float(params["TimeOut"])
     special = data["json"].get("special") or {}
@@ -1108,7 +1231,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         if stopped is None:
             # the run-time gauges measure the initial state here, so that their first JIT
             # compilation counts in startup_s, not in runtime_s
-            gauges = _make_gauges(data, params, outdir, resume, float(sol.time))
+            gauges = _make_gauges(data, params, outdir, resume, float(sol.time), sol.periodicity)
     finally:
         notice.done()
     if stopped is not None:
@@ -1123,6 +1246,14 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     runtime = wall_prev
     steps_at_start = int(sol.nstep)
     t_loop = _time.perf_counter()
+
+    step_lines = []     # warnings of the step checks (DtMin, MinFluidStop): run.log with the next output
+
+    def note_step_warnings():
+        for line in sph.take_step_warnings():
+            step_lines.append(line)
+            if not quiet:
+                warnings.warn(line)
 
     def write_part(k):
         pos, arrays = sph.snapshot()
@@ -1146,6 +1277,9 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         for line in excl_lines:
             files.log("WARNING: " + line)
             warnings.warn(line)
+        for line in step_lines:
+            files.log("WARNING: " + line)
+        step_lines.clear()
         excluded_log.record(sol.take_excluded())
         if body_log is not None:
             body_log.record()
@@ -1182,10 +1316,18 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                 dt_lo, dt_hi = min(dt_lo, sol.last_dt), max(dt_hi, sol.last_dt)
                 if dtlog is not None:
                     dtlog.add(t_step, (sol.last_dt,) + sol.step_dt_terms)
-                sph.check(0)
+                try:
+                    sph.check(0)
+                finally:
+                    note_step_warnings()
                 if gauges is not None:
                     gauges.after_step(sol)
-                if time_reached(sol.time, next_out, out_times.smallest) or sol.time >= tmax:
+                # MinFluidStop: that instant is written and the run ends normally (DualSPHysics)
+                min_fluid = sph.min_fluid_reached() if sph.npf_minimum else ""
+                if min_fluid:
+                    sph.step_warnings.append(min_fluid)
+                    note_step_warnings()
+                if time_reached(sol.time, next_out, out_times.smallest) or sol.time >= tmax or min_fluid:
                     part += 1
                     write_part(part)
                     dt_lo, dt_hi = math.inf, 0.0
@@ -1198,6 +1340,9 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                     if extra:
                         next_extra = _next_multiple(sol.time, extra)
                 progress.update(sol.time, sol.nstep, sol.state.n)
+                if min_fluid:
+                    status, code, message = "completed", 0, min_fluid
+                    break
                 if stop.signal is not None:
                     status, code, message = "interrupted", 1, _interrupted(stop.signal, sol.time, outdir, part)
                     break
@@ -1225,6 +1370,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     progress.update(sol.time, sol.nstep, sol.state.n, force=True)
     progress.close()
     writer.close()
+    for line in step_lines:                         # those after the last output (a stopped run)
+        files.log("WARNING: " + line)
     files.log(f"{status}: t={sol.time:.6g} s, {sol.nstep} steps, runtime {runtime:.2f} s"
               + (f" -- {message}" if message else ""))
     files.write_json(status=status, message=message, steps=int(sol.nstep), physical_time=float(sol.time),
@@ -1257,13 +1404,14 @@ def _next_multiple(t: float, step: float) -> float:
     return k * step
 
 
-def _make_gauges(data, params, outdir, resume, t):
-    """Run-time gauges of ``<special><gauges>`` (None when the case has none)."""
+def _make_gauges(data, params, outdir, resume, t, periodicity=None):
+    """Run-time gauges of ``<special><gauges>`` (None when the case has none); with periodic
+    boundaries they see the fluid's periodic copies as the interaction does."""
     items = (data["json"].get("gauges") or {}).get("items") or []
     if not items:
         return None
     from .measure.gauges import RunGauges
-    return RunGauges(data, params, outdir, resume=resume, time=t)
+    return RunGauges(data, params, outdir, resume=resume, time=t, periodicity=periodicity)
 
 
 def _threading_layer() -> str:

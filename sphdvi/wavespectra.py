@@ -21,7 +21,8 @@ sphdvi series is the same sea state as DualSPHysics's, not the same realisation)
 * ``stretched``: N bins of equal energy (edges at equal steps of the cumulative spectrum), so the
   waves crowd about the peak and all carry the same amplitude; each at its bin's energy centroid;
 * ``cosstretched``: the bins below and above fp (their counts in proportion to the two bands'
-  widths) narrow towards fp along a quarter cosine; each wave at its bin's centre.
+  widths, at least one each: N ≥ 2) narrow towards fp along a quarter cosine; each wave at its
+  bin's centre.
 """
 from __future__ import annotations
 
@@ -86,6 +87,9 @@ def _edges(how: str, n: int, fmin: float, fp: float, fmax: float, s) -> np.ndarr
         edges[0], edges[-1] = fmin, fmax
         return edges
     if how == "cosstretched":
+        if n < 2:
+            raise ValueError(f"the cosstretched discretization needs at least 2 waves, one on each side of fp "
+                             f"(got {n})")
         n_lo = min(n - 1, max(1, round(n * (fp - fmin) / (fmax - fmin))))
         n_hi = n - n_lo
         lo = fp - (fp - fmin) * (1.0 - np.cos(0.5 * np.pi * np.arange(n_lo, -1, -1) / n_lo))

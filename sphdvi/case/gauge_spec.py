@@ -13,7 +13,8 @@ as floats, the multi-form elements as ``{attribute: number}`` (``pointdp``
 ``{"start": t0, "end": t1}`` (a gauge's window inherits the attributes it
 does not give from ``<default>``, as in DualSPHysics), ``target``
 ``{"mkbound": n}``, mesh ``outputdata``/``outputfmt`` ``{"value": "a,b"}``
-(lower case, checked) and ``kclimit`` ``{"value": v | "none"}``.
+(lower case, checked), ``kclimit`` and ``kcdummy`` ``{"value": v | "none"}``, mesh
+``size<k>`` a float (``value``) or ``{"length", "distpt"}``.
 
 What DualSPHysics means, and what is therefore checked:
 
@@ -25,13 +26,16 @@ What DualSPHysics means, and what is therefore checked:
 * ``pointdp``, ``masslimit``, ``distlimit``: exactly one of their attributes,
   > 0 (``JGaugeSystem`` rejects a non-positive pointdp, masslimit or distlimit);
   ``height`` > 0;
-* mesh: a zero ``vec<k>`` means "no extent along k" (DualSPHysics then reads
-  no ``size<k>``), so it is accepted with a zero or absent ``size<k>`` and
-  rejected with a positive one; ``size<k>`` >= 0 (``size 0``: one node along
-  that axis, the single-point pressure probes of the Lobovsky case);
-  ``outputdata`` among vel, veldir, rhop, zsurf (zsurf needs a column:
-  ``size3`` > 0 along a non-zero ``vec3``; veldir a non-zero ``dirdat``);
-  ``outputfmt`` among csv, bin; ``kclimit`` a number >= 0 or ``none``;
+* mesh: ``<size<k> length=".." distpt=".."/>`` as DualSPHysics (the extent along
+  ``vec<k>`` and the distance between its nodes, :func:`mesh_axis`), or sphdvi's
+  older ``<size<k> value=".."/>`` (nodes dp apart); a zero ``vec<k>`` means "no
+  extent along k" (DualSPHysics then reads no ``size<k>``), so it is accepted
+  with a zero or absent ``size<k>`` and rejected with a positive one; length
+  >= 0 (0: one node along that axis, the single-point pressure probes of the
+  Lobovsky case), distpt > 0; ``outputdata`` among vel, veldir, rhop, zsurf
+  (zsurf needs a column: ``size3`` > 0 along a non-zero ``vec3``; veldir a
+  non-zero ``dirdat``); ``outputfmt`` among csv, bin; ``kclimit`` a number >= 0
+  or ``none``, ``kcdummy`` a number or ``none``;
 * the number of sample points of a gauge (swl line samples, mesh nodes, mesh
   zsurf samples) is at most :data:`MAX_GAUGE_POINTS`;
 * names become file names (``Gauges<Type>_<name>.csv``): not empty, at most
@@ -68,6 +72,32 @@ def mesh_count(size: float, dp: float) -> float:
     """Nodes along one mesh axis of length ``size`` spaced ``dp`` (``measure.gauges.MeshGauge`` uses it)."""
     q = size / dp
     return math.floor(q + 1e-9) + 1.0 if math.isfinite(q) else math.inf
+
+
+def mesh_axis(size, dp: float) -> tuple[float, float]:
+    """(nodes, spacing) along one mesh axis from its ``<sizeK>``.
+
+    DualSPHysics's form ``{"length": L, "distpt": d}``: ``floor((L + 0.01 d)/d) + 1`` nodes
+    ``d`` apart when ``L >= d``, else one node (``JMeshData::MakeMeshPt``); sphdvi's older
+    ``value`` form (a plain length): nodes ``dp`` apart."""
+    if isinstance(size, dict):
+        length, dist = float(size["length"]), float(size["distpt"])
+        if not length >= dist:
+            return 1.0, dist
+        q = (length + 0.01 * dist) / dist
+        return (math.floor(q) + 1.0 if math.isfinite(q) else math.inf), dist
+    return mesh_count(float(size or 0.0), dp), dp
+
+
+def zsurf_step(size3, dp: float) -> float:
+    """The sampling step of a mesh gauge's zsurf column: its nodes (``distpt``) in DualSPHysics's
+    form (``JGaugeMesh`` finds zsurf from the nodes' mass sums), ZSURF_STEP dp in the ``value`` form."""
+    return float(size3["distpt"]) if isinstance(size3, dict) else ZSURF_STEP * dp
+
+
+def mesh_length(size) -> float:
+    """The length of a ``<sizeK>`` in either form."""
+    return float(size["length"]) if isinstance(size, dict) else float(size or 0.0)
 
 
 # ---------------------------------------------------------------------------------
@@ -125,12 +155,31 @@ def _outputfmt(reader, c):
     return {"value": ",".join(dict.fromkeys(items))}
 
 
-def _kclimit(reader, c):
+def _number_or_none(reader, c, nonnegative):
+    """``{"value": v | "none"}`` (``kclimit``, ``kcdummy``)."""
     raw = c.get("value")
     if raw is not None and raw.strip().lower() == "none":
         reader.mark(c, "value")
         return {"value": "none"}
-    return {"value": reader.num(c, "value", nonnegative=True)}
+    return {"value": reader.num(c, "value", nonnegative=nonnegative)}
+
+
+def _mesh_size(reader, c):
+    """``<sizeK length=".." distpt=".."/>`` (DualSPHysics: the extent along vecK and the distance
+    between its nodes) or sphdvi's older ``<sizeK value=".."/>`` (nodes dp apart)."""
+    has_value = c.get("value") is not None
+    has_dual = c.get("length") is not None or c.get("distpt") is not None
+    reader.mark(c, "value", "length", "distpt")
+    if has_value and has_dual:
+        raise reader.error(c, "gives value together with length/distpt",
+                           'length=".." and distpt=".." (DualSPHysics), or value=".." (nodes dp apart)')
+    if has_value:
+        return reader.num(c, "value", nonnegative=True)
+    if c.get("length") is None or c.get("distpt") is None:
+        missing = "length" if c.get("length") is None else "distpt"
+        raise reader.error(c, f"missing attribute '{missing}'",
+                           'length=".." [m] and distpt=".." [m] (the distance between the nodes, > 0)')
+    return {"length": reader.num(c, "length", nonnegative=True), "distpt": reader.num(c, "distpt", positive=True)}
 
 
 def read_field(reader, c, kind, inherited=None):
@@ -146,7 +195,7 @@ def read_field(reader, c, kind, inherited=None):
     if kind == "positive":
         return reader.num(c, "value", positive=True)
     if kind == "size":
-        return reader.num(c, "value", nonnegative=True)
+        return _mesh_size(reader, c)
     if kind == "count":
         return reader.integer(c, "value", lo=0, hi=2**31 - 1)
     if kind == "mkbound":
@@ -158,7 +207,9 @@ def read_field(reader, c, kind, inherited=None):
     if kind == "outputfmt":
         return _outputfmt(reader, c)
     if kind == "kclimit":
-        return _kclimit(reader, c)
+        return _number_or_none(reader, c, nonnegative=True)
+    if kind == "kcdummy":
+        return _number_or_none(reader, c, nonnegative=False)
     raise AssertionError(f"unknown gauge field kind {kind!r}")
 
 
@@ -250,26 +301,26 @@ def check_gauge(reader, c, d: dict, elements: dict, dp) -> None:
         for k in (1, 2, 3):
             default = [1.0 * (k == 1), 1.0 * (k == 2), 1.0 * (k == 3)]
             vecs[k] = np.linalg.norm(d.get(f"vec{k}", default))
-            if vecs[k] == 0 and d.get(f"size{k}", 0.0) > 0:
+            if vecs[k] == 0 and mesh_length(d.get(f"size{k}")) > 0:
                 raise reader.error(elements[f"vec{k}"], f"mesh gauge '{name}': <vec{k}> is the zero vector but "
-                                   f"<size{k}> is {d[f'size{k}']:g}",
-                                   f"a non-zero <vec{k}>, or <size{k} value=\"0\"/> (no extent along it)")
-        if "zsurf" in outputs and (vecs[3] == 0 or d.get("size3", 0.0) <= 0):
+                                   f"<size{k}> is {mesh_length(d[f'size{k}']):g} long",
+                                   f"a non-zero <vec{k}>, or no extent along it")
+        if "zsurf" in outputs and (vecs[3] == 0 or mesh_length(d.get("size3")) <= 0):
             raise reader.error(elements.get("outputdata", c),
                                f"mesh gauge '{name}': zsurf needs a column to search the surface along",
-                               "<size3 value> > 0 along a non-zero <vec3>")
+                               "<size3 length> > 0 along a non-zero <vec3>")
         if "veldir" in outputs and "dirdat" in d and np.linalg.norm(d["dirdat"]) == 0:
             raise reader.error(elements["dirdat"], f"mesh gauge '{name}': <dirdat> is the zero vector",
                                "a non-zero direction for veldir (default 1,0,0)")
         if dp:
-            counts = [mesh_count(d.get(f"size{k}", 0.0), dp) if vecs[k] > 0 else 1.0 for k in (1, 2, 3)]
+            counts = [mesh_axis(d.get(f"size{k}"), dp)[0] if vecs[k] > 0 else 1.0 for k in (1, 2, 3)]
             nodes = counts[0] * counts[1] * counts[2]
             _too_many(reader, c, f"mesh gauge '{name}'", nodes,
-                      f"smaller <size1..3> (nodes are dp = {dp:g} m apart; at most {MAX_GAUGE_POINTS:,} nodes)")
+                      f"smaller <size1..3> or a larger distpt (at most {MAX_GAUGE_POINTS:,} nodes)")
             if "zsurf" in outputs:
-                samples = counts[0] * counts[1] * line_samples(d["size3"], ZSURF_STEP * dp)
+                samples = counts[0] * counts[1] * line_samples(mesh_length(d["size3"]), zsurf_step(d["size3"], dp))
                 _too_many(reader, c, f"mesh gauge '{name}' (zsurf)", samples,
-                          f"a smaller mesh or <size3> (zsurf samples every {ZSURF_STEP:g} dp along vec3)")
+                          "a smaller mesh, a shorter <size3> or a larger distpt along it")
 
 
 def read_gauges(reader, el, common: dict, specs: dict) -> dict:
@@ -298,5 +349,8 @@ def read_gauges(reader, el, common: dict, specs: dict) -> dict:
         if dp is None:
             dp = case_dp(reader, el) or 0.0
         check_gauge(reader, c, d, elements, dp or None)
+        if not d.get("output", out["default"].get("output", False)):
+            reader.warn(c, f"gauge '{name}' writes no file: DualSPHysics's default is <output value=\"false\"/> "
+                        "(add <output value=\"true\"/> to it or to <default>); sphdvi does not compute it")
         out["items"].append(d)
     return out

@@ -22,7 +22,7 @@ from .constants import hydrostatic_density, resolve_constants
 from .model import Body, Case, Constants
 from ..io.atomic import make_folder
 from .reader import (case_name_from_path, open_case, parse_domain_spec, read_constantsdef,
-                     read_mkconfig, read_sections)
+                     read_mkconfig, read_sections, check_periodic)
 
 TYPE_FIXED, TYPE_MOVING, TYPE_FLOATING, TYPE_FLUID = 0, 1, 2, 3
 TYPE_NAMES = {0: "Fixed boundary", 1: "Moving boundary", 2: "Floating", 3: "Fluid"}
@@ -101,10 +101,11 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     case = Case(name=casename, file=os.path.abspath(path), source=text, constantsdef=cdef,
                 boundcount=boundcount, fluidcount=fluidcount)
     read_sections(case, root, reader)
+    check_periodic(reader, root, case.parameters_set, case.parameters, consts.is2d)
     particles, mkinfo = assemble_particles(case, drawing, consts, reader)
     normals = case_normals(case, particles, consts, drawing, reader)
     bodies = floating_bodies(case, particles, consts, drawing.primitives, reader)
-    apply_floating_velocities(particles, bodies)
+    apply_floating_velocities(particles, bodies, consts.is2d, case, reader)
     domain = resolve_domain(case, particles, consts, reader)
     check_case(case, particles, bodies, mkinfo, domain, reader)
     warn_gauges_outside(case.special.get("gauges"), domain, consts.is2d, reader)
@@ -403,12 +404,32 @@ def floating_bodies(case: Case, particles: dict, consts: Constants, primitives, 
     return bodies
 
 
-def apply_floating_velocities(particles: dict, bodies: list) -> None:
-    """Initial body velocities become the rigid velocity field v + ω × (r − c) of its particles."""
+def apply_floating_velocities(particles: dict, bodies: list, is2d: bool = False, case=None, reader=None) -> None:
+    """Initial body velocities become the rigid velocity field v + ω × (r − c) of its particles,
+    without their components along a locked degree of freedom (translationDOF / rotationDOF 0, and
+    in 2D the y translation and the x, z rotations), which the multibody body drops too (System.add_body;
+    DualSPHysics applies the constraints to the body's velocity); a velocity given along a locked
+    DOF is warned about (``reader``), at the <floating> of ``case`` that sets it."""
     for b in bodies:
+        tmask = np.asarray(b.translation_dof, float).copy()
+        rmask = np.asarray(b.rotation_dof, float).copy()
+        if is2d:
+            tmask[1] = 0.0
+            rmask[0] = rmask[2] = 0.0
+        v0, w0 = np.asarray(b.linearvelini, float), np.asarray(b.angularvelini, float)
+        v, w = v0 * tmask, w0 * rmask
+        if reader is not None and (np.any(v != v0) or np.any(w != w0)):
+            line = next((fd.line for fd in (case.floatings if case is not None else []) if b.mkbound in fd.mkbound),
+                        None)
+            lost = [f"linearvelini {'xyz'[k]}={v0[k]:g}" for k in range(3) if v[k] != v0[k]]
+            lost += [f"angularvelini {'xyz'[k]}={w0[k]:g}" for k in range(3) if w[k] != w0[k]]
+            reader.warnings.add(f"floating mkbound {b.mkbound}: the initial velocity along a locked degree of "
+                                f"freedom is ignored ({', '.join(lost)}; translationDOF/rotationDOF 0"
+                                + (", or out of the 2D plane" if is2d else "") + ")",
+                                file=reader.file, line=line, element="floating")
         sl = slice(b.begin, b.begin + b.count)
         r = particles["pos"][sl] - np.asarray(b.center)
-        particles["vel"][sl] = np.asarray(b.linearvelini) + np.cross(np.asarray(b.angularvelini), r)
+        particles["vel"][sl] = v + np.cross(w, r)
 
 
 def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody) -> dict | None:
@@ -579,12 +600,13 @@ def gauge_extent_points(g: dict) -> list:
     if kind == "maxz":
         return [g["point0"], np.add(g["point0"], [0.0, 0.0, g.get("height", 0.0)])]
     if kind == "mesh":
+        from .gauge_spec import mesh_length
         far = np.asarray(g["point"], float).copy()
         for k in (1, 2, 3):
             v = np.asarray(g.get(f"vec{k}", np.eye(3)[k - 1]), float)
             n = np.linalg.norm(v)
             if n > 0:
-                far += g.get(f"size{k}", 0.0) * v / n
+                far += mesh_length(g.get(f"size{k}")) * v / n
         return [g["point"], far]
     return []
 

@@ -55,7 +55,8 @@ PARAMETERS: dict[str, Param] = {
     "DensityDTvalue": Param("float", 0.1, "density diffusion coefficient delta", (), 0.0, 1.0),
     "Shifting": Param("int", 0, "0:none, 1:ignore bound, 2:ignore fixed, 3:full, 4:full advanced", (0, 1, 2, 3, 4)),
     "ShiftCoef": Param("float", -2.0, "shifting coefficient", (), -1e6, 0.0),
-    "ShiftTFS": Param("float", 0.0, "free-surface threshold (0: 1.5 in 2D, 2.75 in 3D)", (), 0.0, 1e6),
+    "ShiftTFS": Param("float", 0.0, "free-surface threshold of div r (0: no free-surface detection; "
+                      "typically 1.5 in 2D, 2.75 in 3D)", (), 0.0, 1e6),
     "ShiftAdvCoef": Param("float", -0.01, "advanced shifting coefficient", (), -1e6, 0.0),
     "ShiftAdvALE": Param("int", 0, "advanced shifting ALE correction", (0, 1)),
     "ShiftAdvNCPress": Param("int", 0, "advanced shifting non-conservative pressure", (0, 1)),

@@ -156,6 +156,7 @@ def read_sections(case: Case, root, reader: CaseReader) -> None:
     params, set_keys, domain = read_parameters(reader, execution)
     case.parameters, case.parameters_set, case.simulationdomain = params, set_keys, domain
     case.special = read_special(reader, execution)
+    check_shifting(reader, root, set_keys, case.special)
 
 
 def _mk_list(reader, el, attr):
@@ -396,7 +397,7 @@ def read_motion(reader, casedef) -> list:
 
 def _read_movement_chain(reader, obj):
     from .datafiles import MOTION_FILE_ALIASES as aliases, read_motion_file
-    begin = reader.child(obj, "begin")
+    begins = [b for b in reader.children(obj) if b.tag == "begin"]
     movs, elements = {}, {}
     order = []
     for m in reader.children(obj):
@@ -446,34 +447,86 @@ def _read_movement_chain(reader, obj):
             raise reader.error(obj, f"movement {d['id']} continues with next={d['next']}, which does not exist",
                                "next naming an id of this object")
     chain = {"movements": [movs[i] for i in order]}
-    if begin is not None:
-        mov = reader.integer(begin, "mov", lo=0)
-        if mov not in movs:
-            raise reader.error(begin, f"mov={mov} names no movement", "an id of a movement of this object")
-        start = reader.num(begin, "start", 0.0, nonnegative=True)
-        finish = reader.num(begin, "finish", None) if begin.get("finish") is not None else None
-        if finish is not None and finish < 0:
-            finish = None            # DualSPHysics's finish="-1": no end
-        if finish is not None and finish < start:
-            raise reader.error(begin, f"finish={finish:g} comes before start={start:g}",
-                               "finish >= start, or -1 (no end)")
-        chain["begin"] = {"mov": mov, "start": start, "finish": finish}
-    elif order:
-        chain["begin"] = {"mov": order[0], "start": 0.0, "finish": None}
-    if "begin" in chain:
-        # a loop of movements (next=) whose durations add up to 0 would never advance time
-        path, cur = [], chain["begin"]["mov"]
-        while cur is not None and cur not in path and movs[cur]["duration"] >= 0:
-            path.append(cur)
-            cur = movs[cur]["next"]
-        if cur is not None and cur in path:
-            loop = path[path.index(cur):]
-            if sum(movs[i]["duration"] for i in loop) <= 0:
-                ids = " -> ".join(str(i) for i in loop + [cur])
-                raise reader.error(elements[loop[-1]], f"the movements {ids} loop forever without advancing time "
-                                   "(their durations add up to 0)",
-                                   "a positive duration in the loop, or a movement without next")
+    events = [_read_begin(reader, b, movs) for b in begins]
+    if not begins and order:
+        events = [{"mov": order[0], "start": 0.0, "finish": None}]
+    for event in events:
+        _check_zero_loop(reader, movs, elements, event["mov"])
+    if events:
+        chain["begin"] = events[0]
+        chain["events"] = events
+        _check_concurrent_events(reader, begins, movs, events)
     return chain
+
+
+def _read_begin(reader, begin, movs) -> dict:
+    """One ``<begin mov start finish>`` of an object: an event starting the movement ``mov`` at
+    ``start``, its chain stopped at ``finish`` (-1 or none: no end), as DualSPHysics's JMotion::EventAdd."""
+    mov = reader.integer(begin, "mov", lo=0)
+    if mov not in movs:
+        raise reader.error(begin, f"mov={mov} names no movement", "an id of a movement of this object")
+    start = reader.num(begin, "start", 0.0, nonnegative=True)
+    finish = reader.num(begin, "finish", None) if begin.get("finish") is not None else None
+    if finish is not None and finish < 0:
+        finish = None            # DualSPHysics's finish="-1": no end
+    if finish is not None and finish < start:
+        raise reader.error(begin, f"finish={finish:g} comes before start={start:g}",
+                           "finish >= start, or -1 (no end)")
+    return {"mov": mov, "start": start, "finish": finish}
+
+
+def _check_zero_loop(reader, movs, elements, first) -> None:
+    """A loop of movements (next=) whose durations add up to 0 would never advance time: an error."""
+    path, cur = [], first
+    while cur is not None and cur not in path and movs[cur]["duration"] >= 0:
+        path.append(cur)
+        cur = movs[cur]["next"]
+    if cur is not None and cur in path:
+        loop = path[path.index(cur):]
+        if sum(movs[i]["duration"] for i in loop) <= 0:
+            ids = " -> ".join(str(i) for i in loop + [cur])
+            raise reader.error(elements[loop[-1]], f"the movements {ids} loop forever without advancing time "
+                               "(their durations add up to 0)",
+                               "a positive duration in the loop, or a movement without next")
+
+
+_TURNING = {"mvrot", "mvrotace", "mvrotsinu", "mvrotfile"}
+
+
+def _event_span(movs, event) -> tuple[float, float, bool]:
+    """(start, end, turns) of an event: when its chain of movements runs (end: inf for a movement
+    of duration -1 or a loop) and whether one of its movements rotates the object."""
+    path, cur, end = [], event["mov"], event["start"]
+    while cur is not None and cur not in path:
+        path.append(cur)
+        dur = movs[cur]["duration"]
+        end = np.inf if dur < 0 or end == np.inf else end + dur
+        cur = movs[cur]["next"]
+    if cur is not None:
+        end = np.inf
+    if event["finish"] is not None:
+        end = min(end, event["finish"])
+    return event["start"], end, any(movs[i]["type"] in _TURNING for i in path)
+
+
+def _check_concurrent_events(reader, begins, movs, events) -> None:
+    """Several ``<begin>`` of one object are events that each run their own chain (DualSPHysics's
+    JMotionObj::ProcesTime moves the object by every active chain's step in turn). sphdvi composes
+    the chains' transforms in order of their start, which is DualSPHysics's motion where their
+    times do not overlap or where the overlapping ones only translate (translations commute); two
+    overlapping events one of which rotates make a motion that depends on the time step there."""
+    spans = [_event_span(movs, e) for e in events]
+    for i, (s1, e1, turn1) in enumerate(spans):
+        for j in range(i + 1, len(spans)):
+            s2, e2, turn2 = spans[j]
+            if (turn1 or turn2) and s2 < e1 and s1 < e2:
+                raise reader.error(begins[j] if j < len(begins) else begins[i],
+                                   f"two <begin> events of this object run at the same time "
+                                   f"({s1:g}-{e1:g} s and {s2:g}-{e2:g} s) and one of them rotates it: "
+                                   "concurrent events with a rotation are not supported by sphdvi",
+                                   "events whose times do not overlap (finish= or durations), or only "
+                                   "translations (mvrect, mvrectace, mvrectsinu, mvrectfile, mvcir...) in "
+                                   "overlapping ones")
 
 
 MATERIAL_KEYS = {"Young_Modulus": "young", "PoissonRatio": "poisson",
@@ -927,6 +980,7 @@ GAUGE_SPECS = {
     "force": {"target": "mkbound"},
     "mesh": {"point": "vec", "vec1": "vec", "vec2": "vec", "vec3": "vec", "size1": "size", "size2": "size",
              "size3": "size", "dirdat": "vec", "masslimit": "oneof:value,coef", "kclimit": "kclimit",
+             "kcdummy": "kcdummy",
              "outputdata": "outputdata", "outputfmt": "outputfmt", "buffersize": "count"},
 }
 
@@ -979,6 +1033,10 @@ def read_wavepaddles(reader, el) -> list:
                                "implemented by sphdvi", "waveorder 1 (first order: the spectrum's linear waves)")
         if c.tag.startswith("flap") and ("flapaxis0" not in d or "flapaxis1" not in d):
             raise reader.error(c, "missing <flapaxis0>/<flapaxis1>", "the two points of the hinge axis")
+        if c.tag.startswith("flap") and not d.get("variabledraft", 0.0) > -d["depth"]:
+            raise reader.error(reader.child(c, "variabledraft"), f"<variabledraft> value={d['variabledraft']:g} puts "
+                               f"the hinge at or above the still water (depth {d['depth']:g} m)",
+                               "the hinge's depth below the bottom (> 0) or above it (< 0, above -depth)")
         if c.tag.startswith("flap") and d["flapaxis0"] == d["flapaxis1"]:
             raise reader.error(reader.child(c, "flapaxis1"), f"<flapaxis0> and <flapaxis1> are the same point "
                                f"{d['flapaxis0']}, so they define no hinge axis", "two distinct points on the hinge axis")
@@ -1150,6 +1208,10 @@ def _read_spectrum_options(reader, c, d: dict) -> None:
     d.setdefault("waves", 50)
     if d["waves"] < 1:
         raise reader.error(reader.child(c, "waves"), f"<waves> value={d['waves']}", "at least 1 wave")
+    if d["waves"] < 2 and d["discretization"] == "cosstretched":
+        raise reader.error(reader.child(c, "waves"), f"<waves> value={d['waves']} with the cosstretched "
+                           "discretization, whose bins narrow towards fp from both sides",
+                           "at least 2 waves (one below fp and one above), or another discretization")
     d.setdefault("randomseed", 0)
     d.setdefault("ramptime", 0.0)
     raw = d.pop("serieini", None)
@@ -1161,7 +1223,8 @@ def _read_spectrum_options(reader, c, d: dict) -> None:
             raise reader.error(el, f"<serieini> value={d['serieini']:g} is negative", "a time >= 0 in the series [s]")
         if str(raw.get("autofit", "false")).strip().lower() in ("true", "1"):
             reader.warn(el, "<serieini autofit> is not needed by sphdvi: the paddle starts from where it is "
-                            "drawn (the series less its value at serieini) and ramps up; autofit is ignored")
+                            "drawn without a jump (the ramp of <ramptime> starts the series from rest; without "
+                            "one the series less its value at serieini is played); autofit is ignored")
 
 
 def read_piston_solitary(reader, c) -> dict:
@@ -1269,23 +1332,89 @@ def read_timeout(reader, el) -> list:
 
 
 def read_shifting(reader, el) -> dict:
-    d = {"zones": []}
-    for c in reader.children(el):
-        if c.tag == "shiftingzone":
-            zone = _value_children(reader, c, {"posref": "vec", "size": "vec", "vecx": "vec", "vecy": "vec",
-                                               "vecz": "vec", "rotateaxis": "raw"}, required=("posref",))
-            d["zones"].append(zone)
-        elif c.tag in ("mode", "coefficient", "fsthreshold"):
-            continue
-        else:
-            raise reader.error(c, f"unknown element <{c.tag}> in <shifting>", "mode, coefficient, fsthreshold, shiftingzone")
-    if el.find("mode") is not None:
-        d["mode"] = int(reader.child_value(el, "mode", lo=0, hi=4))
-    if el.find("coefficient") is not None:
-        d["coefficient"] = reader.child_value(el, "coefficient")
-    if el.find("fsthreshold") is not None:
-        d["fsthreshold"] = reader.child_value(el, "fsthreshold", nonnegative=True)
+    """``<special><shifting>`` as JSphShifting::ReadXml: ``<mode>`` 0-3 (required),
+    ``<coefficient>`` (-2) and ``<fsthreshold>`` (0), and the ``<shiftingzone>`` boxes
+    (``posref`` + ``size``, or ``posref`` + ``vecx/vecy/vecz``, optionally turned by
+    ``<rotateaxis>``), each stored as posref and its three edge vectors."""
+    reader.check_children(el, {"mode", "coefficient", "fsthreshold", "shiftingzone"})
+    mode = reader.child(el, "mode")
+    if mode is None:
+        raise reader.error(el, "<shifting> has no <mode>",
+                           '<mode value="0..3"/> (0 none, 1 no bound, 2 no fixed, 3 full)')
+    d = {"mode": int(reader.integer(mode, "value"))}
+    if d["mode"] not in (0, 1, 2, 3):
+        raise reader.error(mode, f"shifting mode {d['mode']} is not valid in <special><shifting>",
+                           "0 (none), 1 (no bound), 2 (no fixed) or 3 (full); advanced shifting (4) is "
+                           "Shifting=4 in <parameters>, without <special><shifting>")
+    d["coefficient"] = reader.child_value(el, "coefficient", -2.0)
+    d["fsthreshold"] = reader.child_value(el, "fsthreshold", 0.0, nonnegative=True)
+    d["zones"] = [_shifting_zone(reader, c) for c in reader.children(el, "shiftingzone")] if d["mode"] else []
     return d
+
+
+def _shifting_zone(reader, c) -> dict:
+    """One ``<shiftingzone>``: its posref and edge vectors (JSphShifting::ReadXml)."""
+    posref = reader.vec3(reader.child(c, "posref", True))
+    if reader.child(c, "size") is not None:
+        reader.check_children(c, {"posref", "size", "rotateaxis"})
+        vecs = np.diag(reader.vec3(reader.child(c, "size")))
+    else:
+        reader.check_children(c, {"posref", "vecx", "vecy", "vecz", "rotateaxis"})
+        vecs = np.array([reader.vec3(reader.child(c, t, True)) for t in ("vecx", "vecy", "vecz")])
+    rot = reader.child(c, "rotateaxis")
+    if rot is not None and reader.num(rot, "angle", 0.0):
+        from .gencase import rotate_about_axis
+        units = reader.text_attr(rot, "anglesunits", "degrees", choices={"degrees", "radians"})
+        ang = reader.num(rot, "angle")
+        ang = np.radians(ang) if units.lower() == "degrees" else ang
+        reader.check_children(rot, {"point1", "point2"})
+        p1, p2 = (reader.vec3(reader.child(rot, t, True)) for t in ("point1", "point2"))
+        if not np.linalg.norm(p2 - p1) > 0:
+            raise reader.error(rot, "point1 and point2 of <rotateaxis> are the same point", "two distinct points")
+        # JMatrix4d::MatrixRot's sense, as <rotateaxis> of <initials> (sphdvi.case.gencase)
+        pts = rotate_about_axis(np.vstack([posref, posref + vecs]), p2, p1, float(ang))
+        posref, vecs = pts[0], pts[1:] - pts[0]
+    oblique = (vecs - np.diag(np.diag(vecs))).any()
+    if oblique and abs(np.linalg.det(vecs)) < 1e-12 * max(1.0, float(np.abs(vecs).max())) ** 3:
+        raise reader.error(c, "vecx, vecy and vecz of <shiftingzone> span no volume",
+                           "three independent edge vectors (or <size>)")
+    return {"line": c.sourceline, "posref": posref.tolist(), "vecs": vecs.tolist()}
+
+
+def check_shifting(reader, root, set_keys, special) -> None:
+    """Shifting defined both in ``<parameters>`` (the Shifting key, any value) and in
+    ``<special><shifting>`` is refused, as JSph::LoadCaseConfig does."""
+    if "shifting" in special and "Shifting" in set_keys:
+        el = root.find("execution/special/shifting")
+        key = next((p for p in root.iterfind("execution/parameters/parameter") if p.get("key") == "Shifting"), None)
+        line = getattr(key, "sourceline", None)
+        raise reader.error(el, "Shifting is defined several times (in <special><shifting> and <execution><parameters>"
+                           + (f", line {line}" if line else "") + ")",
+                           "one of them: the Shifting parameter, or <special><shifting>")
+
+
+def check_periodic(reader, root, set_keys, params, is2d) -> None:
+    """The periodic keys as DualSPHysics reads them (:func:`sphdvi.sph.periodic.periodic_config`):
+    a periodic y in a 2D case is an error; a pair key written with value 0 (it still switches
+    periodicity on) and increments it resets are warned about."""
+    from ..sph.periodic import PAIR_KEYS, periodic_config
+
+    def element(key):
+        return next((p for p in root.iterfind("execution/parameters/parameter") if p.get("key") == key), None)
+    try:
+        periodic_config(set_keys, params, is2d)
+    except ValueError as exc:
+        raise reader.error(element(str(exc).split(":")[0]), str(exc),
+                           "periodicity along x and/or z only (a 2D case lies in the x-z plane)") from None
+    pairs = [k for k, _ in PAIR_KEYS if k in set_keys]
+    for key in pairs:
+        if not params.get(key):
+            reader.warn(element(key), f"{key}={params.get(key)}: DualSPHysics switches this periodicity on when the "
+                                      "key is present, whatever its value (so does sphdvi); remove the key for none")
+    incs = [k for k in set_keys if "PeriodicInc" in k]
+    if pairs and incs:
+        reader.warn(element(incs[0]), f"{', '.join(incs)} ignored: {pairs[-1]} resets the periodic increments to 0 "
+                                      "(as DualSPHysics)")
 
 
 ACC_COLUMNS = ("linx", "liny", "linz", "angx", "angy", "angz")

@@ -142,13 +142,23 @@ class ParticleGrid:
         return np.ascontiguousarray(np.concatenate(cols, axis=1))
 
 
-def fluid_grid(pos, vel, rhop, mass, press, ptype, spec: KernelSpec) -> ParticleGrid:
+def fluid_grid(pos, vel, rhop, mass, press, ptype, spec: KernelSpec, periodicity=None) -> ParticleGrid:
     """Grid of the fluid particles (``ptype == 3``) with vel, rhop, press, mass and
-    volume m/rho: the input of interpolation, surfaces and forces."""
+    volume m/rho: the input of interpolation, surfaces and forces.
+
+    With a :class:`~sphdvi.sph.periodic.Periodicity`, the fluid particles within 2h of a
+    periodic end get their ghost copies across it, so that a point near the end has its
+    whole kernel support (DualSPHysics's gauges search the cell division, which holds
+    the periodic copies)."""
     sel = np.flatnonzero(np.asarray(ptype) == FLUID)
+    fpos = np.asarray(pos, np.float64)[sel]
+    if periodicity is not None and sel.size:
+        src, disp = periodicity.ghosts(fpos, 2.0 * spec.h)
+        sel = np.concatenate([sel, sel[src]])
+        fpos = np.concatenate([fpos, fpos[src] + disp])
     rho = np.asarray(rhop, np.float64)[sel]
     m = np.asarray(mass, np.float64)[sel]
-    return ParticleGrid(np.asarray(pos)[sel], spec, {
+    return ParticleGrid(fpos, spec, {
         "vel": np.asarray(vel, np.float64)[sel], "rhop": rho,
         "press": np.asarray(press, np.float64)[sel], "mass": m, "vol": m / rho})
 

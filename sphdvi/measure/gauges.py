@@ -3,21 +3,39 @@
 Types and outputs (``;``-separated, first column ``time [s]``, in OUT):
 
 * ``velocity`` -> ``GaugesVel_<name>.csv``: ``time;velx;vely;velz;posx;posy;posz``,
-  Shepard kernel interpolation at ``point`` (empty when the kernel sum < 0.5);
+  kernel interpolation at ``point``, Shepard-normalised where the kernel sum is at
+  least 0.5 and 0 below (DualSPHysics's JGaugeVelocity writes the raw sum
+  sum_b V_b W u_b everywhere, which reads low by the kernel sum near a surface:
+  24 % at a dam-break front);
 * ``swl`` -> ``GaugesSWL_<name>.csv``: ``time;swlx;swly;swlz;pos0x..pos2z``, free
   surface along ``point0`` -> ``point2`` sampled every ``pointdp`` (``value`` [m] or
   ``coefdp``, default 0.5 dp) where the kernel sum drops below ``masslimit``
   (``coef``, default 0.5 in 3D / 0.4 in 2D; ``value`` [kg] is divided by massfluid);
-* ``maxz`` -> ``GaugesMaxZ_<name>.csv``: ``time;zmax;posx;posy;posz``, the highest
-  fluid particle within ``distlimit`` (``value`` [m], ``coefdp`` or ``coefh``,
-  default 1.5 dp) horizontally of ``point0`` and up to ``height`` above it;
+  ``point0`` on a dry line, ``point2`` on one that never leaves the water (JGaugeSwl);
+* ``maxz`` -> ``GaugesMaxZ_<name>.csv``: ``time;zmax;posx;posy;posz`` (pos = ``point0``),
+  the highest fluid particle within ``distlimit`` (``value`` [m], ``coefdp`` or
+  ``coefh``, default 1.5 dp) horizontally of ``point0`` and up to ``height`` above it;
+  ``point0``'s z when there is none (DualSPHysics writes the domain's lowest z);
 * ``force`` -> ``GaugesForce_<name>.csv``: ``time;force;forcex;forcey;forcez``, the
-  fluid force on the particles of ``<target mkbound>`` (per metre in 2D);
-* ``mesh`` -> ``GaugesMesh_<name>.csv``: nodes ``point + i dp e1 + j dp e2 + k dp e3``
-  (e = unit ``vec1..3``, ``size1..3`` lengths, spacing dp), ``outputdata`` among
-  ``vel,veldir,rhop,zsurf`` (veldir: velocity along ``dirdat``; zsurf: free surface
-  along ``vec3`` over ``size3`` for each (i, j) column), ``dirdat`` (default 1,0,0
-  as in DualSPHysics), ``kclimit`` (default 0.5, ``NONE`` disables).
+  fluid force on the particles of ``<target mkbound>`` (per metre in 2D): pressure
+  and viscous terms with the case's kernel (DualSPHysics's JGaugeForce: the pressure
+  term alone, Wendland, fixed and moving targets only; sphdvi also takes floating
+  ones);
+* ``mesh`` -> one file per ``outputdata`` item, ``GaugesMesh_<name>_Vel.csv``,
+  ``_VelDir``, ``_Rhop``, ``_Zsurf`` (DualSPHysics's names), columns ``v(i:j:k)``
+  (``.x .y .z`` for Vel): nodes ``point + i d1 e1 + j d2 e2 + k d3 e3`` (e = unit
+  ``vec1..3``; ``<sizeK length distpt>`` gives the extent and the spacing dK, the
+  older ``<sizeK value>`` the extent with spacing dp); veldir is the velocity along
+  ``dirdat`` (default 1,0,0), zsurf the free surface along ``vec3`` for each (i, j)
+  column (the column's base when dry, its top when it never leaves the water);
+  kernel correction as JGaugeMesh: Shepard where the kernel sum >= ``kclimit``
+  (default 0.5), ``kcdummy`` (default 0) below it, the raw sums with ``kcdummy``
+  ``none`` below it or with ``kclimit`` ``none`` everywhere.
+
+As DualSPHysics's JGaugeSystem, a gauge writes its file only with ``<output
+value="true"/>`` (on it or in ``<default>``; gencase warns about one without), and
+then a row every ``outputdt`` (default TimeOut); sphdvi computes it only then, at
+``computedt``.
 
 Gauge input is checked at gencase (:mod:`sphdvi.case.gauge_spec`), so the items
 read here are valid; a case file written before those checks that still holds
@@ -25,8 +43,8 @@ an invalid gauge stops the run at start-up with exit code 2.
 
 Each gauge is computed at ``t = 0`` and then at the first step reaching each
 multiple of ``computedt`` (default TimeOut; 0 = every step) inside
-``computetime start end``; rows are kept every ``outputdt`` inside
-``outputtime``; ``output value="false"`` writes no file.  The new rows are
+``computetime start end``; rows are kept every ``outputdt`` (default TimeOut)
+inside ``outputtime``.  The new rows are
 appended at every TimeOut and at the end, in one write each (the cost of an
 output does not grow with the rows written before); a new run starts each file
 anew (header only), a resume cuts it back to the restart time, atomically.  The interpolation,
@@ -39,7 +57,7 @@ import os
 
 import numpy as np
 
-from ..case.gauge_spec import SWL_DEFAULT_COEFDP, ZSURF_STEP, mesh_count, name_problem
+from ..case.gauge_spec import SWL_DEFAULT_COEFDP, mesh_axis, mesh_length, name_problem, zsurf_step
 from ..errors import InputError
 from ..io.atomic import append_text, complete_lines, write_text_atomic
 from . import core
@@ -87,19 +105,33 @@ class Schedule:
 class StateView:
     """One particle state (solver order or case order) and its lazily built fluid grid."""
 
-    def __init__(self, time, pos, vel, rhop, mass, press, ptype, mk, spec):
+    def __init__(self, time, pos, vel, rhop, mass, press, ptype, mk, spec, periodicity=None):
         self.time = float(time)
         self.pos, self.vel, self.rhop, self.mass = pos, vel, rhop, mass
         self.press, self.ptype, self.mk = press, ptype, mk
         self.spec = spec
+        self.periodicity = periodicity
         self._grid = None
 
     @property
     def grid(self) -> core.ParticleGrid:
         if self._grid is None:
             self._grid = core.fluid_grid(self.pos, self.vel, self.rhop, self.mass, self.press, self.ptype,
-                                         self.spec)
+                                         self.spec, self.periodicity)
         return self._grid
+
+
+def kernel_corrected(values, ksum, kclimit, kcdummy):
+    """Kernel-interpolated ``values`` (Shepard-normalised, (P, k)) as DualSPHysics's JGaugeMesh
+    writes them: normalised where ``ksum >= kclimit``, ``kcdummy`` below it, the raw sums
+    ``values * ksum`` below it when ``kcdummy`` is None, and everywhere when ``kclimit`` is None."""
+    raw = np.where(ksum[:, None] > 0, values * ksum[:, None], 0.0)
+    if kclimit is None:
+        return raw
+    below = ksum < kclimit
+    out = np.array(values, dtype=np.float64)
+    out[below] = raw[below] if kcdummy is None else kcdummy
+    return out
 
 
 # ---------------------------------------------------------------------------------
@@ -120,6 +152,10 @@ class Gauge:
     def filename(self):
         return f"Gauges{self.prefix}_{self.name}.csv"
 
+    def files(self) -> list:
+        """[(file name, header columns)]: the row of :meth:`compute` is these files' columns in turn."""
+        return [(self.filename(), tuple(self.header))]
+
 
 class VelocityGauge(Gauge):
     prefix = "Vel"
@@ -130,7 +166,8 @@ class VelocityGauge(Gauge):
         self.point = np.asarray(item["point"], float).reshape(1, 3)
 
     def compute(self, view):
-        vel, _ = core.interpolate(view.grid, self.point, ("vel",))
+        vel, ksum = core.interpolate(view.grid, self.point, ("vel",), kclimit=None)
+        vel = kernel_corrected(vel, ksum, core.DEFAULT_KCLIMIT, 0.0)
         return list(vel[0]) + list(self.point[0])
 
 
@@ -153,6 +190,7 @@ class SwlGauge(Gauge):
 
     def compute(self, view):
         s = core.surface_along_lines(view.grid, self.p0, self.p2, self.step, self.limit)
+        s = np.where(np.isnan(s), self.p0, s)            # a dry line: its bottom point (JGaugeSwl)
         return list(s[0]) + list(self.p0[0]) + list(self.p2[0])
 
 
@@ -175,7 +213,8 @@ class MaxZGauge(Gauge):
         idx = np.empty(1, np.int64)
         K.column_max_z(self.p0, np.array([self.p0[0, 2] + self.height]),
                        np.ascontiguousarray(view.pos[fl], dtype=np.float64), self.radius, self.spec.is2d, out, idx)
-        return [out[0], self.p0[0, 0], self.p0[0, 1], out[0]]
+        zmax = out[0] if idx[0] >= 0 else self.p0[0, 2]
+        return [zmax, self.p0[0, 0], self.p0[0, 1], self.p0[0, 2]]
 
 
 class ForceGauge(Gauge):
@@ -200,56 +239,68 @@ class ForceGauge(Gauge):
 
 class MeshGauge(Gauge):
     prefix = "Mesh"
+    FILE_KEYS = {"vel": "Vel", "veldir": "VelDir", "rhop": "Rhop", "zsurf": "Zsurf"}
 
     def __init__(self, item, spec, data):
         super().__init__(item, spec, data)
         self.origin = np.asarray(item.get("point", [0, 0, 0]), float)
-        dp = spec.dp
-        axes, counts = [], []
+        axes, counts, steps = [], [], []
         for k in (1, 2, 3):
             v = np.asarray(item.get(f"vec{k}", [1.0 * (k == 1), 1.0 * (k == 2), 1.0 * (k == 3)]), float)
             nv = np.linalg.norm(v)
             axes.append(v / nv if nv > 0 else np.zeros(3))
-            size = float(item.get(f"size{k}", 0.0) or 0.0)
-            counts.append(int(mesh_count(size, dp)) if nv > 0 else 1)
+            n, d = mesh_axis(item.get(f"size{k}"), spec.dp) if nv > 0 else (1, 0.0)
+            counts.append(int(n))
+            steps.append(d)
         self.axes, self.counts = axes, counts
-        ii, jj, kk = np.meshgrid(*(np.arange(c) for c in counts), indexing="ij")
-        self.nodes = (self.origin + dp * (ii[..., None] * axes[0] + jj[..., None] * axes[1]
-                                          + kk[..., None] * axes[2])).reshape(-1, 3)
-        self.nodes = np.ascontiguousarray(self.nodes)
+        # node (i, j, k) -> row i + j n1 + k n1 n2 (DualSPHysics's order, i fastest)
+        kk, jj, ii = np.meshgrid(*(np.arange(c) for c in counts[::-1]), indexing="ij")
+        self.nodes = np.ascontiguousarray((self.origin + ii[..., None] * steps[0] * axes[0]
+                                           + jj[..., None] * steps[1] * axes[1]
+                                           + kk[..., None] * steps[2] * axes[2]).reshape(-1, 3))
         outd = (item.get("outputdata") or {}).get("value") or "vel,rhop"
-        self.outputs = [s.strip().lower() for s in outd.split(",") if s.strip()]
-        bad = [s for s in self.outputs if s not in ("vel", "veldir", "rhop", "zsurf")]
+        self.outputs = list(dict.fromkeys(s.strip().lower() for s in outd.split(",") if s.strip()))
+        bad = [s for s in self.outputs if s not in self.FILE_KEYS]
         if bad:
             raise ValueError(f"mesh gauge '{self.name}': unknown outputdata {bad}; expected vel, veldir, rhop, zsurf")
         kc = (item.get("kclimit") or {}).get("value")
         self.kclimit = None if (kc is not None and str(kc).strip().upper() == "NONE") else _num(
             item.get("kclimit") or {}, "value", core.DEFAULT_KCLIMIT)
+        kd = (item.get("kcdummy") or {}).get("value")
+        self.kcdummy = None if (kd is not None and str(kd).strip().upper() == "NONE") else _num(
+            item.get("kcdummy") or {}, "value", 0.0)
         self.dirdat = np.asarray(item.get("dirdat", [1, 0, 0]), float)
         ml = item.get("masslimit") or {}
         if _num(ml, "value") is not None and spec.massfluid > 0:
             self.limit = _num(ml, "value") / spec.massfluid
         else:
             self.limit = _num(ml, "coef", spec.surface_threshold)
-        base = self.origin + dp * (np.arange(counts[0])[:, None, None] * axes[0]
-                                   + np.arange(counts[1])[None, :, None] * axes[1])
-        self.col0 = base.reshape(-1, 3)
-        self.col1 = self.col0 + float(item.get("size3", 0.0) or 0.0) * axes[2]
-        cols = []
-        n = self.nodes.shape[0]
+        jj, ii = np.meshgrid(np.arange(counts[1]), np.arange(counts[0]), indexing="ij")
+        self.col0 = np.ascontiguousarray((self.origin + ii[..., None] * steps[0] * axes[0]
+                                          + jj[..., None] * steps[1] * axes[1]).reshape(-1, 3))
+        self.col1 = self.col0 + mesh_length(item.get("size3")) * axes[2]
+        self.zstep = zsurf_step(item.get("size3"), spec.dp)
+        labels = [f"{i}:{j}:{k}" for k in range(counts[2]) for j in range(counts[1]) for i in range(counts[0])]
+        cols12 = [f"{i}:{j}" for j in range(counts[1]) for i in range(counts[0])]
+        self.parts = []
         for o in self.outputs:
             if o == "vel":
-                cols += [f"{c}_{i} [m/s]" for i in range(n) for c in ("velx", "vely", "velz")]
+                head = tuple(f"v({n}).{c} [m/s]" for n in labels for c in "xyz")
             elif o == "veldir":
-                cols += [f"veldir_{i} [m/s]" for i in range(n)]
+                head = tuple(f"v({n}) [m/s]" for n in labels)
             elif o == "rhop":
-                cols += [f"rhop_{i} [kg/m^3]" for i in range(n)]
+                head = tuple(f"v({n}) [kg/m^3]" for n in labels)
             else:
-                cols += [f"zsurf_{i} [m]" for i in range(self.col0.shape[0])]
-        self.header = tuple(cols)
+                head = tuple(f"v({n}) [m]" for n in cols12)
+            self.parts.append((f"Gauges{self.prefix}_{self.name}_{self.FILE_KEYS[o]}.csv", head))
+        self.header = tuple(c for _, h in self.parts for c in h)
+
+    def files(self):
+        return list(self.parts)
 
     def compute(self, view):
-        vals, _ = core.interpolate(view.grid, self.nodes, ("vel", "rhop"), kclimit=self.kclimit)
+        vals, ksum = core.interpolate(view.grid, self.nodes, ("vel", "rhop"), kclimit=None)
+        vals = kernel_corrected(vals, ksum, self.kclimit, self.kcdummy)
         row = []
         for o in self.outputs:
             if o == "vel":
@@ -260,7 +311,8 @@ class MeshGauge(Gauge):
             elif o == "rhop":
                 row += list(vals[:, 3])
             else:
-                s = core.surface_along_lines(view.grid, self.col0, self.col1, ZSURF_STEP * self.spec.dp, self.limit)
+                s = core.surface_along_lines(view.grid, self.col0, self.col1, self.zstep, self.limit)
+                s = np.where(np.isnan(s), self.col0, s)        # a dry column: its base (JGaugeMesh)
                 row += list(s @ self.axes[2])
         return row
 
@@ -273,17 +325,27 @@ GAUGE_TYPES = {"velocity": VelocityGauge, "swl": SwlGauge, "maxz": MaxZGauge, "f
 # the run-time driver
 # ---------------------------------------------------------------------------------
 class _Slot:
-    """A gauge with its schedules and the rows not yet written."""
+    """A gauge with its schedules, its files and the rows not yet written."""
 
-    def __init__(self, gauge, compute, output, write, path):
-        self.gauge, self.compute, self.output, self.write, self.path = gauge, compute, output, write, path
+    def __init__(self, gauge, compute, output, outdir):
+        self.gauge, self.compute, self.output = gauge, compute, output
+        self.files = [(os.path.join(outdir, name), header) for name, header in gauge.files()]
         self.rows: list = []
 
-    def header(self) -> str:
-        return "time [s];" + ";".join(self.gauge.header) + "\n"
+    @staticmethod
+    def header(columns) -> str:
+        return "time [s];" + ";".join(columns) + "\n"
 
-    def pending_text(self) -> str:
-        return "".join(";".join([f"{r[0]:.15g}"] + [_fmt(v) for v in r[1:]]) + "\n" for r in self.rows)
+    def pending(self):
+        """(path, header, text of the new rows) of each of the gauge's files."""
+        out, start = [], 1
+        for path, columns in self.files:
+            stop = start + len(columns)
+            text = "".join(";".join([f"{r[0]:.15g}"] + [_fmt(v) for v in r[start:stop]]) + "\n"
+                           for r in self.rows)
+            out.append((path, self.header(columns), text))
+            start = stop
+        return out
 
 
 def _fmt(v) -> str:
@@ -304,15 +366,18 @@ def _lines_up_to(path, tmax):
 class RunGauges:
     """Computes the case's gauges during a run at their ``computedt`` (see the module doc)."""
 
-    def __init__(self, data, params, outdir, resume=False, time=0.0):
+    def __init__(self, data, params, outdir, resume=False, time=0.0, periodicity=None):
         self.spec = core.KernelSpec.from_case(data, params)
         self.outdir = outdir
+        self.periodicity = periodicity
         gauges = data["json"].get("gauges") or {}
         default = gauges.get("default") or {}
         self.tout = float(params.get("TimeOut") or 0.0) or 0.01
         self.slots = []
         for raw in gauges.get("items") or []:
             item = {**default, **raw}
+            if item.get("output", False) is not True:
+                continue            # DualSPHysics's default: no file; nothing else reads it here
             try:
                 problem = name_problem(str(item["name"]))
                 if problem:
@@ -324,33 +389,32 @@ class RunGauges:
                                    _num(ct, "end", math.inf))
                 ot = item.get("outputtime") or {}
                 odt = item.get("outputdt")
-                output = Schedule(compute.dt if odt is None else float(odt), _num(ot, "start", 0.0),
+                output = Schedule(self.tout if odt is None else float(odt), _num(ot, "start", 0.0),
                                   _num(ot, "end", math.inf))
             except (KeyError, ValueError, TypeError, ZeroDivisionError, OverflowError) as exc:
                 # only a case file written before gencase checked the gauges gets here
                 raise InputError(f"gauge '{item.get('name')}' (case file line {item.get('line')}) is invalid: "
                                  f"{type(exc).__name__}: {exc}; run 'sphdvi gencase' again to see what is "
                                  "wrong with it") from None
-            write = item.get("output", True) is not False
-            self.slots.append(_Slot(gauge, compute, output, write, os.path.join(outdir, gauge.filename())))
+            self.slots.append(_Slot(gauge, compute, output, outdir))
         self.next_flush = 1
         if resume:
             for s in self.slots:
                 # the rows up to the restart time stay; anything later (or torn) is cut
-                if s.write:
-                    kept = _lines_up_to(s.path, time + EPS_REL * max(1.0, time))
-                    write_text_atomic(s.path, s.header() + "".join(kept))
+                for path, columns in s.files:
+                    kept = _lines_up_to(path, time + EPS_REL * max(1.0, time))
+                    write_text_atomic(path, s.header(columns) + "".join(kept))
                 s.compute.skip_to(time)
                 s.output.skip_to(time)
             self.next_flush = int(math.floor(time / self.tout + 1e-9)) + 1
         else:
             for s in self.slots:
                 # a new run starts its files anew (an earlier run's rows must not stay above)
-                if s.write:
-                    write_text_atomic(s.path, s.header())
+                for path, columns in s.files:
+                    write_text_atomic(path, s.header(columns))
             p = data["particles"]
             view = StateView(0.0, p["pos"], p["vel"], p["rhop"], p["mass"], self.spec.tait_pressure(p["rhop"]),
-                             p["type"], p["mk"], self.spec)
+                             p["type"], p["mk"], self.spec, periodicity)
             self._measure(view)
             self.flush()
 
@@ -367,7 +431,8 @@ class RunGauges:
         if not any(s.compute.dt <= 0 or t >= s.compute.k * s.compute.dt - s.compute.eps() for s in self.slots):
             return
         st = solver.state
-        view = StateView(t, st.pos, st.vel, st.rhop, st.mass, solver.press, st.ptype, st.mk, self.spec)
+        view = StateView(t, st.pos, st.vel, st.rhop, st.mass, solver.press, st.ptype, st.mk, self.spec,
+                         self.periodicity)
         self._measure(view)
         if t >= self.next_flush * self.tout - EPS_REL * max(1.0, self.tout):
             self.flush()
@@ -376,13 +441,11 @@ class RunGauges:
     def flush(self):
         """Append the new rows to the CSV files (header first when a file is new)."""
         for s in self.slots:
-            if not s.write:
-                s.rows = []
-                continue
-            if not os.path.exists(s.path):
-                write_text_atomic(s.path, s.header())
             if s.rows:
-                append_text(s.path, s.pending_text())
+                for path, header, text in s.pending():
+                    if not os.path.exists(path):
+                        write_text_atomic(path, header)
+                    append_text(path, text)
                 s.rows = []
 
     def close(self):

@@ -41,6 +41,19 @@ class Snapshot:
     mass: np.ndarray
 
 
+def case_periodicity(data: dict, params: dict):
+    """The run's :class:`~sphdvi.sph.periodic.Periodicity` (None without periodic axes): measurements
+    near a periodic end see the fluid's periodic copies, as the run's interaction does."""
+    from ..simulation import periodic_axes, periodic_params
+    from ..sph.periodic import Periodicity
+    c = data["constants"]
+    axes = periodic_axes(data, params)
+    if not axes:
+        return None
+    return Periodicity(axes, np.asarray(data["particles"]["pos"], float), float(c["dp"]),
+                       periodic_params(data, params))
+
+
 class RunOutput:
     """A run folder: the case file, its kernel spec and the particle snapshots."""
 
@@ -61,6 +74,7 @@ class RunOutput:
             except (json.JSONDecodeError, OSError):
                 pass
         self.spec = core.KernelSpec.from_case(self.data, self.params)
+        self.periodicity = case_periodicity(self.data, self.params)
         p = self.data["particles"]
         idp = np.asarray(p["idp"], np.int64)
         self.mass_by_idp = np.zeros(int(idp.max(initial=-1)) + 1)
@@ -135,7 +149,8 @@ class RunOutput:
 
     def fluid_grid(self, snap: Snapshot) -> core.ParticleGrid:
         press = snap.press if snap.press is not None else self.spec.tait_pressure(snap.rhop)
-        return core.fluid_grid(snap.pos, snap.vel, snap.rhop, snap.mass, press, snap.ptype, self.spec)
+        return core.fluid_grid(snap.pos, snap.vel, snap.rhop, snap.mass, press, snap.ptype, self.spec,
+                               self.periodicity)
 
     def domain_z(self):
         d = self.data.get("domain") or {}

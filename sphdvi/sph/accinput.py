@@ -144,12 +144,17 @@ def add_acc_input(ace, pos, vel, mk, ptype, inp: AccInput, t: float, gravity: np
 
 
 @njit(cache=True)
-def fluid_ace_max2(ace, ptype):
-    """max |a|² over the fluid particles (the force term of the time step)."""
+def fluid_ace_max2(ace, ptype, gx=0.0, gy=0.0, gz=0.0):
+    """max |a|² of the force term of the time step, as DualSPHysics's ComputeAceMax: over
+    fluid (their ace less the gravity (gx, gy, gz) it holds) and floating particles."""
     amax = 0.0
     for i in range(ace.shape[0]):
-        if ptype[i] == 3:
-            a = ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
+        pt = ptype[i]
+        if pt >= 2:
+            if pt == 3:
+                a = (ace[i, 0] - gx) ** 2 + (ace[i, 1] - gy) ** 2 + (ace[i, 2] - gz) ** 2
+            else:
+                a = ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
             if a > amax:
                 amax = a
     return amax

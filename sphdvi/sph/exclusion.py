@@ -1,8 +1,9 @@
 """Particle exclusion bookkeeping (DualSPHysics "particles out").
 
 DualSPHysics removes a fluid particle from the run when its density leaves
-[RhopOutMin, RhopOutMax], when it leaves the simulation domain, or when its
-values are not finite.  These helpers return masks and counts (numpy only).
+[RhopOutMin, RhopOutMax], when it leaves the simulation domain, when it moves
+more than MovLimit (0.9 x 2h) in one update ("movement", DualSPHysics's
+CODE_OUTMOV), or (sphdvi's own) when its values are not finite.  These helpers return masks and counts (numpy only).
 """
 import numpy as np
 
@@ -11,7 +12,9 @@ from .state import FLUID
 REASON_RHOP = 1
 REASON_POS = 2
 REASON_NAN = 3
-REASON_NAMES = {REASON_RHOP: "rhop", REASON_POS: "position", REASON_NAN: "not finite"}
+REASON_MOV = 4
+REASON_NAMES = {REASON_RHOP: "rhop", REASON_POS: "position", REASON_NAN: "not finite",
+                REASON_MOV: "movement"}
 
 
 def rhop_out_mask(rhop, ptype, rhop_min, rhop_max):

@@ -15,21 +15,35 @@ Symplectic position Verlet (Leimkuhler 1996), DualSPHysics form:
 
 Boundary particles (DBC) integrate their density only, clamped to
 rho >= rho0; moving and floating particles (ptype 1, 2) move with their
-imposed velocity, r += v dt.  Fluid particles whose density leaves
-[RhopOutMin, RhopOutMax], whose values are not finite, or (when a domain is
-given) that leave the domain box are flagged in ``out`` (1 density, 2
-position, 3 not finite); the drivers return how many were flagged.
+imposed velocity, r += v dt.  Fluid particles whose values are not finite,
+that leave the domain box (when a domain is given), whose density leaves
+[RhopOutMin, RhopOutMax], or whose displacement in the update exceeds
+MovLimit in a component are flagged in ``out`` (3 not finite, 2 position,
+1 density, 4 movement: the first that applies, DualSPHysics's order in
+JSphCpu::UpdatePos after sphdvi's own "not finite"); the drivers return how
+many were flagged.  As DualSPHysics (ComputeSymplecticPre), the Symplectic
+predictor checks too, on the state at t + dt/2 (the solver removes those
+particles before the corrector).  MovLimit is DualSPHysics's 0.9 Scell with
+Scell = 2h (its default CellMode "full"; JSph::ConfigCellDivision), whatever
+cell size sphdvi's own neighbour search uses.  A particle exactly on the
+domain's upper limit stays in: DualSPHysics takes it out (dx >= MapRealSize),
+but its domain has a margin of 0.05 h (BORDER_MAP) beyond the case's that
+sphdvi's has not.
 
-Shifting (Lind et al. 2012, DualSPHysics form): dr_s = A h |v| dt grad C,
-set to zero where the free-surface detector div r < ShiftTFS.  It is added to
-the fluid displacement (Verlet step, Symplectic corrector) when ``shift`` is on.
+Shifting 1-3 (Lind et al. 2012, DualSPHysics JSphShifting::RunCpu):
+dr_s = A h |v| dt grad C; with ShiftTFS > 0 it is zero where the free-surface
+detector div r < ShiftTFS and ramps up above it, times (div r - ShiftTFS)/(d - ShiftTFS)
+(d the dimension: 1 in the bulk); each component is then limited to +-0.1 dp.  It
+is added to the fluid displacement (Verlet step, Symplectic corrector) when
+``shift`` is on.
 With ``shift`` 4 (advanced shifting) ``shiftpos`` already holds the displacement
 (:mod:`sphdvi.sph.shifting_adv`).
 
 ``ip`` holds the step parameters: [dt, rhop0, RhopOutMin, RhopOutMax,
 ShiftCoef*h, ShiftTFS, use_domain, xmin, ymin, zmin, xmax, ymax, zmax,
-move] where move = 1 lets moving/floating particles advance with their
-velocity (no motion hook).
+move, 0.1 dp, d - ShiftTFS, MovLimit] where move = 1 lets moving/floating
+particles advance with their velocity (no motion hook); 0.1 dp and d - ShiftTFS
+are read with Shifting 1-3 only; MovLimit <= 0 switches the movement check off.
 """
 import math
 
@@ -38,25 +52,51 @@ from numba import njit, prange, literally
 
 
 @njit(cache=True, error_model="numpy")
-def _out_code(x, y, z, rho, rmin, rmax, usedom, x0, y0, z0, x1, y1, z1):
-    """Exclusion code of a fluid particle (0 keep, 1 density, 2 position, 3 not finite)."""
+def _out_code(x, y, z, rho, rmin, rmax, usedom, x0, y0, z0, x1, y1, z1, moved=False):
+    """Exclusion code of a fluid particle (0 keep, 1 density, 2 position, 3 not finite,
+    4 movement: ``moved``); position before density before movement, as DualSPHysics's
+    JSphCpu::UpdatePos labels them (CODE_SetOutPos, OutRho, OutMov)."""
     if not (math.isfinite(rho) and math.isfinite(x) and math.isfinite(y)
             and math.isfinite(z)):
         return 3
-    if rho < rmin or rho > rmax:
-        return 1
     if usedom:
         if x < x0 or y < y0 or z < z0 or x > x1 or y > y1 or z > z1:
             return 2
+    if rho < rmin or rho > rmax:
+        return 1
+    if moved:
+        return 4
     return 0
 
 
 @njit(cache=True, error_model="numpy")
-def _shift_factor(vx, vy, vz, det, coefh, tfs, dt):
-    """A h |v| dt, or 0 at the free surface (div r < ShiftTFS)."""
-    if det < tfs:
-        return 0.0
-    return coefh * math.sqrt(vx * vx + vy * vy + vz * vz) * dt
+def _too_far(d, movlim):
+    """A displacement component beyond MovLimit (DualSPHysics's UpdatePos outmov; off when
+    movlim <= 0)."""
+    return movlim > 0.0 and abs(d) > movlim
+
+
+@njit(cache=True, error_model="numpy")
+def _shift_factor(vx, vy, vz, det, coefh, tfs, coeftfs, dt):
+    """JSphShifting::RunCpu's magnitude: A h |v| dt; with ShiftTFS > 0, 0 where
+    div r < ShiftTFS and times (div r - ShiftTFS)/(d - ShiftTFS) elsewhere."""
+    umagn = coefh * math.sqrt(vx * vx + vy * vy + vz * vz) * dt
+    if tfs != 0.0:
+        if det < tfs:
+            return 0.0
+        umagn *= (det - tfs) / coeftfs
+    return umagn
+
+
+@njit(cache=True, error_model="numpy")
+def _limited(d, maxd):
+    """A shifting component limited to +-0.1 dp (JSphShifting::RunCpu's maxdist; DualSPHysics
+    v5.4 clamps both signs, some earlier versions only the positive one)."""
+    if d > maxd:
+        return maxd
+    if d < -maxd:
+        return -maxd
+    return d
 
 
 @njit(cache=True, error_model="numpy")
@@ -76,6 +116,12 @@ def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar
     y1 = ip[11]
     z1 = ip[12]
     move = ip[13] != 0.0
+    maxd = 0.0
+    coeftfs = 1.0
+    if shift > 0 and shift < 4:
+        maxd = ip[14]
+        coeftfs = ip[15]
+    movlim = ip[16]
     dt205 = 0.5 * dt * dt
     dt2 = dt if euler else 2.0 * dt
     nout = 0
@@ -89,17 +135,19 @@ def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar
         rhop_m1[i] = r
         if pt == 3:
             sf = 0.0
-            if shift == 4:
-                sf = 1.0        # advanced shifting: shiftpos is the displacement itself
-            elif shift > 0:
+            if shift > 0 and shift < 4:     # (shift 4: shiftpos is the displacement itself)
                 sf = _shift_factor(vel[i, 0], vel[i, 1], vel[i, 2], shiftdet[i],
-                                   coefh, tfs, dt)
+                                   coefh, tfs, coeftfs, dt)
+            moved = False
             for k in range(3):
                 v = vel[i, k]
                 a = ace[i, k]
                 dx = v * dt + a * dt205
-                if shift > 0:
-                    dx += sf * shiftpos[i, k]
+                if shift == 4:
+                    dx += shiftpos[i, k]
+                elif shift > 0:
+                    dx += _limited(sf * shiftpos[i, k], maxd)
+                moved |= _too_far(dx, movlim)
                 pos[i, k] += dx
                 if euler:
                     vn = v + a * dt
@@ -109,7 +157,7 @@ def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar
                 vel[i, k] = vn
             rhop[i] = rn
             code = _out_code(pos[i, 0], pos[i, 1], pos[i, 2], rn, rmin, rmax, usedom,
-                             x0, y0, z0, x1, y1, z1)
+                             x0, y0, z0, x1, y1, z1, moved)
             out[i] = code
             if code != 0:
                 nout += 1
@@ -149,10 +197,15 @@ def verlet_parallel(shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar, ptyp
 
 @njit(cache=True, error_model="numpy")
 def _sym_pre_range(i0, i1, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
-                   ptype, ip):
+                   ptype, ip, out):
     dt05 = 0.5 * ip[0]
     rhop0 = ip[1]
+    rmin = ip[2]
+    rmax = ip[3]
+    usedom = ip[6] != 0.0
     move = ip[13] != 0.0
+    movlim = ip[16]
+    nout = 0
     for i in range(i0, i1):
         pt = ptype[i]
         for k in range(3):
@@ -160,33 +213,48 @@ def _sym_pre_range(i0, i1, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
             vel_pre[i, k] = vel[i, k]
         rhop_pre[i] = rhop[i]
         if pt == 3:
-            rhop[i] = rhop_pre[i] + dt05 * ar[i]
+            rn = rhop_pre[i] + dt05 * ar[i]
+            rhop[i] = rn
+            moved = False
             for k in range(3):
-                pos[i, k] = pos_pre[i, k] + dt05 * vel_pre[i, k]
+                dx = dt05 * vel_pre[i, k]
+                moved |= _too_far(dx, movlim)
+                pos[i, k] = pos_pre[i, k] + dx
                 vel[i, k] = vel_pre[i, k] + dt05 * ace[i, k]
+            # DualSPHysics's ComputeSymplecticPre: density and UpdatePos at t + dt/2
+            code = _out_code(pos[i, 0], pos[i, 1], pos[i, 2], rn, rmin, rmax, usedom,
+                             ip[7], ip[8], ip[9], ip[10], ip[11], ip[12], moved)
+            out[i] = code
+            if code != 0:
+                nout += 1
         else:
+            out[i] = 0
             rhop[i] = max(rhop_pre[i] + dt05 * ar[i], rhop0)
             if pt >= 1 and move:
                 for k in range(3):
                     pos[i, k] = pos_pre[i, k] + dt05 * vel[i, k]
+    return nout
 
 
 @njit(cache=True, error_model="numpy")
 def symplectic_pre_serial(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
-                          ptype, ip):
-    """Symplectic predictor: saves the state at n in ``*_pre`` and advances dt/2."""
-    _sym_pre_range(0, pos.shape[0], pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
-                   ptype, ip)
+                          ptype, ip, out):
+    """Symplectic predictor: saves the state at n in ``*_pre`` and advances dt/2; returns
+    the count of fluid particles flagged in ``out`` at the half step."""
+    return _sym_pre_range(0, pos.shape[0], pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace,
+                          ar, ptype, ip, out)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def symplectic_pre_parallel(pos, vel, rhop, pos_pre, vel_pre, rhop_pre, ace, ar,
-                            ptype, ip):
+                            ptype, ip, out):
     """Threaded :func:`symplectic_pre_serial`."""
     n = pos.shape[0]
+    nout = 0
     for c in prange((n + CHUNK - 1) // CHUNK):
-        _sym_pre_range(c * CHUNK, min(n, (c + 1) * CHUNK), pos, vel, rhop, pos_pre,
-                       vel_pre, rhop_pre, ace, ar, ptype, ip)
+        nout += _sym_pre_range(c * CHUNK, min(n, (c + 1) * CHUNK), pos, vel, rhop, pos_pre,
+                               vel_pre, rhop_pre, ace, ar, ptype, ip, out)
+    return nout
 
 
 @njit(cache=True, error_model="numpy")
@@ -207,6 +275,12 @@ def _sym_corr_range(i0, i1, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, a
     y1 = ip[11]
     z1 = ip[12]
     move = ip[13] != 0.0
+    maxd = 0.0
+    coeftfs = 1.0
+    if shift > 0 and shift < 4:
+        maxd = ip[14]
+        coeftfs = ip[15]
+    movlim = ip[16]
     nout = 0
     for i in range(i0, i1):
         pt = ptype[i]
@@ -214,21 +288,23 @@ def _sym_corr_range(i0, i1, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, a
         rn = rhop_pre[i] * (2.0 - eps) / (2.0 + eps)
         if pt == 3:
             sf = 0.0
-            if shift == 4:
-                sf = 1.0        # advanced shifting: shiftpos is the displacement itself
-            elif shift > 0:
+            if shift > 0 and shift < 4:     # (shift 4: shiftpos is the displacement itself)
                 sf = _shift_factor(vel[i, 0], vel[i, 1], vel[i, 2], shiftdet[i],
-                                   coefh, tfs, dt)
+                                   coefh, tfs, coeftfs, dt)
             rhop[i] = rn
+            moved = False
             for k in range(3):
                 vn = vel_pre[i, k] + dt * ace[i, k]
                 dx = (vel_pre[i, k] + vn) * dt05
-                if shift > 0:
-                    dx += sf * shiftpos[i, k]
+                if shift == 4:
+                    dx += shiftpos[i, k]
+                elif shift > 0:
+                    dx += _limited(sf * shiftpos[i, k], maxd)
+                moved |= _too_far(dx, movlim)
                 vel[i, k] = vn
                 pos[i, k] = pos_pre[i, k] + dx
             code = _out_code(pos[i, 0], pos[i, 1], pos[i, 2], rn, rmin, rmax, usedom,
-                             x0, y0, z0, x1, y1, z1)
+                             x0, y0, z0, x1, y1, z1, moved)
             out[i] = code
             if code != 0:
                 nout += 1

@@ -22,7 +22,10 @@ kernel sums over its neighbours ``b`` found through the cell list:
 * density diffusion D_a (``DensityDT``), as DualSPHysics applies it:
   1 Molteni & Colagrossi (2009) over fluid and floating neighbours, on fluid
   particles with no fixed/moving boundary neighbour (with mDBC walls, cst[22]
-  = 1, over the wall particles too, as DualSPHysics); 2 Fourtakas et al.
+  = 1, over the wall particles too, as DualSPHysics) and no neighbour from a
+  floating body whose particles are no heavier than 1.2 fluid particles
+  (cst[23]; DualSPHysics's DELTA_HEAVYFLOATING; the mass compared is the one
+  the fluid sees, rho0 dp^d for an mDBC body); 2 Fourtakas et al.
   (2019) with the hydrostatic correction, over fluid-fluid pairs, on fluid
   particles with no fixed/moving boundary neighbour; 3 the same over
   fluid-fluid pairs on all fluid particles;
@@ -42,8 +45,18 @@ kernel sums over its neighbours ``b`` found through the cell list:
   (exact for a linear pressure field), instead of the symmetric one.
 
 Boundary particles (DBC; ptype 0 fixed, 1 moving) get continuity only, from
-their fluid and floating neighbours.  Floating particles (ptype 2) interact
-with fluid only; their ``ace`` excludes gravity (the body solver adds it).
+their fluid and floating neighbours.  Floating particles (ptype 2) take the
+momentum and continuity terms; their ``ace`` excludes gravity (the body solver
+adds it).  Which neighbours they see follows DualSPHysics's FtMode
+(InteractionForcesFluid / InteractionForcesBound, ``ftmode`` flag):
+1, ``RigidAlgorithm`` 1 (FtMode Sph, the default): every neighbour, fixed and
+moving walls (with Visco x ViscoBoundFactor) and other floating particles
+included: that DBC repulsion is the body's only contact with the walls;
+2, ``RigidAlgorithm`` 0 or 3 (FtMode Ext, collisions left to the multibody
+engine): fluid neighbours only, and the walls' continuity skips floating
+particles; 0: no floating particles in the scene (those branches compiled out).
+With ``Shifting`` 1 a floating neighbour switches a fluid particle's shifting
+off, as a wall does.
 
 mDBC slip modes 2 and 3 (flag mdbc2 = 1, :mod:`sphdvi.sph.mdbc`): for a wall
 neighbour the continuity term keeps the wall's own (motion) velocity, while
@@ -52,7 +65,7 @@ velocity ``tvel`` (one row per packed row); walls switched off by mDBC carry
 zero packed mass.
 
 Feature flags are ``numba.literally`` arguments (compile-time constants):
-kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, adv 0..3, mdbc2 0/1.  The 2D (x-z plane) and 3D
+kern 1/2, visco 1/2/3, ddt 0..3, shift 0..3, adv 0..3, mdbc2 0/1, ftmode 0..2.  The 2D (x-z plane) and 3D
 paths are separate functions.
 """
 import math
@@ -187,20 +200,27 @@ def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
 
 
 @njit(cache=True, error_model="numpy")
-def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c):
+def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst):
     """Time-step terms of rows i0..i1 (eq. 10; DualSPHysics ``DtVariable``):
-    dtmax[c] = (max |a|^2 over fluid, max |v|^2 over ptype >= vel_type, max
-    viscdt), read while the rows are in cache."""
+    dtmax[c] = (max |a|^2 over fluid and floating particles without gravity (DualSPHysics's
+    ComputeAceMax: the fluid's ace minus cst[12:15]; a floating ace has no gravity), max |v|^2
+    over ptype >= vel_type, max viscdt), read while the rows are in cache."""
     amax = 0.0
     vmax = 0.0
     cmax = 0.0
+    gx = cst[12]
+    gy = cst[13]
+    gz = cst[14]
     for i in range(i0, i1):
         o = oi[i]
         if viscdt[o] > cmax:
             cmax = viscdt[o]
         pt = ptype[i]
-        if pt == 3:
-            a = ace[o, 0] ** 2 + ace[o, 1] ** 2 + ace[o, 2] ** 2
+        if pt >= 2:
+            if pt == 3:
+                a = (ace[o, 0] - gx) ** 2 + (ace[o, 1] - gy) ** 2 + (ace[o, 2] - gz) ** 2
+            else:
+                a = ace[o, 0] ** 2 + ace[o, 1] ** 2 + ace[o, 2] ** 2
             if a > amax:
                 amax = a
         if pt >= vel_type:
@@ -219,7 +239,7 @@ def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c):
 # 2D (x-z plane)
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start,
                        ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel, tvel, nctype):
     kern = literally(kern)
@@ -228,12 +248,14 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
     shift = literally(shift)
     adv = literally(adv)
     mdbc2 = literally(mdbc2)
+    ftmode = literally(ftmode)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
     eta2 = cst[2]
     eta2l = cst[21]
     ddt1_walls = cst[22] != 0.0     # Molteni DDT across mDBC walls (DualSPHysics: not DBC)
+    ft_light = cst[23]              # 1.2 x fluid particle mass: a lighter floating neighbour stops DDT 1
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -270,8 +292,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
             for z in range(zlo, zhi + 1):
                 row = z * ncx
                 for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
-                    if ptype[j] < 2:
-                        continue
+                    if ptype[j] < 2 or (ftmode == 2 and ptype[j] == 2):
+                        continue    # FtMode Ext: walls do not see floating particles
                     dx = xi - nb[j, 0]
                     dz = zi - nb[j, 1]
                     r2 = dx * dx + dz * dz
@@ -343,8 +365,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                 if r2 >= r2max or r2 < 1e-18:
                     continue
                 ptj = ptype[j]
-                if pti == 2 and ptj != 3:
-                    continue  # floating particles see fluid only
+                if ftmode == 2 and pti == 2 and ptj != 3:
+                    continue  # FtMode Ext: floating particles see fluid only
                 boundj = ptj < 2
                 q = math.sqrt(r2) * inv_h
                 fac = kernel_fac(kern, q, alpha_h2)
@@ -420,6 +442,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                 acez += coef * mfac * dz
                 # density diffusion
                 if ddt == 1:
+                    if ftmode != 0 and ptj == 2 and nb[j, 6] <= ft_light:
+                        ddt_off = True      # DELTA_HEAVYFLOATING: no DDT next to a light body
                     if boundj and not ddt1_walls:
                         ddt_off = True
                     else:
@@ -435,6 +459,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                 if shift > 0:
                     if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
                         sh_off = True
+                    if shift == 1 and ftmode != 0 and ptj == 2:
+                        sh_off = True       # SHIFT_NoBound: floating neighbours too
                     mr = mfac * irj
                     shx += mr * dx
                     shz += mr * dz
@@ -483,7 +509,7 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
 
 
 @njit(cache=True, error_model="numpy")
-def rates_2d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+def rates_2d_serial(kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start, ncx,
                     ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Serial driver of the 2D interaction (use below ~10k particles).
 
@@ -495,18 +521,19 @@ def rates_2d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, ce
     shift = literally(shift)
     adv = literally(adv)
     mdbc2 = literally(mdbc2)
+    ftmode = literally(ftmode)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start,
                         ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
-        _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
+        _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_2d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx,
+def rates_2d_parallel(kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start, ncx,
                       ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Threaded driver of the 2D interaction (prange over chunks of particles)."""
     kern = literally(kern)
@@ -515,21 +542,22 @@ def rates_2d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, 
     shift = literally(shift)
     adv = literally(adv)
     mdbc2 = literally(mdbc2)
+    ftmode = literally(ftmode)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+        _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start,
                         ncx, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
-        _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
+        _dt_maxima(i0, i1, True, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst)
 
 
 # --------------------------------------------------------------------------
 # 3D
 # --------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start,
                        ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet,
                        gradvel, tvel, nctype):
     kern = literally(kern)
@@ -538,12 +566,14 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
     shift = literally(shift)
     adv = literally(adv)
     mdbc2 = literally(mdbc2)
+    ftmode = literally(ftmode)
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
     eta2 = cst[2]
     eta2l = cst[21]
     ddt1_walls = cst[22] != 0.0     # Molteni DDT across mDBC walls (DualSPHysics: not DBC)
+    ft_light = cst[23]              # 1.2 x fluid particle mass: a lighter floating neighbour stops DDT 1
     alpha = cst[3]
     alpha_h2 = cst[4]
     cs0h = cst[5] * h
@@ -585,8 +615,8 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                 for y in range(ylo, yhi + 1):
                     row = (z * ncy + y) * ncx
                     for j in range(cell_start[row + xlo], cell_start[row + xhi + 1]):
-                        if ptype[j] < 2:
-                            continue
+                        if ptype[j] < 2 or (ftmode == 2 and ptype[j] == 2):
+                            continue    # FtMode Ext: walls do not see floating particles
                         dx = xi - nb[j, 0]
                         dy = yi - nb[j, 1]
                         dz = zi - nb[j, 2]
@@ -681,8 +711,8 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                     if r2 >= r2max or r2 < 1e-18:
                         continue
                     ptj = ptype[j]
-                    if pti == 2 and ptj != 3:
-                        continue
+                    if ftmode == 2 and pti == 2 and ptj != 3:
+                        continue  # FtMode Ext: floating particles see fluid only
                     boundj = ptj < 2
                     q = math.sqrt(r2) * inv_h
                     fac = kernel_fac(kern, q, alpha_h2)
@@ -772,6 +802,8 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                     acey += coef * mfac * dy
                     acez += coef * mfac * dz
                     if ddt == 1:
+                        if ftmode != 0 and ptj == 2 and nb[j, 8] <= ft_light:
+                            ddt_off = True      # DELTA_HEAVYFLOATING: no DDT next to a light body
                         if boundj and not ddt1_walls:
                             ddt_off = True
                         else:
@@ -786,6 +818,8 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
                     if shift > 0:
                         if boundj and (shift == 1 or (shift == 2 and ptj == 0)):
                             sh_off = True
+                        if shift == 1 and ftmode != 0 and ptj == 2:
+                            sh_off = True       # SHIFT_NoBound: floating neighbours too
                         mr = mfac * irj
                         shx += mr * dx
                         shy += mr * dy
@@ -849,7 +883,7 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell
 
 
 @njit(cache=True, error_model="numpy")
-def rates_3d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+def rates_3d_serial(kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start, ncx, ncy,
                     ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Serial driver of the 3D interaction (27-cell stencil as 9 x-rows);
     time-step maxima per chunk in dtmax as :func:`rates_2d_serial`."""
@@ -859,18 +893,19 @@ def rates_3d_serial(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, ce
     shift = literally(shift)
     adv = literally(adv)
     mdbc2 = literally(mdbc2)
+    ftmode = literally(ftmode)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start,
                         ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
-        _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
+        _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def rates_3d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start, ncx, ncy,
+def rates_3d_parallel(kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start, ncx, ncy,
                       ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, dtmax, nctype):
     """Threaded driver of the 3D interaction."""
     kern = literally(kern)
@@ -879,14 +914,15 @@ def rates_3d_parallel(kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, 
     shift = literally(shift)
     adv = literally(adv)
     mdbc2 = literally(mdbc2)
+    ftmode = literally(ftmode)
     n = nb.shape[0]
     vel_type = int(cst[19])
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, nb, ptype, cell, oi, cell_start,
+        _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, ptype, cell, oi, cell_start,
                         ncx, ncy, ncz, cst, tau, ace, ar, viscdt, shiftpos, shiftdet, gradvel, tvel, nctype)
-        _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c)
+        _dt_maxima(i0, i1, False, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst)
 
 
 # --------------------------------------------------------------------------

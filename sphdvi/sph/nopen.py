@@ -55,7 +55,7 @@ from . import _env  # noqa: F401
 import numpy as np
 from numba import njit, prange
 
-from .integrators import _out_code
+from .integrators import _out_code, _too_far
 
 CHUNK = 256
 NCOL = 7
@@ -199,11 +199,15 @@ def detect_parallel(is2d, nb, ptype, cell, oi, normals, wallvel, pos, cell_start
 
 
 @njit(cache=True, error_model="numpy")
-def _recheck(i, pos, rhop, ip, out):
-    """Exclusion code of particle i after its correction; returns the change in flagged count."""
+def _recheck(i, pos, rhop, ip, out, start):
+    """Exclusion code of particle i after its correction (``start``: the positions its step's
+    displacement is measured from, for MovLimit); returns the change in flagged count."""
     old = out[i]
+    moved = False
+    for k in range(3):
+        moved |= _too_far(pos[i, k] - start[i, k], ip[16])
     code = _out_code(pos[i, 0], pos[i, 1], pos[i, 2], rhop[i], ip[2], ip[3], ip[6] != 0.0,
-                     ip[7], ip[8], ip[9], ip[10], ip[11], ip[12])
+                     ip[7], ip[8], ip[9], ip[10], ip[11], ip[12], moved)
     out[i] = code
     return (1 if code != 0 else 0) - (1 if old != 0 else 0)
 
@@ -221,7 +225,7 @@ def _verlet_range(i0, i1, pos, vel, vel_m1, rhop, ptype, npshift, ip, out):
                 vn = vel_m1[i, k] + dv          # vel_m1 holds v^n after the Verlet step
                 vel[i, k] = vn
                 pos[i, k] = npshift[i, 4 + k] + vn * dt
-        dn += _recheck(i, pos, rhop, ip, out)
+        dn += _recheck(i, pos, rhop, ip, out, npshift[:, 4:7])
     return dn
 
 
@@ -259,7 +263,7 @@ def _sym_range(i0, i1, pos, vel, pos_pre, vel_pre, rhop, ptype, npshift, ip, out
                 vn = vel_pre[i, k] + dv
                 vel[i, k] = vn
                 pos[i, k] = pos_pre[i, k] + vn * dt + sh
-        dn += _recheck(i, pos, rhop, ip, out)
+        dn += _recheck(i, pos, rhop, ip, out, pos_pre)
     return dn
 
 

@@ -1,12 +1,17 @@
 """Periodic boundaries by ghost copies (numpy bookkeeping, kernels unchanged).
 
-A periodic axis k has a period vector S_k (S_k[k] = L_k, the other two
-components are DualSPHysics's ``*PeriodicInc*`` offsets).  Before every
-interaction the particles within 2h of either end of the periodic box get
-ghost copies shifted by -S_k or +S_k (axes processed in turn, so corner
-ghosts of ghosts exist for two periodic axes); the interaction runs on the
-extended set and the rates of the real particles are copied back.  After
-every step the real particles that left the box are wrapped back by S_k.
+A periodic axis k has a period vector S_k: S_k[k] = L_k and, on the other two
+axes, minus DualSPHysics's ``*PeriodicInc*`` offsets, i.e. S_k is minus
+DualSPHysics's PeriXinc/PeriYinc/PeriZinc (JSph::LoadCaseParticles sets
+PeriXinc = (-Lx, XPeriodicIncY, XPeriodicIncZ)).  As JSphCpu::UpdatePos, a
+particle leaving through the high end comes back at the low end with the
+increment added (x - Lx, z + XPeriodicIncZ), one leaving through the low end
+with it subtracted (pos + S_k).  Before every interaction the particles within
+2h of the low end get ghost copies at pos + S_k (above the high end, the
+increment subtracted) and those within 2h of the high end at pos - S_k (as
+JSphCpuSingle::PeriodicMakeList; axes processed in turn, so corner ghosts of
+ghosts exist for two periodic axes); the interaction runs on the extended set
+and the rates of the real particles are copied back.
 
 The periodic box starts at the minimum particle coordinate of the initial
 state and its length is the extent of the particles along the axis plus dp
@@ -34,10 +39,11 @@ class Periodicity:
             self.shift[k, k] = self.length[k]
             others = [m for m in range(3) if m != k]
             for m, key in zip(others, inc[k]):
-                self.shift[k, m] = float(params.get(key) or 0.0)
+                self.shift[k, m] = -float(params.get(key) or 0.0)
 
     def wrap(self, pos):
-        """Bring particles that left the periodic box back in (in place)."""
+        """Bring particles that left the periodic box back in (in place), as
+        JSphCpu::UpdatePos: above the box pos - S_k, below it pos + S_k."""
         for k in self.axes:
             lo, hi = self.lo[k], self.lo[k] + self.length[k]
             below = pos[:, k] < lo
@@ -60,3 +66,43 @@ class Periodicity:
             disp = np.concatenate([disp, disp[low] + self.shift[k], disp[high] - self.shift[k]])
         n = pos.shape[0]
         return src[n:], disp[n:]
+
+    def min_image(self, r):
+        """The shortest periodic image of the separations ``r`` (N, 3), in place:
+        along each periodic axis the period vector is added or subtracted until
+        the component lies within half a period (DualSPHysics's FtPeriodicDist
+        for the distance of a floating particle to its body's centre)."""
+        for k in self.axes:
+            n = np.rint(r[:, k] / self.length[k])
+            if n.any():
+                r -= n[:, None] * self.shift[k]
+        return r
+
+
+INC_KEYS = {"x": ("XPeriodicIncY", "XPeriodicIncZ"), "y": ("YPeriodicIncX", "YPeriodicIncZ"),
+            "z": ("ZPeriodicIncX", "ZPeriodicIncY")}
+PAIR_KEYS = (("XYPeriodic", "xy"), ("XZPeriodic", "xz"), ("YZPeriodic", "yz"))
+
+
+def periodic_config(written, params, is2d):
+    """Periodic axes and increments of a case as JSph::LoadConfigParameters sets them.
+
+    ``written``: the parameter keys the case writes.  An axis is periodic when one
+    of its ``*PeriodicInc*`` keys is written (any value, even 0); a written
+    XYPeriodic / XZPeriodic / YZPeriodic (any value, even 0) makes that pair
+    periodic and the third axis not, and resets every increment to 0 (in that
+    order, the last written pair winning).  Returns (sorted axes, {Inc key: value});
+    a periodic y in a 2D case is a ValueError, as in DualSPHysics."""
+    written = set(written)
+    axes = {a for a, keys in INC_KEYS.items() if written.intersection(keys)}
+    incs = {k: float(params.get(k) or 0.0) for keys in INC_KEYS.values() for k in keys if k in written}
+    for key, pair in PAIR_KEYS:
+        if key in written:
+            axes = set(pair)
+            incs = {}
+    if is2d and "y" in axes:
+        why = next((k for k, pair in PAIR_KEYS if k in written and "y" in pair), None) \
+            or next(k for k in INC_KEYS["y"] if k in written)
+        raise ValueError(f"{why}: cannot use periodic conditions in Y with 2D simulations "
+                         "(DualSPHysics refuses it too)")
+    return sorted(axes), incs

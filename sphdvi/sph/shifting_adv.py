@@ -62,12 +62,15 @@ their support, see :func:`_displace_ale_range`).  With ALE:
 * the interaction (:mod:`sphdvi.sph.interaction`) adds the ALE terms with the
   shifting velocity :math:`\delta\mathbf v = \delta\mathbf r/\Delta t`.
 
-In these runs the shift and types are computed before the interaction that
-uses them: in the Symplectic predictor, from the positions at t^n, kept for the
-corrector and applied in it (DualSPHysics's order; plain Shifting 4 evaluates
-them in the corrector, at the half step); with Verlet every step, the ALE
-velocity taking the previous step's dt (DualSPHysics runs advanced shifting with
-Symplectic only: its Verlet step ignores it).
+The shift and types are computed before the interaction that uses them: in the
+Symplectic predictor, from the positions at t^n, kept for the corrector and
+applied in it (DualSPHysics's order, JSphCpuSingle::PreLoopProcedure, for plain
+Shifting 4 and with ALE / NCPress); plain Shifting 4 shifts nothing in the first
+step, as DualSPHysics (Nstep != 0), while with ALE / NCPress sphdvi computes the
+types and shift of the first step too (DualSPHysics starts them as type 3 and no
+shift); with Verlet every step, the ALE velocity taking the previous step's dt
+(DualSPHysics runs advanced shifting with Symplectic only: its Verlet step
+ignores it).
 """
 import math
 

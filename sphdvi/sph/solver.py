@@ -108,7 +108,10 @@ class SPHSolver:
         Called at the end of every step (time already advanced).  It must
         set ``state.pos`` and ``state.vel`` of the moving (ptype 1) and
         floating (ptype 2) particles.  Without a hook those particles move
-        with their current velocity, r += v dt.
+        with their current velocity, r += v dt.  The attribute ``half_step_hook``
+        (callable(solver, dt_half), None by default) is called by the Symplectic
+        step between the predictor and the corrector's interaction (time not yet
+        advanced), to place the floating particles at the half step.
     parallel_threshold : int
         Below this many particles the serial kernels run (no thread launch).
     light_threshold : int
@@ -119,7 +122,8 @@ class SPHSolver:
         ``*PeriodicInc*`` key is present in the case (even with value 0), which
         the caller knows; here an axis is periodic when it is listed, when one
         of its Inc keys is non-zero, or when XYPeriodic/XZPeriodic/YZPeriodic
-        is 1.  See :mod:`sphdvi.sph.periodic`.
+        is 1 (that pair only, increments reset, as DualSPHysics); y in 2D is a
+        ValueError.  See :mod:`sphdvi.sph.periodic`.
     cell_mode : "auto" (default), "2h" or "h"
         Cell size of the neighbour search (DualSPHysics ``-cellmode``: full = 2h,
         half = h); ``auto`` takes h unless the grid would be sparse (see
@@ -134,6 +138,10 @@ class SPHSolver:
         interpolated linearly at the start of each step (end values outside),
         as DualSPHysics's JSphDtFixed does; ``dt_error`` keeps the largest
         excess of the imposed dt over the variable (CFL) one.
+    shift_zones : list of dict or None
+        ``<special><shifting><shiftingzone>`` boxes (``posref``, ``vecs``: the three edge
+        vectors as rows): with Shifting 1-3 only the fluid particles inside one of them
+        are shifted (:mod:`sphdvi.sph.shift_zones`).
     visco_table : (n, 2) array or None
         ``ViscoTime`` as (time [s], Visco) rows: Visco (and Visco x
         ViscoBoundFactor) is interpolated linearly at the start of each step
@@ -149,7 +157,7 @@ class SPHSolver:
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
                  parallel_threshold=PARALLEL_THRESHOLD, light_threshold=LIGHT_THRESHOLD,
                  periodic=None, normals=None,
-                 cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None):
+                 cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None, shift_zones=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.acc_inputs = list(acc_inputs or [])     # imposed accelerations (sphdvi.sph.accinput)
@@ -170,10 +178,15 @@ class SPHSolver:
                                   # the step that removed them), idp, pos, vel, rhop, reason
         self.last_dt = 0.0
         self._setup_constants()
+        self._warn_fixed_below_dtmin()
         self._domain = None
         if domain is not None:
             self._domain = (np.array(domain[0], float), np.array(domain[1], float))
         self.periodicity = self._setup_periodic(periodic)
+        self.shift_zones = None
+        if shift_zones and self.rates_shift:
+            from .shift_zones import zone_arrays
+            self.shift_zones = zone_arrays(shift_zones)
         self.cell_mode = self._choose_cell_mode(cell_mode)
         self.cells = _cells.CellList(self.h, self.is2d, half=self.cell_mode == "h")
         self.cst[18] = self.cells.stencil
@@ -187,6 +200,10 @@ class SPHSolver:
             self.wall_ace = np.zeros((state.n, 3))
         self._no_wall_ace = np.zeros((1, 3))
         self._no_tvel = np.zeros((1, 3))
+        self.ftmode = self._floating_mode(state)
+        # Symplectic: called between the predictor and the corrector's interaction with the
+        # half step dt/2, to move the floating bodies there (set by the caller; see _step_symplectic)
+        self.half_step_hook = None
         self._verlet_count = 0
         self.reorder_every = REORDER_EVERY
         self._reorder_next = False
@@ -263,10 +280,9 @@ class SPHSolver:
                     raise ValueError(f"{key} must be 0 or 1")
                 if v:
                     self.adv |= bit
-        # whether the next compute_rates runs the advanced-shifting pass: plain Shifting 4
-        # runs it in the Symplectic corrector, ALE / NCPress runs in the predictor
-        # (DualSPHysics order: shift and types from the positions at t^n, used by both
-        # interactions of the step); Verlet runs it every step
+        # whether the next compute_rates runs the advanced-shifting pass: the Symplectic
+        # predictor (DualSPHysics order: shift and types from the positions at t^n, used by
+        # both interactions of the step and applied in the corrector); Verlet every step
         self._need_shift_adv = True
         self.step_algorithm = int(p["StepAlgorithm"])
         if self.step_algorithm not in (1, 2):
@@ -278,7 +294,7 @@ class SPHSolver:
                           "counterpart (use StepAlgorithm=2)")
         self.verlet_steps = int(p["VerletSteps"])
         alpha = kernel_alpha(self.kernel, h, self.is2d)
-        cst = np.zeros(23)
+        cst = np.zeros(24)
         cst[0] = h
         cst[1] = 4.0 * h * h
         cst[2] = (0.1 * h) ** 2
@@ -295,6 +311,10 @@ class SPHSolver:
         cst[17] = self.gamma
         cst[18] = 1.0
         cst[20] = 0.0       # 1/dt of the shifting velocity (ShiftAdvALE), set each step
+        # DensityDT 1: a floating neighbour no heavier than 1.2 fluid particles stops the DDT
+        # (DualSPHysics's DELTA_HEAVYFLOATING, massp <= MassFluid*1.2)
+        massfluid = c.get("massfluid", c.get("mass_fluid")) or self.rhop0 * self.dp ** (2 if self.is2d else 3)
+        cst[23] = 1.2 * float(massfluid)
         self.cst = cst
         self._set_visco(float(p["Visco"]))
         self.dtmin = float(p["DtMin"]) or float(p["CoefDtMin"]) * h / self.cs0
@@ -311,12 +331,44 @@ class SPHSolver:
         self.sps_smag = (0.12 * self.dp) ** 2
         self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
         self.shift_tfs = float(p["ShiftTFS"])
-        self.ip = np.zeros(14)
+        self.ip = np.zeros(17)
         self.ip[1] = self.rhop0
         self.ip[2] = float(p["RhopOutMin"])
         self.ip[3] = float(p["RhopOutMax"])
         self.ip[4] = float(p["ShiftCoef"]) * h
         self.ip[5] = self.shift_tfs
+        self.ip[14] = 0.1 * self.dp                                  # shifting limit per component
+        self.ip[15] = (2.0 if self.is2d else 3.0) - self.shift_tfs   # TFS ramp's denominator
+        # DualSPHysics's MovLimit = 0.9 Scell, Scell = 2h (CellMode full, its default): a fluid
+        # particle moving more in one update is excluded ("movement"); sphdvi's own cell size
+        # (h or 2h, a speed choice) does not change it
+        self.movlimit = 0.9 * 2.0 * h
+        self.ip[16] = self.movlimit
+
+    def _warn_fixed_below_dtmin(self):
+        """DtFixed, or a DtFixedFile value, below DtMin is kept (sphdvi steps with it), but
+        DualSPHysics's DtVariable raises the imposed dt to DtMin too ("DTs adjusted to DtMin")."""
+        what = []
+        if self.dtfixed > 0.0 and self.dtfixed < self.dtmin:
+            what.append(f"DtFixed ({self.dtfixed:g} s)")
+        elif self.dtfixed == 0.0 and self.dt_table is not None and self.dt_table.shape[0]:
+            low = float(self.dt_table[:, 1].min())
+            if 0.0 < low < self.dtmin:
+                what.append(f"DtFixedFile (down to {low:g} s)")
+        for w in what:
+            warnings.warn(f"{w} is below DtMin ({self.dtmin:g} s): sphdvi steps with it, DualSPHysics would "
+                          "raise each such step to DtMin (its DtVariable clamps the imposed dt too); set "
+                          "DtMin below it for the same run in both")
+
+    def _floating_mode(self, state):
+        """The interaction's ``ftmode`` flag (DualSPHysics's FtMode, JSph::LoadConfigParameters):
+        0 without floating particles; 1 for ``RigidAlgorithm`` 1 (FtMode Sph, the default:
+        floating particles feel walls and other bodies through the SPH terms); 2 for 0 and 3
+        (FtMode Ext: fluid only, collisions are the multibody engine's)."""
+        if not np.any(state.ptype == 2):
+            return 0
+        ra = self.params.get("RigidAlgorithm")
+        return 1 if ra is None or int(ra) == 1 else 2
 
     def _choose_cell_mode(self, mode):
         """Cells of h (5x5 / 125-cell stencil) where the grid stays small, else 2h.
@@ -345,6 +397,9 @@ class SPHSolver:
         return "h" if float(np.prod(ext)) <= 8.0 * pos.shape[0] else "2h"
 
     def _setup_periodic(self, periodic):
+        """The periodic axes: those listed, those with a non-zero Inc key, or the pair of a
+        XYPeriodic/XZPeriodic/YZPeriodic = 1, which (as in DualSPHysics) also switches
+        the third axis off and resets the increments; a periodic y in 2D is refused."""
         p = self.params
         axes = set(periodic or ())
         pairs = {"x": ("XPeriodicIncY", "XPeriodicIncZ"), "y": ("YPeriodicIncX", "YPeriodicIncZ"),
@@ -353,10 +408,11 @@ class SPHSolver:
             if any(p.get(k) for k in keys):
                 axes.add(ax)
         for key, both in (("XYPeriodic", "xy"), ("XZPeriodic", "xz"), ("YZPeriodic", "yz")):
-            if p.get(key):
-                axes.update(both)
-        if self.is2d:
-            axes.discard("y")
+            if self.params.get(key):
+                axes = set(both)
+                p = {k: v for k, v in p.items() if k not in PERIODIC_KEYS}
+        if self.is2d and "y" in axes:
+            raise ValueError("cannot use periodic conditions in Y with 2D simulations (as DualSPHysics)")
         if not axes:
             return None
         from .periodic import Periodicity
@@ -446,13 +502,13 @@ class SPHSolver:
     def _kernels(self, parallel):
         """Entry points of the compiled interaction kernels for this run's flags."""
         key = ("rates", self.is2d, self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv,
-               self._mdbc2_flag, bool(parallel))
+               self._mdbc2_flag, self.ftmode, bool(parallel))
         if key in _ENTRY_CACHE:
             return _ENTRY_CACHE[key]
         sfx = "parallel" if parallel else "serial"
         rates = getattr(_ia, ("rates_2d_" if self.is2d else "rates_3d_") + sfx)
         k = {
-            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3, 4, 5)),
+            "rates": specialised(rates, self._rates_args(), (0, 1, 2, 3, 4, 5, 6)),
             "pack": getattr(_ia, "pack_" + sfx),
             "sps": getattr(_sps, "sps_tau_" + sfx),
         }
@@ -480,7 +536,7 @@ class SPHSolver:
         ptype_rows, oi, tau_rows = self._rows
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
         return ((self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag,
-                 self.nb, ptype_rows, self.cell_sorted, oi, self.cells.cell_start) + geo
+                 self.ftmode, self.nb, ptype_rows, self.cell_sorted, oi, self.cells.cell_start) + geo
                 + (self.cst, tau_rows, self.ace, self.ar, self.viscdt, self.shiftpos,
                    self.shiftdet, self.gradvel, self._tvel(self.nb.shape[0]), self.dtmax, self.nctype))
 
@@ -568,6 +624,9 @@ class SPHSolver:
             self._compute_rates_periodic()
         else:
             self._compute_rates_cells()
+        if self.shift_zones is not None:
+            from .shift_zones import unshift_outside
+            unshift_outside(self.state.pos, self.state.ptype, self.shiftpos, *self.shift_zones)
         if self.acc_inputs:
             self._add_acc_inputs()
 
@@ -581,7 +640,7 @@ class SPHSolver:
                                    parallel=self._use_parallel(light=True))
         if added:
             self.dtmax[:, 0] = 0.0
-            self.dtmax[0, 0] = fluid_ace_max2(self.ace, s.ptype)
+            self.dtmax[0, 0] = fluid_ace_max2(self.ace, s.ptype, *self.gravity)
 
     def _compute_rates_cells(self):
         if self._reorder_next:
@@ -749,8 +808,8 @@ class SPHSolver:
                                  src_row=row_of[idx], nctype=nctype)
             self.fstype[dst] = fstype[real]
             self.fsnormal[dst] = fsnormal[real]
+            self.shiftpos[dst] = shiftpos[real]
             if self.adv:
-                self.shiftpos[dst] = shiftpos[real]
                 self.nctype[dst] = nctype[real]
         shiftpos_r = shiftpos
         nctype_r = self.nctype
@@ -759,14 +818,15 @@ class SPHSolver:
             # copy takes its real particle's, as DualSPHysics does
             shiftpos_r = np.ascontiguousarray(self.shiftpos[idx])
             nctype_r = np.ascontiguousarray(self.nctype[idx])
-        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag, nb,
-                   ptype_e, cell_e, np.arange(ne), self.cells.cell_start, *geo, self.cst, tau, ace, ar, viscdt,
+        k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag,
+                   self.ftmode, nb, ptype_e, cell_e, np.arange(ne), self.cells.cell_start, *geo, self.cst, tau,
+                   ace, ar, viscdt,
                    shiftpos_r, shiftdet, gradvel, self._tvel(ne), np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)),
                    nctype_r)
         self.ace[dst] = ace[real]
         self.ar[dst] = ar[real]
         self.viscdt[dst] = viscdt[real]
-        if self.shift and not self.adv:
+        if self.rates_shift:
             self.shiftpos[dst] = shiftpos[real]
             self.shiftdet[dst] = shiftdet[real]
         if self.visco_kind == 2:
@@ -774,7 +834,8 @@ class SPHSolver:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
         # time-step terms of the real particles only (a ghost at the edge of the
         # extended set misses neighbours and has a meaningless acceleration)
-        self.dtmax = np.array([_ts.dt_terms(self.ace, s.vel, self.viscdt, s.ptype, self.dt_vel_type)])
+        self.dtmax = np.array([_ts.dt_terms(self.ace, s.vel, self.viscdt, s.ptype, self.dt_vel_type,
+                                            *self.gravity)])
 
     def _fixed_dt(self, t):
         """DtFixed, or the DtFixedFile value at time t; 0 when dt is variable."""
@@ -790,8 +851,11 @@ class SPHSolver:
         self.cst[6] = visco
         self.cst[7] = visco * float(self.params["ViscoBoundFactor"])
 
-    def _variable_dt(self, t):
-        """The dt of a step starting at time t (eq. 10, or the imposed one)."""
+    def _variable_dt(self, t, count=True):
+        """The dt of a step starting at time t (eq. 10, or the imposed one), DualSPHysics's
+        DtVariable: a variable dt below DtMin is raised to it (``_clamped`` says whether it
+        was; counted in ``n_dtmin`` when ``count``)."""
+        self._clamped = False
         fixed = self._fixed_dt(t)
         if fixed > 0.0 and self.dt_table is None and not self.keep_dt_terms:
             return fixed
@@ -807,7 +871,9 @@ class SPHSolver:
             return fixed
         if dt < self.dtmin:
             dt = self.dtmin
-            self.n_dtmin += 1
+            self._clamped = True
+            if count:
+                self.n_dtmin += 1
         return dt
 
     def _set_ip(self, dt):
@@ -856,8 +922,12 @@ class SPHSolver:
         dt = self._variable_dt(self.time)
         self.step_dt_terms = self.dt_terms
         self._set_ip(dt)
+        # DualSPHysics's ComputeVerlet: VerletStep++ first, an Euler step when it reaches
+        # VerletSteps (steps VerletSteps, 2 VerletSteps, ...), then back to 0
+        self._verlet_count += 1
         euler = self._verlet_count >= self.verlet_steps
-        self._verlet_count = 0 if euler else self._verlet_count + 1
+        if euler:
+            self._verlet_count = 0
         k = self._integrators(self._use_parallel(light=True))
         nout = k["verlet"](*self._verlet_args(euler))
         if self.nopen:
@@ -873,14 +943,30 @@ class SPHSolver:
         s = self.state
         if self.adv & 1:
             self.cst[20] = 1.0 / dt      # ALE: shifting velocity dr/dt of this step
-        self._need_shift_adv = bool(self.adv)
+        # Shifting 4: shift (and types) from the positions at t^n, in the predictor, applied
+        # in the corrector; plain Shifting 4 not in the first step (DualSPHysics's
+        # PreLoopProcedure: runshift = predictor && Nstep != 0)
+        self._need_shift_adv = self.shift == 4 and (self.nstep != 0 or bool(self.adv))
+        if self.shift == 4 and not self._need_shift_adv:
+            self.shiftpos[:] = 0.0
         self._need_nopen = False
         self.compute_rates()
-        self._need_shift_adv = not self.adv
+        # DualSPHysics's ComputeStep_Sym: dt_p = DtVariable(false) from the predictor's terms
+        dt_p = self._variable_dt(self.time + dt, count=False)
+        clamped = self._clamped
+        self._need_shift_adv = False
         self._need_nopen = True
         k = self._integrators(self._use_parallel(light=True))
-        k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
-                     self.ace, self.ar, s.ptype, self.ip)
+        npre = k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
+                            self.ace, self.ar, s.ptype, self.ip, self.out)
+        if self.half_step_hook is not None:
+            # floating bodies to t + dt/2 for the corrector (DualSPHysics: RunFloating(dt/2, predictor))
+            self.half_step_hook(self, 0.5 * dt)
+        if npre:
+            # flagged at the half step: out before the corrector, as DualSPHysics's RunCellDivide;
+            # Shifting 4's shift, found in the predictor, goes on to the corrector
+            self._exclude(self.time + dt,
+                          carry=("shiftpos", "nctype", "fstype", "fsnormal") if self.shift == 4 else ())
         self._in_corrector = True
         try:
             self.compute_rates()
@@ -890,7 +976,11 @@ class SPHSolver:
         nout = k["sym_corr"](*self._corr_args())
         if self.nopen:
             nout += self._nopen_apply(True)
-        self.dt_pre = self._variable_dt(self.time + dt)
+        # the next step's dt: min(dt_p, dt_c) as ComputeStep_Sym (<savedt> keeps the corrector's
+        # terms, as its SaveDt); a step counts once in n_dtmin when either was raised to DtMin
+        self.dt_pre = min(dt_p, self._variable_dt(self.time + dt, count=False))
+        if clamped or self._clamped:
+            self.n_dtmin += 1
         if nout:
             self._exclude(self.time + dt)
         return dt
@@ -905,9 +995,11 @@ class SPHSolver:
         return n
 
     # ------------------------------------------------------------------ exclusion
-    def _exclude(self, t_end: float):
+    def _exclude(self, t_end: float, carry=()):
         """Remove the flagged fluid particles from the state and work arrays, and keep an
-        event of them (what they were when the step ending at ``t_end`` removed them)."""
+        event of them (what they were when the step ending at ``t_end`` removed them).
+        ``carry``: per-particle work arrays (attribute names) kept, less those rows, rather
+        than allocated anew."""
         s = self.state
         codes = self.out.copy()
         bad = codes != 0
@@ -923,7 +1015,11 @@ class SPHSolver:
             a = getattr(self, name)
             if a.shape[0] == keep.shape[0]:
                 setattr(self, name, np.ascontiguousarray(a[keep]))
+        kept = {name: np.ascontiguousarray(getattr(self, name)[keep]) for name in carry
+                if getattr(self, name).shape[0] == keep.shape[0]}
         self._alloc()
+        for name, a in kept.items():
+            setattr(self, name, a)
 
     def take_excluded(self) -> list:
         """The exclusion events since the last call (oldest first); the list starts anew."""
@@ -960,7 +1056,8 @@ class SPHSolver:
         for name in self.CHECKPOINT_SCALARS:
             value = ck["scalars"][name]
             setattr(self, name, value.item() if isinstance(value, np.generic) else value)
-        self.n_excluded = dict(ck["n_excluded"])
+        # a reason added since the checkpoint was written ("movement") starts from 0
+        self.n_excluded = {**{name: 0 for name in REASON_NAMES.values()}, **dict(ck["n_excluded"])}
         return missing
 
     # ------------------------------------------------------------------ outputs

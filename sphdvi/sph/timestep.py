@@ -5,9 +5,13 @@ r"""Variable time step (Monaghan & Kos 1999; DualSPHysics eq. 10).
   dt    = CFL min(dt_f, dt_cv),
 
 limited below by DtMin (0 => CoefDtMin h/c0); ``DtFixed`` > 0 replaces it.
-The maxima run over fluid particles for |f|, over fluid and floating
-particles for |v| (all particles with DtAllParticles = 1) and over all
-particles for the viscous term, as DualSPHysics does.
+As DualSPHysics v5.4: |f| is the interaction's acceleration without gravity
+(DualSPHysics zeroes Ace in PreInteraction_Forces, adds the ``<accinputs>``
+there, and adds gravity only in the update, ComputeVerletVarsFluid /
+ComputeSymplecticPre / Corr) over fluid and floating particles
+(JSphCpuSingle::ComputeAceMax runs from Npb on); |v| over fluid and floating
+particles (all particles with DtAllParticles = 1); the viscous term over all
+particles.  sphdvi's fluid ``ace`` holds gravity, so g is taken off here.
 """
 import math
 
@@ -16,18 +20,23 @@ from numba import njit
 
 
 @njit(cache=True, error_model="numpy")
-def dt_terms(ace, vel, viscdt, ptype, vel_type=2):
-    """(max |a|^2 over fluid, max |v|^2 over particles with ptype >= vel_type
-    (2: fluid and floating, DualSPHysics's default; 0: all, DtAllParticles=1),
-    max viscdt over all)."""
+def dt_terms(ace, vel, viscdt, ptype, vel_type=2, gx=0.0, gy=0.0, gz=0.0):
+    """(max |a - g|^2 over fluid and |a|^2 over floating particles (DualSPHysics's
+    ComputeAceMax: no gravity; a floating ``ace`` has none), max |v|^2 over particles
+    with ptype >= vel_type (2: fluid and floating, DualSPHysics's default; 0: all,
+    DtAllParticles=1), max viscdt over all).  (gx, gy, gz): the gravity in the fluid's ace."""
     amax = 0.0
     vmax = 0.0
     cmax = 0.0
     for i in range(ace.shape[0]):
         if viscdt[i] > cmax:
             cmax = viscdt[i]
-        if ptype[i] == 3:
-            a = ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
+        pt = ptype[i]
+        if pt >= 2:
+            if pt == 3:
+                a = (ace[i, 0] - gx) ** 2 + (ace[i, 1] - gy) ** 2 + (ace[i, 2] - gz) ** 2
+            else:
+                a = ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
             if a > amax:
                 amax = a
         if ptype[i] >= vel_type:

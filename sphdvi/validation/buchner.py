@@ -45,7 +45,7 @@ def reference_record(reference_dir: str) -> tuple[np.ndarray, np.ndarray]:
 def wall_pressure(outdir: str) -> tuple[np.ndarray, np.ndarray]:
     """(T, p/ρgH) at the probe P1 from the run's density gauge (no fluid at the probe: p = 0)."""
     c = case_data(outdir)["constants"]
-    sim = gauge_table(outdir, "Mesh", "P1")
+    sim = gauge_table(outdir, "Mesh", "P1_Rhop")
     p = c["b"] * ((sim[:, 1] / c["rhop0"]) ** c["gamma"] - 1.0) / (c["rhop0"] * G * H)
     return sim[:, 0] * math.sqrt(G / H), np.nan_to_num(p, nan=0.0)
 

@@ -62,7 +62,7 @@ def wall_pressures(outdir: str) -> dict:
     c = _constants(outdir)
     out = {}
     for name in SENSORS:
-        sim = gauge_table(outdir, "Mesh", name)
+        sim = gauge_table(outdir, "Mesh", f"{name}_Rhop")
         p = c["b"] * ((sim[:, 1] / c["rhop0"]) ** c["gamma"] - 1.0) / (c["rhop0"] * G * H)
         out[name] = (sim[:, 0] * math.sqrt(G / H), np.nan_to_num(p, nan=0.0))
     return out

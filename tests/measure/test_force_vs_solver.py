@@ -35,7 +35,11 @@ def scene(is2d, rng, dp=0.02, n=14):
 
 @pytest.mark.parametrize("is2d,kernel,visco", [(True, 2, 1), (True, 1, 3), (False, 1, 1), (False, 2, 3)])
 def test_force_equals_solver_ace(is2d, kernel, visco):
-    """Wendland/cubic (tensile correction), artificial/laminar viscosity, 2D and 3D."""
+    """Wendland/cubic (tensile correction), artificial/laminar viscosity, 2D and 3D.  Per particle
+    with RigidAlgorithm 0 (floating particles see the fluid only); with 1, the default, they also
+    feel each other (DualSPHysics's FtMode Sph), pair forces that cancel in the body's force, and
+    with the artificial viscosity (central pair forces) in its moment too: those then equal the
+    fluid's (the laminar term's pair forces lie along v_ab and leave a moment, as in DualSPHysics)."""
     rng = np.random.default_rng(7)
     state = scene(is2d, rng)
     dp = 0.02
@@ -44,7 +48,8 @@ def test_force_equals_solver_ace(is2d, kernel, visco):
     consts = {"dp": dp, "h": h, "cs0": cs0, "rhop0": 1000.0, "gamma": 7.0, "b": cs0 ** 2 * 1000.0 / 7.0,
               "gravity": [0.0, 0.0, -9.81], "is2d": is2d, "cflnumber": 0.2}
     params = {"Kernel": kernel, "ViscoTreatment": visco, "Visco": 0.05 if visco == 1 else 1e-3,
-              "ViscoBoundFactor": 1.0, "DensityDT": 0}
+              "ViscoBoundFactor": 1.0, "DensityDT": 0, "RigidAlgorithm": 0}
+    sph1 = SPHSolver(state.copy(), consts, dict(params, RigidAlgorithm=1))
     sol = SPHSolver(state, consts, params)
     sol.compute_rates()
     s = sol.state
@@ -57,3 +62,12 @@ def test_force_equals_solver_ace(is2d, kernel, visco):
     scale = np.abs(expected).max()
     assert scale > 0
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * scale)
+    sph1.compute_rates()
+    s1 = sph1.state
+    fl1 = s1.ptype == 2
+    f1 = s1.mass[fl1, None] * sph1.ace[fl1]
+    c = s.pos[fl].mean(axis=0)
+    np.testing.assert_allclose(f1.sum(axis=0), got.sum(axis=0), rtol=0, atol=1e-10 * scale)
+    if visco == 1:
+        np.testing.assert_allclose(np.cross(s1.pos[fl1] - c, f1).sum(axis=0),
+                                   np.cross(s.pos[fl] - c, got).sum(axis=0), rtol=0, atol=1e-10 * scale * dp)

@@ -209,11 +209,12 @@ def test_valid_gauges_run(tmp_path):
     r = invoke("run", case, "-o", out, "--tmax", "0.02", "--threads", "1", "-q")
     assert r.exit_code == 0, r.output
     names = sorted(p.name for p in out.glob("Gauges*.csv"))
-    assert names == ["GaugesForce_F1.csv", "GaugesMaxZ_M1.csv", "GaugesMesh_P1.csv", "GaugesMesh_Z.csv",
-                     "GaugesSWL_S1.csv", "GaugesVel_V.1-a.csv"]
-    head = (out / "GaugesMesh_Z.csv").read_text().splitlines()[0].split(";")
-    assert len(head) == 1 + 4 * 3 * 26 + 4                   # time; vel of 4 x 26 nodes; zsurf of 4 columns
-    assert len((out / "GaugesMesh_P1.csv").read_text().splitlines()[0].split(";")) == 2
+    assert names == ["GaugesForce_F1.csv", "GaugesMaxZ_M1.csv", "GaugesMesh_P1_Rhop.csv", "GaugesMesh_Z_Vel.csv",
+                     "GaugesMesh_Z_Zsurf.csv", "GaugesSWL_S1.csv", "GaugesVel_V.1-a.csv"]
+    head = (out / "GaugesMesh_Z_Vel.csv").read_text().splitlines()[0].split(";")
+    assert len(head) == 1 + 4 * 3 * 26                       # time; vel of 4 x 26 nodes
+    assert len((out / "GaugesMesh_Z_Zsurf.csv").read_text().splitlines()[0].split(";")) == 1 + 4   # 4 columns
+    assert len((out / "GaugesMesh_P1_Rhop.csv").read_text().splitlines()[0].split(";")) == 2
 
 
 def test_run_of_old_case_file_with_invalid_gauge_is_exit_2(tmp_path):
@@ -226,7 +227,7 @@ def test_run_of_old_case_file_with_invalid_gauge_is_exit_2(tmp_path):
     for change, words in ((lambda i: i.update(pointdp={"coefdp": "abc"}), "could not convert"),
                           (lambda i: i.pop("point0"), "point0"),
                           (lambda i: i.update(name="../x"), "contains '/'")):
-        item = dict(data["json"]["gauges"]["items"][0])
+        item = dict(data["json"]["gauges"]["items"][0], output=True)
         change(item)
         d = {**data, "json": {**data["json"], "gauges": {"default": {}, "items": [item]}}}
         with pytest.raises(InputError, match=words):

@@ -16,7 +16,7 @@ DAMBREAK = REPO / "cases" / "dambreak2d" / "CaseDambreakVal2D_Def.xml"
 GAUGES = """<gauges>
     <default><output value="true" /></default>
     <velocity name="V1"><point x="0.5" y="0" z="0.5" /></velocity>
-    <velocity name="V2"><point x="0.9" y="0" z="1.8" /><computedt value="0" /></velocity>
+    <velocity name="V2"><point x="0.9" y="0" z="1.8" /><computedt value="0" /><outputdt value="0" /></velocity>
     <swl name="S1"><point0 x="0.5" y="0" z="-0.05" /><point2 x="0.5" y="0" z="2.5" /></swl>
     <maxz name="M1"><point0 x="0.5" y="0" z="0" /><height value="3" /></maxz>
     <force name="F1"><target mkbound="0" /></force>
@@ -46,8 +46,9 @@ def run_out(tmp_path_factory):
 
 def test_gauge_files(run_out):
     names = sorted(p.name for p in run_out.glob("Gauges*.csv"))
-    assert names == ["GaugesForce_F1.csv", "GaugesMaxZ_M1.csv", "GaugesMesh_G1.csv", "GaugesSWL_S1.csv",
-                     "GaugesVel_V1.csv", "GaugesVel_V2.csv"]
+    assert names == ["GaugesForce_F1.csv", "GaugesMaxZ_M1.csv", "GaugesMesh_G1_Rhop.csv", "GaugesMesh_G1_Vel.csv",
+                     "GaugesMesh_G1_VelDir.csv", "GaugesMesh_G1_Zsurf.csv", "GaugesSWL_S1.csv",
+                     "GaugesVel_V1.csv", "GaugesVel_V2.csv"]          # not 'Off' (<output value="false"/>)
     head = (run_out / "GaugesVel_V1.csv").read_text().splitlines()[0]
     assert head == "time [s];velx [m/s];vely [m/s];velz [m/s];posx [m];posy [m];posz [m]"
     meta = __import__("json").loads((run_out / "run.json").read_text())
@@ -55,15 +56,20 @@ def test_gauge_files(run_out):
     assert v2.time.shape[0] == meta["steps"] + 1          # computedt 0: every step (and t=0)
     m1 = read_table(str(run_out / "GaugesMaxZ_M1.csv"))
     assert m1.data[0, 0] == pytest.approx(2.0)            # top particle of the 2 m column at t=0
+    np.testing.assert_allclose(m1.data[:, 1:], [[0.5, 0.0, 0.0]] * m1.time.shape[0])   # posx..posz: point0
     s1 = read_table(str(run_out / "GaugesSWL_S1.csv"))
     assert abs(s1.data[0, 2] - 2.0 - 0.02) < 0.02          # surface of the column within dp/2
-    g1 = read_table(str(run_out / "GaugesMesh_G1.csv"))
     nodes = 11 * 63                                        # 0.4/dp+1 along vec1, 2.5/dp+1 along vec3
-    assert len(g1.names) == nodes * 5 + 11                 # vel (3), veldir, rhop per node; zsurf per column
-    zs = g1.data[0, -11:]
+    tables = {k: read_table(str(run_out / f"GaugesMesh_G1_{k}.csv")) for k in ("Vel", "VelDir", "Rhop", "Zsurf")}
+    assert [len(tables[k].names) for k in ("Vel", "VelDir", "Rhop", "Zsurf")] == [3 * nodes, nodes, nodes, 11]
+    head = (run_out / "GaugesMesh_G1_Vel.csv").read_text().splitlines()[0].split(";")
+    assert head[:4] == ["time [s]", "v(0:0:0).x [m/s]", "v(0:0:0).y [m/s]", "v(0:0:0).z [m/s]"]
+    assert head[-1] == "v(10:0:62).z [m/s]"                # DualSPHysics's order: i fastest
+    zs = tables["Zsurf"].data[0]
     assert np.all(np.abs(zs - 2.02) < 0.02)
-    rhop = g1.data[0, nodes * 4:nodes * 5]
-    assert np.isfinite(rhop[:20]).all() and np.isnan(rhop[-10:]).all()   # k fastest: low nodes in water, top in air
+    rhop = tables["Rhop"].data[0]
+    # i fastest: the first rows of nodes are in the water; the top ones, in the air, read kcdummy (0)
+    assert np.all(np.abs(rhop[:33] - 1000) < 30) and np.all(rhop[-11:] == 0.0)
 
 
 def test_velocity_gauge_matches_measure_points(run_out):

@@ -12,7 +12,7 @@ from lxml import etree
 from sphdvi.case.reader import read_wavepaddles
 from sphdvi.case.xmldoc import CaseReader
 from sphdvi.errors import CaseError
-from sphdvi.motion import WavePaddle, piston_height_to_stroke, wave_number
+from sphdvi.motion import SpectrumPaddle, WavePaddle, piston_height_to_stroke, wave_number
 from sphdvi.wave_absorption import PistonAbsorber, linear_reflection
 
 G = 9.81
@@ -160,6 +160,33 @@ def test_drift_correction_brings_the_piston_back():
     expect = limit * (1 - (1 - tau[first] / 1.2) ** 3)
     assert np.allclose(diff[started:][first], expect * np.sign(-rb[started, 3]), atol=1e-12, rtol=0)
     assert abs(diff[-1]) > 1.5 * limit
+
+
+@pytest.mark.parametrize("phase, ramp", [(0.5, 0.0), (1.5, 0.0), (0.5, 2.0), (0.25, 0.0)])
+def test_drift_is_measured_from_the_theory_s_mean_position(phase, ramp):
+    """A surface that meets the target leaves nothing to absorb, so no drift correction: the piston's
+    distance is measured from where the theory centres it (−S/2 sin φ without a ramp: it swings over
+    [−S, 0] for φ = π/2, past 1.8 S/2 from its rest position), not from the rest position."""
+    corr = {"coefstroke": 1.8, "coefperiod": 1.0, "powerfunc": 3.0}
+    a = absorber({"correction": corr, "startawas": 2.4}, {"phase": phase, "ramp": ramp})
+    rec = drive(a, lambda t, target: 0.3 + target, 12.0)
+    assert math.isnan(a.corr_start) and np.abs(rec[:, 1]).max() < 1e-15
+    assert np.abs(rec[:, 3] - a.paddle.mean_position()).max() <= a.paddle.stroke_amplitude() * (1 + 1e-12)
+    assert a.paddle.mean_position() == pytest.approx(0.0 if ramp else -a.paddle.stroke_amplitude() *
+                                                     math.sin(phase * math.pi), abs=1e-15)
+
+
+def test_irregular_drift_is_measured_from_the_series_mean():
+    """An unramped irregular series starts from its value at serieini and so swings about −that value."""
+    spec = {"type": "piston_spectrum", "mkbound": 10, "depth": 0.3, "waveheight": 0.04, "waveperiod": 1.4,
+            "spectrum": "jonswap", "waves": 50, "discretization": "stretched", "peakcoef": 3.3, "randomseed": 0,
+            "serieini": 0.0, "ramptime": 0.0, "start": 0.0, "duration": 0.0, "gainstroke": 1.0}
+    o = {"startawas": 0.0, "swl": 0.3, "elevation": 1, "gaugey": 0.0,
+         "correction": {"coefstroke": 1.8, "coefperiod": 1.0, "powerfunc": 3.0}}
+    a = PistonAbsorber(SpectrumPaddle(spec), o, g=G, dp=0.01, h=0.017, is2d=True, face_x=0.0, zlim=(0.0, 1.0))
+    assert abs(a.paddle.mean_position()) > 0.5 * a.paddle.stroke_amplitude()
+    rec = drive(a, lambda t, target: 0.3 + target, 40.0, dt=2e-3)
+    assert math.isnan(a.corr_start) and np.abs(rec[:, 1]).max() < 1e-15
 
 
 def test_acceleration_limit_holds_the_velocity_change_per_step():

@@ -111,9 +111,12 @@ def test_stroke_is_bieseis_per_wave(kind, transfer):
 
 def test_ramp_gain_serieini_start_and_duration():
     base = SpectrumPaddle(spec())
-    ramped = SpectrumPaddle(spec(ramptime=2.0))
-    assert ramped.stroke_position(0.5)[0] == pytest.approx(0.25 * base.stroke_position(0.5)[0])
-    assert ramped.stroke_position(3.0) == pytest.approx(base.stroke_position(3.0))
+    ramped = SpectrumPaddle(spec(ramptime=2.0))     # from rest about the rest position: not shifted
+    free = base.stroke_position(0.5)[0] - base.mean_position()
+    assert base.mean_position() != 0 and ramped.mean_position() == 0
+    assert ramped.stroke_position(0.5)[0] == pytest.approx(0.25 * free)
+    assert ramped.stroke_position(3.0) == pytest.approx((base.stroke_position(3.0)[0] - base.mean_position(),
+                                                         base.stroke_position(3.0)[1]))
     double = SpectrumPaddle(spec(gainstroke=2.0))
     assert double.stroke_position(1.3)[0] == pytest.approx(2 * base.stroke_position(1.3)[0])
     later = SpectrumPaddle(spec(serieini=5.0))                  # the series from its 5th second, from rest

@@ -98,16 +98,27 @@ def test_particles_follow_the_body(case_data):
 
 
 def test_frozen_bodies_during_ftpause(case_data):
-    """FtPause: the body does not move and its particles stay, but the clock goes on."""
+    """FtPause: the body does not move and its particles stay, but the clock goes on; the
+    pause holds while the step's start time is below FtPause (DualSPHysics's RunFloating:
+    TimeStep < FtPause), and bodies.csv's loads are then what acts on the held body, its weight
+    plus the fluid's force and moment (DualSPHysics keeps computing them for its output)."""
     fluidcount = int(case_data["json"]["mkconfig"]["fluidcount"])
     fb = FloatingBodies(case_data, MotionSet([], []), fluidcount, ftpause=0.1)
     sol = _solver(case_data)
     sel = sol.state.ptype == 2
     sol.ace[sel] = [0.0, 0.0, -9.81]
+    sol.ace[sel, 0] = sol.state.pos[sel, 2] - sol.state.pos[sel, 2].mean()     # a moment about y
     before = sol.state.pos.copy()
     sol.time = 0.05
     fb.step(sol, 1e-3)
     assert np.array_equal(sol.state.pos, before) and fb.system.time == 0.05
+    F, T = fb.loads(sol, np.flatnonzero(sel), np.zeros(int(sel.sum()), np.int64))
+    m = fb.system.mass[0]
+    assert np.allclose(fb.system.total_force[0], F[0] + m * fb.system.gravity, rtol=1e-12)
+    assert np.allclose(fb.system.total_torque[0], T[0], rtol=1e-12) and abs(T[0, 1]) > 0
+    sol.time = 0.1005           # a step from 0.0995 to 0.1005: started in the pause
+    fb.step(sol, 1e-3)
+    assert np.array_equal(sol.state.pos, before)
     sol.time = 0.2
     fb.step(sol, 1e-3)
     assert sol.state.pos[sel, 2].max() < before[sel, 2].max()     # free fall once released
@@ -129,3 +140,43 @@ def test_imposed_motion_moves_its_mk_only():
     assert np.allclose(state.pos[:2], pos0[:2] + 0.5 * v, atol=1e-12)
     assert np.allclose(state.vel[:2], v)
     assert np.array_equal(state.pos[2:], pos0[2:]) and not state.vel[2:].any()
+
+
+@pytest.mark.parametrize("algo", [2, 1])
+def test_symplectic_corrector_sees_the_bodies_at_the_half_step(case_data, tmp_path, algo):
+    """DualSPHysics's ComputeStep_Sym moves the floating bodies to t + dt/2 after the predictor
+    (RunFloating(dt/2, predictor)) and advances them by dt from the step's start after the
+    corrector: the floating particles the corrector's interaction sees are displaced by
+    V dt/2 from those the predictor's saw, and the step ends at x^n + dt V^(n+1) (the multibody
+    state put back after the half step).  Verlet evaluates once, with the bodies at t^n."""
+    from sphdvi.simulation import SPHRun, apply_overrides, special_parameters
+    params = apply_overrides(special_parameters(case_data), ["FtPause=0", f"StepAlgorithm={algo}"])
+    sph = SPHRun(case_data, params, str(tmp_path))
+    sol, fb = sph.solver, sph.floating
+    s = sol.state
+    sel = np.flatnonzero(s.ptype == 2)
+    fb.system.vel[0] = [0.5, 0.0, 0.3]
+    fb.carry_particles(sol, sel, fb.body_of_idp[s.idp[sel]])
+    seen = []
+    rates = sol.compute_rates
+
+    def spy():
+        fl = sol.state.ptype == 2
+        seen.append(sol.state.pos[fl].mean(axis=0))
+        rates()
+
+    sol.compute_rates = spy
+    for _ in range(3):
+        seen.clear()
+        x0 = fb.system.pos[0].copy()
+        dt = sol.step()
+        v1 = fb.system.vel[0]
+        assert np.allclose(fb.system.pos[0], x0 + dt * v1, rtol=0, atol=1e-12)
+        if algo == 1:
+            assert len(seen) == 1
+            continue
+        assert len(seen) == 2
+        shift = seen[1] - seen[0]
+        # the half step's velocity, V^n + a dt/2, is within dt |a| of V^(n+1)
+        assert np.allclose(shift[[0, 2]], 0.5 * dt * v1[[0, 2]], rtol=2e-2)
+        assert shift[1] == 0.0

@@ -72,7 +72,10 @@ def test_initial_velocity_in_an_sph_run_flies_ballistic(tmp_path, algo):
     text = text.replace('<floating mkbound="5" rhopbody="500" />',
                         '<floating mkbound="5" rhopbody="500"><linearvelini x="0.5" y="0" z="2" />'
                         '<angularvelini x="0" y="3" z="0" /></floating>')
-    assert text.count('z="0.75"') == 2 and "linearvelini" in text
+    # the flight reaches z ~ 1.1: the domain must hold it (a floating particle out of it stops the run)
+    text = text.replace("</parameters>", '<simulationdomain><posmin x="default" y="default" z="default" />'
+                        '<posmax x="default" y="default" z="2" /></simulationdomain></parameters>')
+    assert text.count('z="0.75"') == 2 and "linearvelini" in text and "simulationdomain" in text
     case = tmp_path / "CaseBallistic_Def.xml"
     case.write_text(text)
     out = tmp_path / "out"
@@ -91,3 +94,31 @@ def test_initial_velocity_in_an_sph_run_flies_ballistic(tmp_path, algo):
     z_exact = d["z"][0] + 2.0 * t - 0.5 * 9.81 * t ** 2
     assert np.abs(d["z"] - z_exact).max() <= 9.81 * t[-1] * dtmax
     assert np.abs(d["vz"] - (2.0 - 9.81 * t)).max() < 1e-8
+
+
+def test_initial_velocity_along_a_locked_dof_is_ignored_with_a_warning(tmp_path):
+    """translationDOF x=0 with <linearvelini x=0.5>: the body's velocity is masked by its DOF
+    (System.add_body), and now its particles' too, so that the first step does not push the
+    water at 0.5 m/s (a pressure pulse that tilted the symmetric box by 3 degrees); gencase
+    warns that the velocity along the locked DOF is ignored.  The free components stay: vz
+    and the spin about y give the particles v = (0, 0, 0.2) + w x (r - c)."""
+    from sphdvi.io.casefile import read_case_h5
+    text = FLOATING_BOX.replace('<floating mkbound="5" rhopbody="500" />',
+                                '<floating mkbound="5" rhopbody="500"><translationDOF x="0" y="1" z="1"/>'
+                                '<rotationDOF x="1" y="1" z="1"/><linearvelini x="0.5" y="0" z="0.2"/>'
+                                '<angularvelini x="0" y="1.5" z="0"/></floating>')
+    assert "translationDOF" in text
+    case = tmp_path / "CaseDof_Def.xml"
+    case.write_text(text)
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out"), "--dp", "0.02"])
+    assert r.exit_code == 0, r.output
+    assert "floating mkbound 5: the initial velocity along a locked degree of freedom is ignored" in r.output
+    assert "linearvelini x=0.5" in r.output and "CaseDof_Def.xml:" in r.output
+    data = read_case_h5(str(next((tmp_path / "out").glob("*.h5"))))
+    p = data["particles"]
+    sel = p["type"] == 2
+    c = p["pos"][sel].mean(axis=0)          # the body's centre (no <center>)
+    w = np.array([0.0, 1.5, 0.0])
+    expected = np.array([0.0, 0.0, 0.2]) + np.cross(w, p["pos"][sel] - c)
+    assert np.allclose(p["vel"][sel], expected, atol=1e-12)
+    assert not p["vel"][p["type"] != 2].any()

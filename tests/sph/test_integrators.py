@@ -42,7 +42,7 @@ def _exact(t, x0, amp, phi, r0):
 
 
 def _ip(dt):
-    ip = np.zeros(14)
+    ip = np.zeros(17)
     ip[0] = dt
     ip[1] = 1000.0
     ip[2] = 0.0
@@ -63,7 +63,7 @@ def run_symplectic(nsteps, T=1.0):
     corr = specialised(I.symplectic_corr_serial,
                        (0, pos, vel, rho, *pre, vel, rho, ptype, dummy2, dummy1, ip, out), (0,))
     for _ in range(nsteps):
-        I.symplectic_pre_serial(pos, vel, rho, *pre, -W * W * (pos - x0), -K * rho, ptype, ip)
+        I.symplectic_pre_serial(pos, vel, rho, *pre, -W * W * (pos - x0), -K * rho, ptype, ip, out)
         corr(0, pos, vel, rho, *pre, -W * W * (pos - x0), -K * rho, ptype, dummy2, dummy1, ip, out)
     ex = _exact(T, x0, amp, phi, r0)
     return np.abs(pos - ex[0]).max(), np.abs(rho - ex[2]).max()
@@ -89,8 +89,10 @@ def run_verlet(nsteps, exact_start, verlet_steps, T=1.0):
     for _ in range(nsteps):
         ace[:] = -W * W * (pos - x0)
         ar[:] = -K * rho
+        count += 1                  # as the solver (DualSPHysics's ComputeVerlet)
         euler = count >= verlet_steps
-        count = 0 if euler else count + 1
+        if euler:
+            count = 0
         step(0, euler, pos, vel, rho, vm1, rm1, ace, ar, ptype, dummy2, dummy1, ip, out)
     ex = _exact(T, x0, amp, phi, r0)
     return np.abs(pos - ex[0]).max(), np.abs(rho - ex[2]).max()

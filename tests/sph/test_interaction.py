@@ -14,7 +14,10 @@ from _helpers import constants, jittered_block, random_state
 def reference_rates(s, c, p):
     """O(N^2) transcription of the DualSPHysics equations (AV or laminar, DDT 0-3).
 
-    Written pair by pair in textbook form, independently of the kernel code.
+    Written pair by pair in textbook form, independently of the kernel code.  Floating
+    particles as DualSPHysics's FtMode: RigidAlgorithm 1 (Sph) every neighbour, 0 / 3
+    (Ext) fluid only, and then the walls' continuity skips them; Molteni's DDT is off next
+    to a floating particle no heavier than 1.2 rho0 dp^d (DELTA_HEAVYFLOATING).
     """
     is2d = c["is2d"]
     h = c["h"]
@@ -28,6 +31,8 @@ def reference_rates(s, c, p):
     ar = np.zeros(n)
     g = np.asarray(c["gravity"])
     delta = p["DensityDTvalue"]
+    ext = p.get("RigidAlgorithm", 1) != 1
+    light = 1.2 * rho0 * c["dp"] ** (2 if is2d else 3)
     wdp = kernel_w(1, c["dp"] / h, kernel_alpha(1, h, is2d))
     for a in range(n):
         fluid_a = s.ptype[a] == 3
@@ -45,8 +50,10 @@ def reference_rates(s, c, p):
                 continue
             bound_b = s.ptype[b] < 2
             float_b = s.ptype[b] == 2
-            if float_a and s.ptype[b] != 3:
-                continue            # floating particles see fluid only
+            if ext and float_a and s.ptype[b] != 3:
+                continue            # FtMode Ext: floating particles see fluid only
+            if ext and s.ptype[a] < 2 and float_b:
+                continue            # ... and the walls do not see them
             if s.ptype[a] < 2 and bound_b:
                 continue            # boundary-boundary pairs are not computed
             gradW = kernel_fac(kind, r / h, alpha / h ** 2) * rab
@@ -70,6 +77,8 @@ def reference_rates(s, c, p):
                 ace[a] += mb * 4 * vis * (rab @ gradW) / ((ra + rb) * (r * r + eta2)) * vab
             ddt = p["DensityDT"]
             if ddt == 1:
+                if float_b and mb <= light:
+                    ddt_off = True      # a light floating neighbour switches it off
                 if bound_b and p.get("Boundary", 1) != 2:
                     ddt_off = True      # DBC walls switch Molteni's term off; mDBC walls take part
                 else:
@@ -109,18 +118,24 @@ def block_over_a_wall(rng, dp, is2d, lift):
 
 
 @pytest.mark.parametrize("is2d", [True, False])
-@pytest.mark.parametrize("kernel,visco,ddt", [(2, 1, 0), (2, 1, 2), (2, 1, 3), (1, 1, 1),
-                                              (2, 3, 2), (1, 3, 0)])
-def test_rates_match_reference(is2d, kernel, visco, ddt):
+@pytest.mark.parametrize("kernel,visco,ddt,rigid", [(2, 1, 0, 1), (2, 1, 2, 1), (2, 1, 3, 1), (1, 1, 1, 1),
+                                                    (2, 3, 2, 1), (1, 3, 0, 1), (1, 1, 1, 0), (2, 3, 2, 3)])
+def test_rates_match_reference(is2d, kernel, visco, ddt, rigid):
+    """Against :func:`reference_rates`, with floating particles in the water (one heavy,
+    two light) and next to the wall, under RigidAlgorithm 1 (FtMode Sph) and 0 / 3 (Ext)."""
     rng = np.random.default_rng(7)
     dp = 0.02
     pos, ptype, nbd = block_over_a_wall(rng, dp, is2d, 2 * dp)
-    ptype[nbd + (len(pos) - nbd) // 2 + np.arange(3)] = 2      # a few floating particles
+    inner = nbd + (len(pos) - nbd) // 2 + np.arange(3)
+    ptype[inner] = 2                                            # a few floating particles
+    ptype[nbd + np.arange(2)] = 2                               # and two by the wall
     s = random_state(pos, dp, is2d, rng, ptype)
     s.vel[ptype == 0] = 0.0
+    vol = dp ** (2 if is2d else 3)
+    s.mass[inner] = 1000.0 * vol * np.array([1.5, 1.1, 0.5])    # heavy, light, light
     c = constants(dp, is2d, g=9.81)
     p = {"Kernel": kernel, "ViscoTreatment": visco, "Visco": 0.05 if visco == 1 else 1e-3,
-         "ViscoBoundFactor": 2.0, "DensityDT": ddt, "DensityDTvalue": 0.1}
+         "ViscoBoundFactor": 2.0, "DensityDT": ddt, "DensityDTvalue": 0.1, "RigidAlgorithm": rigid}
     sol = SPHSolver(s, c, p)
     sol.compute_rates()
     ace_ref, ar_ref = reference_rates(sol.state, c, sol.params)

@@ -122,7 +122,7 @@ def test_corrector_without_mdbc_keeps_the_predicted_wall_density():
     r._reorder_next = True         # as step() does on step 0
     r.compute_rates()
     k = r._integrators(False)
-    k["sym_pre"](s.pos, s.vel, s.rhop, r.pos_pre, r.vel_pre, r.rhop_pre, r.ace, r.ar, s.ptype, r.ip)
+    k["sym_pre"](s.pos, s.vel, s.rhop, r.pos_pre, r.vel_pre, r.rhop_pre, r.ace, r.ar, s.ptype, r.ip, r.out)
     predicted = s.rhop.copy()
     r.boundary = 1                 # the corrector's rates with the walls as they are
     r.compute_rates()

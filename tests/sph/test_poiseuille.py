@@ -87,7 +87,7 @@ def run_poiseuille(n, t_end=D * D / NU, nx=12, layers=3, artificial=False, coefh
         extra["ViscoLaminarEta"] = eta
     if ghostvel is not None:
         extra["MdbcGhostVelocity"] = ghostvel
-    sol = SPHSolver(st, c, {"StepAlgorithm": 2, "DtFixed": 0.1 * h * h / NU, **visc, **extra},
+    sol = SPHSolver(st, c, {"StepAlgorithm": 2, "DtFixed": 0.1 * h * h / NU, "DtMin": 0.01 * h * h / NU, **visc, **extra},
                     periodic="x", normals=normals)
     transient = []
     for ts in sample_times:
@@ -357,7 +357,7 @@ def run_channel_3d(n, slip, t_end, nxy=6, layers=3, ghostvel=1):
     st = FluidState(pos, mass=1000 * dp ** 3, ptype=pt)
     normals = np.zeros((len(pos), 3))
     normals[:len(bd), 2] = np.where(bd[:, 2] < 0, -bd[:, 2], D - bd[:, 2])
-    sol = SPHSolver(st, c, {"StepAlgorithm": 2, "DtFixed": 0.1 * h * h / NU, "ViscoTreatment": 3,
+    sol = SPHSolver(st, c, {"StepAlgorithm": 2, "DtFixed": 0.1 * h * h / NU, "DtMin": 0.01 * h * h / NU, "ViscoTreatment": 3,
                             "Visco": NU, "Boundary": 2, "SlipMode": slip, "MdbcGhostVelocity": ghostvel},
                     periodic="xy", normals=normals)
     sol.run(t_end)
