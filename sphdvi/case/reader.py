@@ -449,7 +449,9 @@ def _read_movement_chain(reader, obj):
     chain = {"movements": [movs[i] for i in order]}
     events = [_read_begin(reader, b, movs) for b in begins]
     if not begins and order:
-        events = [{"mov": order[0], "start": 0.0, "finish": None}]
+        # JMotion starts an object's movements only through its events (<begin>)
+        reader.warn(obj, "movements without a <begin mov=\"..\" start=\"..\"/>: the object does not move "
+                    "(DualSPHysics's JMotion runs a movement only from an event)")
     for event in events:
         _check_zero_loop(reader, movs, elements, event["mov"])
     if events:

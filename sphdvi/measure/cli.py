@@ -135,7 +135,9 @@ def measure():
               help="Points: 'x,y,z;x,y,z' (2D: 'x,z' allowed) or a file with one point a line "
                    "(MeasureTool POINTS/POINTSLIST files too).")
 @click.option("--vars", "variables", default="vel,rhop,press", show_default=True,
-              help="Comma-separated: vel, rhop, press, mass, vol.")
+              help="Comma-separated: vel, rhop, press, mass, vol (kernel averages of the particles' mass and "
+                   "volume m/rho), kcorr (the kernel sum sum_b V_b W, MeasureTool's: about 1 inside the water, "
+                   "0.5 at a flat surface).")
 @click.option("--kclimit", type=FiniteFloat(min=0), default=0.5, show_default=True,
               help="Kernel-sum threshold below which a point has no value (empty field).")
 @click.option("--correction", type=click.Choice(["shepard", "linear"]), default="shepard", show_default=True,

@@ -18,7 +18,8 @@ from ..errors import InputError
 from . import core
 from .tables import Table
 
-UNITS = {"vel": "m/s", "rhop": "kg/m^3", "press": "Pa", "mass": "kg", "vol": "m^3"}
+UNITS = {"vel": "m/s", "rhop": "kg/m^3", "press": "Pa", "mass": "kg", "vol": "m^3", "kcorr": "-"}
+UNITS_2D = {"mass": "kg/m", "vol": "m^2"}      # a 2D particle is a prism 1 m deep
 VARS = ("vel", "rhop", "press")
 
 
@@ -322,7 +323,7 @@ def measure_points(run: RunOutput, points, variables=VARS, kclimit=core.DEFAULT_
         for i in range(points.shape[0]):
             for comp in _component_names(v, spec.is2d):
                 names.append(f"{comp}_{i}")
-                units.append(UNITS[v])
+                units.append(UNITS_2D.get(v, UNITS[v]) if spec.is2d else UNITS[v])
                 positions.append(points[i])
     times, parts, rows = [], [], []
     near: dict = {}
@@ -333,10 +334,14 @@ def measure_points(run: RunOutput, points, variables=VARS, kclimit=core.DEFAULT_
         if motion is not None:
             R, t = motion(snap)
             points = start @ R.T + t
-        vals, _ = core.interpolate(grid, points, variables, order=order, kclimit=kclimit)
+        fields = [v for v in variables if v != "kcorr"]
+        vals, ksum = core.interpolate(grid, points, fields, order=order, kclimit=kclimit)
         # column order: variable, point, component
         row, col = [], 0
         for v in variables:
+            if v == "kcorr":        # the kernel sum itself (MeasureTool's kcorr): ~1 in the water
+                row.append(ksum)
+                continue
             ncomp = 3 if v == "vel" else 1
             row.append(vals[:, col:col + ncomp].reshape(-1))
             col += ncomp

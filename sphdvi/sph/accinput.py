@@ -31,6 +31,8 @@ import numpy as np
 from . import _env  # noqa: F401
 from numba import njit, prange
 
+from .timestep import force_term_ace2
+
 
 def integrated_velocities(table: np.ndarray) -> np.ndarray:
     """Rows (t, v_lin (3), ω (3)) of DualSPHysics's ComputeVelocity: v_0 = 0,
@@ -149,12 +151,7 @@ def fluid_ace_max2(ace, ptype, gx=0.0, gy=0.0, gz=0.0):
     fluid (their ace less the gravity (gx, gy, gz) it holds) and floating particles."""
     amax = 0.0
     for i in range(ace.shape[0]):
-        pt = ptype[i]
-        if pt >= 2:
-            if pt == 3:
-                a = (ace[i, 0] - gx) ** 2 + (ace[i, 1] - gy) ** 2 + (ace[i, 2] - gz) ** 2
-            else:
-                a = ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
-            if a > amax:
-                amax = a
+        a = force_term_ace2(ace, i, ptype[i], gx, gy, gz)
+        if a > amax:
+            amax = a
     return amax

@@ -88,6 +88,15 @@ def _shift_factor(vx, vy, vz, det, coefh, tfs, coeftfs, dt):
     return umagn
 
 
+@njit(cache=True, inline="always")
+def _shift_limits(ip, shift):
+    """(max displacement per component, dim - ShiftTFS) of Shifting 1-3 from ``ip`` (ip[14], ip[15]);
+    (0, 1) otherwise."""
+    if shift > 0 and shift < 4:
+        return ip[14], ip[15]
+    return 0.0, 1.0
+
+
 @njit(cache=True, error_model="numpy")
 def _limited(d, maxd):
     """A shifting component limited to +-0.1 dp (JSphShifting::RunCpu's maxdist; DualSPHysics
@@ -116,11 +125,7 @@ def _verlet_range(i0, i1, shift, euler, pos, vel, rhop, vel_m1, rhop_m1, ace, ar
     y1 = ip[11]
     z1 = ip[12]
     move = ip[13] != 0.0
-    maxd = 0.0
-    coeftfs = 1.0
-    if shift > 0 and shift < 4:
-        maxd = ip[14]
-        coeftfs = ip[15]
+    maxd, coeftfs = _shift_limits(ip, shift)
     movlim = ip[16]
     dt205 = 0.5 * dt * dt
     dt2 = dt if euler else 2.0 * dt
@@ -275,11 +280,7 @@ def _sym_corr_range(i0, i1, shift, pos, vel, rhop, pos_pre, vel_pre, rhop_pre, a
     y1 = ip[11]
     z1 = ip[12]
     move = ip[13] != 0.0
-    maxd = 0.0
-    coeftfs = 1.0
-    if shift > 0 and shift < 4:
-        maxd = ip[14]
-        coeftfs = ip[15]
+    maxd, coeftfs = _shift_limits(ip, shift)
     movlim = ip[16]
     nout = 0
     for i in range(i0, i1):

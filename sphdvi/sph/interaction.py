@@ -74,6 +74,7 @@ from ._env import CHUNK
 from numba import njit, prange, literally
 
 from .kernels import kernel_fac, kernel_w
+from .timestep import force_term_ace2
 
 
 @njit(cache=True, error_model="numpy")
@@ -216,13 +217,9 @@ def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst
         if viscdt[o] > cmax:
             cmax = viscdt[o]
         pt = ptype[i]
-        if pt >= 2:
-            if pt == 3:
-                a = (ace[o, 0] - gx) ** 2 + (ace[o, 1] - gy) ** 2 + (ace[o, 2] - gz) ** 2
-            else:
-                a = ace[o, 0] ** 2 + ace[o, 1] ** 2 + ace[o, 2] ** 2
-            if a > amax:
-                amax = a
+        a = force_term_ace2(ace, o, pt, gx, gy, gz)
+        if a > amax:
+            amax = a
         if pt >= vel_type:
             if is2d:
                 v = nb[i, 2] ** 2 + nb[i, 3] ** 2

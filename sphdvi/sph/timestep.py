@@ -19,6 +19,17 @@ from . import _env  # noqa: F401
 from numba import njit
 
 
+@njit(cache=True, inline="always")
+def force_term_ace2(ace, i, pt, gx, gy, gz):
+    """|a|^2 of row i in the force condition, as DualSPHysics's ComputeAceMax: fluid (ptype 3)
+    less the gravity (gx, gy, gz) its ace holds, floating (2) as it is (no gravity), -1 otherwise."""
+    if pt == 3:
+        return (ace[i, 0] - gx) ** 2 + (ace[i, 1] - gy) ** 2 + (ace[i, 2] - gz) ** 2
+    if pt == 2:
+        return ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
+    return -1.0
+
+
 @njit(cache=True, error_model="numpy")
 def dt_terms(ace, vel, viscdt, ptype, vel_type=2, gx=0.0, gy=0.0, gz=0.0):
     """(max |a - g|^2 over fluid and |a|^2 over floating particles (DualSPHysics's
@@ -31,14 +42,9 @@ def dt_terms(ace, vel, viscdt, ptype, vel_type=2, gx=0.0, gy=0.0, gz=0.0):
     for i in range(ace.shape[0]):
         if viscdt[i] > cmax:
             cmax = viscdt[i]
-        pt = ptype[i]
-        if pt >= 2:
-            if pt == 3:
-                a = (ace[i, 0] - gx) ** 2 + (ace[i, 1] - gy) ** 2 + (ace[i, 2] - gz) ** 2
-            else:
-                a = ace[i, 0] ** 2 + ace[i, 1] ** 2 + ace[i, 2] ** 2
-            if a > amax:
-                amax = a
+        a = force_term_ace2(ace, i, ptype[i], gx, gy, gz)
+        if a > amax:
+            amax = a
         if ptype[i] >= vel_type:
             v = vel[i, 0] ** 2 + vel[i, 1] ** 2 + vel[i, 2] ** 2
             if v > vmax:

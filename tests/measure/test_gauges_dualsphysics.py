@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from case.casetext import case_xml
 from sphdvi.case.gauge_spec import mesh_axis
 from sphdvi.cli import main
 from sphdvi.measure.gauges import kernel_corrected
@@ -144,71 +145,24 @@ def test_gauges_see_across_a_periodic_end(tmp_path):
     np.testing.assert_allclose(res.data[:, 0], res.data[:, 1], rtol=0.05)
 
 
-PERIODIC_CASE = """<?xml version="1.0" encoding="UTF-8" ?>
-<case>
-    <casedef>
-        <constantsdef>
-            <gravity x="0" y="0" z="-9.81" />
-            <rhop0 value="1000" />
-            <hswl value="0" auto="true" />
-            <gamma value="7" />
-            <speedsystem value="0" auto="true" />
-            <coefsound value="20" />
-            <speedsound value="0" auto="true" />
-            <coefh value="1.0" />
-            <cflnumber value="0.2" />
-        </constantsdef>
-        <mkconfig boundcount="240" fluidcount="9" />
-        <geometry>
-            <definition dp="0.02">
-                <pointmin x="-0.06" y="0" z="-0.06" />
-                <pointmax x="0.7" y="0" z="0.4" />
-            </definition>
-            <commands>
-                <mainlist>
-                    <setdrawmode mode="full" />
+PERIODIC_CASE = case_xml(
+    pointmin=("-0.06", "0", "-0.06"), pointmax=("0.7", "0", "0.4"),
+    commands="""
                     <setmkfluid mk="0" />
-                    <drawbox>
-                        <boxfill>solid</boxfill>
-                        <point x="0" y="-1" z="0.02" />
-                        <size x="0.58" y="2" z="0.18" />
-                    </drawbox>
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0.02" /><size x="0.58" y="2" z="0.18" /></drawbox>
                     <setmkbound mk="0" />
-                    <drawbox>
-                        <boxfill>solid</boxfill>
-                        <point x="0" y="-1" z="-0.04" />
-                        <size x="0.58" y="2" z="0.04" />
-                    </drawbox>
-                </mainlist>
-            </commands>
-        </geometry>
-    </casedef>
-    <execution>
-        <special>
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="-0.04" /><size x="0.58" y="2" z="0.04" /></drawbox>""",
+    special="""
             <gauges>
-                <default>
-                    <computedt value="0.01" />
-                    <output value="true" />
-                </default>
-                <swl name="edge">
-                    <point0 x="0.0" y="0" z="0.0" />
-                    <point2 x="0.0" y="0" z="0.35" />
-                </swl>
-                <swl name="mid">
-                    <point0 x="0.3" y="0" z="0.0" />
-                    <point2 x="0.3" y="0" z="0.35" />
-                </swl>
+                <default><computedt value="0.01" /><output value="true" /></default>
+                <swl name="edge"><point0 x="0.0" y="0" z="0.0" /><point2 x="0.0" y="0" z="0.35" /></swl>
+                <swl name="mid"><point0 x="0.3" y="0" z="0.0" /><point2 x="0.3" y="0" z="0.35" /></swl>
                 <velocity name="vedge"><point x="0.0" y="0" z="0.1" /></velocity>
                 <velocity name="vmid"><point x="0.3" y="0" z="0.1" /></velocity>
-            </gauges>
-        </special>
-        <parameters>
+            </gauges>""",
+    parameters="""
             <parameter key="XPeriodicIncZ" value="0" />
             <parameter key="StepAlgorithm" value="2" />
             <parameter key="DensityDT" value="1" />
             <parameter key="TimeMax" value="0.02" />
-            <parameter key="TimeOut" value="0.01" />
-        </parameters>
-    </execution>
-</case>
-"""
+            <parameter key="TimeOut" value="0.01" />""")

@@ -331,3 +331,15 @@ def test_trackmk_errors(tank2d):
     assert r.exit_code == 2 and "--trackmk 77" in r.output and "Traceback" not in r.output
     r = invoke("measure", "points", out, "--points", "0.5,0,0.2", "--trackmk", "2", "--trackmkbound", "0")
     assert r.exit_code == 2 and "at most one of --trackmk and --trackmkbound" in r.output
+
+
+def test_kcorr_is_the_kernel_sum_and_2d_units_are_per_metre(tank2d):
+    """kcorr (MeasureTool's): ~1 inside the still water, ~0.5 at its surface, 0 in the air, never
+    blanked by --kclimit; mass and vol of a 2D case are per metre of depth (kg/m, m^2)."""
+    tank, out = tank2d
+    pts = [[0.5, 0.0, 0.2], [0.5, 0.0, DEPTH], [0.5, 0.0, DEPTH + 0.2]]
+    t, _ = measure_points(RunOutput(out), pts, ["kcorr", "mass", "vol"])
+    assert t.names[:3] == ["kcorr_0", "kcorr_1", "kcorr_2"]
+    k = t.data[0, :3]
+    assert abs(k[0] - 1.0) < 0.02 and 0.35 < k[1] < 0.65 and k[2] == 0.0, k
+    assert t.units[3:6] == ["kg/m"] * 3 and t.units[6:] == ["m^2"] * 3

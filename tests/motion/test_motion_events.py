@@ -64,3 +64,12 @@ def test_concurrent_events_with_a_rotation_are_a_case_error(tmp_path):
     with pytest.raises(CaseError, match="run at the same time .* rotates it") as e:
         read(tmp_path, body)
     assert e.value.element == "begin" and e.value.line == 3
+
+
+def test_an_object_without_begin_does_not_move(tmp_path):
+    """JMotion runs a movement only from an event: movements without a <begin> leave the object
+    where it is (sphdvi started the first one at t = 0), and gencase says so."""
+    motions, reader = read(tmp_path, RECT.format(1, -1, "", 0.1, 0))
+    assert any("without a <begin" in str(w) for w in reader.warnings)
+    r = MotionSet(motions).transform(1, 1.0)
+    assert np.allclose(r.d, 0.0) and np.allclose(r.V, 0.0)
