@@ -99,7 +99,8 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
 @click.option("--threads", type=click.IntRange(min=1), default=None,
               help="Threads (default: SLURM_CPUS_PER_TASK or the CPU affinity).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
-              help="Override any <parameters> key, e.g. --set Visco=0.05 (repeatable).")
+              help="Override any <parameters> key, e.g. --set Visco=0.05 (repeatable). A file of ViscoTime or "
+                   "DtFixedFile is relative to the current directory (in the XML: to the case's folder).")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted run from its last output, with the --tmax/--tout/--set it was "
                    "started with (--tmax may be raised to extend it).")

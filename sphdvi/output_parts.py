@@ -92,7 +92,10 @@ def _cylinder(f, pos, ptype, mk, fluidcount, shift):
     r = pos - p1
     along = r @ axis
     radial = r - along[:, None] * axis
-    return (along >= 0) & (along <= length) & (np.einsum("ij,ij->i", radial, radial) <= f["radius"] ** 2)
+    inside = (along >= 0) & (along <= length)
+    if f.get("radius") is None:         # no <radius>: the slab between the end planes (DualSPHysics)
+        return inside
+    return inside & (np.einsum("ij,ij->i", radial, radial) <= f["radius"] ** 2)
 
 
 def _type(f, pos, ptype, mk, fluidcount, shift):

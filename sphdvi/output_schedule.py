@@ -7,8 +7,10 @@ the first row's time the next output is that time.  A case uses it to write ofte
 the events it studies (the impacts of a sloshing tank) and seldom in between.  Without it,
 outputs are TimeOut apart: the times (k+1) TimeOut, computed exactly as the loop always has.
 
-The schedule steps from one scheduled time to the next (not from the clock), so that a step that
-ends a round-off short of an output time cannot schedule that output twice.
+After an output the run asks for the first scheduled time after the clock (``first_after``, as
+DualSPHysics's ``GetNextTime(TimeStep)``: a step longer than the interval skips the times it
+jumped over), with a tolerance, so that a step that ends a round-off short of an output time
+cannot schedule that output twice.
 """
 from __future__ import annotations
 

@@ -86,6 +86,22 @@ def default_threads() -> int:
 # ---------------------------------------------------------------------------------
 # parameters from the case file and the command line
 # ---------------------------------------------------------------------------------
+def absolute_file_sets(sets) -> tuple:
+    """``--set ViscoTime=FILE`` / ``--set DtFixedFile=FILE``: FILE, like every path on the command
+    line, is relative to the current directory; it is made absolute here, so that run.json keeps
+    a path that ``--resume`` finds from any directory (in the XML the value is relative to the
+    case's folder, as DualSPHysics's DirCase)."""
+    from .case.reader import DATA_FILE_KEYS
+    out = []
+    for item in sets or ():
+        key, sep, value = str(item).partition("=")
+        value = value.strip()
+        if sep and key.strip() in DATA_FILE_KEYS and value and value.upper() != "NONE":
+            item = f"{key.strip()}={os.path.abspath(os.path.expanduser(value))}"
+        out.append(item)
+    return tuple(out)
+
+
 def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
     """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError.
 
@@ -336,6 +352,7 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
         raise InputError(f"--resume: {outdir} holds no run to continue (no {RESTART_FILE}"
                          + ("; its run stopped before its first output" if started else "") + "); start it with "
                          f"'sphdvi run {outdir}'" + (" --overwrite" if started else ""))
+    sets = absolute_file_sets(sets)
     if resume:
         if tmax is not None:
             _check_resume_tmax(float(tmax), outdir)
@@ -465,7 +482,7 @@ def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quie
     tout = out_times.rows[0][1] if out_times.uniform else float(params["TimeOut"])
     extra = params.get("TimeOutExtra")
     schedule = StepSchedule(float(params["TimeMax"]), tout, dt,
-                            extra if extra is not None and extra < tout else None,
+                            extra if extra is not None and extra >= 0 else None,
                             None if out_times.uniform else out_times)
     system, names = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
     if not system._packed:
@@ -1308,7 +1325,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             next_out = (out_times.first_after(float(sol.time), TIME_TOLERANCE * max(1.0, out_times.smallest))
                         if resume else out_times.after(out_times.nth(part)))
             extra = params.get("TimeOutExtra")
-            extra = float(extra) if body_log is not None and extra is not None and extra < tout else None
+            # DualSPHysics's TimeOutExtra: rows whenever it is >= 0 (whatever TimeOut or <timeout> say)
+            extra = float(extra) if body_log is not None and extra is not None and extra >= 0 else None
             next_extra = _next_multiple(sol.time, extra) if extra else 0.0
             while not time_reached(sol.time, tmax):
                 t_step = sol.time
@@ -1331,7 +1349,9 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                     part += 1
                     write_part(part)
                     dt_lo, dt_hi = math.inf, 0.0
-                    next_out = out_times.after(next_out)
+                    # the first output time after the clock (DualSPHysics's GetNextTime(TimeStep)):
+                    # a step longer than the interval skips the times it jumped over
+                    next_out = out_times.first_after(float(sol.time), TIME_TOLERANCE * max(1.0, out_times.smallest))
                     if extra:
                         next_extra = _next_multiple(sol.time, extra)
                 elif extra is not None and time_reached(sol.time, next_extra, extra):

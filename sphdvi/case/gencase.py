@@ -231,10 +231,12 @@ def apply_initials(case: Case, particles: dict, consts: Constants, reader) -> No
     items = list(case.initials) + list((case.special.get("initialize") or {}).get("velocity", []))
     for item in items:
         sel = _select(case, particles, item)
-        if not sel.any():
+        if not sel.any():      # DualSPHysics (JDsInitializeOp_FluidVel::Run) reports "(0 particles)" and goes on
             tag = item.get("element", item["type"])
-            raise CaseError(f"<{tag}> selects no particles", file=reader.file, line=item["line"],
-                            element=tag, expected="mkfluid/mkbound labels that were drawn")
+            reader.warnings.add(f"it selects no particles (none of its mkfluid/mkbound labels"
+                                f"{' inside its onlypos box' if item.get('onlypos') else ''}): it sets nothing",
+                                file=reader.file, line=item["line"], element=tag)
+            continue
         kind = item["type"]
         if kind == "velocity":
             if "vel" in item:

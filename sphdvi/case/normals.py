@@ -15,9 +15,10 @@ corner point to the outline's corner, the floor beside it straight up):
 
 1. a fixed or moving boundary looks at the open cells inside the particles' bounding box
    (a tank's outside is not water) on the side of the fluid: the vector to the surface must
-   have a positive component towards the nearest fluid particle within 6 dp, or, with no
-   fluid near, towards the centroid of all fluid particles (the back layers of a thick wall
-   or flap face the water, not the dry air behind them);
+   have a positive component towards the nearest fluid particle within 8 dp (an exact
+   radius, so that the choice does not depend on the particles' order or on how a search grid
+   falls on them), or, with no fluid near, towards the centroid of all fluid particles (the
+   back layers of a thick wall or flap face the water, not the dry air behind them);
 2. a floating body looks at every open cell around it: a body is wet on every side in time,
    so its normals point out of it (the top rows of a floating box, dry at the start, would
    otherwise face the water under the box and point down through it).
@@ -39,7 +40,15 @@ b. its sign faces the fluid as in 1, except on floating bodies, where it points 
    plate);
 c. N = n̂ · (k + 1/2) dp, k the number of boundary layers in front of the particle along n̂
    (found by stepping dp along n̂), so that the ghost node r + 2N lies in the fluid for
-   every layer of a thick wall.
+   every layer of a thick wall;
+d. on a fixed or moving boundary of several layers, where that N points away from the nearest
+   open point or puts the ghost node in a boundary particle's cell, the lattice surface is
+   used after all: the nearest point on flat walls (towards the fluid), else the nearest open
+   point. That is the top of a tank's wall, where the neighbours are one-sided and the fluid
+   may lie on one side of the tank only: GenCase draws its layers one dp higher each, a
+   staircase, and the derived N pointed into the wall (ghost node inside it) or, 4.5 dp long,
+   out of the tank (a ghost node never submerged: a wall particle switched off for ever
+   with SlipMode 2, 3), differently on the two walls of a mirror-symmetric tank.
 
 Particles of a boundary that never meets the fluid get a normal too; it is harmless.
 """
@@ -81,13 +90,15 @@ def _cell_span(sorted_keys, ix, iy, iz, nx, ny):
 
 
 @njit(cache=True)
-def _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, reach):
-    """The vector from boundary particle i to the nearest fluid particle within ``reach``
-    grid cells, or to the centroid of all fluid particles when none is that near."""
+def _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, reach, rmax2):
+    """The vector from boundary particle i to the nearest fluid particle within sqrt(``rmax2``)
+    (``reach`` grid cells cover that radius), or to the centroid of all fluid particles when
+    none is that near. An exact radius: which fluid particle counts does not depend on how the
+    search grid falls on the particles (a mirror image of the scene gets the mirror image)."""
     ix = int((bpos[i, 0] - lo[0]) * inv)
     iy = int((bpos[i, 1] - lo[1]) * inv)
     iz = int((bpos[i, 2] - lo[2]) * inv)
-    best = 1e300
+    best = rmax2
     t = np.empty(3)
     for k in range(3):
         t[k] = fcentroid[k] - bpos[i, k]
@@ -108,13 +119,14 @@ def _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, re
 
 
 @njit(cache=True)
-def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floating, t, out):
+def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floating, t, out, flat_only):
     """The nearest point to ``p`` of the open lattice cells (``solid`` False) within 9 cells of
     ``cell`` (p's lattice index): the cell boxes of side dp about origin + index * dp. A fixed
     boundary (not ``floating``) takes cells inside [ilo, ihi] (the particles' bounding box) whose
     point lies towards ``t`` (the fluid); of equally near points one on flat walls
-    (:func:`_on_flat_walls`), then the one most along ``t``. Writes the vector p -> point to
-    ``out``; True when that point lies on flat walls (False also when no open cell is that near)."""
+    (:func:`_on_flat_walls`), then the one most along ``t``; with ``flat_only`` points on flat
+    walls only. Writes the vector p -> point to ``out``; returns 2 when that point lies on flat
+    walls, 1 when not, 0 when no open cell is that near."""
     tn = np.sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2])
     tol = 1e-9 * dp
     best = 1e300
@@ -160,6 +172,8 @@ def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floatin
                     for k in range(3):
                         q_arr[k] = p[k] + v[k]
                     is_flat = _on_flat_walls(solid, glo, cc_arr, q_arr, origin, dp, is2d)
+                    if flat_only and not is_flat:
+                        continue
                     if (d < best - tol or (is_flat and not flat)
                             or (is_flat == flat and along > best_along)):
                         best = min(best, d)
@@ -167,7 +181,9 @@ def _nearest_open_point(p, cell, solid, glo, ilo, ihi, origin, dp, is2d, floatin
                         flat = is_flat
                         found = True
                         out[0], out[1], out[2] = v[0], v[1], v[2]
-    return found and flat
+    if not found:
+        return 0
+    return 2 if flat else 1
 
 
 @njit(cache=True)
@@ -232,6 +248,8 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward, lattice, solid
     ``glo``) and [ilo, ihi] bound the cells of the particles' bounding box."""
     out = np.zeros((nb, 3))
     done = np.zeros(nb, np.bool_)            # N final (the lattice surface)
+    near = np.zeros((nb, 3))                 # the nearest open point off flat walls (fixed boundaries)
+    has_near = np.zeros(nb, np.bool_)
     cell = 2.05 * dp      # a little over the search radius: rounding never hides a neighbour
     lo = np.empty(3)
     hi = np.empty(3)
@@ -252,7 +270,9 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward, lattice, solid
     forder = np.argsort(fkeys)
     fsorted = fkeys[forder]
     r2 = (2.0 * dp) ** 2 * 1.0001
-    reach = 3            # fluid search radius about 6 dp = 3 cells
+    # fluid search radius 8 dp (4 cells; exact, rounding aside: independent of the grid's alignment)
+    reach = 4
+    rmax2 = (8.0 * dp) ** 2 * (1.0 + 1e-9)
     lidx = np.zeros(3, np.int64)
     for i in range(nb):
         ix = int((bpos[i, 0] - lo[0]) * inv)
@@ -302,7 +322,7 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward, lattice, solid
             thin = w[0] < 0.1 * w[1]                # a single layer (line in 2D, sheet in 3D)
         else:
             n[2] = 1.0
-        t = _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, reach)
+        t = _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, reach, rmax2)
         oblique = thin and max(abs(n[0]), abs(n[1]), abs(n[2])) < OBLIQUE_COS
         if lattice and not (thin and (oblique or outward[i])):
             for k in range(3):
@@ -310,10 +330,15 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward, lattice, solid
             if is2d:
                 lidx[1] = 0
             v = np.zeros(3)
-            if _nearest_open_point(bpos[i], lidx, solid, glo, ilo, ihi, origin, dp, is2d, outward[i], t, v):
+            found = _nearest_open_point(bpos[i], lidx, solid, glo, ilo, ihi, origin, dp, is2d, outward[i], t, v,
+                                        False)
+            if found == 2:
                 out[i, :] = v
                 done[i] = True
                 continue
+            if found == 1 and not outward[i] and not thin:
+                near[i, :] = v
+                has_near[i] = True
         clear = not thin and cx * cx + cy * cy + cz * cz > (0.25 * dp) ** 2
         if clear:
             n[0], n[1], n[2] = -cx, -cy, -cz        # away from the boundary's own mass
@@ -348,7 +373,35 @@ def _normals_kernel(bpos, nb, fpos, dp, is2d, fcentroid, outward, lattice, solid
         layers = _layers_along(bpos, i, 1.0, out, dp, lo, inv, nx, ny, bsorted, border)
         for k in range(3):
             out[i, k] *= (0.5 + layers) * dp
+    # a neighbour-derived N that points away from the nearest open point or puts the ghost node
+    # r + 2N inside the boundary (the end of a wall, where the neighbours are one-sided) gives way
+    # to the lattice surface
+    for i in range(nb):
+        if not has_near[i]:
+            continue
+        dot = out[i, 0] * near[i, 0] + out[i, 1] * near[i, 1] + out[i, 2] * near[i, 2]
+        if dot > -1e-6 * dp * dp and not _ghost_in_solid(bpos[i], out[i], solid, glo, origin, dp, is2d):
+            continue
+        t = _toward_fluid(bpos, i, fpos, fsorted, forder, lo, inv, nx, ny, fcentroid, reach, rmax2)
+        for k in range(3):
+            lidx[k] = int(np.rint((bpos[i, k] - origin[k]) / dp))
+        if is2d:
+            lidx[1] = 0
+        v = np.zeros(3)
+        if _nearest_open_point(bpos[i], lidx, solid, glo, ilo, ihi, origin, dp, is2d, False, t, v, True) == 2:
+            out[i, :] = v                   # the nearest point on flat walls
+        else:
+            out[i, :] = near[i]
     return out
+
+
+@njit(cache=True)
+def _ghost_in_solid(p, nvec, solid, glo, origin, dp, is2d):
+    """Whether the ghost node p + 2 ``nvec`` lies in a lattice cell that a boundary particle fills."""
+    c0 = int(np.rint((p[0] + 2.0 * nvec[0] - origin[0]) / dp))
+    c1 = 0 if is2d else int(np.rint((p[1] + 2.0 * nvec[1] - origin[1]) / dp))
+    c2 = int(np.rint((p[2] + 2.0 * nvec[2] - origin[2]) / dp))
+    return _is_solid(solid, glo, c0, c1, c2)
 
 
 @njit(cache=True)

@@ -173,16 +173,27 @@ def read_fluid_velocity(reader, el) -> dict:
     if box is not None:
         item["onlypos"] = box
     item["direction"] = _nonzero(reader, el, "direction", _vector(reader, el, "direction"))
-    given = [t for t in ("velocity", "velocity2", "velocity3") if reader.child(el, t) is not None]
+    item["profile"], item["params"] = read_velocity_profile(reader, el)
+    return item
+
+
+VELOCITY_PROFILES = {"velocity": ("v",), "velocity2": ("v", "v2", "z", "z2"),
+                     "velocity3": ("v", "v2", "v3", "z", "z2", "z3")}
+
+
+def read_velocity_profile(reader, el) -> tuple:
+    """The one velocity profile of ``el`` (``<fluidvelocity>``, or ``<initials><velocity>`` with a
+    ``<direction>``): ``<velocity v>``, ``<velocity2 v v2 z z2>`` or ``<velocity3 v v2 v3 z z2 z3>``,
+    every attribute required, the heights distinct (JDsInitializeOp_FluidVel::ReadXml; equal
+    heights leave the line or parabola undefined). Returns (profile tag, {name: value})."""
+    given = [t for t in VELOCITY_PROFILES if reader.child(el, t) is not None]
     if len(given) > 1:
         raise reader.error(reader.child(el, given[1]), "several velocity profiles", "one of <velocity>, <velocity2>, <velocity3>")
     if not given:
         raise reader.error(el, "missing velocity profile", '<velocity v=".."/>, <velocity2 .../> or <velocity3 .../>')
     p = reader.child(el, given[0])
-    names = {"velocity": ("v",), "velocity2": ("v", "v2", "z", "z2"), "velocity3": ("v", "v2", "v3", "z", "z2", "z3")}
-    item["profile"] = given[0]
-    item["params"] = {k: reader.num(p, k) for k in names[given[0]]}
-    zs = [item["params"][k] for k in ("z", "z2", "z3") if k in item["params"]]
+    params = {k: reader.num(p, k) for k in VELOCITY_PROFILES[given[0]]}
+    zs = [params[k] for k in ("z", "z2", "z3") if k in params]
     if len(set(zs)) < len(zs):
         raise reader.error(p, f"the heights z of <{given[0]}> repeat", "distinct heights z, z2 (, z3)")
-    return item
+    return given[0], params

@@ -148,7 +148,8 @@ def _read_sphere(reader, el) -> dict:
     _check_children(reader, el, {"centre", "radius", "ftfollow"})
     d = _ftfollow(reader, el)
     d["centre"] = _point(reader, el, "centre", required=d["ftfollow"] is None)   # a followed body's centre
-    d["radius"] = _positive(reader, el, "radius")
+    # JDsOutputPartsOp_Cylinder: <radius> is optional (DBL_MAX: the slab between the end planes)
+    d["radius"] = _positive(reader, el, "radius") if reader.child(el, "radius") is not None else None
     return d
 
 
@@ -158,7 +159,8 @@ def _read_cylinder(reader, el) -> dict:
     d["point1"], d["point2"] = _point(reader, el, "point1"), _point(reader, el, "point2")
     if np.allclose(d["point1"], d["point2"], rtol=0, atol=0):
         raise reader.error(el, "point1 equals point2", "the two ends of the cylinder's axis")
-    d["radius"] = _positive(reader, el, "radius")
+    # JDsOutputPartsOp_Cylinder: <radius> is optional (DBL_MAX: the slab between the end planes)
+    d["radius"] = _positive(reader, el, "radius") if reader.child(el, "radius") is not None else None
     return d
 
 

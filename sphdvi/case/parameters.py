@@ -73,11 +73,13 @@ PARAMETERS: dict[str, Param] = {
     "TimeMax": Param("float", 1.0, "simulated time [s]", (), 0.0, 1e12),
     "TimeOut": Param("float", 0.01, "output interval [s]", (), 0.0, 1e12, positive=True),
     "TimeOutExtra": Param("float", None, "interval of the extra floating-body outputs (bodies.csv, "
-                          "links.csv) between TimeOut outputs [s] (0: every step; not set: none)", (), 0.0, 1e12),
+                          "links.csv) between the outputs [s] (0: every step; negative, DualSPHysics's "
+                          "default -1, or not set: none)", (), -1e12, 1e12),
     "RhopOutMin": Param("float", 700.0, "minimum valid density [kg/m3]", (), 0.0, 1e9),
     "RhopOutMax": Param("float", 1300.0, "maximum valid density [kg/m3]", (), 0.0, 1e9),
     "PartsOutMax": Param("float", 1.0, "deprecated: fraction of fluid allowed out", (), 0.0, 1.0),
-    "WrnPartsOut": Param("int", 1, "warn about excluded particles", (0, 1)),
+    # DualSPHysics reads WrnPartsOut as "!= 0"
+    "WrnPartsOut": Param("int", 1, "warn about excluded particles (0: no; any other value: yes)"),
     "MinFluidStop": Param("float", 0.0, "stop when the fluid fraction falls below this", (), 0.0, 1.0),
     "XPeriodicIncY": Param("float", 0.0, "periodic X: increment of Y"),
     "XPeriodicIncZ": Param("float", 0.0, "periodic X: increment of Z"),

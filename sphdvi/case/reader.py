@@ -17,7 +17,7 @@ from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import parse_mk_range
-from .normals_xml import read_initialize, read_normals, read_onlypos
+from .normals_xml import read_initialize, read_normals, read_onlypos, read_velocity_profile
 from .outputs_xml import read_outputparts, read_savedt
 from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
                          coerce, constant_hint, default_parameters, domain_from_deprecated, parameter_warnings)
@@ -78,11 +78,13 @@ def read_constantsdef(reader: CaseReader, casedef) -> ConstantsDef:
         return c
     reader.check_children(el, {"lattice", "gravity", "rhop0", "rhopgradient", "hswl", "gamma",
                                "speedsystem", "coefsound", "speedsound", "coefh", "hdp",
-                               "cflnumber", "h", "b", "massbound", "massfluid", "coefhdp"})
+                               "cflnumber", "h", "b", "massbound", "massfluid", "coefhdp",
+                               "coefficient", "eps"})
     lat = reader.child(el, "lattice")
     if lat is not None:
-        c.lattice_bound = reader.integer(lat, "bound", 1, lo=1, hi=2)
-        c.lattice_fluid = reader.integer(lat, "fluid", 1, lo=1, hi=2)
+        c.lattice_bound = _lattice(reader, lat, "bound")
+        c.lattice_fluid = _lattice(reader, lat, "fluid")
+    _read_eps(reader, el)
     g = reader.child(el, "gravity")
     if g is not None:
         c.gravity = reader.vec3(g).tolist()
@@ -100,15 +102,51 @@ def read_constantsdef(reader: CaseReader, casedef) -> ConstantsDef:
     c.b = _auto_value(reader, el, "b", positive=True)
     c.massbound = _auto_value(reader, el, "massbound", positive=True)
     c.massfluid = _auto_value(reader, el, "massfluid", positive=True)
-    coefh = reader.child(el, "coefh")
+    coefh = _coefh_element(reader, el)
     hdp = reader.child(el, "hdp")
     if coefh is not None and hdp is not None:
-        raise reader.error(hdp, "both <coefh> and <hdp> are given", "only one of them")
+        raise reader.error(hdp, f"both <{coefh.tag}> and <hdp> are given", "only one of them")
     if hdp is not None:
         c.hdp = reader.num(hdp, "value", positive=True, hi=100.0)
     elif coefh is not None:
         c.coefh = reader.num(coefh, "value", positive=True, hi=100.0)
     return c
+
+
+def _lattice(reader, lat, attr: str) -> int:
+    """``<lattice bound|fluid>``: 1, the cubic lattice, the only one sphdvi draws.  GenCase's
+    lattice 2 (JCaseCtes::ReadXmlDef: any value but 1) is a staggered lattice with twice the
+    particles (GenCase's log: a 9^3 block gives 1458): refused rather than drawn differently."""
+    v = reader.integer(lat, attr, 1, lo=1, hi=2)
+    if v != 1:
+        raise reader.error(lat, f"{attr}=\"{v}\": GenCase's lattice 2 (a staggered lattice, twice "
+                                "the particles) is not supported; sphdvi draws "
+                                "the cubic lattice only", f'{attr}="1" (or no <lattice>)')
+    return v
+
+
+def _read_eps(reader, el) -> None:
+    """``<eps value>`` (XSPH epsilon): read and unused, with DualSPHysics's warning when it is
+    not 0 (JCaseCtes::ReadXmlDef reads it, JSph::LoadCaseConfig warns)."""
+    eps = reader.child(el, "eps")
+    if eps is not None and reader.num(eps, "value", 0.0) != 0.0:
+        reader.warn(eps, "Eps value is not used (this correction was removed from DualSPHysics; "
+                         "sphdvi ignores it too)")
+
+
+def _coefh_element(reader, el):
+    """The element that gives coefh: ``<coefh>``, else ``<coefficient>``, its older name
+    (JCaseCtes::ReadXmlDef reads <coefficient> when <coefh> is absent or 0).  Both given
+    (coefh not 0): <coefh> is used and <coefficient> ignored, with a warning."""
+    coefh = reader.child(el, "coefh")
+    alias = reader.child(el, "coefficient")
+    if alias is None:
+        return coefh
+    if coefh is None or reader.num(coefh, "value", 0.0) == 0.0:
+        return alias
+    reader.mark(alias, "value")
+    reader.warn(alias, "<coefficient> is ignored: <coefh> is given (as DualSPHysics)")
+    return coefh
 
 
 def _auto_value(reader, parent, tag, **checks):
@@ -316,14 +354,7 @@ def read_initials(reader, casedef) -> list:
             direction = reader.child(item, "direction")
             if direction is not None:
                 d["direction"] = reader.vec3(direction).tolist()
-                for prof in ("velocity", "velocity2", "velocity3"):
-                    p = reader.child(item, prof)
-                    if p is not None:
-                        d["profile"] = prof
-                        d["params"] = {k: reader.num(p, k) for k in p.keys()
-                                       if k in ("v", "v2", "v3", "z", "z2", "z3")}
-                if "profile" not in d:
-                    raise reader.error(item, "velocity with <direction> needs <velocity v=..>, <velocity2> or <velocity3>")
+                d["profile"], d["params"] = read_velocity_profile(reader, item)   # as <fluidvelocity>'s
             else:
                 d["vel"] = reader.vec3(item).tolist()
         elif tag == "densityuniform":
@@ -1292,25 +1323,96 @@ def read_piston_solitary(reader, c) -> dict:
 
 
 def read_damping(reader, el) -> list:
-    spec = {"limitmin": "vec", "limitmax": "vec", "overlimit": "num", "redumax": "num", "factorxyz": "vec"}
+    """``<special><damping>`` as JDsDamping::ReadXml: ``<dampingzone>`` (JDsDampingOp_Plane,
+    with an optional ``<domain>``), ``<dampingbox>`` and ``<dampingcylinder>``
+    (:mod:`sphdvi.sph.damping`)."""
+    readers = {"dampingzone": _damping_plane, "dampingbox": _damping_box, "dampingcylinder": _damping_cylinder}
     out = []
     for c in reader.children(el):
-        if c.tag != "dampingzone":
-            raise reader.error(c, f"<damping><{c.tag}> is not supported by sphdvi", "<dampingzone>")
-        d = {"type": "zone", "line": c.sourceline}
-        d.update(_value_children(reader, c, spec, required=("limitmin", "limitmax")))
-        d.setdefault("overlimit", 0.0)
-        d.setdefault("redumax", 10.0)
-        d.setdefault("factorxyz", [1.0, 1.0, 1.0])
-        if np.allclose(d["limitmin"], d["limitmax"]):
-            raise reader.error(c, "limitmin equals limitmax", "two different points")
-        for k in ("overlimit", "redumax"):
-            if not d[k] >= 0:
-                raise reader.error(c, f"<{k}> is {d[k]:g}", f"{k} >= 0")
-        if not all(v >= 0.0 for v in d["factorxyz"]):
-            raise reader.error(c, f"<factorxyz> is {d['factorxyz']}", "factors >= 0")
-        out.append(d)
+        if c.tag not in readers:
+            raise reader.error(c, f"unknown damping zone <{c.tag}>", "<dampingzone>, <dampingbox> or <dampingcylinder>")
+        out.append(readers[c.tag](reader, c))
     return out
+
+
+def _damping_common(reader, c, kind: str, shape: set) -> dict:
+    """What every damping shape reads (JDsDampingOp_*::ReadXml): ``<overlimit>`` (0),
+    ``<redumax>`` (10), ``<factorxyz>`` (each of x, y, z 1 when omitted), all >= 0."""
+    reader.check_children(c, {"overlimit", "redumax", "factorxyz"} | shape)
+    d = {"type": kind, "line": c.sourceline,
+         "overlimit": reader.child_value(c, "overlimit", 0.0), "redumax": reader.child_value(c, "redumax", 10.0),
+         "factorxyz": reader.vec3(reader.child(c, "factorxyz"), np.ones(3), missing=1.0).tolist()}
+    for k in ("overlimit", "redumax"):
+        if not d[k] >= 0:
+            raise reader.error(reader.child(c, k), f"<{k}> is {d[k]:g}", f"{k} >= 0")
+    if not all(v >= 0.0 for v in d["factorxyz"]):
+        raise reader.error(reader.child(c, "factorxyz"), f"<factorxyz> is {d['factorxyz']}", "factors >= 0")
+    return d
+
+
+def _damping_plane(reader, c) -> dict:
+    """``<dampingzone>``: ``<limitmin>``, ``<limitmax>`` and an optional ``<domain zmin zmax>``
+    with ``<point1..4 x y>`` (the zone's lateral limits)."""
+    d = _damping_common(reader, c, "zone", {"limitmin", "limitmax", "domain"})
+    d["limitmin"], d["limitmax"] = (reader.vec3(reader.child(c, t, True)).tolist() for t in ("limitmin", "limitmax"))
+    if np.allclose(d["limitmin"], d["limitmax"]):
+        raise reader.error(c, "limitmin equals limitmax", "two different points")
+    dom = reader.child(c, "domain")
+    if dom is not None:
+        names = ("point1", "point2", "point3", "point4")
+        reader.check_children(dom, set(names))
+        d["domain"] = {"zmin": reader.num(dom, "zmin"), "zmax": reader.num(dom, "zmax"),
+                       "points": [[reader.num(p, "x"), reader.num(p, "y")]
+                                  for p in (reader.child(dom, t, True) for t in names)]}
+        if d["domain"]["zmin"] > d["domain"]["zmax"]:
+            raise reader.error(dom, f"zmin={d['domain']['zmin']:g} is above zmax={d['domain']['zmax']:g}", "zmin <= zmax")
+    return d
+
+
+def _damping_box(reader, c) -> dict:
+    """``<dampingbox>``: ``<directions value>`` (JDsDampingOp_Box::ReadXmlDirections: top,
+    bottom, left, right, front, back, all, each +added or -removed; default all) and the
+    ``<limitmin>`` / ``<limitmax>`` boxes (``<pointini>``, ``<pointend>``), the limitmin box
+    inside the limitmax one."""
+    from ..sph.damping import BOX_SIDES
+    d = _damping_common(reader, c, "box", {"directions", "limitmin", "limitmax"})
+    sides = [s[0] for s in BOX_SIDES]
+    text = reader.child(c, "directions")
+    words = reader.text_attr(text, "value").replace(",", " ").lower().split() if text is not None else []
+    chosen = set(sides) if not words else set()
+    for w in words:
+        name = w.lstrip("+-")
+        if name not in sides + ["all"]:
+            raise reader.error(text, f"direction {w!r} is not valid", "top, bottom, left, right, front, back or all, "
+                               "each optionally +/-")
+        group = set(sides) if name == "all" else {name}
+        chosen = chosen - group if w.startswith("-") else chosen | group
+    if not chosen:
+        raise reader.error(text, "no direction is active", "at least one of top, bottom, left, right, front, back")
+    d["directions"] = [s for s in sides if s in chosen]
+    for t in ("limitmin", "limitmax"):
+        box = reader.child(c, t, True)
+        reader.check_children(box, {"pointini", "pointend"})
+        d[t] = [reader.vec3(reader.child(box, k, True)).tolist() for k in ("pointini", "pointend")]
+        if not np.all(np.asarray(d[t][0]) <= d[t][1]):
+            raise reader.error(box, f"<{t}>: pointini {d[t][0]} is above pointend {d[t][1]}", "pointini <= pointend")
+    if not (np.all(np.asarray(d["limitmax"][0]) <= d["limitmin"][0])
+            and np.all(np.asarray(d["limitmin"][1]) <= d["limitmax"][1])):
+        raise reader.error(c, "the <limitmin> box is not inside the <limitmax> box", "limitmin inside limitmax")
+    return d
+
+
+def _damping_cylinder(reader, c) -> dict:
+    """``<dampingcylinder>``: the axis ``<point1>``, ``<point2>`` and the radii
+    ``<limitmin radius>`` <= ``<limitmax radius>``."""
+    d = _damping_common(reader, c, "cylinder", {"point1", "point2", "limitmin", "limitmax"})
+    d["point1"], d["point2"] = (reader.vec3(reader.child(c, t, True)).tolist() for t in ("point1", "point2"))
+    d["limitmin"], d["limitmax"] = (reader.num(reader.child(c, t, True), "radius", nonnegative=True)
+                                    for t in ("limitmin", "limitmax"))
+    if d["limitmin"] > d["limitmax"]:
+        raise reader.error(c, f"limitmin radius {d['limitmin']:g} is above limitmax radius {d['limitmax']:g}",
+                           "limitmin <= limitmax")
+    return d
 
 
 def read_timeout(reader, el) -> list:
@@ -1459,7 +1561,8 @@ def read_accinputs(reader, el) -> list:
 
 def _acc_table(reader, c) -> np.ndarray:
     """The (time, linx, liny, linz, angx, angy, angz) rows of one ``<accinput>``: from
-    ``<acctimes>`` (missing values 0) or the ``<acctimesfile>``; two rows at least, rising times."""
+    ``<acctimes>`` (missing values 0) or the ``<acctimesfile>``; two rows at least, times that do not
+    decrease (two rows at one time: a step change of the acceleration, as JLinearValue)."""
     table_el, file_el = reader.child(c, "acctimes"), reader.child(c, "acctimesfile")
     if (table_el is None) == (file_el is None):
         raise reader.error(c, "<accinput> needs one of <acctimes> and <acctimesfile>" +
@@ -1482,8 +1585,11 @@ def _acc_table(reader, c) -> np.ndarray:
     if table.shape[0] < 2:
         raise reader.error(where, f"{table.shape[0]} row(s) of accelerations{place}",
                            "at least two (time, linx, liny, linz, angx, angy, angz) rows")
-    if np.any(np.diff(table[:, 0]) <= 0):
-        raise reader.error(where, f"the times of the accelerations do not rise{place}", "rising times")
+    if np.any(np.diff(table[:, 0]) < 0):     # a repeated time is a step (JLinearValue)
+        row = int(np.flatnonzero(np.diff(table[:, 0]) < 0)[0]) + 1
+        raise reader.error(where, f"the times of the accelerations go back (row {row + 1}: time {table[row, 0]:g} "
+                           f"after {table[row - 1, 0]:g}){place}", "times that do not decrease (a repeated time "
+                           "is a step change)")
     return table
 
 

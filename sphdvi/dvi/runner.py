@@ -69,39 +69,47 @@ def build_system(bodies, links=(), materials=(), **system_kw):
 
 
 class StepSchedule:
-    """The fixed-step schedule of a body-only run: ``nsteps`` steps of ``dt``, an output every
-    ``every`` steps and at the last step, and with TimeOutExtra (``tout_extra``; None: none,
-    0: every step) a row every ``extra`` steps in between.  ``output_times``: an
-    :class:`~sphdvi.output_schedule.OutputSchedule` of uneven output times (DualSPHysics's
-    ``<special><timeout>``) instead of one every ``tout``: each output at the step nearest it."""
+    """The fixed-step schedule of a body-only run: ``nsteps`` steps of ``dt``, an output at the first
+    step that reaches each output time and at the last step, the next output time being the first
+    one after that step's time (DualSPHysics's ``TimeStep >= TimePartNext`` and
+    ``GetNextTime(TimeStep)``, as an SPH run's loop); ``output_times``: an
+    :class:`~sphdvi.output_schedule.OutputSchedule` of uneven output times (``<special><timeout>``)
+    instead of one every ``tout``.  With TimeOutExtra (``tout_extra``; None: none, 0: every step)
+    a row at the first step reaching each multiple of it after the previous row (TimeOutExtraUpdate)."""
 
     def __init__(self, tmax, tout, dt, tout_extra=None, output_times=None):
+        from ..output_schedule import OutputSchedule
         self.dt = float(dt)
         # the steps that reach TimeMax, as an SPH run's (one that ends between two steps takes the
         # next: round() stopped --tmax 1.0125 at 1.012 with dt 1e-3)
         n = tmax / dt
         self.nsteps = int(math.ceil(n - 1e-9 * max(1.0, n)))
-        self.every = max(1, int(round(tout / dt)))
-        self.extra = None if tout_extra is None else max(1, int(round(tout_extra / dt)))
-        self.steps = None
-        if output_times is not None:
-            self.steps, t = set(), 0.0
-            while True:
-                t = output_times.after(t)
-                k = max(1, int(round(t / self.dt)))
-                if k > self.nsteps:
-                    break
-                self.steps.add(k)
+        sched = output_times if output_times is not None else OutputSchedule.every(float(tout))
+        tol = 1e-9 * max(1.0, sched.smallest)
+        self.steps = self._reaching(sched.after(0.0), lambda t: sched.first_after(t, tol))
+        self.every_step = tout_extra is not None and float(tout_extra) <= 0.0
+        self.extra = None
+        if tout_extra is not None and not self.every_step:
+            te = float(tout_extra)
+            self.extra = self._reaching(te, lambda t: (math.floor(t / te * (1 + 1e-12)) + 1) * te)
+
+    def _reaching(self, t, following):
+        """The steps at which the times t, following(step time), ... are first reached."""
+        steps = set()
+        while True:
+            k = max(1, int(math.ceil(t / self.dt - 1e-9 * max(1.0, t / self.dt))))
+            if k > self.nsteps:
+                return steps
+            steps.add(k)
+            t = following(k * self.dt)
 
     def is_output(self, k):
         """Step ``k`` (1-based) ends at an output time."""
-        if self.steps is not None:
-            return k in self.steps or k == self.nsteps
-        return k % self.every == 0 or k == self.nsteps
+        return k in self.steps or k == self.nsteps
 
     def is_row(self, k):
         """Step ``k`` ends at an output or a TimeOutExtra time."""
-        return self.is_output(k) or (self.extra is not None and k % self.extra == 0)
+        return self.is_output(k) or self.every_step or (self.extra is not None and k in self.extra)
 
 
 # the columns of bodies.csv after time and body, and of links.csv after time and link

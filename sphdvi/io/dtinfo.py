@@ -9,10 +9,14 @@
   ``ViscDtMax`` (1/s) and ``VelMax`` (m/s).  A term that the step's dt did not come from
   (the first Symplectic step, whose dt is DtIni) is left out of the statistics; a column
   with none is empty.
-* ``DtAllInfo.csv`` (``alldt``): ``Time;Dtf``, a row per step.
+* ``DtAllInfo.csv`` (``alldt``): ``Time [s];Dtf [s]``, a row per step.
 
-Rows are appended at each output; the row of the interval in progress is written when
-the interval ends and at the end of the run.  A resume cuts both files back to the rows
+The column names carry DualSPHysics's units (``Time [s]``, ``Dtf_mean [s]``, ``AceMax_mean [m/s^2]``,
+``ViscDtMax_mean``, ``VelMax_mean [m/s]``).
+
+Rows are appended at each output, which closes the interval in progress as DualSPHysics
+does (its later steps start a row of their own, timed by their first step); a row is also
+written when its interval ends and at the end of the run.  A resume cuts both files back to the rows
 its checkpoint counted and goes on with the interval in progress (:meth:`DtLog.get_state`).
 """
 from __future__ import annotations
@@ -29,9 +33,14 @@ TERMS = ("Dtf", "Dt1", "Dt2")
 FULL_TERMS = ("AceMax", "ViscDtMax", "VelMax")
 
 
+UNITS = {"Dtf": " [s]", "Dt1": " [s]", "Dt2": " [s]", "AceMax": " [m/s^2]", "ViscDtMax": "", "VelMax": " [m/s]"}
+DTALLINFO_HEADER = "Time [s];Dtf [s]"
+
+
 def dtinfo_header(fullinfo: bool) -> str:
+    """DualSPHysics's column names, units included (JDsSaveDt::SaveFileValues)."""
     names = TERMS + (FULL_TERMS if fullinfo else ())
-    return "Time;Values;" + ";".join(f"{n}_{s}" for n in names for s in ("mean", "min", "max"))
+    return "Time [s];Values;" + ";".join(f"{n}_{s}{UNITS[n]}" for n in names for s in ("mean", "min", "max"))
 
 
 def _fmt(v: float) -> str:
@@ -61,7 +70,7 @@ class DtLog:
         if state is None:
             write_text_atomic(self.path, self.header + "\n")
             if self.all_path:
-                write_text_atomic(self.all_path, "Time;Dtf\n")
+                write_text_atomic(self.all_path, DTALLINFO_HEADER + "\n")
         else:
             self._resume(state)
 
@@ -100,7 +109,11 @@ class DtLog:
 
     # -- the files -----------------------------------------------------------------------
     def flush(self) -> None:
-        """Append the complete rows (at each output)."""
+        """Append the rows at an output: as DualSPHysics's JDsSaveDt::SaveData, the interval in
+        progress is closed there (its steps after the output start a row of their own), so that
+        no row spans an output."""
+        if self.count:
+            self._close_interval()
         if self.rows:
             append_text(self.path, "".join(self.rows))
             self.written += len(self.rows)
@@ -127,7 +140,7 @@ class DtLog:
         self.written, self.all_written = int(st["written"]), int(st["all_written"])
         self.t0, self.count, self.acc = float(st["t0"]), int(st["count"]), st["acc"]
         for path, header, n in ((self.path, self.header, self.written),
-                                (self.all_path, "Time;Dtf", self.all_written)):
+                                (self.all_path, DTALLINFO_HEADER, self.all_written)):
             if path is None:
                 continue
             rows = complete_lines(path)[1:n + 1] if os.path.exists(path) else []

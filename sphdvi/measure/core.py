@@ -56,10 +56,12 @@ class KernelSpec:
 
     @property
     def wdp_inv(self) -> float:
-        """1/W(dp) of the cubic kernel (tensile correction), 0 for Wendland."""
+        """1/W(dp) of the cubic kernel (tensile correction), 0 for Wendland; W(dp) taken
+        at q = 2/3 whatever dp/h, as DualSPHysics (FunSphKernel.h GetKernelCubic_Ctes)
+        and the solver."""
         if self.kind != 1:
             return 0.0
-        return 1.0 / K.kernel_w(1, self.dp / self.h, K.kernel_alpha(1, self.h, self.is2d))
+        return 1.0 / K.kernel_w(1, 1.0 / 1.5, K.kernel_alpha(1, self.h, self.is2d))
 
     @property
     def surface_threshold(self) -> float:

@@ -63,9 +63,23 @@ class AccInput:
         table), or None outside the active interval."""
         if not (self.start <= t <= self.end):
             return None
-        acc = np.array([np.interp(t, self.table[:, 0], self.table[:, k]) for k in range(1, 7)])
-        vel = np.array([np.interp(t, self.velocities[:, 0], self.velocities[:, k]) for k in range(1, 7)])
+        acc = linear_value(self.table[:, 0], self.table[:, 1:7], t)
+        vel = linear_value(self.velocities[:, 0], self.velocities[:, 1:7], t)
         return acc[:3], acc[3:], vel[:3], vel[3:]
+
+
+def linear_value(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
+    """The row of ``values`` at time t, as DualSPHysics's JLinearValue::FindTime/GetValue3d3d:
+    linear between the rows around t, the first or last row outside the table; at a time
+    the table repeats (a step), the first of its rows (the value before the step), the last
+    one just after it."""
+    nxt = min(max(int(np.searchsorted(times, t, side="left")), 1), times.size - 1)
+    pre = nxt - 1
+    if t <= times[pre]:
+        return values[pre].copy()
+    if t >= times[nxt]:
+        return values[nxt].copy()
+    return values[pre] + (values[nxt] - values[pre]) * ((t - times[pre]) / (times[nxt] - times[pre]))
 
 
 def acc_inputs(specs) -> list:

@@ -81,11 +81,13 @@ from .timestep import force_term_ace2
 def _hydrostatic_drho(x, rhop0, inv_gamma):
     """rho0 ((1+x)^(1/gamma) - 1): hydrostatic density difference (Fourtakas).
 
-    Called with x = rho0 |g| (z_a - z_b) / B (= -DDTgz dz), this is
+    Called with x = -rho0 g_z (z_a - z_b) / B (cst[9] = rho0 g_z / B), this is
     rho^H_b - rho^H_a, so that (rho_b - rho_a) - rho^H_ba vanishes in a
-    hydrostatic column.  (Written literally with DualSPHysics's DDTgz dz,
-    DDTgz = rho0 g_z / B < 0, the correction would double the hydrostatic
-    difference instead; tests/sph/test_interaction.py checks the cancellation.)
+    hydrostatic column (tests/sph/test_interaction.py checks the cancellation).
+    DualSPHysics (JSph::ConfigConstants2, JSphCpu::InteractionForcesFluid)
+    computes rh = 1 + DDTgz drz with DDTgz = rho0 |g_z| / B > 0, drz = z_a - z_b:
+    the same x for downward gravity (g_z < 0).  Only for g_z > 0 do they differ:
+    DualSPHysics keeps |g_z|, sphdvi follows the sign of gravity.
 
     Binomial series for |x| < 0.01 (relative error < 1e-10), pow otherwise.
     """

@@ -122,6 +122,15 @@ velocity in the continuity gives -1.4 %, and this treatment -0.7 %
 
 ``NoPenetration`` (slip modes 2 and 3) corrects the fluid particles next to
 the walls, not the boundary particles: :mod:`sphdvi.sph.nopen`.
+
+Periodic boundaries: the correction runs on the extended set (the particles and
+their copies within 2h of the periodic ends); a copy of a wall or floating
+particle then takes its real particle's packed density, pressure, mass (zero
+when dry) and tangential velocity (:func:`copy_to_periodic_rows`), as
+DualSPHysics gets by wrapping the ghost node into the domain (UpdatePeriodicPos
+in InteractionMdbcCorrectionT2 / InteractionMdbc2CorrectionT2): the copy's own
+ghost node, up to 2h beyond the end, sees only part of a kernel of fluid
+(0.5-1.7 kg/m3 off in a disturbed channel).
 """
 import math
 
@@ -432,6 +441,27 @@ def _refresh_packed(i0, i1, is2d, ptype, oi, rhop, cst, nb):
         if ptype[i] == 3:
             continue
         _set_packed(nb, i, is2d, rhop[oi[i]], cst, False)
+
+
+@njit(cache=True, error_model="numpy")
+def copy_to_periodic_rows(is2d, nb, ptype, src_row, tvel):
+    """Periodic copies of wall and floating particles: the packed density, pressure,
+    mass (zero when dry) and 1/rho, and the tangential velocity (``tvel`` with one row
+    per packed row, mDBC2; shorter: none) of packed row ``src_row[i]``, the row of the
+    real particle, as DualSPHysics gets by wrapping the ghost node into the domain
+    (UpdatePeriodicPos in InteractionMdbcCorrectionT2 / InteractionMdbc2CorrectionT2):
+    the copy's own ghost node sees only the truncated extended set."""
+    c0 = 4 if is2d else 6
+    has_tvel = tvel.shape[0] >= nb.shape[0]
+    for i in range(nb.shape[0]):
+        s = src_row[i]
+        if s == i or ptype[i] == 3:
+            continue
+        for c in range(c0, c0 + 4):
+            nb[i, c] = nb[s, c]
+        if has_tvel:
+            for c in range(3):
+                tvel[i, c] = tvel[s, c]
 
 
 @njit(cache=True, error_model="numpy")

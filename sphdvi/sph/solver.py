@@ -306,7 +306,10 @@ class SPHSolver:
         cst[10] = self.rhop0
         cst[11] = 1.0 / self.gamma
         cst[12:15] = self.gravity
-        cst[15] = 1.0 / kernel_w(1, self.dp / h, kernel_alpha(1, h, self.is2d)) if self.kernel == 1 else 0.0
+        # cubic tensile correction f = (W(r)/W(dp))^4 with DualSPHysics's W(dp) = W(q = 2/3)
+        # (FunSphKernel.h GetKernelCubic_Ctes: deltap = 1/1.5 fixed, i.e. h = 1.5 dp assumed
+        # whatever coefh), not W at the case's own dp/h
+        cst[15] = 1.0 / kernel_w(1, 1.0 / 1.5, kernel_alpha(1, h, self.is2d)) if self.kernel == 1 else 0.0
         cst[16] = self.b
         cst[17] = self.gamma
         cst[18] = 1.0
@@ -328,8 +331,7 @@ class SPHSolver:
         # Molteni-Colagrossi DDT: DualSPHysics switches it off next to DBC walls but sums
         # over mDBC walls (their density is the corrected one)
         cst[22] = 1.0 if self.boundary == 2 else 0.0
-        self.sps_smag = (0.12 * self.dp) ** 2
-        self.sps_blin = (2.0 / 3.0) * 0.0066 * self.dp ** 2
+        self.sps_smag, self.sps_blin = _sps.sps_constants(self.dp, self.is2d)
         self.shift_tfs = float(p["ShiftTFS"])
         self.ip = np.zeros(17)
         self.ip[1] = self.rhop0
@@ -786,7 +788,12 @@ class SPHSolver:
             fn(self.kernel, self.is2d, nb, ptype_e, np.arange(ne), normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
                self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
-            bound = (order < n) & ((ptype_e < 2) | ((ptype_e == 2) & (self.slip == 1)))
+            # a copy's ghost node sees a truncated extended set: it takes its real particle's result
+            real_e = order < n
+            row_of = np.empty(n, np.int64)
+            row_of[order[real_e]] = np.flatnonzero(real_e)
+            mdbc.copy_to_periodic_rows(self.is2d, nb, ptype_e, row_of[idx], self._tvel(ne))
+            bound = real_e & (ptype_e != 3)
             s.rhop[order[bound]] = rhop_e[bound]
             if self.nopen and self._need_nopen:
                 ar_e = np.arange(ne)

@@ -213,3 +213,58 @@ def test_thin_walls_are_found_in_3d(layers, thin):
     found = thin_wall_mkbounds(pos, n, ptype, np.zeros(len(pos), int), dp, h)
     assert {mk: fewest for mk, (fewest, _) in found.items()} == thin
     assert layers_needed(h, dp) == 3 and layers_needed(dp * np.sqrt(2), dp) == 2      # 3D and 2D, coefh 1
+
+
+def _dambreak_box(dp=0.02, mirrored=False):
+    """GenCase's particles of CaseDambreakMdbc2D's tank scaled to 0.4 x 0.3 m (3 layers drawn
+    outwards, each one dp higher than the one inside it) with a 0.2 x 0.2 m water column in its
+    left corner; ``mirrored``: the same scene mirrored about x = 0.2."""
+    pts = []
+    for k in range(3):
+        xs = np.arange(-k * dp, 0.4 + k * dp + dp / 2, dp)
+        zs = np.arange(-k * dp + dp, 0.3 + k * dp + dp / 2, dp)
+        pts += [[x, 0, -k * dp] for x in xs] + [[-k * dp, 0, z] for z in zs] + [[0.4 + k * dp, 0, z] for z in zs]
+    g = np.arange(dp, 0.2 + dp / 2, dp)
+    fx, fz = np.meshgrid(g, g)
+    pos = np.vstack([np.round(pts, 12), np.column_stack([fx.ravel(), 0 * fx.ravel(), fz.ravel()])])
+    ptype = np.array([0] * len(pts) + [3] * fx.size)
+    if mirrored:
+        pos[:, 0] = 0.4 - pos[:, 0]
+    return pos, ptype
+
+
+def test_wall_tops_get_mirror_normals_into_the_tank():
+    """The tops of a tank's walls (a staircase: each layer one dp above the one inside it) get
+    mirror-image normals on the two sides whatever the water's place (here in the left half),
+    each towards the tank: the ghost node r + 2N inside the tank, in no boundary particle's cell
+    (the right wall's second layer got N = (1.4, -4.3) dp, out of the tank; the left wall's
+    (-0.2, -0.4) dp, into the wall)."""
+    dp = 0.02
+    pos, ptype = _dambreak_box(dp)
+    n = boundary_normals(pos, ptype, dp, True)
+    b = ptype == 0
+    cells = {tuple(np.rint(p[[0, 2]] / dp).astype(int)) for p in pos[b]}
+    top = np.flatnonzero(b & (pos[:, 2] > 0.25) & (pos[:, 0] < 0.2))
+    assert len(top) == 12
+    for i in top:
+        j = np.flatnonzero(b & np.isclose(pos[:, 0], 0.4 - pos[i, 0]) & np.isclose(pos[:, 2], pos[i, 2]))[0]
+        assert n[j] == pytest.approx(n[i] * [-1, 1, 1], abs=1e-9 * dp)
+        for k in (i, j):
+            g = pos[k] + 2 * n[k]
+            assert 0.0 < g[0] < 0.4 and 0.0 < g[2] <= 0.3 + 1e-9, (pos[k], n[k] / dp)
+            assert tuple(np.rint(g[[0, 2]] / dp).astype(int)) not in cells, (pos[k], n[k] / dp)
+
+
+def test_normals_follow_the_scene_under_mirroring_and_reordering():
+    """The normals do not depend on the particles' order, and the mirror image of a scene
+    (water included) gets the mirror image of its normals."""
+    dp = 0.02
+    pos, ptype = _dambreak_box(dp)
+    n = boundary_normals(pos, ptype, dp, True)
+    pm, _ = _dambreak_box(dp, mirrored=True)
+    nm = boundary_normals(pm, ptype, dp, True)
+    np.testing.assert_allclose(nm * [-1, 1, 1], n, atol=1e-9 * dp)
+    perm = np.random.default_rng(1).permutation(len(pos))
+    npm = np.empty_like(n)
+    npm[perm] = boundary_normals(pos[perm], ptype[perm], dp, True)
+    np.testing.assert_allclose(npm, n, atol=1e-9 * dp)

@@ -81,6 +81,23 @@ def test_bad_accinputs_are_clear_errors(tmp_path, special, message):
     assert message in r.output and "Traceback" not in r.output, r.output
 
 
+def test_a_repeated_time_is_accepted_and_a_decreasing_one_refused(tmp_path):
+    """Rows with one time twice are a step change of the acceleration (DualSPHysics's
+    JLinearValue takes them; sphdvi refused them as "do not rise"); a time that goes back
+    stays an error."""
+    from sphdvi.case.gencase import build_case
+    step = ('<acctimes><timevalue time="0" /><timevalue time="1" /><timevalue time="1" linx="2" />'
+            '<timevalue time="3" linx="2" /></acctimes>')
+    (tmp_path / "push.csv").write_text("0 1 0 0 0 0 0\n1 1 0 0 0 0 0\n")
+    special = FLOAT.replace('<acctimes><timevalue time="0" /><timevalue time="1" /></acctimes>', step)
+    case = write_case(tmp_path, case_xml(dp="0.05", commands=BLOCKS, special=special, parameters=PARAMS))
+    r = build_case(case, str(tmp_path / "g"))
+    assert [row[:2] for row in r.case.special["accinputs"][0]["table"]] == [[0, 0], [1, 0], [1, 2], [3, 2]]
+    (tmp_path / "push.csv").write_text("0 1 0 0 0 0 0\n2 1 0 0 0 0 0\n1 1 0 0 0 0 0\n")
+    r = invoke(["gencase", case, "-o", tmp_path / "g2", "-q"])
+    assert r.exit_code == 2 and "the times of the accelerations go back (row 3: time 1 after 2)" in r.output, r.output
+
+
 def test_a_short_file_row_is_reported_with_its_line(tmp_path):
     (tmp_path / "push.csv").write_text("0 1 0 0 0 0 0\n1 1 0 0\n")
     case = write_case(tmp_path, case_xml(dp="0.05", commands=BLOCKS, special=FLOAT, parameters=PARAMS))

@@ -10,7 +10,7 @@ from sphdvi.cli import main
 from sphdvi.dvi.runner import StepSchedule
 from sphdvi.output_schedule import OutputSchedule
 
-from run.test_run import final_state, small_case
+from run.test_run import REPO, final_state, small_case
 
 TIMEOUT = ('<timeout><tout time="0" timeout="0.004"/><tout time="0.006" timeout="0.001"/>'
            '<tout time="0.0085" timeout="0.003"/></timeout>')
@@ -131,3 +131,56 @@ def test_a_single_timeout_row_sets_the_interval_of_a_body_only_run(tmp_path):
     r = invoke(["run", case, "-o", out, "--tmax", "0.1", "-q"])
     assert r.exit_code == 0, r.output
     assert np.allclose(run_times(out), np.arange(0, 0.1001, 0.02), atol=1e-9)
+
+
+def test_a_step_longer_than_the_interval_skips_the_times_it_jumped(tmp_path):
+    """DualSPHysics's GetNextTime(TimeStep): after an output the next one is the first scheduled
+    time after the clock.  Outputs 1e-4 s apart with steps of ~1.3e-4 s until 0.01, then 0.005
+    apart: one output per step until 0.01, then 0.015, 0.02 (sphdvi stepped from the previous
+    scheduled time, fell behind the clock, and then wrote every step long after 0.01)."""
+    path = small_case(tmp_path)
+    rows = '<timeout><tout time="0" timeout="0.0001"/><tout time="0.01" timeout="0.005"/></timeout>'
+    path.write_text(path.read_text().replace("<special>", "<special>" + rows, 1))
+    out = tmp_path / "o"
+    r = invoke(["run", path, "-o", out, "--tmax", "0.02", "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    t = run_times(out)
+    late = t[t > 0.0101]
+    assert late.size == 2 and np.all(np.abs(late - [0.015, 0.02]) < 2e-4), late
+    steps = [int(line.split(",")[2]) for line in (out / "run.csv").read_text().splitlines()[1:]]
+    early = np.diff(steps)[: int(np.count_nonzero(t <= 0.0101)) - 1]
+    assert np.all(early == 1)                                  # every step an output before 0.01
+
+
+def test_body_only_outputs_at_the_first_step_reaching_their_time():
+    """As an SPH run (and DualSPHysics): an output at the first step whose end reaches it, the next
+    time after that step's; not the nearest step (round-half-even put 0.0025 at step 2, before it)."""
+    def outputs(tout, tmax=0.012, dt=1e-3, table=None):
+        s = StepSchedule(tmax, tout, dt, None, table)
+        return [k for k in range(1, s.nsteps + 1) if s.is_output(k)]
+    assert outputs(0.0025) == [3, 5, 8, 10, 12]                # 12: the last step
+    assert outputs(0.0015) == [2, 3, 5, 6, 8, 9, 11, 12]
+    assert outputs(None, table=OutputSchedule([(0, 0.0025), (0.0075, 0.0035)]))[:2] == [3, 5]
+    extra = StepSchedule(0.012, 0.01, 1e-3, 0.0025)
+    assert [k for k in range(1, 13) if extra.is_row(k) and not extra.is_output(k)] == [3, 5, 8]
+
+
+def test_timeoutextra_rows_whatever_timeout_says(tmp_path):
+    """DualSPHysics writes the extra floating rows whenever TimeOutExtra >= 0 (negative, its default
+    -1: none), with a <timeout> table too; sphdvi dropped them when TimeOutExtra >= TimeOut (and
+    refused -1, and a WrnPartsOut other than 0 and 1, which DualSPHysics reads as != 0)."""
+    case = tmp_path / "CaseFloatingBox2D_Def.xml"
+    src = (REPO / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml").read_text()
+    case.write_text(src.replace("<special>", '<special><timeout><tout time="0" timeout="0.05"/></timeout>', 1)
+                    if "<special>" in src else src.replace("<parameters>", '<special><timeout><tout time="0" '
+                                                           'timeout="0.05"/></timeout></special><parameters>', 1))
+    common = ["--dp", "0.04", "--tmax", "0.1", "--threads", "1", "-q", "--set", "FtPause=0", "--set", "TimeOut=0.01"]
+    out = tmp_path / "o"
+    r = invoke(["run", case, "-o", out, "--set", "TimeOutExtra=0.02"] + common)
+    assert r.exit_code == 0, r.output
+    times = np.unique([float(x.split(",")[0]) for x in (out / "bodies.csv").read_text().splitlines()[1:]])
+    assert times.size == 7 and np.all(np.abs(times - [0, 0.02, 0.04, 0.05, 0.06, 0.08, 0.1]) < 5e-4), times
+    r = invoke(["run", case, "-o", tmp_path / "n", "--set", "TimeOutExtra=-1", "--set", "WrnPartsOut=2"] + common)
+    assert r.exit_code == 0, r.output
+    assert np.unique([float(x.split(",")[0]) for x in
+                      (tmp_path / "n" / "bodies.csv").read_text().splitlines()[1:]]).size == 3

@@ -58,6 +58,9 @@ def test_box_plane_sphere_cylinder():
     along = (s > 0.28) & (s < 1.72)
     off = np.abs(pos[:, 0] - pos[:, 2]) / np.sqrt(2)
     assert np.array_equal(sel, along & (off < 0.1)) and sel.sum() == 7 + 16
+    # without <radius> (JDsOutputPartsOp_Cylinder: DBL_MAX) the slab between the end planes
+    sel, pos, _, _ = select([flt("cylinder", point1=[0.14, 0, 0.14], point2=[0.86, 0, 0.86], radius=None)])
+    assert np.array_equal(sel, along)
 
 
 def test_operations_inverse_types_mk_and_groups():

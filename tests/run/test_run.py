@@ -713,6 +713,33 @@ def test_viscotime_from_case(tmp_path):
     assert r.exit_code == 2 and "ViscoTime" in r.output and "visco.txt" in r.output and "line 2" in r.output
 
 
+def test_set_viscotime_file_is_kept_absolute_for_resume(tmp_path, monkeypatch):
+    """``--set ViscoTime=FILE``: FILE relative to the current directory (as any path on the
+    command line), stored absolute in run.json, so that ``--resume`` from another directory
+    finds it (run.json kept 'visco.txt', and the resume failed to read it)."""
+    data, elsewhere = tmp_path / "data", tmp_path / "elsewhere"
+    data.mkdir()
+    elsewhere.mkdir()
+    (data / "visco.txt").write_text("0 0.05\n1 0.03\n")
+    case = small_case(tmp_path)
+    out = tmp_path / "b"
+    common = ["--tout", "0.004", "--threads", "1", "-q"]
+    monkeypatch.chdir(data)
+    r = invoke(["run", case, "-o", out, "--tmax", "0.004", "--set", "ViscoTime=visco.txt"] + common)
+    assert r.exit_code == 0, r.output
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["overrides"]["set"] == [f"ViscoTime={data / 'visco.txt'}"]
+    assert meta["parameters"]["ViscoTime"] == str(data / "visco.txt")
+    monkeypatch.chdir(elsewhere)
+    r = invoke(["run", out, "--resume", "--tmax", "0.008"] + common)
+    assert r.exit_code == 0, r.output
+    assert json.loads((out / "run.json").read_text())["status"] == "completed"
+    # the same --set given again on resume, from elsewhere, names another file: refused as a change
+    (elsewhere / "visco.txt").write_text("0 0.05\n1 0.03\n")
+    r = invoke(["run", out, "--resume", "--tmax", "0.012", "--set", "ViscoTime=visco.txt"] + common)
+    assert r.exit_code == 2 and "ViscoTime" in r.output and str(elsewhere / "visco.txt") in r.output, r.output
+
+
 def test_exclusion_warnings_as_dualsphysics(tmp_path):
     """WrnPartsOut: a warning (terminal and run.log) when the particles excluded since the
     previous output reach 1 % of the fluid, then 2, 5, 10, 20 ... %, and when all excluded

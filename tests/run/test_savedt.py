@@ -44,7 +44,8 @@ def test_each_step_row_obeys_the_time_step_formula(tmp_path):
     assert r.exit_code == 0, r.output
     head, rows = read_rows(out / "DtInfo.csv")
     assert head == dtinfo_header(True)
-    assert head.startswith("Time;Values;Dtf_mean;Dtf_min;Dtf_max;Dt1_mean") and head.endswith("VelMax_max")
+    assert head.startswith("Time [s];Values;Dtf_mean [s];Dtf_min [s];Dtf_max [s];Dt1_mean [s]")   # DualSPHysics's
+    assert "AceMax_mean [m/s^2]" in head and ";ViscDtMax_mean;" in head and head.endswith("VelMax_max [m/s]")
     rows = np.array(rows)
     steps = run_steps(out)
     assert rows.shape == (steps, 20) and np.all(rows[:, 1] == 1)
@@ -63,7 +64,7 @@ def test_each_step_row_obeys_the_time_step_formula(tmp_path):
     np.testing.assert_allclose(dt2, cfl * h / (np.maximum(c0, 10 * vel) + h * visc), rtol=1e-11)
     _, every = read_rows(out / "DtAllInfo.csv")
     every = np.array(every)
-    assert (out / "DtAllInfo.csv").read_text().startswith("Time;Dtf\n")
+    assert (out / "DtAllInfo.csv").read_text().startswith("Time [s];Dtf [s]\n")
     np.testing.assert_array_equal(every, rows[:, [0, 2]])
     assert every[:, 1].sum() == pytest.approx(meta["physical_time"], rel=1e-12)
 
@@ -84,8 +85,16 @@ def test_intervals_window_and_bitwise_resume(tmp_path, algorithm):
     every = np.array(every)
     assert every[0, 0] >= 0.004 and every[-1, 0] <= 0.016 and every[0, 0] - every[0, 1] < 0.004
     assert rows[:, 1].sum() == len(every)               # every step of the window, once
-    k = np.floor((rows[:, 0] - 0.004) / 0.003)
-    assert list(k) == list(range(len(k)))                # a row per interval, in order
+    # a row per interval, cut at every output as DualSPHysics's JDsSaveDt::SaveData does: a new row
+    # where a step starts in another interval than the one before or after an output
+    outputs = np.array([float(x.split(",")[1]) for x in (a / "run.csv").read_text().splitlines()[1:]])
+    starts = every[:, 0]
+    k = np.floor((starts - 0.004) / 0.003)
+    new_row = np.ones(len(starts), bool)
+    new_row[1:] = (k[1:] != k[:-1]) | [np.any((outputs > t0 + 1e-9) & (outputs <= t1 + 1e-9))
+                                       for t0, t1 in zip(starts[:-1], starts[1:])]
+    np.testing.assert_array_equal(rows[:, 0], starts[new_row])
+    assert len(rows) > len(np.unique(k))                  # some intervals were cut by an output
     assert np.all(rows[:, 3] <= rows[:, 2]) and np.all(rows[:, 2] <= rows[:, 4])
     if algorithm == 2:          # a Symplectic step's dt is the min of the terms found before it
         np.testing.assert_allclose(rows[:, 3], np.minimum(rows[:, 6], rows[:, 9]), rtol=1e-11)

@@ -32,6 +32,24 @@ def test_velocities_are_integrated_with_each_rows_own_acceleration():
     assert vlin[0] == pytest.approx(0.75) and w[1] == pytest.approx(0.5)
 
 
+def test_a_repeated_time_is_a_step_as_jlinearvalue():
+    """Rows 0:0, 1:0, 1:2, 3:2 ("switch on at t = 1"): JLinearValue::FindTime/GetValue3d3d
+    gives the row before the step at t = 1 itself and the one after it just past; the velocity
+    gains nothing over the zero-length row (a_k · 0)."""
+    from sphdvi.sph.accinput import linear_value
+    table = np.array([[0, 0, 0, 0, 0, 0, 0], [1, 0, 0, 0, 0, 0, 0], [1, 2, 0, 0, 0, 4, 0],
+                      [3, 2, 0, 0, 0, 4, 0]], float)
+    inp = AccInput(spec(table.tolist(), start=-5.0))      # active before the table: its first row
+    got = {t: inp.values(t) for t in (-1.0, 0.5, 1.0, 1.0 + 1e-12, 2.0, 5.0)}
+    assert [float(got[t][0][0]) for t in got] == [0.0, 0.0, 0.0, 2.0, 2.0, 2.0]
+    assert [float(got[t][1][1]) for t in got] == [0.0, 0.0, 0.0, 4.0, 4.0, 4.0]
+    assert got[2.0][2][0] == pytest.approx(2.0) and got[1.0][2][0] == 0.0 and got[5.0][3][1] == pytest.approx(8.0)
+    # a table without repeated times: np.interp's values
+    t, v = np.array([0.0, 0.5, 2.0]), np.array([[1.0], [3.0], [-1.0]])
+    for x in (-1, 0, 0.25, 0.5, 1.2, 2, 3):
+        assert linear_value(t, v, x)[0] == pytest.approx(np.interp(x, t, v[:, 0]), abs=1e-15)
+
+
 def reference(pos, vel, lin, ang, vlin, w, centre, angular):
     """The added acceleration in DualSPHysics's form (numpy, per particle)."""
     d = pos - centre

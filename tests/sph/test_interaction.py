@@ -33,7 +33,9 @@ def reference_rates(s, c, p):
     delta = p["DensityDTvalue"]
     ext = p.get("RigidAlgorithm", 1) != 1
     light = 1.2 * rho0 * c["dp"] ** (2 if is2d else 3)
-    wdp = kernel_w(1, c["dp"] / h, kernel_alpha(1, h, is2d))
+    # tensile correction: DualSPHysics's W(dp) is W at q = 2/3 (FunSphKernel.h
+    # GetKernelCubic_Ctes, deltap = 1/1.5) whatever dp/h, not W(dp/h)
+    wdp = kernel_w(1, 1.0 / 1.5, kernel_alpha(1, h, is2d))
     for a in range(n):
         fluid_a = s.ptype[a] == 3
         float_a = s.ptype[a] == 2
