@@ -1,6 +1,7 @@
 """``<special><shifting>`` as DualSPHysics reads it (JSphShifting::ReadXml, JSph::LoadCaseConfig):
 mode 0-3 only, no second definition in <parameters>, and the zones, which a run honours."""
 import numpy as np
+from case.casetext import case_xml, write_case      # tests/case (tests/ is on the path: conftest)
 from click.testing import CliRunner
 
 from sphdvi.cli import main
@@ -8,46 +9,25 @@ from sphdvi.io.casefile import read_case_h5
 from sphdvi.io.vtkhdf import read_step, step_times
 from sphdvi.simulation import shift_zones
 
-CASE = """<?xml version="1.0" encoding="UTF-8" ?>
-<case>
-    <casedef>
-        <constantsdef><gravity x="0" y="0" z="-9.81" /><coefh value="1.0" /><coefsound value="20" /></constantsdef>
-        <geometry>
-            <definition dp="0.02"><pointmin x="-0.06" y="0" z="-0.06" /><pointmax x="0.6" y="0" z="0.4" /></definition>
-            <commands><mainlist>
-                <setmkfluid mk="0" />
-                <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="0.2" y="2" z="0.3" /></drawbox>
-                <setmkbound mk="0" />
-                <drawbox><boxfill>bottom | left | right</boxfill><point x="-0.02" y="-1" z="-0.02" />
-                    <size x="0.6" y="2" z="0.4" /></drawbox>
-            </mainlist></commands>
-        </geometry>
-    </casedef>
-    <execution>
-        <special>
-            SPECIAL
-        </special>
-        <parameters>
-            PARAMS
-            <parameter key="StepAlgorithm" value="2" />
-            <parameter key="DensityDT" value="1" />
-            <parameter key="TimeMax" value="0.03" />
-            <parameter key="TimeOut" value="0.03" />
-        </parameters>
-    </execution>
-</case>
-"""
-
 
 def _case(tmp_path, special, params="", name="CaseShift"):
-    case = tmp_path / f"{name}_Def.xml"
-    case.write_text(CASE.replace("SPECIAL", special).replace("PARAMS", params))
-    return case
+    """A 2D dam 0.2 x 0.3 m in a tank 0.6 m wide with ``special`` in <special> and ``params`` first
+    in <parameters>."""
+    text = case_xml(pointmin=("-0.06", "0", "-0.06"), pointmax=("0.6", "0", "0.4"), mkconfig="", commands="""
+                    <setmkfluid mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="0.2" y="2" z="0.3" /></drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>bottom | left | right</boxfill><point x="-0.02" y="-1" z="-0.02" />
+                        <size x="0.6" y="2" z="0.4" /></drawbox>""",
+                    special=special, parameters=params + '<parameter key="StepAlgorithm" value="2" />'
+                    '<parameter key="DensityDT" value="1" /><parameter key="TimeMax" value="0.03" />'
+                    '<parameter key="TimeOut" value="0.03" />')
+    return write_case(tmp_path, text, f"{name}_Def.xml")
 
 
 def _gencase(tmp_path, special, params=""):
     case = _case(tmp_path, special, params)
-    return CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "g")])
+    return CliRunner().invoke(main, ["gencase", case, "-o", str(tmp_path / "g")])
 
 
 def test_mode_4_is_refused_in_special(tmp_path):
@@ -97,7 +77,7 @@ def test_flat_oblique_zone_is_refused(tmp_path):
 def _final_positions(tmp_path, name, special):
     case = _case(tmp_path, special, name=name)
     out = tmp_path / f"out_{name}"
-    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q"])
+    r = CliRunner().invoke(main, ["run", case, "-o", str(out), "--threads", "1", "-q"])
     assert r.exit_code == 0, r.output
     path = str(out / "particles.vtkhdf")
     last = read_step(path, len(step_times(path)) - 1)

@@ -10,67 +10,38 @@ whose particles leave the simulation domain stops the run as DualSPHysics's JSph
 import json
 
 import numpy as np
+from case.casetext import case_xml, write_case      # tests/case (tests/ is on the path: conftest)
 from click.testing import CliRunner
 
 from sphdvi.cli import main
 
 DP = 0.02
-# 2D tank 0.6 m wide with one layer of wall particles (the floor at z = 0), water 0.2 m deep,
-# a box 0.12 x 0.08 m of density 2000 released in the water (the auditor's sink.xml)
-TANK = """<?xml version="1.0" encoding="UTF-8" ?>
-<case>
-    <casedef>
-        <constantsdef>
-            <gravity x="0" y="0" z="-9.81" />
-            <rhop0 value="1000" />
-            <coefsound value="20" />
-            <coefh value="1.0" />
-            <cflnumber value="0.2" />
-        </constantsdef>
-        <mkconfig boundcount="240" fluidcount="9" />
-        <geometry>
-            <definition dp="0.02">
-                <pointmin x="-0.1" y="0" z="-0.1" />
-                <pointmax x="0.7" y="0" z="0.5" />
-            </definition>
-            <commands>
-                <mainlist>
+
+
+def tank_case(water, box):
+    """2D tank 0.6 m wide with one layer of wall particles (the floor at z = 0), water (width,
+    depth) in its left corner and a box 0.12 x 0.08 m of density 2000 with its lower-left corner
+    at ``box`` (the auditor's sink.xml: water (0.6, 0.2), the box released in it)."""
+    return case_xml(pointmin=("-0.1", "0", "-0.1"), pointmax=("0.7", "0", "0.5"), commands=f"""
                     <setmkfluid mk="0" />
                     <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" />
-                        <size x="WX" y="2" z="WZ" /></drawbox>
+                        <size x="{water[0]}" y="2" z="{water[1]}" /></drawbox>
                     <setmkbound mk="0" />
                     <drawbox><boxfill>bottom | left | right</boxfill><point x="0" y="-1" z="0" />
                         <size x="0.6" y="2" z="0.4" /></drawbox>
                     <setmkbound mk="5" />
-                    <drawbox><boxfill>solid</boxfill><point x="BX" y="-1" z="BZ" />
-                        <size x="0.12" y="2" z="0.08" /></drawbox>
-                </mainlist>
-            </commands>
-        </geometry>
-        <floatings>
-            <floating mkbound="5" rhopbody="2000" />
-        </floatings>
-    </casedef>
-    <execution>
-        <parameters>
-            <parameter key="StepAlgorithm" value="2" />
-            <parameter key="Visco" value="0.05" />
-            <parameter key="DensityDT" value="2" />
-            <parameter key="TimeMax" value="1.5" />
-            <parameter key="TimeOut" value="0.05" />
-        </parameters>
-    </execution>
-</case>
-"""
+                    <drawbox><boxfill>solid</boxfill><point x="{box[0]}" y="-1" z="{box[1]}" />
+                        <size x="0.12" y="2" z="0.08" /></drawbox>""",
+                    casedef_extra='\n        <floatings><floating mkbound="5" rhopbody="2000" /></floatings>',
+                    parameters='<parameter key="StepAlgorithm" value="2" /><parameter key="Visco" value="0.05" />'
+                               '<parameter key="DensityDT" value="2" /><parameter key="TimeMax" value="1.5" />'
+                               '<parameter key="TimeOut" value="0.05" />')
 
 
 def run_tank(tmp_path, name, water, box, rigid, tmax):
-    """Run the tank with water (width, depth) and the box's lower-left corner ``box``; the
-    CLI result, the out folder and bodies.csv as a structured array."""
-    text = TANK.replace("WX", str(water[0])).replace("WZ", str(water[1]))
-    text = text.replace("BX", str(box[0])).replace("BZ", str(box[1]))
-    case = tmp_path / f"{name}.xml"
-    case.write_text(text)
+    """Run ``tank_case(water, box)``; the CLI result, the out folder and bodies.csv as a
+    structured array."""
+    case = write_case(tmp_path, tank_case(water, box), f"{name}.xml")
     out = tmp_path / f"out_{name}"
     r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "-q", "--threads", "1", "--tmax", str(tmax),
                                   "--set", f"RigidAlgorithm={rigid}"])

@@ -1,42 +1,21 @@
 """A floating body across a periodic boundary: its particles are wrapped into the periodic box,
 its centre is not; the moment takes the particle-to-centre distance as its shortest periodic
 image (DualSPHysics's FtPeriodicDist in FtPartsSumAce / FtPartsUpdate)."""
-import shutil
-from pathlib import Path
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
-from sphdvi.cli import main
 from sphdvi.coupling import FloatingBodies
-from sphdvi.io.casefile import read_case_h5
 from sphdvi.motion import MotionSet
 from sphdvi.sph.periodic import Periodicity
-from sphdvi.sph.state import FluidState
 
-CASE = Path(__file__).resolve().parents[2] / "cases" / "floatingbox2d" / "CaseFloatingBox2D_Def.xml"
-
-
-@pytest.fixture(scope="module")
-def case_data(tmp_path_factory):
-    d = tmp_path_factory.mktemp("fbp")
-    shutil.copy(CASE, d / CASE.name)
-    r = CliRunner().invoke(main, ["gencase", str(d / CASE.name), "-o", str(d / "out")])
-    assert r.exit_code == 0, r.output
-    return read_case_h5(str(next((d / "out").glob("*.h5"))))
+from test_coupling import _coupling, _solver, case_data  # noqa: F401 (case_data: the gencased floatingbox2d)
 
 
 def _setup(data, periodicity):
-    fb = FloatingBodies(data, MotionSet(data["json"].get("motions", []), []),
-                        int(data["json"]["mkconfig"]["fluidcount"]))
-    p = data["particles"]
-    state = FluidState(p["pos"].copy(), p["vel"].copy(), p["rhop"].copy(), p["mass"].copy(), p["type"],
-                       p["idp"], p["mk"])
-    sol = SimpleNamespace(state=state, ace=np.zeros_like(state.pos), time=0.0, normals=None, periodicity=periodicity)
-    sel = np.flatnonzero(state.ptype == 2)
-    return fb, sol, sel, fb.body_of_idp[state.idp[sel]]
+    fb, sol = _coupling(data), _solver(data)
+    sol.periodicity = periodicity
+    sel = np.flatnonzero(sol.state.ptype == 2)
+    return fb, sol, sel, fb.body_of_idp[sol.state.idp[sel]]
 
 
 def _edge_through_the_body(data, inc=0.0):

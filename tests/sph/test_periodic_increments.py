@@ -12,6 +12,7 @@ from sphdvi.sph import SPHSolver
 from sphdvi.sph.periodic import Periodicity, periodic_config
 
 from _helpers import constants, jittered_block, random_state
+from case.casetext import case_xml, write_case      # tests/case (tests/ is on the path: conftest)
 
 DP = 0.1
 
@@ -54,10 +55,8 @@ def test_min_image_undoes_wraps_with_increments():
 
 def test_inclined_channel_wraps_consistently_in_a_run():
     """A block moving in +x with XPeriodicIncZ: what leaves at xmax comes back IncZ higher."""
-    rng = np.random.default_rng(3)
-    dp = 0.01
-    pos = jittered_block(10, dp, True, rng, jitter=0.0)
-    s = random_state(pos, dp, True, rng, vscale=0.0)
+    rng, dp = np.random.default_rng(3), 0.01
+    s = random_state(jittered_block(10, dp, True, rng, jitter=0.0), dp, True, rng, vscale=0.0)
     s.vel[:, 0] = 1.0
     sol = SPHSolver(s, constants(dp, True, g=0.0), {"StepAlgorithm": 2, "XPeriodicIncZ": 0.05},
                     periodic="x")
@@ -94,47 +93,35 @@ def test_solver_refuses_y_periodicity_in_2d():
         SPHSolver(random_state(pos, 0.01, True, rng), constants(0.01, True), {}, periodic="xy")
 
 
-CASE = """<?xml version="1.0" encoding="UTF-8" ?>
-<case>
-    <casedef>
-        <constantsdef><gravity x="0" y="0" z="-9.81" /><coefh value="1.0" /><coefsound value="20" /></constantsdef>
-        <geometry>
-            <definition dp="0.02"><pointmin x="-0.06" y="0" z="-0.06" /><pointmax x="0.5" y="0" z="0.4" /></definition>
-            <commands><mainlist>
-                <setmkfluid mk="0" />
-                <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0.02" /><size x="0.38" y="2" z="0.2" /></drawbox>
-                <setmkbound mk="0" />
-                <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="-0.04" /><size x="0.38" y="2" z="0.04" /></drawbox>
-            </mainlist></commands>
-        </geometry>
-    </casedef>
-    <execution>
-        <parameters>
-            PARAMS
-            <parameter key="StepAlgorithm" value="2" />
-            <parameter key="TimeMax" value="0.01" />
-            <parameter key="TimeOut" value="0.01" />
-        </parameters>
-    </execution>
-</case>
-"""
+def _case_text(params):
+    """A 2D channel 0.38 m long (fluid on a solid bed) with ``params`` on a line of their own, first
+    in <parameters>."""
+    return case_xml(pointmin=("-0.06", "0", "-0.06"), pointmax=("0.5", "0", "0.4"), mkconfig="", commands="""
+                    <setmkfluid mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0.02" /><size x="0.38" y="2" z="0.2" /></drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="-0.04" /><size x="0.38" y="2" z="0.04" /></drawbox>""",
+                    parameters=f"\n{params}\n" '<parameter key="StepAlgorithm" value="2" />'
+                               '<parameter key="TimeMax" value="0.01" /><parameter key="TimeOut" value="0.01" />')
 
 
 def _gencase(tmp_path, params):
+    """gencase of the channel: the CLI result and the line of the case file that holds ``params``."""
     from sphdvi.cli import main
-    case = tmp_path / "CasePer_Def.xml"
-    case.write_text(CASE.replace("PARAMS", params))
-    return CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "g")])
+    text = _case_text(params)
+    case = write_case(tmp_path, text, "CasePer_Def.xml")
+    line = text[:text.index(params)].count("\n") + 1
+    return CliRunner().invoke(main, ["gencase", case, "-o", str(tmp_path / "g")]), line
 
 
 def test_gencase_refuses_y_periodicity_in_2d_with_the_line(tmp_path):
-    r = _gencase(tmp_path, '<parameter key="YPeriodicIncX" value="0" />')
+    r, line = _gencase(tmp_path, '<parameter key="YPeriodicIncX" value="0" />')
     assert r.exit_code == 2, r.output
-    assert "YPeriodicIncX" in r.output and "2D" in r.output and ":17:" in r.output
+    assert "YPeriodicIncX" in r.output and "2D" in r.output and f":{line}:" in r.output
 
 
 def test_gencase_warns_of_a_pair_key_with_value_0_and_reset_increments(tmp_path):
-    r = _gencase(tmp_path, '<parameter key="XZPeriodic" value="0" /><parameter key="XPeriodicIncZ" value="0.1" />')
+    r, _ = _gencase(tmp_path, '<parameter key="XZPeriodic" value="0" /><parameter key="XPeriodicIncZ" value="0.1" />')
     assert r.exit_code == 0, r.output
     assert "XZPeriodic=0" in r.output and "resets the periodic increments" in r.output
     from sphdvi.io.casefile import read_case_h5
