@@ -43,6 +43,7 @@ from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_b
 from .io.atomic import make_folder, remove_leftover_temporaries
 from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
 from .io.dtinfo import DTINFO_FILE, DtLog
+from .sph.periodic import PERIODIC_KEYS as PERIODIC_PARAM_KEYS      # numpy only
 from .io.runfolder import (NORMALS_FILE, OVERWRITTEN_DIR, SetAside, check_new_run_folder, earlier_exports,
                            earlier_results, restored_on_bad_input, stored_overrides)
 from .sph.damping import damping_zones
@@ -218,8 +219,6 @@ def periodic_params(data: dict, params: dict) -> dict:
     return out
 
 
-PERIODIC_PARAM_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ", "ZPeriodicIncX",
-                       "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
 
 
 def _periodic_config(data: dict, params: dict):

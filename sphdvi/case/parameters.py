@@ -105,8 +105,6 @@ PARAMETERS: dict[str, Param] = {
     "DivCleanKp": Param("float", 0.0, "coefficient of divergence cleaning (no effect: not supported)"),
 }
 
-PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ",
-                 "ZPeriodicIncX", "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
 DEPRECATED = {"PartsOutMax", "IncZ", "DomainFixed", "DeltaSPH", "PosDouble"} | {
     k for k in PARAMETERS if k.startswith("DomainFixed")}
 

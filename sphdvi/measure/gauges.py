@@ -293,7 +293,6 @@ class MeshGauge(Gauge):
             else:
                 head = tuple(f"v({n}) [m]" for n in cols12)
             self.parts.append((f"Gauges{self.prefix}_{self.name}_{self.FILE_KEYS[o]}.csv", head))
-        self.header = tuple(c for _, h in self.parts for c in h)
 
     def files(self):
         return list(self.parts)

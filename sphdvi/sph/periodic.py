@@ -82,6 +82,8 @@ class Periodicity:
 INC_KEYS = {"x": ("XPeriodicIncY", "XPeriodicIncZ"), "y": ("YPeriodicIncX", "YPeriodicIncZ"),
             "z": ("ZPeriodicIncX", "ZPeriodicIncY")}
 PAIR_KEYS = (("XYPeriodic", "xy"), ("XZPeriodic", "xz"), ("YZPeriodic", "yz"))
+# every periodic execution parameter
+PERIODIC_KEYS = tuple(k for keys in INC_KEYS.values() for k in keys) + tuple(k for k, _ in PAIR_KEYS)
 
 
 def periodic_config(written, params, is2d):

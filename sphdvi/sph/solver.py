@@ -43,6 +43,7 @@ import numpy as np
 from . import cells as _cells
 from . import integrators as _int
 from . import interaction as _ia
+from . import shift_zones as _shift_zones
 from . import sps as _sps
 from . import timestep as _ts
 from .accinput import add_acc_input, fluid_ace_max2
@@ -59,8 +60,6 @@ DEFAULT_PARAMS = {
     "DtIni": 0.0, "DtMin": 0.0, "DtFixed": 0.0, "RhopOutMin": 700.0,
     "RhopOutMax": 1300.0, "Boundary": 1,
 }
-PERIODIC_KEYS = ("XPeriodicIncY", "XPeriodicIncZ", "YPeriodicIncX", "YPeriodicIncZ",
-                 "ZPeriodicIncX", "ZPeriodicIncY", "XYPeriodic", "XZPeriodic", "YZPeriodic")
 # Below this many particles every kernel runs serially.  Measured on the 2D dam
 # break, 2 threads against 1 (Verlet, whole steps): x0.86 at 301 particles,
 # x1.1 at 530-1,000, x1.35-1.58 at 1,900, x1.55-1.66 at 3,600-5,500.
@@ -185,8 +184,7 @@ class SPHSolver:
         self.periodicity = self._setup_periodic(periodic)
         self.shift_zones = None
         if shift_zones and self.rates_shift:
-            from .shift_zones import zone_arrays
-            self.shift_zones = zone_arrays(shift_zones)
+            self.shift_zones = _shift_zones.zone_arrays(shift_zones)
         self.cell_mode = self._choose_cell_mode(cell_mode)
         self.cells = _cells.CellList(self.h, self.is2d, half=self.cell_mode == "h")
         self.cst[18] = self.cells.stencil
@@ -402,22 +400,16 @@ class SPHSolver:
         """The periodic axes: those listed, those with a non-zero Inc key, or the pair of a
         XYPeriodic/XZPeriodic/YZPeriodic = 1, which (as in DualSPHysics) also switches
         the third axis off and resets the increments; a periodic y in 2D is refused."""
-        p = self.params
-        axes = set(periodic or ())
-        pairs = {"x": ("XPeriodicIncY", "XPeriodicIncZ"), "y": ("YPeriodicIncX", "YPeriodicIncZ"),
-                 "z": ("ZPeriodicIncX", "ZPeriodicIncY")}
-        for ax, keys in pairs.items():
-            if any(p.get(k) for k in keys):
-                axes.add(ax)
-        for key, both in (("XYPeriodic", "xy"), ("XZPeriodic", "xz"), ("YZPeriodic", "yz")):
-            if self.params.get(key):
-                axes = set(both)
-                p = {k: v for k, v in p.items() if k not in PERIODIC_KEYS}
+        from .periodic import PERIODIC_KEYS, Periodicity, periodic_config
+        # a key counts here when it has a value (the caller lists the axes the case's keys switch on)
+        given = {k for k in PERIODIC_KEYS if self.params.get(k)}
+        axes, incs = periodic_config(given, self.params, self.is2d)
+        axes = set(axes) | set(periodic or ())
         if self.is2d and "y" in axes:
             raise ValueError("cannot use periodic conditions in Y with 2D simulations (as DualSPHysics)")
         if not axes:
             return None
-        from .periodic import Periodicity
+        p = {**{k: v for k, v in self.params.items() if k not in PERIODIC_KEYS}, **incs}
         per = Periodicity(axes, self.state.pos, self.dp, p)
         if self._domain is not None:
             for k in per.axes:      # no exclusion along a periodic axis
@@ -627,8 +619,7 @@ class SPHSolver:
         else:
             self._compute_rates_cells()
         if self.shift_zones is not None:
-            from .shift_zones import unshift_outside
-            unshift_outside(self.state.pos, self.state.ptype, self.shiftpos, *self.shift_zones)
+            _shift_zones.unshift_outside(self.state.pos, self.state.ptype, self.shiftpos, *self.shift_zones)
         if self.acc_inputs:
             self._add_acc_inputs()
 
