@@ -41,7 +41,7 @@ from .errors import DivergenceError, InputError, SphdviError
 from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_bodies_checkpoint,
                             load_sph_checkpoint, save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import make_folder, remove_leftover_temporaries
-from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles
+from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles, startup_warnings_logged
 from .io.dtinfo import DTINFO_FILE, DtLog
 from .sph.periodic import PERIODIC_KEYS as PERIODIC_PARAM_KEYS      # numpy only
 from .io.runfolder import (NORMALS_FILE, OVERWRITTEN_DIR, SetAside, check_new_run_folder, earlier_exports,
@@ -339,7 +339,16 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
     ``set_aside`` when it made one), put back if the run stops on bad input before its start-up
     is through, deleted once it is; ``--resume`` reuses the
     --tmax/--tout/--set of the interrupted run.  ``stop``: a :class:`_Stop` the caller
-    installed before its own start-up work (a signal then interrupts the run cleanly)."""
+    installed before its own start-up work (a signal then interrupts the run cleanly).  The
+    start-up's warnings go to run.log too (:func:`startup_warnings_logged`)."""
+    files = RunFiles(outdir)
+    with startup_warnings_logged(files):
+        return _run(files, case_h5, outdir, tmax=tmax, tout=tout, threads=threads, sets=sets, resume=resume,
+                    quiet=quiet, expect_dp=expect_dp, overwrite=overwrite, stop=stop, set_aside=set_aside)
+
+
+def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, sets, resume, quiet, expect_dp,
+         overwrite, stop, set_aside) -> RunResult:
     from .io.casefile import read_case_h5
     t_start = _time.perf_counter()
     data = read_case_h5(case_h5)
@@ -371,7 +380,6 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
         _warn_set_aside_left(outdir)
     if not resume and set_aside is None:
         set_aside = SetAside(outdir, earlier_results(outdir) + earlier_exports(outdir))
-    files = RunFiles(outdir)
     if set_aside is not None:
         files.on_start = set_aside.discard     # the new run's start-up passed its checks
     base_meta = {

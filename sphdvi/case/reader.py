@@ -103,6 +103,7 @@ def read_constantsdef(reader: CaseReader, casedef) -> ConstantsDef:
     c.massbound = _auto_value(reader, el, "massbound", positive=True)
     c.massfluid = _auto_value(reader, el, "massfluid", positive=True)
     coefh = _coefh_element(reader, el)
+    _warn_coefhdp(reader, el)
     hdp = reader.child(el, "hdp")
     if coefh is not None and hdp is not None:
         raise reader.error(hdp, f"both <{coefh.tag}> and <hdp> are given", "only one of them")
@@ -132,6 +133,16 @@ def _read_eps(reader, el) -> None:
     if eps is not None and reader.num(eps, "value", 0.0) != 0.0:
         reader.warn(eps, "Eps value is not used (this correction was removed from DualSPHysics; "
                          "sphdvi ignores it too)")
+
+
+def _warn_coefhdp(reader, el):
+    """``<coefhdp>`` is no element DualSPHysics reads (JCaseCtes::ReadXmlDef takes h/dp from
+    ``<hdp value>``; CoefHdp is its internal name): ignored, as there, but said."""
+    wrong = reader.child(el, "coefhdp")
+    if wrong is not None:
+        reader.mark(wrong, *wrong.attrib)
+        reader.warn(wrong, "<coefhdp> is ignored (DualSPHysics does not read it): "
+                           "h = hdp*dp is given as <hdp value=\"...\"/>")
 
 
 def _coefh_element(reader, el):

@@ -11,10 +11,12 @@
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
 import time as _time
+import warnings
 
 import numpy as np
 
@@ -36,6 +38,8 @@ class RunFiles:
         self.csv_path = os.path.join(outdir, "run.csv")
         self.meta: dict = {}
         self.on_start = None     # called once by start(): --overwrite deletes the earlier run's files then
+        self.startup_warnings: list[str] = []   # said before run.log began: written at its head
+        self.log_started = False
 
     def write_json(self, **updates) -> None:
         self.meta.update(updates)
@@ -50,8 +54,8 @@ class RunFiles:
         append_text(self.csv_path, row + "\n")
 
     def start(self) -> None:
-        """A new run: empty run.log and run.csv (header only)."""
-        write_text_atomic(self.log_path, "")
+        """A new run: run.log with the start-up warnings only, run.csv with its header only."""
+        write_text_atomic(self.log_path, self._take_startup_warnings())
         write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n")
         if self.on_start is not None:
             self.on_start()
@@ -61,7 +65,7 @@ class RunFiles:
         """On resume: the log and the CSV rows of the first ``nparts`` outputs, without what was
         written after the restart output (the run goes on from there and writes it again)."""
         lines = log_to_part(complete_lines(self.log_path), nparts - 1)
-        write_text_atomic(self.log_path, "".join(line + "\n" for line in lines))
+        write_text_atomic(self.log_path, "".join(line + "\n" for line in lines) + self._take_startup_warnings())
         rows = complete_lines(self.csv_path)[1:nparts + 1]
         write_text_atomic(self.csv_path, RUN_CSV_HEADER + "\n" + "".join(r + "\n" for r in rows))
         if os.path.exists(self.json_path):
@@ -70,6 +74,32 @@ class RunFiles:
                     self.meta = json.load(fh)
                 except json.JSONDecodeError:
                     self.meta = {}
+
+
+    def _take_startup_warnings(self) -> str:
+        self.log_started = True
+        lines, self.startup_warnings = self.startup_warnings, []
+        return "".join(f"WARNING: {w}\n" for w in lines)
+
+
+@contextlib.contextmanager
+def startup_warnings_logged(files: RunFiles):
+    """The UserWarnings of a run's start-up (the --set checks, the initial density window,
+    DtFixed below DtMin, thin mDBC walls, ...) shown as always and also kept for run.log, where
+    :meth:`RunFiles.start` / :meth:`RunFiles.load_existing` write them (DualSPHysics's Run.out
+    holds its warnings too).  Warnings after run.log began are the run loop's to log."""
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, UserWarning) and not files.log_started:
+            files.startup_warnings.append(str(message))
+        shown(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = shown
 
 
 def log_to_part(lines: list[str], part: int) -> list[str]:

@@ -54,3 +54,11 @@ def test_lattice_2_is_refused(tmp_path, attrs):
     with pytest.raises(CaseError, match=r"lattice 2 .* not supported") as e:
         build(tmp_path, CONSTANTS.replace("<constantsdef>", f"<constantsdef><lattice {attrs} />"))
     assert e.value.line is not None
+
+
+def test_coefhdp_is_ignored_and_said(tmp_path):
+    """<coefhdp> is no DualSPHysics element (h/dp is <hdp value>): h stays coefh's, with a warning
+    (it was accepted silently)."""
+    r = build(tmp_path, CONSTANTS.replace('<coefh value="1.0" />', '<coefh value="1.0" /><coefhdp value="2" />'))
+    assert r.constants.h == pytest.approx(math.sqrt(2) * 0.02)
+    assert any("<coefhdp> is ignored" in w and "<hdp value=" in w for w in r.warnings)

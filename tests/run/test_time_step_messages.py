@@ -106,6 +106,27 @@ def test_a_density_window_that_excludes_the_initial_fluid(drawn, tmp_path):
     msg = json.loads((out / "run.json").read_text())["message"]
     assert "RhopOutMin/RhopOutMax [1001.5, 1300] exclude the initial fluid" in msg
     assert "time step" not in msg
+    # the start-up warning is in run.log too, at its head (it went to stderr only)
+    first = (out / "run.log").read_text().splitlines()[0]
+    assert first.startswith("WARNING: 750 of 1250 fluid particles start with a density outside")
+
+
+def test_startup_warnings_are_logged_once_and_again_on_resume(drawn, tmp_path):
+    """A --set warning of the start-up heads run.log; a resume keeps it and logs its own start-up's."""
+    out = tmp_path / "o"
+    said = "WARNING: --set FtSaveAce: parameter 'FtSaveAce' has no effect in sphdvi"
+    with pytest.warns(UserWarning, match="FtSaveAce"):
+        r = run(drawn, out, "FtSaveAce=1", tmax="0.02")
+    assert r.exit_code == 0, r.output
+    log = (out / "run.log").read_text().splitlines()
+    assert log[0].startswith(said) and sum(x.startswith(said) for x in log) == 1
+    with pytest.warns(UserWarning, match="FtSaveAce"):
+        r = invoke(["run", out, "--resume", "--tmax", "0.04", "-q"])
+    assert r.exit_code == 0, r.output
+    log = (out / "run.log").read_text().splitlines()
+    assert log[0].startswith(said) and sum(x.startswith(said) for x in log) == 2
+    resumed = next(i for i, x in enumerate(log) if x.startswith("resumed from part"))
+    assert log[resumed - 1].startswith(said)
 
 
 def test_movement_is_a_reason_of_excluded_csv(drawn, tmp_path):
