@@ -26,6 +26,8 @@ The fluid side is the solver's arrays; nothing here writes files.
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .errors import DivergenceError
@@ -87,6 +89,10 @@ class FloatingBodies:
                                                **mech["system"])
         self.mkbounds = [int(m) for m in mech["mkbounds"]]
         self.is2d = bool(data["constants"]["is2d"])
+        self.scale = np.asarray(mech.get("scaleforce", np.ones((len(self.mkbounds), 3))), float)
+        if not self.is2d and np.any(self.scale != 1.0):
+            warnings.warn("<chrono><scaleforce> should be used only for 2D simulations (as DualSPHysics warns); "
+                          "this case is 3D")
         self.normals0 = normals0
         self.ftpause = float(ftpause)
         p = data["particles"]
@@ -104,7 +110,17 @@ class FloatingBodies:
     def loads(self, solver, sel: np.ndarray, body: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Force and moment about each body's centre of the accelerations of its particles
         (``sel``: rows of the floating particles, ``body``: their body): the fluid's alone
-        (gravity is the multibody system's), in 2D restricted to the x-z plane."""
+        (gravity is the multibody system's), in 2D restricted to the x-z plane.
+
+        ``<scaleforce>`` (DualSPHysics's JChBody::SetScaleForce, per body and axis) multiplies
+        the fluid's force. Confirmed from DualSPHysics's public source: the factors are read per
+        mkbound (ranges) and handed to its Chrono library with the body, with a warning in 3D.
+        Not confirmed (the library's source is closed): whether the moment is scaled too and
+        whether the gravity part of the acceleration DualSPHysics sends is; sphdvi scales the
+        fluid's force only (the moment, gravity and ``<linearforce>`` are not scaled)."""
+        if body.size and body.min() < 0:
+            raise RuntimeError(f"floating particle idp {int(solver.state.idp[sel[np.argmin(body)]])} belongs to "
+                               "no multibody body")
         s = solver.state
         nb = self.system.nb
         f = s.mass[sel, None] * solver.ace[sel]
@@ -121,6 +137,7 @@ class FloatingBodies:
         if self.is2d:
             F[:, 1] = 0.0
             T[:, 0] = T[:, 2] = 0.0
+        F *= self.scale
         return F, T
 
     def paused(self, t_start: float) -> bool:

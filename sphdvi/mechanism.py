@@ -12,7 +12,10 @@ with a collision envelope of ``distancedp``·dp.
 Links map one to one: ``link_hinge`` → hinge, ``link_spheric`` → spherical,
 ``link_pointline`` → point-line (``rotvector``/``rotvector2`` lock rotations),
 ``link_linearspring`` → spring-damper, ``link_coulombdamping`` → Coulomb damper,
-``link_pulley`` → pulley. Stiffness and damping tables become time tables.
+``link_pulley`` → pulley. Stiffness and damping tables become time tables (a point-line's act on
+its rotations only). A ``<floating>`` the section does not list is a free body without links or
+collision shape (DualSPHysics moves it with its own rigid-body update); ``<scaleforce>`` factors
+are returned per body for the coupling.
 In 2D cases bodies move in the x–z plane (y translation and x, z rotations locked).
 A ``<floating>``'s ``<linearvel>``/``<angularvel>`` tables impose its velocity (a ``none``
 component stays free) and ``<linearforce>``/``<angularforce>`` add an external force and
@@ -27,21 +30,18 @@ from .errors import CaseError
 TYPE_FLOATING, TYPE_MOVING, TYPE_FLUID = 2, 1, 3
 
 
-def _vector_series(spec, what):
+def _vector_series(spec, what, allow_none=True):
     """A ``<linearvel>``-style table ({"times", "values"} with None for a free component,
-    or {"file"}: rows time;x;y;z) -> t -> [x|None, y|None, z|None], linear in time and
-    held beyond the ends; None when no table."""
+    or {"file"}, what an older case file holds: rows time;x;y;z, read as the case reader reads
+    it, ``none`` a free component where ``allow_none``) -> t -> [x|None, y|None, z|None],
+    linear in time and held beyond the ends; None when no table."""
     if spec is None:
         return None
     if "file" in spec:
-        from .case.datafiles import read_columns
-        data = read_columns(spec["file"], 4, what)
-        if data.shape[0] == 0:
-            raise CaseError(f"{what}: no data rows", file=spec["file"], expected="rows of time;x;y;z")
-        times, values = data[:, 0], data[:, 1:4]
-    else:
-        times = np.asarray(spec["times"], float)
-        values = np.asarray([[np.nan if c is None else c for c in row] for row in spec["values"]], float)
+        from .case.datafiles import read_vector_table
+        spec = dict(zip(("times", "values"), read_vector_table(spec["file"], what, allow_none=allow_none)))
+    times = np.asarray(spec["times"], float)
+    values = np.asarray([[np.nan if c is None else c for c in row] for row in spec["values"]], float)
     free = np.isnan(values).any(axis=0)        # 'none' in any row: that component is free
 
     def at(t):
@@ -53,8 +53,8 @@ def _floating_drivers(fb, name):
     """(imposed_velocity, external_load) callables of a floating body's tables, or None."""
     lin = _vector_series(fb.get("linearvel"), f"<linearvel> of '{name}'")
     ang = _vector_series(fb.get("angularvel"), f"<angularvel> of '{name}'")
-    force = _vector_series(fb.get("linearforce"), f"<linearforce> of '{name}'")
-    torque = _vector_series(fb.get("angularforce"), f"<angularforce> of '{name}'")
+    force = _vector_series(fb.get("linearforce"), f"<linearforce> of '{name}'", allow_none=False)
+    torque = _vector_series(fb.get("angularforce"), f"<angularforce> of '{name}'", allow_none=False)
 
     def imposed(t):
         return (lin(t) if lin else [None] * 3) + (ang(t) if ang else [None] * 3)
@@ -66,12 +66,19 @@ def _floating_drivers(fb, name):
 
 
 def _table(v):
-    """A stiffness/damping value: number, {"times","values"} or {"file"} → number or [[t, v], ...]."""
+    """A stiffness/damping value: number, {"times","values"} or {"file"} → number or [[t, v], ...].
+    The case reader reads a ``file=`` table at gencase (``{"file"}`` is what an older case file
+    holds): read here the same way, as DualSPHysics's JLinearValue::LoadFile (JReadDatafile's
+    separators and '#' comments, at least two rows)."""
     if v is None or isinstance(v, (int, float)):
         return v
-    if "file" in v:
-        data = np.genfromtxt(v["file"], delimiter=";", comments="#", invalid_raise=False)
-        data = data[~np.isnan(data).any(axis=1)]
+    if "times" not in v:
+        from .case.datafiles import read_columns
+        data = read_columns(v["file"], 2, "stiffness/damping table")
+        if data.shape[0] < 2:
+            raise CaseError("stiffness/damping table: fewer than two (time, value) rows", file=v["file"],
+                            expected="at least two lines 'time value' (DualSPHysics: \"Cannot be less than two "
+                                     "values.\")")
         return data[:, :2].tolist()
     return [[t, x] for t, x in zip(v["times"], v["values"])]
 
@@ -120,8 +127,7 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
     bound = p["type"] != TYPE_FLUID
     floating = {int(b["mkbound"]): b for b in js.get("bodies_extra", [])}
     collision = chrono.get("collision", {"activate": False, "distancedp": 0.5, "contactmethod": 0})
-    entries = chrono.get("bodies") or [{"kind": "floating", "id": f"floating{mk}", "mkbound": mk,
-                                        "modelfile": None} for mk in sorted(floating)]
+    entries = _body_entries(chrono.get("bodies") or [], floating)
     materials, bodies, mkbounds = {}, [], []
     for entry in entries:
         mkb = int(entry["mkbound"])
@@ -165,7 +171,40 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
     if solver.get("type"):
         system["solver"] = solver["type"].lower()
     return {"bodies": bodies, "links": links, "materials": list(materials.values()), "system": system,
-            "mkbounds": mkbounds}
+            "mkbounds": mkbounds, "scaleforce": _scale_forces(chrono.get("scaleforce") or [], mkbounds)}
+
+
+def _body_entries(listed: list, floating: dict) -> list:
+    """The multibody system's bodies: the ``<chrono>`` section's, then every ``<floating>`` it
+    does not list as a plain free body (no links, no collision shape). DualSPHysics moves such a
+    floating with its own rigid-body update (JSphCpuSingle::RunFloating, ``usechrono`` false:
+    JChronoObjects::ConfigBodyFloating finds no ``<bodyfloating>``), which for a body that no link
+    or Chrono contact touches is what a free body here does; its fluid loads stay its own."""
+    entries = list(listed)
+    taken = {int(e["mkbound"]) for e in listed}
+    ids = {e["id"] for e in listed}
+    for mk in sorted(floating):
+        if mk in taken:
+            continue
+        name = f"floating{mk}"
+        while name in ids:
+            name += "_free"
+        ids.add(name)
+        entries.append({"kind": "floating", "id": name, "mkbound": mk, "modelfile": None})
+    return entries
+
+
+def _scale_forces(items: list, mkbounds: list) -> np.ndarray:
+    """Per body, the per-axis factors of ``<scaleforce><body mkbound x y z/>`` (1 where none):
+    DualSPHysics's JChronoObjects::ReadScaleForces (JChBody::SetScaleForce). Applied to the
+    fluid's force on the body (coupling.FloatingBodies.loads); see there what is confirmed."""
+    scale = np.ones((len(mkbounds), 3))
+    row = {int(m): i for i, m in enumerate(mkbounds)}
+    for item in items:
+        for mk in (item["mkbound"] if isinstance(item["mkbound"], list) else [item["mkbound"]]):
+            if int(mk) in row:
+                scale[row[int(mk)]] = item["scale"]
+    return scale
 
 
 def _motion_callable(motions, mkb, centre):
@@ -177,9 +216,13 @@ def _motion_callable(motions, mkb, centre):
 
 
 def _link(ln: dict, bodies: list) -> dict:
+    """One ``<link_*>`` as a multibody link. Its name is the reader's (DualSPHysics's default
+    names, JChronoObjects::ReadXml); a case file written before gets ``Link_<id1>_<id2>`` or
+    ``Link_<id1>`` (to the ground). A point-line's stiffness/damping is torsional, on its free
+    rotations only (the DSPH format's "Torsional stiffness [Nm/rad]"): it slides freely."""
     kind = ln["type"]
     b1, b2 = ln["idbody1"], ln.get("idbody2")
-    name = ln.get("name") or f"Link_{b1}_{b2 if b2 else 'ground'}"
+    name = ln.get("name") or (f"Link_{b1}_{b2}" if b2 else f"Link_{b1}")
     out = {"body1": b1, "body2": b2, "name": name}
     if kind == "hinge":
         out.update(kind="hinge", point=ln["rotpoint"], axis=ln["rotvector"])
@@ -204,8 +247,8 @@ def _link(ln: dict, bodies: list) -> dict:
         return out
     else:
         raise CaseError(f"link type {kind} is not supported")
-    if ln.get("stiffness") is not None:
-        out["stiffness"] = _table(ln["stiffness"])
-    if ln.get("damping") is not None:
-        out["damping"] = _table(ln["damping"])
+    for key in ("stiffness", "damping"):
+        if ln.get(key) is not None:
+            value = _table(ln[key])
+            out[key] = {"rx": value, "ry": value, "rz": value} if kind == "pointline" else value
     return out

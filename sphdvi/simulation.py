@@ -724,6 +724,8 @@ class SPHRun:
         c = dict(data["constants"])
         self.consts = c
         fluidcount = int(data["json"]["mkconfig"]["fluidcount"])
+        if not resume:          # the initial state's densities (a resumed run's are its own)
+            _check_initial_density(p["rhop"][p["type"] == 3], params)
         state = FluidState(p["pos"], p["vel"], p["rhop"], p["mass"], p["type"], p["idp"], p["mk"],
                            rhop0=c["rhop0"])
         js = data["json"]
@@ -739,6 +741,13 @@ class SPHRun:
         for k in periodic:
             i = "xyz".index(k)
             domain[1][i] += c["dp"]
+        if periodic:
+            from .sph.periodic import Periodicity
+            try:
+                Periodicity(periodic, p["pos"], float(c["dp"]), params).check_length(2.0 * float(c["h"]))
+            except ValueError as exc:
+                raise InputError(str(exc)) from None
+        _check_boundary_in_domain(p, domain, fluidcount)
         normals0 = None
         if int(params.get("Boundary", 1)) == 2:
             from .case.normals import boundary_normals
@@ -805,8 +814,7 @@ class SPHRun:
         self.dtmin_seen = 0
         self.dtmin_warn_at = 1          # the next count of DtMin steps warned about (1, 10, 100, ...)
         self.step_warnings = []         # lines for run.log (and stderr) found by check()
-        # the initial state's densities (a resumed run starts from its restart output instead)
-        self.rhop_window_excludes = None if resume else _warn_initial_density(p["rhop"][p["type"] == 3], params)
+        self.out_faces = set()          # faces of the domain that fluid excluded for its position crossed
 
     @staticmethod
     def _mdbc_only_on(normals, p, fluidcount: int, mkbound_list: str):
@@ -832,58 +840,171 @@ class SPHRun:
             absorber.update(t, dt, absorber.measure(solver.state, t - dt) if absorber.absorbs(t, dt) else math.nan)
         if self.moving is not None:
             self.moving.apply(solver, t)
+            self._check_moving_in_domain(solver)
         if self.floating is not None:
             self.floating.step(solver, dt)
         for zone in self.damping:
             zone.apply(solver.state, dt)
 
+    def _check_moving_in_domain(self, solver) -> None:
+        """Stop the run (DivergenceError, exit 3) when a moving boundary particle has left the
+        simulation domain: DualSPHysics excludes it at its next cell division and aborts
+        (JSphCpuSingle::RunCellDivide -> JSph::AbortBoundOut, "Fixed, moving or floating particles
+        were excluded"); sphdvi's cells would clamp it into the edge cells and go on."""
+        dom = solver._domain
+        if dom is None:
+            return
+        s = solver.state
+        sel = np.flatnonzero(s.ptype == 1)
+        out = _outside(s.pos[sel], dom)
+        if not out.any():
+            return
+        from .coupling import body_labels
+        rows = sel[out]
+        k = int(rows[0])
+        mkb = int(body_labels(s.mk[k:k + 1], int(self.data["json"]["mkconfig"]["fluidcount"]))[0])
+        faces = [f"{a}-{e}" for j, a in enumerate("xyz") for e, bad in
+                 (("min", s.pos[rows, j] < dom[0][j]), ("max", s.pos[rows, j] > dom[1][j])) if bad.any()]
+        raise DivergenceError(
+            f"t={solver.time:.6g} s, step {solver.nstep}: moving boundary mkbound {mkb} left the simulation "
+            f"domain {_box(dom)} through its {_and(faces)} face{'s' if len(faces) > 1 else ''}: its "
+            f"particle {int(s.idp[k])} is at {_fmt(s.pos[k])} ({rows.size} moving particles out); DualSPHysics "
+            f"stops too (AbortBoundOut: \"Fixed, moving or floating particles were excluded\"): enlarge "
+            f"<simulationdomain> or check the motion")
+
     # -- checks --------------------------------------------------------------------------
-    def check(self, nexcl_before: int) -> None:
-        """Raise DivergenceError when the run has gone unstable."""
+    def check(self, events_before: int = 0) -> None:
+        """Raise DivergenceError when the run has gone unstable.  ``events_before``: the number of
+        exclusion events the solver held before this step; those after it are the step's (a
+        Symplectic step may add two: its predictor's and its corrector's), all searched."""
         sol = self.solver
-        if sol.excluded and sol.n_excluded.get("not finite", 0):
-            ev = sol.excluded[-1]
-            bad = [i for i, r in enumerate(ev["reason"]) if r == "not finite"]
-            if bad:
-                i = bad[0]
-                raise DivergenceError(
-                    f"t={sol.time:.6g} s, step {sol.nstep}: particle {int(ev['idp'][i])} at "
-                    f"{_fmt(ev['pos'][i])} has a non-finite value (NaN or inf); cause: the solution blew up "
-                    f"(try a smaller cflnumber or DtFixed, or more viscosity)")
+        events = [ev for ev in sol.excluded[events_before:] if len(ev["idp"])]
+        for ev in events:
+            self._note_faces(ev)
+        if events and sol.n_excluded.get("not finite", 0):
+            for ev in events:
+                bad = [i for i, r in enumerate(ev["reason"]) if r == "not finite"]
+                if bad:
+                    i = bad[0]
+                    raise DivergenceError(
+                        f"t={sol.time:.6g} s, step {sol.nstep}: particle {int(ev['idp'][i])} at "
+                        f"{_fmt(ev['pos'][i])} has a non-finite value (NaN or inf); cause: the solution blew up "
+                        f"(try a smaller cflnumber or DtFixed, or more viscosity)")
         if sol.n_dtmin > self.dtmin_seen:
             self.dtmin_run += sol.n_dtmin - self.dtmin_seen
             self.dtmin_seen = sol.n_dtmin
             self._warn_dtmin()
             if self.dtmin_run >= DTMIN_STUCK_STEPS:
-                i = int(np.argmax(np.einsum("ij,ij->i", sol.ace, sol.ace)))
                 raise DivergenceError(
-                    f"t={sol.time:.6g} s, step {sol.nstep}: dt held at DtMin for {self.dtmin_run} steps; "
-                    f"largest acceleration on particle {int(sol.state.idp[i])} at {_fmt(sol.state.pos[i])} "
-                    f"({math.sqrt(float(sol.ace[i] @ sol.ace[i])):.3g} m/s2)")
+                    f"t={sol.time:.6g} s, step {sol.nstep}: dt held at DtMin ({sol.dtmin:.3g} s) for "
+                    f"{self.dtmin_run} steps; {self._dtmin_cause()}")
         else:
             self.dtmin_run = 0
         excluded = sum(sol.n_excluded.values())
         new, self.excluded_seen = excluded - self.excluded_seen, excluded
         if new > self.excluded_step_limit:
-            ev = sol.excluded[-1]
             raise DivergenceError(
                 f"t={sol.time:.6g} s, step {sol.nstep}: {new} of {self.n0_fluid} fluid particles excluded in one "
-                f"step (more than {MAX_EXCLUDED_PER_STEP:.0%} at once; dt {sol.last_dt:.3g} s); last: particle "
-                f"{int(ev['idp'][0])} at {_fmt(ev['pos'][0])}, reason {ev['reason'][0]}; "
-                + self._exclusion_cause(ev, "the time step is far too large for the flow (DtFixed?) or the "
-                                            "solution blew up"))
+                f"step (more than {MAX_EXCLUDED_PER_STEP:.0%} at once; dt {sol.last_dt:.3g} s); "
+                + self._last_excluded(events) + "; "
+                + self._exclusion_cause("the time step is far too large for the flow (DtFixed?) or the "
+                                        "solution blew up"))
         limit = self.excluded_limit
         if excluded > limit:
-            ev = sol.excluded[-1]
-            cause = self._exclusion_cause(ev, "")
             raise DivergenceError(
                 f"t={sol.time:.6g} s, step {sol.nstep}: {excluded} of {self.n0_fluid} fluid particles excluded "
-                f"(limit {limit}); last: particle {int(ev['idp'][0])} at {_fmt(ev['pos'][0])}, "
-                f"reason {ev['reason'][0]}" + (f"; {cause}" if cause else ""))
+                f"(limit {limit}); " + self._last_excluded(events) + "; excluded so far: "
+                + self._excluded_by_reason() + "; " + self._exclusion_cause(self._divergence_hint()))
         if not np.isfinite(sol.last_dt) or sol.last_dt <= 0:
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: time step {sol.last_dt} is not valid")
         if self.bodies is not None and not (np.isfinite(self.bodies.pos).all() and np.isfinite(self.bodies.vel).all()):
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: a floating body state is not finite")
+
+    @staticmethod
+    def _last_excluded(events: list) -> str:
+        """"last: particle N at (..), reason R": the last row the step wrote to excluded.csv."""
+        if not events:
+            return "last: none this step"
+        ev = events[-1]
+        return (f"last: particle {int(ev['idp'][-1])} at {_fmt(ev['pos'][-1])}, reason {ev['reason'][-1]}")
+
+    def _note_faces(self, ev: dict) -> None:
+        """The faces of the simulation domain the particles excluded for their position in ``ev``
+        crossed (DualSPHysics's "exceeded the -X limit (left limit)" lines of its exclusion report)."""
+        dom = self.solver._domain
+        rows = [i for i, r in enumerate(ev["reason"]) if r == "position"]
+        if dom is None or not rows:
+            return
+        pos = np.asarray(ev["pos"], float)[rows]
+        for k, axis in enumerate("xyz"):
+            if np.any(pos[:, k] < dom[0][k]):
+                self.out_faces.add(f"{axis}-min")
+            if np.any(pos[:, k] > dom[1][k]):
+                self.out_faces.add(f"{axis}-max")
+
+    def _faces(self) -> str:
+        order = [f"{a}-{e}" for a in "xyz" for e in ("min", "max")]
+        faces = [f for f in order if f in self.out_faces]
+        return _and(faces) + (" faces" if len(faces) > 1 else " face")
+
+    def _excluded_by_reason(self) -> str:
+        """The fluid excluded so far by reason (DualSPHysics's "Excluded for: position=.. rhop=..
+        velocity=.."), with the faces of the domain the position exclusions crossed."""
+        n = self.solver.n_excluded
+        parts = []
+        for name in ("position", "rhop", "movement", "not finite"):
+            if n.get(name, 0):
+                where = f" (through the {self._faces()})" if name == "position" and self.out_faces else ""
+                parts.append(f"{name} {n[name]}{where}")
+        return ", ".join(parts) or "none"
+
+    def _divergence_hint(self) -> str:
+        """The likely cause of a run that lost more than its limit of fluid: the domain's faces
+        the fluid left through when most of it went that way, else an unstable solution (naming
+        a cflnumber above 0.5: DualSPHysics's cases use 0.2)."""
+        sol = self.solver
+        n = sol.n_excluded
+        if self.out_faces and 2 * n.get("position", 0) > sum(n.values()):
+            return (f"the fluid left the simulation domain through its {self._faces()} (no wall there? "
+                    f"enlarge <simulationdomain>)")
+        if sol.cfl > 0.5:
+            return (f"the solution went unstable: cflnumber {sol.cfl:g} is large (DualSPHysics's cases use 0.2: "
+                    f"try 0.2-0.4), or more viscosity/density diffusion")
+        return ("the solution went unstable (try a smaller cflnumber or DtFixed, or more viscosity/density "
+                "diffusion)")
+
+    def _dtmin_cause(self) -> str:
+        """Which term of DualSPHysics's dt (JSphCpu::DtVariable, eq. 10) fell below DtMin, with
+        its numbers: the force term dt1 = CFL sqrt(h/|a|max) or the speed term
+        dt2 = CFL h/(max(c0, 10|v|max) + h ViscDtMax), split into its part that dominates (the
+        speed of sound c0, ten times the fastest particle's speed, or the viscous one)."""
+        from .sph.timestep import dt_conditions
+        sol = self.solver
+        s = sol.state
+        a2, v2, cv = sol.dtmax.max(axis=0)
+        dt1, dt2 = (sol.cfl * d for d in dt_conditions(a2, v2, cv, sol.h, sol.cs0))
+        if dt1 <= dt2:
+            # as dt_terms: the fluid's acceleration without gravity, the floating particles' as it is
+            ace = np.where((s.ptype == 3)[:, None], sol.ace - sol.gravity,
+                           np.where((s.ptype == 2)[:, None], sol.ace, 0.0))
+            i = int(np.argmax(np.einsum("ij,ij->i", ace, ace)))
+            return (f"the force term CFL*sqrt(h/|a|max) = {dt1:.3g} s set dt (the speed term gives {dt2:.3g} s): "
+                    f"largest acceleration on particle {int(s.idp[i])} at {_fmt(s.pos[i])} "
+                    f"({math.sqrt(float(ace[i] @ ace[i])):.3g} m/s2)")
+        term = (f"the speed term CFL*h/(max(c0, 10|v|max) + h*ViscDtMax) = {dt2:.3g} s set dt (the force term "
+                f"gives {dt1:.3g} s)")
+        vmax, c0, visc = math.sqrt(v2), sol.cs0, sol.h * float(cv)
+        if visc > max(c0, 10.0 * vmax):
+            return (f"{term}: its viscous part h*ViscDtMax = {visc:.3g} m/s is above c0 = {c0:.3g} m/s and "
+                    f"10|v|max = {10.0 * vmax:.3g} m/s (ViscDtMax {float(cv):.3g} 1/s): lower the viscosity")
+        if 10.0 * vmax > c0:
+            speed = np.einsum("ij,ij->i", s.vel, s.vel) * (s.ptype >= sol.dt_vel_type)
+            i = int(np.argmax(speed))
+            return (f"{term} with 10|v|max = {10.0 * vmax:.3g} m/s > c0 = {c0:.3g} m/s: fastest particle "
+                    f"{int(s.idp[i])} at {_fmt(s.pos[i])} (|v| {vmax:.3g} m/s); the flow is faster than a tenth "
+                    f"of the speed of sound: raise coefsound/speedsound")
+        return (f"{term} with the speed of sound c0 = {c0:.3g} m/s (10|v|max = {10.0 * vmax:.3g} m/s): DtMin is "
+                f"above the CFL dt of the speed of sound: lower DtMin (or CoefDtMin)")
 
     def max_excluded(self) -> int:
         """Excluded fluid particles beyond which the run stops as diverged: PartsOutMax (when
@@ -909,21 +1030,16 @@ class SPHRun:
         return (f"The minimum number of fluid particles ({self.npf_minimum}) was reached: {left} of {self.n0_fluid} "
                 f"left at t={sol.time:.6g} s, step {sol.nstep} (MinFluidStop {float(self.params['MinFluidStop']):g})")
 
-    def _exclusion_cause(self, ev: dict, default: str) -> str:
-        """The likely cause of a mass exclusion (event ``ev``) for the divergence messages: a
-        density window that excludes the initial fluid, dt raised to DtMin in the steps before,
-        or ``default``."""
+    def _exclusion_cause(self, default: str) -> str:
+        """The likely cause of a mass exclusion for the divergence messages: dt raised to DtMin in
+        the steps before, or ``default``.  (A density window that excludes the initial fluid
+        does not start: :func:`_check_initial_density`.)"""
         sol = self.solver
-        win = self.rhop_window_excludes
-        if win is not None and "rhop" in ev["reason"]:
-            lo, hi, rmin, rmax, _ = win
-            return (f"cause: RhopOutMin/RhopOutMax [{rmin:g}, {rmax:g}] exclude the initial fluid (its densities "
-                    f"span [{lo:.6g}, {hi:.6g}] kg/m3): widen them")
         if self.dtmin_run > 0:
             return (f"cause: dt was raised to DtMin ({sol.dtmin:.3g} s) in the last {self.dtmin_run} step(s), "
                     f"above what the CFL and force conditions allowed: DtMin is too large for this flow, or the "
                     f"flow blew up")
-        return f"cause: {default}" if default else ""
+        return f"cause: {default}"
 
     def _warn_dtmin(self) -> None:
         """DualSPHysics's DtVariable warning "N DTs adjusted to DtMin (t:..., nstep:...)" at 1, 10,
@@ -988,21 +1104,65 @@ def min_fluid(params: dict, n0_fluid: int) -> int:
     return int(np.float32(mfs) * np.float32(n0_fluid))
 
 
-def _warn_initial_density(rhop_fluid: np.ndarray, params: dict):
-    """Warn when initial fluid densities lie outside [RhopOutMin, RhopOutMax] (those particles
-    leave the run in its first steps); returns (min, max, RhopOutMin, RhopOutMax, count) then,
-    else None."""
+def _check_initial_density(rhop_fluid: np.ndarray, params: dict) -> None:
+    """DualSPHysics's JSph::CheckRhoLimits (JSph::LoadCaseParticles): a fluid particle that starts
+    with a density outside [RhopOutMin, RhopOutMax] is an input error; the run does not start."""
     if rhop_fluid.size == 0:
-        return None
+        return
     rmin, rmax = float(params.get("RhopOutMin", 700.0)), float(params.get("RhopOutMax", 1300.0))
     out = int(np.count_nonzero((rhop_fluid < rmin) | (rhop_fluid > rmax)))
     if not out:
-        return None
+        return
     lo, hi = float(rhop_fluid.min()), float(rhop_fluid.max())
-    warnings.warn(f"{out} of {rhop_fluid.size} fluid particles start with a density outside RhopOutMin/RhopOutMax "
-                  f"[{rmin:g}, {rmax:g}] (the initial fluid densities span [{lo:.6g}, {hi:.6g}] kg/m3): they are "
-                  "excluded as soon as the run starts, as DualSPHysics would; widen RhopOutMin/RhopOutMax")
-    return lo, hi, rmin, rmax, out
+    raise InputError(f"{out} of {rhop_fluid.size} fluid particles start with a density outside RhopOutMin/RhopOutMax "
+                     f"[{rmin:g}, {rmax:g}] (the initial fluid densities span [{lo:.6g}, {hi:.6g}] kg/m3); "
+                     "DualSPHysics refuses to start such a case too (\"Initial fluid density is out of limits\"): "
+                     "to change the limits modify the value of RhopOutMin and RhopOutMax (<parameters>, or --set)")
+
+
+_BOUNDARY_KINDS = {0: "fixed", 1: "moving", 2: "floating"}
+
+
+def _outside(pos: np.ndarray, domain, tol: float = 0.0) -> np.ndarray:
+    """Rows of ``pos`` outside the box ``domain`` = (posmin, posmax) (beyond ``tol``)."""
+    return np.any((pos < domain[0] - tol) | (pos > domain[1] + tol), axis=1)
+
+
+def _and(items: list) -> str:
+    """'a', 'a and b', 'a, b and c'."""
+    return " and ".join(items) if len(items) < 3 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _box(domain) -> str:
+    return f"{_fmt(domain[0])} - {_fmt(domain[1])}"
+
+
+def _check_boundary_in_domain(p: dict, domain, fluidcount: int) -> None:
+    """Boundary particles (fixed, moving, floating) outside the simulation domain at the start
+    (a <simulationdomain> that cuts the walls) are an input error: DualSPHysics excludes them at
+    its first cell division and aborts (JSph::AbortBoundOut, "Fixed, moving or floating particles
+    were excluded").  The same tolerance as gencase's check of the fluid."""
+    bound = np.flatnonzero(p["type"] != 3)
+    if bound.size == 0:
+        return
+    pos = p["pos"][bound]
+    out = _outside(pos, domain, 1e-9 * max(1.0, float(np.abs(pos).max())))
+    if not out.any():
+        return
+    from .coupling import body_labels
+    rows = bound[out]
+    labels = body_labels(p["mk"][rows], fluidcount)
+    kinds = p["type"][rows]
+    groups = []
+    for mkb in np.unique(labels):
+        sel = labels == mkb
+        groups.append(f"mkbound {int(mkb)} ({_BOUNDARY_KINDS.get(int(kinds[sel][0]), 'boundary')}): "
+                      f"{int(sel.sum())}")
+    i = int(rows[0])
+    raise InputError(f"{rows.size} boundary particles lie outside the simulation domain {_box(domain)}: "
+                     f"{', '.join(groups)} (first: particle {int(p['idp'][i])} at {_fmt(p['pos'][i])}); "
+                     "DualSPHysics excludes them at its first cell division and stops (AbortBoundOut: \"Fixed, "
+                     "moving or floating particles were excluded\"): enlarge <simulationdomain> to hold the walls")
 
 
 def _warn_thin_mdbc_walls(thin: dict, need: int, h_dp: float) -> None:
@@ -1177,8 +1337,9 @@ def _warm_up(sph: "SPHRun") -> float:
     else:
         run = copy.deepcopy(sph)
         clone, bodies = run.solver, run.bodies
-    clone.step()
-    clone.step()
+    with contextlib.suppress(DivergenceError):      # a wall or body leaving the domain: the run says it
+        clone.step()
+        clone.step()
     if bodies is not None:
         bodies.compile_contact_kernels()
     return _time.perf_counter() - t0
@@ -1219,6 +1380,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         if not os.path.exists(ckpt):
             raise InputError(f"--resume: no checkpoint {ckpt} in {outdir}")
         extra = sph.load_checkpoint(ckpt)
+        _refuse_after_min_fluid(sph, outdir)
         part = int(extra["part"])
         if sol.keep_dt_terms:
             dtlog = _resumed_dtlog(outdir, special["savedt"], tout, extra.get("savedt"), sol, files)
@@ -1255,7 +1417,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         if stopped is None:
             # the run-time gauges measure the initial state here, so that their first JIT
             # compilation counts in startup_s, not in runtime_s
-            gauges = _make_gauges(data, params, outdir, resume, float(sol.time), sol.periodicity)
+            gauges = _make_gauges(data, params, outdir, resume, float(sol.time), sol.periodicity,
+                                  extra.get("gauges") if resume else None)
     finally:
         notice.done()
     if stopped is not None:
@@ -1312,6 +1475,9 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         if dtlog is not None:
             dtlog.flush()
             saved["savedt"] = json.dumps({"log": dtlog.get_state(), "terms": list(sol.dt_terms)})
+        if gauges is not None:      # the rows up to this output reach their files before the checkpoint
+            gauges.flush()
+            saved["gauges"] = json.dumps(gauges.get_state())
         sph.save_checkpoint(ckpt, saved)
 
     excl_seen = [sum(sol.n_excluded.values())]
@@ -1337,12 +1503,13 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             next_extra = _next_multiple(sol.time, extra) if extra else 0.0
             while not time_reached(sol.time, tmax):
                 t_step = sol.time
+                events_before = len(sol.excluded)
                 sol.step()
                 dt_lo, dt_hi = min(dt_lo, sol.last_dt), max(dt_hi, sol.last_dt)
                 if dtlog is not None:
                     dtlog.add(t_step, (sol.last_dt,) + sol.step_dt_terms)
                 try:
-                    sph.check(0)
+                    sph.check(events_before)
                 finally:
                     note_step_warnings()
                 if gauges is not None:
@@ -1431,14 +1598,26 @@ def _next_multiple(t: float, step: float) -> float:
     return k * step
 
 
-def _make_gauges(data, params, outdir, resume, t, periodicity=None):
+def _refuse_after_min_fluid(sph, outdir: str) -> None:
+    """--resume of a run that MinFluidStop ended (its checkpoint holds fewer fluid particles
+    than NpfMinimum): DualSPHysics's JSphCpuSingle::Run ends the simulation there, so there is
+    nothing to continue, whatever --tmax says; InputError."""
+    reached = sph.min_fluid_reached() if sph.npf_minimum else ""
+    if reached:
+        raise InputError(f"--resume: the run in {outdir} has ended: {reached[0].lower() + reached[1:]}; "
+                         "a run that MinFluidStop ended cannot go on (not with a larger --tmax either): start it "
+                         f"anew with 'sphdvi run {outdir} --overwrite' (or into another folder with -o)")
+
+
+def _make_gauges(data, params, outdir, resume, t, periodicity=None, state=None):
     """Run-time gauges of ``<special><gauges>`` (None when the case has none); with periodic
-    boundaries they see the fluid's periodic copies as the interaction does."""
+    boundaries they see the fluid's periodic copies as the interaction does; ``state``: the
+    checkpoint's gauge schedules on resume."""
     items = (data["json"].get("gauges") or {}).get("items") or []
     if not items:
         return None
     from .measure.gauges import RunGauges
-    return RunGauges(data, params, outdir, resume=resume, time=t, periodicity=periodicity)
+    return RunGauges(data, params, outdir, resume=resume, time=t, periodicity=periodicity, state=state)
 
 
 def _threading_layer() -> str:

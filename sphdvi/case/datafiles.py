@@ -1,12 +1,26 @@
 """Plain data files a case refers to (DualSPHysics JReadDatafile conventions:
 columns separated by ';', ',', spaces or tabs; '#' starts a comment)."""
+import math
+
 import numpy as np
 
 from ..errors import CaseError
 
 
-def _read_rows(path: str, ncols: int, what: str) -> tuple[np.ndarray, list]:
-    """Numeric rows of ``path`` and the line number of each (see :func:`read_columns`)."""
+def _parse_value(token: str, allow_none: bool) -> float:
+    """One field as JReadDatafile/JLinearValue::ReadNextDouble reads it: a number, or ``none``
+    (any case: a free component, DBL_MAX there, NaN here) where ``allow_none``."""
+    if allow_none and token.lower() == "none":
+        return float("nan")
+    return float(token)
+
+
+def _read_rows(path: str, ncols: int, what: str, *, allow_none: bool = False,
+               finite: bool = True) -> tuple[np.ndarray, list]:
+    """Numeric rows of ``path`` and the line number of each (see :func:`read_columns`). A UTF-8
+    byte-order mark (Excel's "CSV UTF-8", Notepad) is dropped: DualSPHysics's JReadDatafile keeps
+    that first row (atof reads past it). ``finite``: a NaN or infinite value is an error naming its
+    line (a ``none`` read where ``allow_none`` is the only NaN allowed)."""
     rows, lines = [], []
     try:
         with open(path, "rb") as fb:
@@ -14,13 +28,13 @@ def _read_rows(path: str, ncols: int, what: str) -> tuple[np.ndarray, list]:
         if b"\x00" in head:
             raise CaseError(f"{what}: not a text file (it holds NUL bytes)", file=path,
                             expected="a text file of numbers in columns")
-        with open(path, encoding="utf-8", errors="replace") as f:
+        with open(path, encoding="utf-8-sig", errors="replace") as f:
             for lineno, line in enumerate(f, 1):
                 text = line.split("#", 1)[0].replace(";", " ").replace(",", " ").split()
                 if not text:
                     continue
                 try:
-                    vals = [float(v) for v in text]
+                    vals = [_parse_value(v, allow_none) for v in text]
                 except ValueError:
                     if not rows:      # a header line
                         continue
@@ -29,6 +43,13 @@ def _read_rows(path: str, ncols: int, what: str) -> tuple[np.ndarray, list]:
                 if len(vals) < ncols:
                     raise CaseError(f"{what}: {len(vals)} column(s)", file=path, line=lineno,
                                     expected=f"{ncols} numbers per line")
+                if finite:
+                    bad = next((t for t, v in zip(text, vals) if not math.isfinite(v)
+                                and not (allow_none and t.lower() == "none")), None)
+                    if bad is not None:
+                        raise CaseError(f"{what}: '{bad}' in '{line.strip()[:80]}' is not a finite number",
+                                        file=path, line=lineno, expected="finite numbers"
+                                        + (" (or none for a free component)" if allow_none else ""))
                 rows.append(vals)
                 lines.append(lineno)
     except OSError as exc:
@@ -38,11 +59,41 @@ def _read_rows(path: str, ncols: int, what: str) -> tuple[np.ndarray, list]:
     return np.asarray([r[:k] for r in rows], float).reshape(-1, k), lines
 
 
-def read_columns(path: str, ncols: int, what: str) -> np.ndarray:
+def read_columns(path: str, ncols: int, what: str, *, allow_none: bool = False) -> np.ndarray:
     """Numeric rows of ``path``, each with at least ``ncols`` columns -> (n, k):
     k is the smallest column count over the rows; leading non-numeric lines
-    are headers, a non-numeric line after the data is an error."""
-    return _read_rows(path, ncols, what)[0]
+    are headers, a non-numeric line after the data is an error, and so is a NaN or
+    infinite value (``none``, read as NaN, is allowed where ``allow_none``)."""
+    return _read_rows(path, ncols, what, allow_none=allow_none)[0]
+
+
+def check_rising_times(times, lines: list, what: str, path: str) -> None:
+    """Times of a time table that do not go back (a repeated time is a step change), the rule of
+    the inline tables and of DualSPHysics's JLinearValue::SetTimeValue ("New time values is lower
+    than previous time"); its FindTime walks the times as sorted."""
+    bad = np.flatnonzero(np.diff(np.asarray(times, float)) < 0)
+    if bad.size:
+        i = int(bad[0]) + 1
+        raise CaseError(f"{what}: times are not in increasing order (time {times[i]:g} after {times[i - 1]:g} "
+                        f"on line {lines[i - 1]})", file=path, line=lines[i], expected="non-decreasing times")
+
+
+def read_vector_table(path: str, what: str, allow_none: bool = False) -> tuple[list, list]:
+    """A ``<floating>`` driver's ``file`` (``<linearvel>``, ``<angularvel>``, ``<linearforce>``,
+    ``<angularforce>``): rows time;x;y;z, as DualSPHysics's JLinearValue::LoadFile reads them (at
+    least two rows; ``none`` for a free velocity component where ``allow_none``) -> (times, rows of
+    [x|None, y|None, z|None]), the form of the inline table."""
+    a, lines = _read_rows(path, 4, what, allow_none=allow_none)
+    if a.shape[0] < 2:
+        found = "no data rows" if a.shape[0] == 0 else f"one data row (line {lines[0]})"
+        raise CaseError(f"{what}: {found}", file=path, expected="at least two lines 'time;x;y;z' "
+                        "(DualSPHysics: \"Cannot be less than two values.\")")
+    bad = np.flatnonzero(np.isnan(a[:, 0]))
+    if bad.size:
+        raise CaseError(f"{what}: the time is none", file=path, line=lines[bad[0]], expected="a time [s]")
+    check_rising_times(a[:, 0].tolist(), lines, what, path)
+    values = [[None if math.isnan(v) else float(v) for v in row[1:4]] for row in a]
+    return a[:, 0].tolist(), values
 
 
 def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.ndarray:
@@ -50,7 +101,7 @@ def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.nda
     ``ncols`` numbers (the ``fields`` attribute), of which ``columns`` (name -> 0-based
     column, ``fieldtime`` among them) are used. Checked as DualSPHysics needs them: at
     least two rows, the used values finite, the times strictly rising. -> (n, ncols)."""
-    a, lines = _read_rows(path, ncols, what)
+    a, lines = _read_rows(path, ncols, what, finite=False)
     if a.shape[0] < 2:
         found = "no data rows" if a.shape[0] == 0 else f"one data row (line {lines[0]})"
         raise CaseError(f"{what}: {found}", file=path,

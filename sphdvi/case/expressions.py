@@ -4,7 +4,10 @@ Attribute values that start with ``#`` are expressions (``x="#SizeX/2"``); the
 values of ``<newvar>``, ``<newvarcte>`` and ``<setvar>`` are expressions without
 the ``#``. The grammar is C-like: ``+ - * / %``, ``^`` (power), comparisons,
 ``&& || !``, parentheses, function calls, and array-like names ``x[1+1]`` that
-mean the variable ``x2``. Strings (``<newvarstr>``) may interpolate
+mean the variable ``x2``. As in C (GenCase's evaluator; GenCase_CaseTemplate.xml's
+``if="Dp!=0.1==(true||false)"``), ``!`` binds tighter than any binary operator, ``< <= > >=``
+tighter than ``== !=``, and comparisons do not chain: ``a!=b==c`` is ``(a!=b)==c`` with the
+first result taken as 0 or 1. Strings (``<newvarstr>``) may interpolate
 expressions between brackets: ``"[Text1]_[Dp*100]"``.
 
 The evaluator walks a Python AST restricted to these node types, so nothing
@@ -59,6 +62,14 @@ def _int(a):
     return float(int(a))
 
 
+def _round_node(pos, posmin, dp):
+    """``posmin + k*dp`` nearest to ``pos`` (halves up, 1e-6 dp tolerance as the drawing's
+    node rounding, :func:`sphdvi.case.draw.lattice.round_idx`)."""
+    if not dp > 0:
+        raise ExpressionError("roundpos(pos, posmin, dp) needs dp > 0")
+    return posmin + math.floor((pos - posmin) / dp + 0.5 + 1e-6) * dp
+
+
 FUNCTIONS = {
     "pi": lambda: math.pi, "e": lambda: math.e,
     "min": min, "max": max, "abs": abs, "sqrt": math.sqrt, "exp": math.exp,
@@ -72,7 +83,13 @@ FUNCTIONS = {
     "fmod": math.fmod, "fmodr": _fmodr, "float": float, "int": _int,
     "rand": _rand, "randint": lambda a, b: float(random.randint(int(a), int(b))),
     "randinit": _randinit, "eval": _eval_cond, "wavelength": _wavelength,
+    "roundpos": _round_node,
 }
+#: roundposx/y/z(pos): GenCase_CaseTemplate.xml lists them (with roundpos(pos,posmin,dp)) without
+#: a definition; sphdvi takes the evident one: the nearest lattice position along that axis,
+#: ``origin + k*Dp`` with the lattice origin of <definition> (pointmin, or the first node of the
+#: pointref-aligned lattice; in 2D the y axis is rounded the same way from posy)
+LATTICE_FUNCTIONS = {"roundposx": 0, "roundposy": 1, "roundposz": 2}
 
 _BINOPS = {
     ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b, ast.Mult: lambda a, b: a * b,
@@ -89,7 +106,7 @@ _MAX_POW = 1e6
 def _to_python(text: str) -> str:
     """Rewrite the C-like operators of DualSPHysics expressions as Python ones."""
     s = text.replace("&&", " and ").replace("||", " or ")
-    s = re.sub(r"!(?!=)", " not ", s)
+    s = re.sub(r"!(?!=)", " ~", s)     # C's unary ! (Python's ~ has unary precedence)
     s = s.replace("^", "**")
     s = re.sub(r"\btrue\b", "True", s)
     s = re.sub(r"\bfalse\b", "False", s)
@@ -102,11 +119,13 @@ class Variables:
     def __init__(self):
         self.values: dict[str, object] = {}
         self.constant: set[str] = set()
+        self.lattice: tuple | None = None   # (origin xyz, dp) once <definition> is read
 
     def copy(self) -> "Variables":
         other = Variables()
         other.values = dict(self.values)
         other.constant = set(self.constant)
+        other.lattice = self.lattice
         return other
 
     # -- definitions -------------------------------------------------------
@@ -220,7 +239,7 @@ class Variables:
             return float(op(a, b))
         if isinstance(node, ast.UnaryOp):
             value = self._eval(node.operand)
-            if isinstance(node.op, ast.Not):
+            if isinstance(node.op, (ast.Not, ast.Invert)):
                 return not value
             if isinstance(node.op, ast.USub):
                 return -self._num(value)
@@ -231,23 +250,16 @@ class Variables:
             values = [self._eval(v) for v in node.values]
             return all(values) if isinstance(node.op, ast.And) else any(values)
         if isinstance(node, ast.Compare):
-            left = self._eval(node.left)
-            for op, comp in zip(node.ops, node.comparators):
-                right = self._eval(comp)
-                fn = _CMPOPS.get(type(op))
-                if fn is None:
-                    raise ExpressionError("unsupported comparison")
-                if not fn(left, right):
-                    return False
-                left = right
-            return True
+            return self._compare(node)
         if isinstance(node, ast.Call):
             if not isinstance(node.func, ast.Name) or node.keywords:
                 raise ExpressionError("only plain function calls are allowed")
+            if node.func.id in LATTICE_FUNCTIONS:
+                return self._round_lattice(node)
             fn = FUNCTIONS.get(node.func.id)
             if fn is None:
-                raise ExpressionError(
-                    f"unknown function '{node.func.id}()'; known: {', '.join(sorted(FUNCTIONS))}")
+                known = ", ".join(sorted([*FUNCTIONS, *LATTICE_FUNCTIONS]))
+                raise ExpressionError(f"unknown function '{node.func.id}()'; known: {known}")
             args = [self._eval(a) for a in node.args]
             if node.func.id != "eval":
                 args = [self._num(a) for a in args]
@@ -255,6 +267,37 @@ class Variables:
         if isinstance(node, ast.IfExp):
             return self._eval(node.body) if self._eval(node.test) else self._eval(node.orelse)
         raise ExpressionError(f"unsupported syntax ({type(node).__name__})")
+
+    def _compare(self, node):
+        """A comparison as C evaluates it: ``< <= > >=`` before ``== !=``, each left to right,
+        a comparison's result (0 or 1) the left operand of the next (no Python chaining)."""
+        groups, eq_ops = [self._eval(node.left)], []
+        for op, comp in zip(node.ops, node.comparators):
+            fn = _CMPOPS.get(type(op))
+            if fn is None:
+                raise ExpressionError("unsupported comparison")
+            right = self._eval(comp)
+            if isinstance(op, (ast.Eq, ast.NotEq)):
+                eq_ops.append(fn)
+                groups.append(right)
+            else:
+                groups[-1] = fn(groups[-1], right)
+        result = groups[0]
+        for fn, right in zip(eq_ops, groups[1:]):
+            result = fn(result, right)
+        return bool(result)
+
+    def _round_lattice(self, node):
+        """roundposx/y/z(pos): the nearest lattice position along x, y or z (see LATTICE_FUNCTIONS)."""
+        name = node.func.id
+        if len(node.args) != 1:
+            raise ExpressionError(f"{name}(pos) takes one argument")
+        if self.lattice is None:
+            raise ExpressionError(f"{name}() needs the particle lattice: use it after <definition> "
+                                  "(not in <predefinition>)")
+        origin, dp = self.lattice
+        axis = LATTICE_FUNCTIONS[name]
+        return _round_node(self._num(self._eval(node.args[0])), float(origin[axis]), float(dp))
 
     def _lookup(self, name: str):
         if name in self.values:

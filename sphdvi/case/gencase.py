@@ -27,6 +27,7 @@ from .reader import (case_name_from_path, open_case, parse_domain_spec, read_con
 TYPE_FIXED, TYPE_MOVING, TYPE_FLOATING, TYPE_FLUID = 0, 1, 2, 3
 TYPE_NAMES = {0: "Fixed boundary", 1: "Moving boundary", 2: "Floating", 3: "Fluid"}
 DEFAULT_MAX_NODES = 200_000_000
+F32_MAX = float(np.finfo(np.float32).max)    # DualSPHysics stores masses, velocities, densities as float
 
 
 @dataclass
@@ -93,7 +94,10 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
                            "drawing commands inside <mainlist> that create particles inside pointmin..pointmax")
     warn_no_fluid(drawing, reader)
     fluid_z = drawing.pos[drawing.is_fluid, 2]
-    consts = resolve_constants(cdef, drawing.dp, drawing.is2d, drawing.posy2d, fluid_z)
+    check_dp(reader, geometry, drawing.dp, drawing.is2d, cdef.rhop0)
+    with np.errstate(over="ignore", invalid="ignore"):      # checked next
+        consts = resolve_constants(cdef, drawing.dp, drawing.is2d, drawing.posy2d, fluid_z)
+    check_constants(reader, casedef, consts, fluid=bool(fluid_z.size))
     if fluid_z.size and not consts.cs0 > 0:
         raise reader.error(casedef.find("constantsdef"), "the speed of sound is zero (the fluid has no height)",
                            'a <speedsound value=".."/> or <hswl value=".."/>')
@@ -106,6 +110,7 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     normals = case_normals(case, particles, consts, drawing, reader)
     bodies = floating_bodies(case, particles, consts, drawing.primitives, reader)
     apply_floating_velocities(particles, bodies, consts.is2d, case, reader)
+    check_particle_values(particles, reader)
     domain = resolve_domain(case, particles, consts, reader)
     check_case(case, particles, bodies, mkinfo, domain, reader)
     warn_gauges_outside(case.special.get("gauges"), domain, consts.is2d, reader)
@@ -113,6 +118,59 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
                          mkinfo=mkinfo, warnings=warnings, primitives=list(drawing.primitives),
                          files=list(drawing.shape_files), normals=normals)
+
+
+def check_dp(reader, geometry, dp: float, is2d: bool, rhop0: float) -> None:
+    """A dp whose particle mass rhop0·dp³ (rhop0·dp² in 2D) is a finite float32, the precision
+    DualSPHysics keeps masses in (GenCase's MassFluid/MassBound); dp=1e308 overflowed to an
+    internal error."""
+    ndim = 2 if is2d else 3
+    limit = math.log10(F32_MAX) - math.log10(rhop0) if rhop0 <= F32_MAX else 300.0   # rhop0: check_constants
+    if ndim * math.log10(dp) > limit:
+        el = geometry.find("definition") if geometry.find("definition") is not None else geometry
+        raise reader.error(el, f"dp={dp:g} is too large: a particle's mass rhop0·dp^{ndim} "
+                               f"({rhop0:g}·{dp:g}^{ndim}) is beyond the float range ({F32_MAX:.3g})",
+                           "dp, the distance between particles [m], of the size of the particles")
+
+
+def check_constants(reader, casedef, consts: Constants, fluid: bool = True) -> None:
+    """The resolved constants (rhop0, h, B, cs0, masses...) finite and within the float range
+    DualSPHysics keeps them in (its StCteSph constants are float): an absurd <constantsdef> value
+    (coefsound 1e300, or a gravity of 1e300 with a fluid: B overflows) is refused here, not left to
+    overflow in the run. Without fluid the speed of sound and B are not used: a gravity of 1e306
+    is left to the run, which stops on the body that goes out, with the cause."""
+    sound = ("coefsound", "hswl", "speedsystem", "cs0", "b")
+    order = ("rhop0", "gamma", "coefsound", "cflnumber", "hswl", "coefh", "speedsystem", "cs0", "h", "b")
+    values = {k: getattr(consts, k) for k in order}          # the inputs first, then what comes of them
+    values.update({k: v for k, v in consts.to_dict().items() if isinstance(v, float) and k not in values})
+    values = {k: v for k, v in values.items() if fluid or k not in sound}
+    for name, value in values.items():
+        if not abs(value) <= F32_MAX:
+            el = casedef.find("constantsdef") if casedef.find("constantsdef") is not None else casedef
+            raise reader.error(el, f"{name} = {value:g} is not a finite number within the float range "
+                                   f"({F32_MAX:.3g}) DualSPHysics keeps its constants in",
+                               "constants of physical sizes (B = rhop0·cs0²/gamma, cs0 = coefsound·"
+                               "sqrt(|g|·hswl), massfluid = rhop0·dp³ are computed from them)")
+
+
+def check_particle_values(particles: dict, reader) -> None:
+    """After the <initials>, the floating bodies and their velocities: every position, velocity,
+    density and mass finite and within the float range the outputs keep (a <rotateaxis> about a
+    zero axis gave NaN positions, a massbody of 1e300 an overflow warning and then a blow-up)."""
+    for name, unit in (("pos", "m"), ("vel", "m/s"), ("rhop", "kg/m3"), ("mass", "kg")):
+        a = np.asarray(particles[name], float)
+        with np.errstate(invalid="ignore", over="ignore"):
+            bad = ~(np.abs(a) <= F32_MAX)
+        if bad.ndim > 1:
+            bad = bad.any(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            idp, mk = int(particles["idp"][i]), int(particles["mk"][i])
+            raise CaseError(f"{int(bad.sum())} particle(s) get a {name} that is not a finite number within the float "
+                            f"range ({F32_MAX:.3g}): particle {idp} (mk {mk}) has {np.asarray(a[i]).tolist()} {unit}",
+                            file=reader.file,
+                            expected="finite values: check the <initials>, <floatings> and <constantsdef> values "
+                                     "of that mk")
 
 
 def warn_no_fluid(drawing, reader) -> None:
@@ -390,9 +448,20 @@ def floating_bodies(case: Case, particles: dict, consts: Constants, primitives, 
                 masspart = rhopbody * vol
             else:
                 masspart = massbody / count
+            if not (abs(massbody) <= F32_MAX and abs(masspart) <= F32_MAX):
+                raise CaseError(f"floating mkbound {mkb}: a body mass of {massbody:g} kg ({masspart:g} kg a "
+                                f"particle) is beyond the float range ({F32_MAX:.3g}) DualSPHysics keeps masses in",
+                                file=reader.file, line=fd.line, element="floating",
+                                expected="a massbody (or rhopbody) of a physical size")
             center = np.asarray(fd.center, float) if fd.center is not None else pos[sel].mean(axis=0)
-            inertia = np.asarray(fd.inertia, float) if fd.inertia is not None else \
-                particle_inertia(pos[sel], center, massbody / count)
+            with np.errstate(over="ignore", invalid="ignore"):      # checked next
+                inertia = np.asarray(fd.inertia, float) if fd.inertia is not None else \
+                    particle_inertia(pos[sel], center, massbody / count)
+            if not (np.abs(center) <= F32_MAX).all() or not (np.abs(inertia) <= F32_MAX).all():
+                raise CaseError(f"floating mkbound {mkb}: its centre {center.tolist()} or inertia "
+                                f"{np.asarray(inertia).tolist()} is not finite within the float range ({F32_MAX:.3g})",
+                                file=reader.file, line=fd.line, element="floating",
+                                expected="a <center> and <inertia> of physical sizes")
             particles["mass"][sel] = masspart
             analytic = analytic_properties(primitives, mkb, consts.is2d,
                                            rhopbody if rhopbody is not None else None, massbody)

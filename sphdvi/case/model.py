@@ -82,7 +82,7 @@ class FloatingDef:
     rotation_dof: list = field(default_factory=lambda: [1, 1, 1])
     linearvelini: list = field(default_factory=lambda: [0.0, 0.0, 0.0])
     angularvelini: list = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    linearvel: dict | None = None        # {"times": [...], "values": [[x|None,...]]} or {"file": path}
+    linearvel: dict | None = None        # {"times": [...], "values": [[x|None,...]]} (a file is read at gencase; older case files hold {"file": path})
     angularvel: dict | None = None
     linearforce: dict | None = None
     angularforce: dict | None = None

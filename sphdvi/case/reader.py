@@ -196,15 +196,16 @@ def read_sections(case: Case, root, reader: CaseReader) -> None:
     case.floatings = read_floatings(reader, casedef)
     case.initials = read_initials(reader, casedef)
     case.motions = read_motion(reader, casedef)
-    case.materials, case.material_links = read_properties(reader, casedef)
+    case.materials, case.material_links = read_properties(reader, casedef, case.fluidcount)
     for fd in case.floatings:
         if fd.property is not None:
-            _check_property_names(reader, fd.property, case.materials, fd.line, "floating")
+            fd.property = _check_property_names(reader, fd.property, case.materials, fd.line, "floating")
     case.normals = read_normals(reader, casedef)
     execution = root.find("execution")
     params, set_keys, domain = read_parameters(reader, execution)
     case.parameters, case.parameters_set, case.simulationdomain = params, set_keys, domain
     case.special = read_special(reader, execution)
+    check_chrono_case(reader, case)
     check_shifting(reader, root, set_keys, case.special)
 
 
@@ -221,7 +222,7 @@ def _series(reader, el, item_tag, allow_none=False):
     if el is None:
         return None
     if el.get("file") is not None:
-        return {"file": reader.resolve_path(el, "file")}
+        return _series_file(reader, el, allow_none)
     times, values = [], []
     for item in reader.children(el, item_tag):
         times.append(reader.num(item, "time", nonnegative=True))
@@ -241,6 +242,19 @@ def _series(reader, el, item_tag, allow_none=False):
     if any(t2 < t1 for t1, t2 in zip(times, times[1:])):
         raise reader.error(el, "times are not in increasing order", "non-decreasing times")
     return {"times": times, "values": values}
+
+
+def _series_file(reader, el, allow_none: bool) -> dict:
+    """A driver's ``file="x.csv"`` (rows time;x;y;z, ``none`` a free component where allowed), read
+    and checked now as the inline table (JLinearValue::LoadFile) -> {"times", "values", "source"}."""
+    from .datafiles import read_vector_table
+    path = reader.resolve_path(el, "file")
+    try:
+        times, values = read_vector_table(path, f"<{el.tag}> file", allow_none)
+    except CaseError as exc:
+        raise reader.error(el, f"{path}{':' + str(exc.line) if exc.line else ''}: {exc.message}",
+                           exc.expected) from None
+    return {"times": times, "values": values, "source": path}
 
 
 def read_floatings(reader, casedef) -> list:
@@ -303,8 +317,6 @@ def read_floatings(reader, casedef) -> list:
                 raise reader.error(inf, f"{len(rows)} <values> rows", "3 rows v11 v12 v13 / v21.. / v31..")
             mat = [[reader.num(r, f"v{i + 1}{j + 1}") for j in range(3)] for i, r in enumerate(rows)]
             fd.inertia = mat
-        if fd.inertia is not None:
-            _check_inertia(reader, ine if ine is not None else inf, np.asarray(fd.inertia, float))
         for tag, attr in (("translationDOF", "translation_dof"), ("rotationDOF", "rotation_dof")):
             d = reader.child(f, tag)
             if d is not None:
@@ -312,6 +324,9 @@ def read_floatings(reader, casedef) -> list:
                 if not np.all(np.isin(v, (0.0, 1.0))):
                     raise reader.error(d, f"{tag} components must be 0 or 1", "0 (locked) or 1 (free)")
                 setattr(fd, attr, [int(x) for x in v])
+        if fd.inertia is not None:
+            _check_inertia(reader, ine if ine is not None else inf, np.asarray(fd.inertia, float),
+                           fd.rotation_dof, _definition_is_2d(reader, casedef))
         for tags, attr in ((("linearvelini", "velini"), "linearvelini"), (("angularvelini", "omegaini"), "angularvelini")):
             for tag in tags:
                 d = reader.child(f, tag)
@@ -325,16 +340,42 @@ def read_floatings(reader, casedef) -> list:
     return out
 
 
-def _check_inertia(reader, el, tensor):
-    """A body's inertia tensor must be symmetric with no negative principal moment (zeros
-    are allowed: a 2D case uses only I_yy)."""
+def _check_inertia(reader, el, tensor, rotation_dof=(1, 1, 1), is2d=False):
+    """A body's inertia tensor must be symmetric with no negative principal moment, and positive
+    about each axis the body may rotate about: a principal moment below 1e-12 of the largest
+    (dvi.system.ZERO_INERTIA) counts as zero and is refused when its axis has a free rotation
+    (2D: only the rotation about y is free, so ``<inertia x="0" y="0.5" z="0"/>`` is fine; 3D:
+    the axes ``<rotationDOF>`` leaves free).  (An inertia computed from the particles of a body
+    drawn as a line is not refused: the run locks the rotation about it, with a warning.)"""
     scale = max(float(np.abs(tensor).max()), 1e-300)
     if np.abs(tensor - tensor.T).max() > 1e-9 * scale:
         raise reader.error(el, "inertia tensor is not symmetric", "v12 = v21, v13 = v31, v23 = v32")
-    lowest = float(np.linalg.eigvalsh(tensor).min())
+    lam, axes = np.linalg.eigh(tensor)
+    lowest = float(lam.min())
     if lowest < -1e-12 * scale:
         raise reader.error(el, f"inertia tensor has a negative principal moment ({lowest:g} kg m²)",
                            "moments of inertia >= 0")
+    top = float(lam.max())
+    free = np.asarray(rotation_dof, float) * (np.array([0.0, 1.0, 0.0]) if is2d else 1.0)
+    for k in range(3):
+        axis = axes[:, k]
+        if (top > 0 and lam[k] > 1e-12 * top) or not np.any(np.abs(axis) * free > 1e-6):
+            continue
+        j = int(np.argmax(np.abs(axis)))
+        name = "xyz"[j] if abs(axis[j]) > 1.0 - 1e-9 else "(" + ", ".join(f"{x:.3g}" for x in axis) + ")"
+        raise reader.error(el, f"the principal moment of inertia about {name} is {max(lam[k], 0.0):g} kg m²: a "
+                               "floating body needs a positive moment about each axis it may rotate about",
+                           "positive moments about the free axes (in 2D I_yy), or that rotation locked with "
+                           "<rotationDOF>")
+
+
+def _definition_is_2d(reader, casedef) -> bool:
+    """GenCase's 2D case: <definition> pointmin and pointmax with the same y."""
+    d = casedef.find("geometry/definition") if casedef is not None else None
+    ends = [d.find(t) for t in ("pointmin", "pointmax")] if d is not None else [None]
+    if any(e is None for e in ends):
+        return False
+    return bool(reader.vec3(ends[0])[1] == reader.vec3(ends[1])[1])
 
 
 def read_initials(reader, casedef) -> list:
@@ -392,6 +433,9 @@ def read_initials(reader, casedef) -> list:
             d["angle_deg"] = ang if units.lower() == "degrees" else float(np.degrees(ang))
             d["axisp1"] = reader.vec3(reader.child(item, "axisp1", True)).tolist()
             d["axisp2"] = reader.vec3(reader.child(item, "axisp2", True)).tolist()
+            if not np.linalg.norm(np.subtract(d["axisp2"], d["axisp1"])) > 0:
+                raise reader.error(item, "axisp1 equals axisp2: the rotation axis has no direction",
+                                   "two different points axisp1 and axisp2")
         out.append(d)
     return out
 
@@ -592,7 +636,7 @@ def _read_material(reader, el) -> Material:
     """A ``<property>``: values as child elements (``<Kfric value="0.3"/>``) or attributes
     (``Restitution_Coefficient_User="0.65"``); as in DualSPHysics, a ``*_User`` value
     overrides the plain one, wherever each is written."""
-    mat = Material(name=reader.text_attr(el, "name"))
+    mat = Material(name=reader.text_attr(el, "name").replace(" ", ""))   # stored without spaces
     plain, user = {}, {}
     for c in reader.children(el):
         key = c.tag.removesuffix("_User")
@@ -621,7 +665,9 @@ def _read_material(reader, el) -> Material:
     return mat
 
 
-def read_properties(reader, casedef):
+def read_properties(reader, casedef, fluidcount: int = 9):
+    """``<properties>``: the materials by name (stored without spaces, found whatever the case,
+    as JCaseProperties::AddProperty / GetIndexProperty) and the links (JCasePropLinks::ReadXml)."""
     el = reader.child(casedef, "properties")
     materials, links = {}, []
     if el is None:
@@ -629,38 +675,74 @@ def read_properties(reader, casedef):
     for c in reader.children(el):
         if c.tag == "property":
             m = _read_material(reader, c)
-            materials[m.name] = m
+            _add_material(materials, m)
         elif c.tag == "propertyfile":
             path = reader.resolve_path(c, "file")
             section = reader.text_attr(c, "path", "")
-            materials.update(_read_property_file(reader, c, path, section))
+            for m in _read_property_file(reader, c, path, section).values():
+                _add_material(materials, m)
         elif c.tag == "links":
             for link in reader.children(c):
                 if link.tag != "link":
                     raise reader.error(link, f"unknown element <{link.tag}>", "<link>")
-                d = {"property": reader.text_attr(link, "property"), "line": link.sourceline}
-                if link.get("mkbound") is not None:
-                    d["mkbound"] = _mk_list(reader, link, "mkbound")
-                if link.get("mkfluid") is not None:
-                    d["mkfluid"] = _mk_list(reader, link, "mkfluid")
-                if "mkbound" not in d and "mkfluid" not in d:
-                    raise reader.error(link, "missing mkbound or mkfluid")
-                links.append(d)
+                links.append(_read_link_mks(reader, link, fluidcount))
         else:
             raise reader.error(c, f"unknown element <{c.tag}> in <properties>", "property, propertyfile, links")
     for d in links:
-        _check_property_names(reader, d["property"], materials, d["line"], "link")
+        d["property"] = _check_property_names(reader, d["property"], materials, d["line"], "link")
     return materials, links
 
 
-def _check_property_names(reader, combo: str, materials: dict, line: int, element: str) -> None:
+def _add_material(materials: dict, m) -> None:
+    """Store a property under its name; one of the same name in another case replaces it."""
+    for key in [k for k in materials if k.lower() == m.name.lower()]:
+        del materials[key]
+    materials[m.name] = m
+
+
+def _read_link_mks(reader, link, fluidcount: int) -> dict:
+    """A ``<link>``'s particles, as JCasePropLinks::ReadXml: ``mkbound``, else ``mkfluid``, else
+    ``mk`` (the global mk: GetProps matches it to the particle's mk, which is mkfluid + 1 for
+    fluid and mkbound + fluidcount + 1 for boundaries, sphdvi's and GenCase's numbering)."""
+    d = {"property": reader.text_attr(link, "property"), "line": link.sourceline}
+    given = [a for a in ("mkbound", "mkfluid", "mk") if link.get(a) is not None]
+    if not given:
+        raise reader.error(link, "missing mkbound, mkfluid or mk", 'mkbound="0" (or mkfluid=, or the global mk=)')
+    if len(given) > 1:
+        reader.mark(link, *given[1:])
+        reader.warn(link, f"{given[0]} and {' and '.join(given[1:])} given: DualSPHysics reads {given[0]} "
+                          f"only, and so does sphdvi")
+    if given[0] != "mk":
+        d[given[0]] = _mk_list(reader, link, given[0])
+        return d
+    first_bound = fluidcount + 1
+    mks = _mk_list(reader, link, "mk")
+    bound = [mk - first_bound for mk in mks if mk >= first_bound]
+    fluid = [mk - 1 for mk in mks if 1 <= mk < first_bound]
+    if bound:
+        d["mkbound"] = bound
+    if fluid:
+        d["mkfluid"] = fluid
+    if len(bound) + len(fluid) < len(mks):
+        reader.warn(link, "mk 0 is no particle's mk (fluids start at mk 1): it links nothing")
+    return d
+
+
+def _check_property_names(reader, combo: str, materials: dict, line: int, element: str) -> str:
     """Each name of a property (or a combination "A + B") of a <link> or a <floating> is defined
-    (a floating's misspelt property fell back to the default material before)."""
+    (a floating's misspelt property fell back to the default material before); returns the
+    combination with each name as defined: DualSPHysics drops the spaces and finds a property
+    whatever the case of its letters (JCaseProperties::GetIndexProperty), so "Steel" is "steel"."""
+    by_lower = {k.lower(): k for k in materials}
+    names = []
     for name in combo.split("+"):
-        if name.strip() not in materials:
+        key = by_lower.get(name.replace(" ", "").lower())
+        if key is None:
             raise CaseError(f"property '{name.strip()}' is not defined", file=reader.file, line=line,
                             element=element, expected="a <property name> defined in <properties> or its propertyfile"
                             + (f" (defined: {', '.join(sorted(materials))})" if materials else ""))
+        names.append(key)
+    return "+".join(names)
 
 
 def _read_property_file(reader, el, path, section):
@@ -881,6 +963,9 @@ def _check_modelfile(reader, el, modelfile: str, body_id: str) -> None:
 
 
 def read_chrono(reader, el) -> dict:
+    """``<special><chrono>`` as DualSPHysics's JChronoObjects::ReadXml reads it: bodies (one per
+    mkbound of a range, an mkbound in one body only), links (DualSPHysics's default names),
+    collision settings, scale forces; options sphdvi does not apply are warned about."""
     allowed = {"savedata", "schemescale", "ompthreads", "collision", "bodyfixed", "bodyfloating",
                "bodymoving", "link_hinge", "link_spheric", "link_pointline", "link_linearspring",
                "link_coulombdamping", "link_pulley", "gravity", "timestepper", "scaleforce",
@@ -895,6 +980,10 @@ def read_chrono(reader, el) -> dict:
             raise reader.error(c, f"<{tag}> (Chrono FEA) is not supported by sphdvi", "rigid bodies and links")
     if el.find("savedata") is not None:
         out["savedata"] = reader.child_value(el, "savedata")
+        if out["savedata"] >= 0:
+            reader.warn(reader.child(el, "savedata"), "<savedata> (DualSPHysics's ChronoExchange_mkbound_XX.csv, "
+                        "ChronoBody_forces.csv, ChronoLink_forces.csv) is not written by sphdvi: bodies.csv and "
+                        "links.csv hold the bodies' and links' data at each output")
     if el.find("schemescale") is not None:
         out["schemescale"] = reader.child_value(el, "schemescale", positive=True)
     if el.find("ompthreads") is not None:
@@ -903,15 +992,58 @@ def read_chrono(reader, el) -> dict:
         s = reader.child(el, "solver")
         out["solver"] = {k: s.get(k) for k in s.keys()}
         reader.mark(s, *s.keys())
-    col = reader.child(el, "collision")
-    if col is not None:
-        reader.check_children(col, {"distancedp", "contactmethod"})
-        out["collision"] = {
-            "activate": reader.boolean(col, "activate", True),
+    _read_chrono_timestepper(reader, reader.child(el, "timestepper"))
+    out["collision"] = _read_chrono_collision(reader, reader.child(el, "collision"), out["collision"])
+    ids = _read_chrono_bodies(reader, el, out)
+    for ln in reader.children(el):
+        if not ln.tag.startswith("link_"):
+            continue
+        out["links"].append(_read_link(reader, ln, ids))
+    _name_chrono_links(reader, el, out["links"])
+    scale = reader.child(el, "scaleforce")
+    if scale is not None:
+        out["scaleforce"] = _read_scaleforce(reader, scale, out["bodies"])
+    return out
+
+
+def _read_chrono_timestepper(reader, ts) -> None:
+    """``<timestepper value alpha>`` (DualSPHysics: 0 Euler implicit linearised, 1 HHT with
+    ``alpha``, default -0.2; other values an error). sphdvi's multibody step is the former:
+    HHT is warned about, ``alpha`` without HHT as DualSPHysics does."""
+    if ts is None:
+        return
+    value = reader.integer(ts, "value", 0)
+    if value not in (0, 1):
+        raise reader.error(ts, f"timestepper value {value}", "0 (Euler implicit linearised) or 1 (HHT)")
+    alpha = reader.num(ts, "alpha", -0.2)
+    if value == 1:
+        reader.warn(ts, f"HHT (timestepper 1, alpha {alpha:g}) is not supported by sphdvi: the Euler implicit "
+                        "linearised stepper (timestepper 0) is used")
+    elif ts.get("alpha") is not None and alpha != 0:
+        reader.warn(ts, "'alpha' is only used by the HHT timestepper (value 1); ignored, as in DualSPHysics")
+
+
+def _read_chrono_collision(reader, col, default: dict) -> dict:
+    """``<collision activate>``: ``activate`` is mandatory and the children are read only when it
+    is true (DualSPHysics's ReadXml: GetAttributeBool(collision, "activate", false))."""
+    if col is None:
+        return default
+    if col.get("activate") is None:
+        raise reader.error(col, "missing attribute 'activate'",
+                           'activate="true" (Chrono collisions) or activate="false"')
+    if not reader.boolean(col, "activate"):
+        return dict(default)
+    reader.check_children(col, {"distancedp", "contactmethod"})
+    return {"activate": True,
             "distancedp": reader.child_value(col, "distancedp", 0.5, nonnegative=True),
-            "contactmethod": int(reader.child_value(col, "contactmethod", 0, lo=0, hi=1)),
-        }
-    ids = {}
+            "contactmethod": int(reader.child_value(col, "contactmethod", 0, lo=0, hi=1))}
+
+
+def _read_chrono_bodies(reader, el, out: dict) -> dict:
+    """The ``<body*>`` elements into ``out["bodies"]`` (one per mkbound, named id+mk for a list);
+    returns {body id: line}. An id or an mkbound used twice is an error
+    (JChronoData::CheckAddBodyError); no body at all a warning (DualSPHysics refuses it)."""
+    ids, owner = {}, {}
     for b in reader.children(el):
         if not b.tag.startswith("body"):
             continue
@@ -922,7 +1054,10 @@ def read_chrono(reader, el) -> dict:
         for name, mk in zip(names, mks):
             if name in ids:
                 raise reader.error(b, f"body id '{name}' is used twice (line {ids[name]})", "unique body ids")
-            ids[name] = b.sourceline
+            if mk in owner:
+                raise reader.error(b, f"mkbound {mk} is already in use for the body '{owner[mk][0]}' (line "
+                                      f"{owner[mk][1]})", "each mkbound in one <chrono> body only")
+            ids[name], owner[mk] = b.sourceline, (name, b.sourceline)
             body = {"kind": kind, "id": name, "mkbound": mk, "line": b.sourceline,
                     "modelfile": reader.text_attr(b, "modelfile", None),
                     "modelnormal": reader.text_attr(b, "modelnormal", "original",
@@ -933,17 +1068,97 @@ def read_chrono(reader, el) -> dict:
             if out["collision"]["activate"] and body["modelfile"]:
                 _check_modelfile(reader, b, body["modelfile"], name)
             out["bodies"].append(body)
-    for ln in reader.children(el):
-        if not ln.tag.startswith("link_"):
-            continue
-        out["links"].append(_read_link(reader, ln, ids))
-    scale = reader.child(el, "scaleforce")
-    if scale is not None:
-        out["scaleforce"] = []
-        for b in reader.children(scale, "body"):
-            out["scaleforce"].append({"mkbound": reader.integer(b, "mkbound", lo=0),
-                                      "scale": reader.vec3(b, default=np.ones(3), missing=1.0).tolist()})
+        if out["collision"]["activate"] and reader.boolean(b, "imposefric", False):
+            reader.warn(b, "imposefric is not supported by sphdvi: the contacts of this body use the pair rule "
+                           "(the smaller friction of the two bodies), not its own Kfric")
+    if not out["bodies"]:
+        reader.warn(el, "<chrono> defines no body: DualSPHysics refuses it (\"There are no defined bodies to use "
+                        "Chrono.\"); sphdvi makes every <floating> a free body")
+    return ids
+
+
+def _name_chrono_links(reader, el, links: list) -> None:
+    """DualSPHysics's link names (JChronoObjects::ReadXml): ``Link_<id1>_<id2>``, ``Link_<id1>`` for a
+    link to the ground, ``_2``, ``_3``... when taken; an explicit name used twice is an error
+    (JChronoData::AddLink*). A ``link_pulley`` whose first body is in no ``link_hinge`` is warned
+    about, as DualSPHysics does."""
+    taken = {}
+    elements = [ln for ln in reader.children(el) if ln.tag.startswith("link_")]
+    hinged = {b for d in links if d["type"] == "hinge" for b in (d["idbody1"], d.get("idbody2")) if b}
+    for ln, d in zip(elements, links):
+        name = d["name"]
+        if name is not None and name in taken:
+            raise reader.error(ln, f"link name '{name}' is already in use (line {taken[name]})", "unique link names")
+        if name is None:
+            base = f"Link_{d['idbody1']}_{d['idbody2']}" if d.get("idbody2") else f"Link_{d['idbody1']}"
+            name, num = base, 2
+            while name in taken:
+                name, num = f"{base}_{num}", num + 1
+        d["name"] = name
+        taken[name] = ln.sourceline
+        if d["type"] == "pulley" and d["idbody1"] not in hinged:
+            reader.warn(ln, f"the body '{d['idbody1']}' also should belong to a link_hinge (as DualSPHysics warns)")
+
+
+def _read_scaleforce(reader, scale, bodies: list) -> list:
+    """``<scaleforce><body mkbound="range" x y z/>``: per-axis factors of the fluid's force on the
+    chrono body of each mkbound (JChronoObjects::ReadScaleForces; an mkbound of no body is an error
+    there too). With no body listed every floating is one: checked at gencase (check_chrono_case)."""
+    reader.check_children(scale, {"body"})
+    known = {b["mkbound"] for b in bodies}
+    out = []
+    for b in reader.children(scale, "body"):
+        mks = _mk_list(reader, b, "mkbound")
+        bad = [mk for mk in mks if known and mk not in known]
+        if bad:
+            raise reader.error(b, f"mkbound {bad[0]} is not a <chrono> body", "the mkbound of a <chrono> body "
+                               "(" + ", ".join(str(m) for m in sorted(known)) + ")")
+        out.append({"mkbound": mks, "scale": reader.vec3(b).tolist(), "line": b.sourceline})
     return out
+
+
+def check_chrono_case(reader, case) -> None:
+    """What ``<chrono>`` needs from the rest of the case, checked at gencase as DualSPHysics does at
+    start-up: with collisions on, each body with a ``modelfile`` has a material with Kfric and
+    Restitution_Coefficient, and Young_Modulus and PoissonRatio under contactmethod 1 (SMC)
+    (JChronoObjects::CheckParams: "Object mkbound=N - Value of Kfric is invalid."); a
+    ``<scaleforce>`` mkbound is a floating's when the section lists no body."""
+    chrono = case.special.get("chrono")
+    if not chrono:
+        return
+    floating_mks = {mk for fd in case.floatings for mk in fd.mkbound}
+    if not chrono["bodies"]:
+        for item in chrono.get("scaleforce", []):
+            bad = [mk for mk in item["mkbound"] if mk not in floating_mks]
+            if bad:
+                raise CaseError(f"<scaleforce> mkbound {bad[0]} is not a floating body", file=reader.file,
+                                line=item["line"], element="body", expected="the mkbound of a <floating>")
+    col = chrono["collision"]
+    if not col["activate"]:
+        return
+    needed = [("kfric", "Kfric"), ("restitution", "Restitution_Coefficient")]
+    if col["contactmethod"] == 1:
+        needed += [("young", "Young_Modulus"), ("poisson", "PoissonRatio")]
+    for body in chrono["bodies"]:
+        if not body["modelfile"]:
+            continue
+        mk = body["mkbound"]
+        combo = next((fd.property for fd in case.floatings if mk in fd.mkbound and fd.property), None)
+        if combo is None:
+            combo = next((ln["property"] for ln in case.material_links if mk in ln.get("mkbound", [])), None)
+        merged = {}
+        for name in (combo or "").split("+"):
+            mat = case.materials.get(name.strip())
+            if mat is not None:
+                merged.update({k: getattr(mat, k) for k, _ in needed if getattr(mat, k) is not None})
+        missing = [label for key, label in needed if merged.get(key) is None]
+        if missing:
+            what = f"its property '{combo}' has no {' or '.join(missing)}" if combo else "it has no property"
+            raise CaseError(f"chrono body '{body['id']}' (mkbound {mk}) collides (modelfile) but {what}: "
+                            f"DualSPHysics stops (\"Object mkbound={mk} - Value of {missing[0]} is invalid.\")",
+                            file=reader.file, line=body["line"], element="body" + body["kind"],
+                            expected=", ".join(label for _, label in needed) + " in a <property> given to the mkbound "
+                            "by <floating property=..> or <properties><links><link mkbound=..>")
 
 
 LINK_SPECS = {
@@ -960,8 +1175,34 @@ LINK_SPECS = {
 LINK_REQUIRED = {
     "link_hinge": ("rotpoint", "rotvector"), "link_spheric": ("rotpoint",),
     "link_pointline": ("slidingvector", "rotpoint"), "link_linearspring": ("point_fb1", "point_fb2", "stiffness", "rest_length"),
-    "link_coulombdamping": ("point_fb1", "point_fb2", "damping"), "link_pulley": ("rotpoint", "rotvector", "radius", "radius2"),
+    "link_coulombdamping": ("point_fb1", "point_fb2", "rest_length", "damping"), "link_pulley": ("rotpoint", "rotvector", "radius", "radius2"),
 }
+
+
+def _read_coef_file(reader, c, tag: str) -> dict:
+    """A link's ``<stiffness file=..>`` / ``<damping file=..>`` table, read at gencase as DualSPHysics's
+    JLinearValue::LoadFile reads it (JReadDatafile: ';', ',', spaces or tabs, '#' comments): at least
+    two (time, value) rows, values finite and >= 0 -> {"times", "values", "file"}."""
+    from .datafiles import _read_rows, check_rising_times
+    path = reader.resolve_path(c, "file")
+    try:
+        a, lines = _read_rows(path, 2, f"<{tag}> table")
+    except CaseError as exc:
+        raise reader.error(c, f"{path}" + (f":{exc.line}" if exc.line else "") + f": {exc.message}",
+                           exc.expected) from None
+    if a.shape[0] < 2:
+        found = "no data rows" if a.shape[0] == 0 else f"one data row (line {lines[0]})"
+        raise reader.error(c, f"{path}: {found}", "at least two lines 'time value' (DualSPHysics: \"Cannot be "
+                                                  "less than two values.\")")
+    bad = np.flatnonzero(~np.isfinite(a[:, :2]).all(axis=1) | (a[:, 1] < 0))
+    if bad.size:
+        raise reader.error(c, f"{path}:{lines[bad[0]]}: {tag} {a[bad[0], 1]:g} at time {a[bad[0], 0]:g}",
+                           f"finite {tag} values >= 0")
+    try:
+        check_rising_times(a[:, 0].tolist(), lines, f"<{tag}> table", path)
+    except CaseError as exc:
+        raise reader.error(c, f"{path}:{exc.line}: {exc.message}", exc.expected) from None
+    return {"times": a[:, 0].tolist(), "values": a[:, 1].tolist(), "file": path}
 
 
 def _read_link(reader, ln, ids) -> dict:
@@ -997,7 +1238,7 @@ def _read_link(reader, ln, ids) -> dict:
                 reader.mark(s, "value")
         elif kind == "coef":
             if c.get("file") is not None:
-                d[tag] = {"file": reader.resolve_path(c, "file")}
+                d[tag] = _read_coef_file(reader, c, tag)
             elif c.get("value") is not None:
                 d[tag] = reader.num(c, "value", nonnegative=True)
             else:
@@ -1005,6 +1246,8 @@ def _read_link(reader, ln, ids) -> dict:
                         for r in reader.children(c)]
                 if not rows:
                     raise reader.error(c, f"<{tag}> has no value", 'value=".." or a time table')
+                if any(t2 < t1 for (t1, _), (t2, _) in zip(rows, rows[1:])):
+                    raise reader.error(c, "times are not in increasing order", "non-decreasing times")
                 d[tag] = {"times": [r[0] for r in rows], "values": [r[1] for r in rows]}
     for tag in ("rotvector", "slidingvector"):
         if tag in d and tag in LINK_REQUIRED[ln.tag] and np.linalg.norm(d[tag]) == 0:

@@ -12,6 +12,8 @@ One call to :meth:`System.step` performs one Anitescu–Tasora step
 4. ``v⁺ = v_free + M⁻¹ Dᵀ γ``, then ``x += h v⁺``, ``q ← q ⊗ exp(h ω⁺_body)``.
 """
 
+import warnings
+
 import numpy as np
 
 from . import collision as col
@@ -63,6 +65,34 @@ def _as_table(v):
 
 def _eval(v, t):
     return v(t) if callable(v) else v
+
+
+ZERO_INERTIA = 1e-12    # principal moments below this fraction of the largest count as none
+
+
+def free_inverse_inertia(I, R, rotation_dof, name="body"):
+    """The body-frame inverse of the inertia tensor ``I`` of a floating body, inverted on the
+    rotations it has inertia for only (a pseudo-inverse): a principal moment below
+    ZERO_INERTIA of the largest (a 2D body's I_xx, I_zz; a body whose particles lie on a line)
+    gives no rotation about its axis, i.e. that rotation is locked (DualSPHysics inverts the
+    tensor as given, JSphCpuSingle::FtCalcForces, and a singular one is unusable there).  A
+    locked axis (``rotation_dof``, world axes at the orientation ``R``) needs no moment; a free
+    one is warned about (the reader refuses a zero moment given in <inertia> about a free axis)."""
+    lam, V = np.linalg.eigh(np.asarray(I, dtype=np.float64))
+    top = float(lam.max())
+    zero = lam <= ZERO_INERTIA * top if top > 0 else np.ones(3, bool)
+    if not zero.any():
+        return np.linalg.inv(I)
+    inv = (V * np.where(zero, 0.0, 1.0 / np.where(zero, 1.0, lam))) @ V.T
+    free = np.asarray(rotation_dof, float)
+    for k in np.flatnonzero(zero):
+        axis = np.asarray(R, float) @ V[:, k]
+        if np.any(np.abs(axis) * free > 1e-6):
+            warnings.warn(f"floating body {name} has no moment of inertia about the axis "
+                          f"({', '.join(f'{x:.3g}' for x in axis)}) (principal moment {lam[k]:.3g}, "
+                          f"below {ZERO_INERTIA:g} of the largest, {top:.3g}): its rotation about that axis is "
+                          "locked")
+    return inv
 
 
 class System:
@@ -218,7 +248,9 @@ class System:
         self.mass = np.append(self.mass, float(mass))
         self.inv_mass = np.append(self.inv_mass, 1.0 / mass if dyn and mass > 0 else 0.0)
         self.I_b = np.concatenate([self.I_b, I[None]])
-        self.inv_I_b = np.concatenate([self.inv_I_b, (np.linalg.inv(I) if dyn else np.zeros((3, 3)))[None]])
+        inv_I = (free_inverse_inertia(I, R, rotation_dof, name if name is not None else f"body{self.nb}")
+                 if dyn else np.zeros((3, 3)))
+        self.inv_I_b = np.concatenate([self.inv_I_b, inv_I[None]])
         self.pos = np.vstack([self.pos, np.asarray(pos, float)[None]])
         self.quat = np.vstack([self.quat, q[None]])
         mask = np.concatenate([np.asarray(translation_dof, float), np.asarray(rotation_dof, float)])

@@ -2,7 +2,9 @@
 
 Layout::
 
-    /                      attrs: format="sphdvi-case", version, casename, source_file
+    /                      attrs: format="sphdvi-case", layout (LAYOUT; absent in the files of
+                           sphdvi 0.1.0 and before, the same layout), version (the sphdvi
+                           that wrote it), casename, source_file
     /particles/pos         (N,3) f8     positions [m]
               /vel         (N,3) f8     velocities [m/s]
               /rhop        (N,)  f8     density [kg/m3]
@@ -32,6 +34,7 @@ from ..errors import InputError, h5_reason
 from .atomic import atomic_path
 
 FORMAT = "sphdvi-case"
+LAYOUT = 1        # the layout below; a change that older readers cannot read raises it
 PARTICLE_FIELDS = ("pos", "vel", "rhop", "mass", "type", "mk", "idp")
 BODY_FIELDS = ("mkbound", "mk", "begin", "count", "mass", "masspart", "center", "inertia",
                "translation_dof", "rotation_dof", "linearvelini", "angularvelini")
@@ -55,6 +58,7 @@ def write_case_h5(path: str, *, casename: str, source_file: str, source_xml: str
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as f:
             f.attrs["format"] = FORMAT
+            f.attrs["layout"] = LAYOUT
             f.attrs["version"] = version
             f.attrs["casename"] = casename
             f.attrs["source_file"] = source_file
@@ -122,10 +126,44 @@ def read_case_h5(path: str) -> dict:
                          "run 'sphdvi gencase' again") from None
 
 
+def _version_tuple(text) -> tuple | None:
+    """(major, minor) of a version string "M.m.p" (None when it is not one)."""
+    parts = str(text).split(".")
+    try:
+        return int(parts[0]), int(parts[1]) if len(parts) > 1 else 0
+    except ValueError:
+        return None
+
+
+def check_layout(path: str, attrs) -> None:
+    """A case file this sphdvi can read: its ``layout`` no newer than :data:`LAYOUT`; a file without
+    one (sphdvi 0.1.0 and before wrote none) is read when the sphdvi ``version`` that wrote it is
+    not newer (0.x: major and minor) than this one."""
+    from .._version import __version__
+    version = _attr_value(attrs.get("version"))
+    again = "run 'sphdvi gencase' again with this sphdvi"
+    if "layout" in attrs:
+        layout = _attr_value(attrs["layout"])
+        if not isinstance(layout, int) or layout < 1:
+            raise InputError(f"{path} is not a valid sphdvi case file: its layout attribute is {layout!r}: {again}")
+        if layout > LAYOUT:
+            raise InputError(f"{path} was written by sphdvi {version} in case-file layout {layout}; this sphdvi "
+                             f"({__version__}) reads layouts up to {LAYOUT}: {again} (or update sphdvi)")
+        return
+    mine, theirs = _version_tuple(__version__), _version_tuple(version)
+    if theirs is None:
+        raise InputError(f"{path} is not a valid sphdvi case file: its version attribute {version!r} is not a "
+                         f"sphdvi version: {again}")
+    if theirs > mine:
+        raise InputError(f"{path} was written by sphdvi {version}, newer than this sphdvi ({__version__}): its "
+                         f"layout may differ: {again} (or update sphdvi)")
+
+
 def _read_case_h5(h5py, path: str) -> dict:
     with h5py.File(path, "r") as f:
         if f.attrs.get("format") != FORMAT:
             raise InputError(f"{path} is not a sphdvi case file (no format=\"{FORMAT}\" attribute)")
+        check_layout(path, f.attrs)
         out = {"casename": _attr_value(f.attrs["casename"]), "version": _attr_value(f.attrs["version"]),
                "source_file": _attr_value(f.attrs["source_file"])}
         out["particles"] = {k: f["particles"][k][...] for k in PARTICLE_FIELDS}
@@ -141,4 +179,44 @@ def _read_case_h5(h5py, path: str) -> dict:
     for key in ("is2d",):
         if key in out["constants"]:
             out["constants"][key] = bool(out["constants"][key])
+    problem = _contents_problem(out)
+    if problem:
+        raise InputError(f"{path} is not a valid sphdvi case file: {problem}: run 'sphdvi gencase' again")
     return out
+
+
+def _contents_problem(out: dict) -> str | None:
+    """What is wrong in a case file's contents (None when nothing): the particle arrays of one
+    length and shape, numeric, finite, types 0-3, ids unique; dp, h and the masses of the
+    constants positive; the numeric parameters numbers; one row per body."""
+    p = out["particles"]
+    n = p["pos"].shape[0] if p["pos"].ndim == 2 else -1
+    for name in PARTICLE_FIELDS:
+        a = p[name]
+        shape = (n, 3) if name in ("pos", "vel") else (n,)
+        if a.shape != shape:
+            return f"particles/{name} has the shape {a.shape}, expected {shape}"
+        if a.dtype.kind not in "fiu":
+            return f"particles/{name} holds {a.dtype} values, expected numbers"
+        if a.dtype.kind == "f" and not np.isfinite(a).all():
+            bad = int(np.flatnonzero(~np.isfinite(a.reshape(n, -1)).all(axis=1))[0])
+            return f"particles/{name} of particle {bad} is {a[bad].tolist()}, expected finite numbers"
+    if n and not np.isin(p["type"], (0, 1, 2, 3)).all():
+        return f"particles/type holds {sorted(set(np.unique(p['type']).tolist()) - {0, 1, 2, 3})}, expected 0-3"
+    if np.unique(p["idp"]).size != n:
+        return "particles/idp holds the same id twice"
+    c = out["constants"]
+    for key in ("dp", "h", "rhop0", "massfluid", "massbound"):
+        if key in c and not (isinstance(c[key], (int, float)) and 0 < c[key] < np.inf):
+            return f"constants/{key} is {c[key]!r}, expected a positive number"
+    from ..case.parameters import PARAMETERS
+    for key, value in out["parameters"].items():
+        spec = PARAMETERS.get(key)
+        if spec is None or spec.kind == "str" or value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            return f"parameters/{key} is {value!r}, expected a number"
+    counts = {np.shape(v)[0] if np.ndim(v) else -1 for v in out["bodies"].values()}
+    if len(counts) > 1:
+        return "the /bodies datasets have different lengths"
+    return None

@@ -131,7 +131,8 @@ def load_sph_checkpoint(path: str, solver, system=None, case_id: dict | None = N
                 if group not in f:
                     raise KeyError(f"no group '{group}'")
             sc = {k: _plain(v) for k, v in f["scalars"].attrs.items()}
-            need = [n for n in ("n_excluded", "part") + tuple(solver.CHECKPOINT_SCALARS) if n not in sc]
+            need = [n for n in ("n_excluded", "part") + tuple(solver.CHECKPOINT_SCALARS)
+                    if n not in sc and n not in getattr(solver, "CHECKPOINT_DEFAULTS", {})]
             need += [f"state/{n}" for n in solver.state.FIELDS if n not in f["state"]]
             if need:
                 raise KeyError(f"no {', '.join(need)}")

@@ -31,16 +31,37 @@ def remove_stale_parts(dest: str, collection: str, written: list[str]) -> None:
             os.unlink(os.path.join(dest, name))
 
 
+def _fluid_particles(outdir: str) -> int | None:
+    """The fluid particles of the run in OUTDIR as its run.json records them (the run's
+    ``fluid_particles``: 0 for a body-only run); None without a readable run.json."""
+    import json
+    try:
+        with open(os.path.join(outdir, "run.json")) as fh:
+            return int(json.load(fh)["fluid_particles"])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+
+
+def missing_particles_message(outdir: str, src: str) -> str:
+    """Why OUTDIR has no particles.vtkhdf to export: a body-only run writes none (run.json
+    says it had no fluid), a fluid run's is missing (deleted or moved), or no run wrote one."""
+    nfluid = _fluid_particles(outdir)
+    if nfluid == 0:
+        return (f"{outdir} holds a body-only run (no fluid): it writes no particles.vtkhdf to export; its results are "
+                "bodies.csv and links.csv")
+    if nfluid is not None:
+        return (f"{src} not found: the run in {outdir} has {nfluid} fluid particles, and its particle file is missing "
+                "(deleted or moved?); put it back, or run the case again")
+    return f"{src} not found: run 'sphdvi run' first"
+
+
 def export_vtp(outdir: str, subdir: str = "vtp") -> list[str]:
     """Write every step of OUTDIR/particles.vtkhdf as ``Part_XXXX.vtp`` and ``particles.pvd``
     into :func:`export_dir` (``subdir``), created when missing; the parts of an earlier export
     beyond this run's steps are deleted; returns the files (.pvd last)."""
     src = os.path.join(outdir, "particles.vtkhdf")
     if not os.path.isfile(src):
-        if os.path.isfile(os.path.join(outdir, "bodies.csv")) and os.path.isfile(os.path.join(outdir, "run.json")):
-            raise InputError(f"{outdir} holds a body-only run (no fluid): it writes no particles.vtkhdf to export; "
-                             "its results are bodies.csv and links.csv")
-        raise InputError(f"{src} not found: run 'sphdvi run' first")
+        raise InputError(missing_particles_message(outdir, src))
     dest = export_dir(outdir, subdir)
     times = step_times(src)
     make_folder(dest, "--dir")

@@ -36,6 +36,17 @@ def _check_layout(f, path: str) -> None:
         raise InputError(f"{path} is not a particle file of sphdvi run: no {(missing or ['Steps NSteps'])[0]}")
 
 
+def require_point_arrays(f, path: str, names) -> None:
+    """InputError naming the first of the point arrays ``names`` that the open particle file
+    ``f`` lacks (its PointData dataset or its Steps/PointDataOffsets entry): a damaged file."""
+    root = f["VTKHDF"]
+    for name in names:
+        for group in ("PointData", "Steps/PointDataOffsets"):
+            if name not in root[group]:
+                raise InputError(f"{path} lacks VTKHDF/{group}/{name} (not a particle file of a sphdvi run, or "
+                                 "damaged)")
+
+
 @contextlib.contextmanager
 def open_particles(path: str):
     """``path`` opened for reading, its layout checked: a corrupt or truncated file, or an
@@ -218,6 +229,7 @@ def read_step(path: str, step: int) -> dict:
         off = int(steps["PointOffsets"][step])
         n = int(root["NumberOfPoints"][step])
         out = {"time": float(steps["Values"][step]), "points": root["Points"][off:off + n]}
+        require_point_arrays(f, path, list(root["PointData"]))
         for name in root["PointData"]:
             o = int(steps["PointDataOffsets"][name][step])
             out[name] = root["PointData"][name][o:o + n]

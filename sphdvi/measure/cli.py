@@ -32,9 +32,10 @@ def _output_options(fn):
     return fn
 
 
-def _check_outputs(csv_path, plot):
+def _check_outputs(csv_path, plot, outdir=None):
     """--csv and --plot are checked before any work: their folder must exist (a missing one
-    is a typo more often than a wish), and --plot needs an image extension."""
+    is a typo more often than a wish), --plot needs an image extension, and neither may name
+    a file of the run in OUTDIR (or of any run or case folder): :func:`_run_file_clash`."""
     for path, hint in ((csv_path, "'--csv'"), (plot, "'--plot'")):
         if path:
             folder = os.path.dirname(os.path.abspath(path))
@@ -43,11 +44,35 @@ def _check_outputs(csv_path, plot):
             if not os.path.isdir(folder):
                 raise click.BadParameter(f"{path}: the folder {folder} does not exist; create it first",
                                          param_hint=hint)
+            clash = _run_file_clash(path, outdir)
+            if clash:
+                raise click.BadParameter(f"{path} is {clash}: measure does not overwrite it; expected another "
+                                         "file name", param_hint=hint)
     if plot:
         ext = os.path.splitext(plot)[1].lower().lstrip(".")
         if ext not in PLOT_FORMATS:
             raise click.BadParameter(f"{plot}: expected an image file name ending in "
                                      f"{', '.join('.' + e for e in PLOT_FORMATS[:4])}, ...", param_hint="'--plot'")
+
+
+def _run_file_clash(path, outdir=None):
+    """What ``path`` is when it is a file sphdvi owns (None otherwise): in OUTDIR, or in a
+    folder holding a run's results or a case (.h5), the files a run or gencase writes there
+    (particles.vtkhdf, restart.h5, <case>.h5, run.json/csv/log, bodies.csv, links.csv,
+    Gauges*.csv, ...); anywhere, an existing HDF5 file (.h5, .vtkhdf).  DualSPHysics's tools
+    suffix what -savecsv names (NAME_<Var>.csv), so they never hit Part_XXXX.bi4 or Run.csv."""
+    from ..io.runfolder import RUN_OUTPUT_FILES, earlier_results, other_case_outputs
+    folder = os.path.realpath(os.path.dirname(os.path.abspath(path)))
+    name = os.path.basename(path)
+    hdf5 = name.lower().endswith((".h5", ".vtkhdf"))
+    case_files = other_case_outputs(folder, "")          # every case's gencase outputs there
+    own = (outdir is not None and folder == os.path.realpath(outdir)) or case_files or earlier_results(folder)
+    gauge = name.startswith("Gauges") and "_" in name and name.endswith(".csv")
+    if own and (name in RUN_OUTPUT_FILES or gauge or hdf5 or name in case_files):
+        return f"a file of the run or case in {os.path.dirname(path) or '.'}"
+    if hdf5 and os.path.isfile(path):
+        return "an HDF5 file (a run's or a case's?)"
+    return None
 
 
 def _warn_y_in_2d(run, pts, option):
@@ -93,21 +118,27 @@ def _emit(table, csv_path, sep, plot):
                    + (f" and {plot}" if plot else ""), err=True)
 
 
-def _points_option(value, param_hint, ncoord=3):
+def _points_option(value, param_hint, ncoord=3, is2d=None):
+    """The points of --points / --at (:func:`.post.parse_points`); read once before the run
+    (its syntax) and again with the case's dimension (``is2d``) once the run is read."""
     from .post import parse_points
     try:
-        return parse_points(value, ncoord=ncoord)
+        return parse_points(value, is2d=is2d, ncoord=ncoord)
     except (ValueError, OSError) as exc:
         raise click.BadParameter(str(exc), param_hint=param_hint) from None
 
 
 def _vector(text, n, param_hint):
+    """``n`` comma-separated finite numbers (--point, --axis)."""
+    import math
     try:
         vals = [float(v) for v in str(text).replace(";", ",").split(",") if v.strip()]
     except ValueError:
         vals = []
     if len(vals) != n:
         raise click.BadParameter(f"'{text}': expected {n} comma-separated numbers", param_hint=param_hint)
+    if not all(math.isfinite(v) for v in vals):
+        raise click.BadParameter(f"'{text}': the numbers must be finite", param_hint=param_hint)
     return vals
 
 
@@ -133,7 +164,7 @@ def measure():
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
 @click.option("--points", "points", required=True, metavar='FILE|"x,y,z;..."',
               help="Points: 'x,y,z;x,y,z' (2D: 'x,z' allowed) or a file with one point a line "
-                   "(MeasureTool POINTS/POINTSLIST files too).")
+                   "(MeasureTool POINTS/POINTSLIST/POINTSENDLIST files too).")
 @click.option("--vars", "variables", default="vel,rhop,press", show_default=True,
               help="Comma-separated: vel, rhop, press, mass, vol (kernel averages of the particles' mass and "
                    "volume m/rho), kcorr (the kernel sum sum_b V_b W, MeasureTool's: about 1 inside the water, "
@@ -159,7 +190,7 @@ def points(outdir, points, variables, kclimit, correction, trackmk, trackmkbound
     With --trackmk the points move rigidly with those particles (a pressure sensor
     on the wall of a moving tank).
     """
-    _check_outputs(csv_path, plot)
+    _check_outputs(csv_path, plot, outdir)
     track = None
     if trackmk is not None and trackmkbound is not None:
         raise click.UsageError("give at most one of --trackmk and --trackmkbound")
@@ -178,6 +209,8 @@ def points(outdir, points, variables, kclimit, correction, trackmk, trackmkbound
         raise click.BadParameter(f"unknown variable(s) {', '.join(bad) or '(none)'}; expected some of "
                                  f"{', '.join(UNITS)}", param_hint="'--vars'")
     run = _run(outdir)
+    if not run.spec.is2d:              # x,z was read as a 2D point: not in a 3D case
+        pts = _points_option(points, "'--points'", is2d=False)
     _warn_y_in_2d(run, pts, "--points")
     if track is None:                  # tracked points move with their particles
         _warn_outside_domain(run, pts, "--points")
@@ -208,7 +241,7 @@ def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot
     threshold going up. Depth: elevation minus the bottom (the top boundary
     particle below the surface, plus dp/2).
     """
-    _check_outputs(csv_path, plot)
+    _check_outputs(csv_path, plot, outdir)
     if threshold is not None and threshold >= 1.0:
         # inside the water the kernel sum is about 1: a level at or above it is never crossed
         click.echo(f"warning: --threshold {threshold:g}: the kernel sum inside the water is about 1, so the surface "
@@ -216,6 +249,8 @@ def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot
     xy = _points_option(at, "'--at'", ncoord=2)
     from .post import measure_elevation
     run = _run(outdir)
+    if not run.spec.is2d:              # x alone was read as a 2D position: not in a 3D case
+        xy = _points_option(at, "'--at'", ncoord=2, is2d=False)
     _warn_y_in_2d(run, xy, "--at")
     _warn_outside_domain(run, xy, "--at", axes=(0, 1))
     _emit(measure_elevation(run, xy, threshold=threshold, dz=dz, first=first, last=last, every=every),
@@ -241,7 +276,7 @@ def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_p
     cubic kernel, viscosity). Columns time,fx,fy,fz,mx,my,mz; per metre of width in 2D.
     """
     from .post import measure_forces, parse_mk_list
-    _check_outputs(csv_path, plot)
+    _check_outputs(csv_path, plot, outdir)
     if (mk is None) == (mkbound is None):
         raise click.UsageError("give exactly one of --mk or --mkbound")
     try:
@@ -273,5 +308,5 @@ def bodies(outdir, first, last, every, csv_path, sep, plot):
     the run's bodies.csv/links.csv at the snapshot times (empty without them).
     """
     from .post import measure_bodies
-    _check_outputs(csv_path, plot)
+    _check_outputs(csv_path, plot, outdir)
     _emit(measure_bodies(outdir, first=first, last=last, every=every), csv_path, sep, plot)

@@ -45,13 +45,18 @@ Each gauge is computed at ``t = 0`` and then at the first step reaching each
 multiple of ``computedt`` (default TimeOut; 0 = every step) inside
 ``computetime start end``; rows are kept every ``outputdt`` (default TimeOut)
 inside ``outputtime``.  The new rows are
-appended at every TimeOut and at the end, in one write each (the cost of an
-output does not grow with the rows written before); a new run starts each file
-anew (header only), a resume cuts it back to the restart time, atomically.  The interpolation,
+appended at every output (part) of the run, before its checkpoint, and at the end,
+in one write each (the cost of an output does not grow with the rows written
+before), as DualSPHysics's JSph::SaveData calls JGaugeSystem::SaveResults; a new run
+starts each file anew (header only), a resume cuts it back to the restart time,
+atomically.  The two schedules of each gauge (next compute, next kept row: JGaugeItem's
+ComputeNext and OutputNext) travel in the checkpoint (:meth:`RunGauges.get_state`), so
+that a resumed run keeps the rows an uninterrupted one keeps.  The interpolation,
 surface and force code is that of ``sphdvi measure`` (:mod:`.core`).
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 
@@ -97,7 +102,8 @@ class Schedule:
         return False
 
     def skip_to(self, t):
-        """After a resume at time t: the next due time is the first multiple after t."""
+        """After a resume at time t from a checkpoint without the gauge schedules (an older
+        sphdvi's): the next due time is the first multiple after t."""
         if self.dt > 0:
             self.k = int(math.floor(t / self.dt + 1e-9)) + 1
 
@@ -365,7 +371,7 @@ def _lines_up_to(path, tmax):
 class RunGauges:
     """Computes the case's gauges during a run at their ``computedt`` (see the module doc)."""
 
-    def __init__(self, data, params, outdir, resume=False, time=0.0, periodicity=None):
+    def __init__(self, data, params, outdir, resume=False, time=0.0, periodicity=None, state=None):
         self.spec = core.KernelSpec.from_case(data, params)
         self.outdir = outdir
         self.periodicity = periodicity
@@ -396,16 +402,13 @@ class RunGauges:
                                  f"{type(exc).__name__}: {exc}; run 'sphdvi gencase' again to see what is "
                                  "wrong with it") from None
             self.slots.append(_Slot(gauge, compute, output, outdir))
-        self.next_flush = 1
         if resume:
             for s in self.slots:
                 # the rows up to the restart time stay; anything later (or torn) is cut
                 for path, columns in s.files:
                     kept = _lines_up_to(path, time + EPS_REL * max(1.0, time))
                     write_text_atomic(path, s.header(columns) + "".join(kept))
-                s.compute.skip_to(time)
-                s.output.skip_to(time)
-            self.next_flush = int(math.floor(time / self.tout + 1e-9)) + 1
+            self.set_state(state, time)
         else:
             for s in self.slots:
                 # a new run starts its files anew (an earlier run's rows must not stay above)
@@ -433,9 +436,24 @@ class RunGauges:
         view = StateView(t, st.pos, st.vel, st.rhop, st.mass, solver.press, st.ptype, st.mk, self.spec,
                          self.periodicity)
         self._measure(view)
-        if t >= self.next_flush * self.tout - EPS_REL * max(1.0, self.tout):
-            self.flush()
-            self.next_flush = int(math.floor(t / self.tout + 1e-9)) + 1
+
+    def get_state(self) -> dict:
+        """The schedules of each gauge (its file name -> [compute k, output k]; JGaugeItem's
+        ComputeNext and OutputNext), for the checkpoint.  The output schedule only moves when a
+        computed row is kept, so it is not a function of the time."""
+        return {s.gauge.filename(): [s.compute.k, s.output.k] for s in self.slots}
+
+    def set_state(self, state, time):
+        """Restore :meth:`get_state` (a dict, or its JSON) on resume; a gauge the checkpoint has
+        no state for (an older sphdvi's) goes on from the first multiples after ``time``."""
+        saved = (json.loads(state) if isinstance(state, (str, bytes)) else state) or {}
+        for s in self.slots:
+            ks = saved.get(s.gauge.filename())
+            if ks is None:
+                s.compute.skip_to(time)
+                s.output.skip_to(time)
+            else:
+                s.compute.k, s.output.k = int(ks[0]), int(ks[1])
 
     def flush(self):
         """Append the new rows to the CSV files (header first when a file is new)."""

@@ -119,10 +119,12 @@ class RunOutput:
 
     def snapshots(self, arrays=("Vel", "Rhop", "Press", "Mk"), first=0, last=None, every=1):
         """Yield :class:`Snapshot` objects for steps first..last (inclusive); a range with no
-        output time in it, or an unreadable particle file, is an InputError."""
-        from ..io.vtkhdf import open_particles
+        output time in it, or an unreadable particle file (one without Idp, Type or one of
+        ``arrays`` but Press, which Rhop gives), is an InputError."""
+        from ..io.vtkhdf import open_particles, require_point_arrays
         self._require_particles()
         with open_particles(self.vtk_path) as f:
+            require_point_arrays(f, self.vtk_path, ["Idp", "Type"] + [a for a in arrays if a != "Press"])
             root = f["VTKHDF"]
             steps = root["Steps"]
             nsteps = int(steps.attrs["NSteps"])
@@ -134,7 +136,7 @@ class RunOutput:
                 o, n = int(offs[k]), int(counts[k])
 
                 def read(name):
-                    if name not in pd:
+                    if name not in pd or name not in steps["PointDataOffsets"]:
                         return None
                     d = steps["PointDataOffsets"][name][k]
                     return pd[name][int(d):int(d) + n]
@@ -178,13 +180,16 @@ def output_range(n: int, first=0, last=None, every=1, source: str = "the run") -
 # ---------------------------------------------------------------------------------
 def parse_points(text: str, is2d: bool | None = None, ncoord: int = 3) -> np.ndarray:
     """Points from ``"x,y,z;x,y,z"`` or a file (one point a line, separators , ; or
-    spaces, ``#`` comments; MeasureTool ``POINTS`` / ``POINTSLIST`` files too).
+    spaces, ``#`` comments; MeasureTool ``POINTS`` / ``POINTSLIST`` / ``POINTSENDLIST``
+    blocks too, as DualSPHysics's doc/help/FilePointsTemplate.txt lays them out).
 
-    ``ncoord=2`` accepts ``x[,y]`` per point (elevation). Raises ValueError.
+    ``ncoord=2`` accepts ``x[,y]`` per point (elevation). ``is2d``: the case's dimension
+    when known: in 3D (False) a point of 2 numbers (``ncoord=2``: of 1) is refused, in 2D or
+    unknown (None) it is x,z (x). Raises ValueError.
     """
     if os.path.isfile(text):
         with open(text, encoding="utf-8") as fh:
-            return _points_from_lines(fh.read().splitlines(), ncoord, source=text)
+            return _points_from_lines(fh.read().splitlines(), ncoord, source=text, is2d=is2d)
     if os.path.isdir(text):
         raise ValueError(f"{text} is a folder; expected a points file or a list of numbers")
     if _looks_like_a_file_name(text):
@@ -192,7 +197,7 @@ def parse_points(text: str, is2d: bool | None = None, ncoord: int = 3) -> np.nda
     items = [s for s in text.replace("\n", ";").split(";") if s.strip()]
     if not items:
         raise ValueError("no points given")
-    return _points_from_lines(items, ncoord, source=None)
+    return _points_from_lines(items, ncoord, source=None, is2d=is2d)
 
 
 def _looks_like_a_file_name(text: str) -> bool:
@@ -214,44 +219,47 @@ def _numbers(line: str):
     return [float(v) for v in line.replace(",", " ").replace(";", " ").replace(":", " ").split()]
 
 
-def _points_from_lines(lines, ncoord, source):
+# points a points file may define at most (a POINTSLIST count of 1e8 ran out of time and memory)
+MAX_POINTS = 1_000_000
+_BLOCK_ROWS = {"POINTSLIST": ("begin", "step", "count"), "POINTSENDLIST": ("begin", "step", "end")}
+
+
+def _points_from_lines(lines, ncoord, source, is2d=None):
+    """The points of a points file's lines (or of the command line's items): plain rows, and
+    the three-row ``POINTSLIST`` / ``POINTSENDLIST`` blocks expanded; ValueError naming the
+    file and line of a bad row."""
     pts = []
     mode = None
-    plist = []
+    block = []                       # the rows of the current list block: (where, text, numbers)
     for no, raw in enumerate(lines, 1):
         line = raw.split("#", 1)[0].strip()
         if not line or line.startswith("//"):
             continue
+        where = f"{source}:{no}: " if source else ""
         word = line.split()[0].upper()
         if word in ("POINTS", "POINTSLIST", "POINTSENDLIST"):
-            mode = word
+            _check_block_complete(mode, block)
+            mode, block = word, []
             continue
-        where = f"{source}:{no}: " if source else ""
         try:
             vals = _numbers(line)
         except ValueError:
             raise ValueError(f"{where}'{raw.strip()}' is not a list of numbers") from None
-        if mode == "POINTSLIST":
+        if mode in _BLOCK_ROWS:
             if len(vals) != 3:
-                raise ValueError(f"{where}'{raw.strip()}': expected 3 numbers in a POINTSLIST")
-            plist.append(vals)
-            if len(plist) == 3:
-                pts.extend(_pointslist(plist))
-                plist = []
+                raise ValueError(f"{where}'{raw.strip()}': expected 3 numbers in a {mode} "
+                                 f"({' / '.join(_BLOCK_ROWS[mode])} rows)")
+            block.append((where, raw.strip(), vals))
+            if len(block) == 3:
+                new = _pointslist(block) if mode == "POINTSLIST" else _pointsendlist(block)
+                if len(pts) + len(new) > MAX_POINTS:
+                    raise ValueError(f"{where}the points so far and this {mode} make {len(pts) + len(new):,} points; "
+                                     f"at most {MAX_POINTS:,}")
+                pts.extend(new)
+                block = []
             continue
-        if ncoord == 2:
-            # a MeasureTool points file has x y z lines (z unused: the whole vertical is
-            # sampled); given on the command line, a third number is a mistake
-            if len(vals) not in ((1, 2, 3) if source else (1, 2)):
-                raise ValueError(f"{where}'{raw.strip()}': expected x or x,y (the elevation is found along the "
-                                 "whole vertical at each x,y: no z)")
-            pts.append([vals[0], vals[1] if len(vals) > 1 else 0.0, 0.0])
-        else:
-            if len(vals) == 2:                  # 2D shorthand x,z
-                vals = [vals[0], 0.0, vals[1]]
-            if len(vals) != 3:
-                raise ValueError(f"{where}'{raw.strip()}': expected 3 coordinates x,y,z")
-            pts.append(vals)
+        pts.append(_plain_point(vals, ncoord, where, raw.strip(), source, is2d))
+    _check_block_complete(mode, block)
     if not pts:
         raise ValueError("no points given")
     arr = np.asarray(pts, np.float64)
@@ -260,12 +268,83 @@ def _points_from_lines(lines, ncoord, source):
     return arr
 
 
-def _pointslist(rows):
-    """MeasureTool POINTSLIST: three rows 'begin x y z', 'step dx dy dz', 'count nx ny nz'."""
-    begin, step, count = (np.asarray(r, float) for r in rows)
-    n = np.maximum(count.astype(int), 1)
-    grid = np.stack(np.meshgrid(*(np.arange(k) for k in n), indexing="ij"), -1).reshape(-1, 3)
-    return (begin + grid * step).tolist()
+def _plain_point(vals, ncoord, where, text, source, is2d):
+    """One point row as x, y, z: ``x,z`` in 2D (``x`` for an elevation's ``x[,y]``), refused
+    in a 3D case (``is2d`` False), where that shorthand would put the point at y = 0."""
+    if ncoord == 2:
+        # a MeasureTool points file has x y z lines (z unused: the whole vertical is
+        # sampled); given on the command line, a third number is a mistake
+        if len(vals) not in ((1, 2, 3) if source else (1, 2)):
+            raise ValueError(f"{where}'{text}': expected x or x,y (the elevation is found along the "
+                             "whole vertical at each x,y: no z)")
+        if len(vals) == 1 and is2d is False:
+            raise ValueError(f"{where}'{text}': the case is 3D: expected x,y")
+        return [vals[0], vals[1] if len(vals) > 1 else 0.0, 0.0]
+    if len(vals) == 2:                  # 2D shorthand x,z
+        if is2d is False:
+            raise ValueError(f"{where}'{text}': the case is 3D: expected x,y,z (x,z is for 2D cases)")
+        vals = [vals[0], 0.0, vals[1]]
+    if len(vals) != 3:
+        raise ValueError(f"{where}'{text}': expected 3 coordinates x,y,z")
+    return vals
+
+
+def _check_block_complete(mode, block):
+    """A POINTSLIST / POINTSENDLIST block cut short (by the end or the next keyword)."""
+    if block:
+        where, text, _ = block[-1]
+        raise ValueError(f"{where}'{text}': the {mode} ends after {len(block)} row(s); expected 3 rows "
+                         f"({' / '.join(_BLOCK_ROWS[mode])})")
+
+
+def _check_block_finite(block, mode):
+    for where, text, vals in block:
+        if not all(math.isfinite(v) for v in vals):
+            raise ValueError(f"{where}'{text}': the {mode} numbers must be finite")
+
+
+def _grid_points(begin, step, counts, where, mode):
+    """begin + (i, j, k) * step for i < counts[0], j < counts[1], k < counts[2] (z varying
+    fastest), refused beyond :data:`MAX_POINTS`."""
+    total = math.prod(counts)
+    if total > MAX_POINTS:
+        raise ValueError(f"{where}the {mode} makes {' x '.join(f'{c:,}' for c in counts)} = {total:,} points; at most "
+                         f"{MAX_POINTS:,}")
+    grid = np.stack(np.meshgrid(*(np.arange(k) for k in counts), indexing="ij"), -1).reshape(-1, 3)
+    return (np.asarray(begin, float) + grid * np.asarray(step, float)).tolist()
+
+
+def _pointslist(block):
+    """MeasureTool POINTSLIST: rows 'BeginX BeginY BeginZ', 'StepX StepY StepZ',
+    'CountX CountY CountZ' (counts: positive whole numbers)."""
+    _check_block_finite(block, "POINTSLIST")
+    (_, _, begin), (_, _, step), (where, text, count) = block
+    if any(c < 1 or c != int(c) for c in count):
+        raise ValueError(f"{where}'{text}': POINTSLIST counts must be whole numbers >= 1 (CountX CountY CountZ)")
+    return _grid_points(begin, step, [int(c) for c in count], where, "POINTSLIST")
+
+
+def _pointsendlist(block):
+    """MeasureTool POINTSENDLIST: rows 'BeginX BeginY BeginZ', 'StepX StepY StepZ',
+    'EndX EndY EndZ': along each axis begin, begin + step, ... up to end (a step of 0: the
+    begin value alone), e.g. x 0..4 by 0.1 = 41 points."""
+    _check_block_finite(block, "POINTSENDLIST")
+    (_, _, begin), (swhere, stext, step), (where, text, end) = block
+    counts = []
+    for axis, b, s, e in zip("XYZ", begin, step, end):
+        if s == 0:
+            counts.append(1)
+            continue
+        q = (e - b) / s
+        if q < -1e-9:
+            raise ValueError(f"{swhere}'{stext}': Step{axis} {s:g} goes away from End{axis} {e:g} "
+                             f"(Begin{axis} {b:g}); expected a step towards the end point, or 0")
+        n = math.floor(q + 1e-6) + 1          # an end within a millionth of a step is kept (rounding)
+        if n > MAX_POINTS:
+            raise ValueError(f"{where}the POINTSENDLIST makes {n:,} points along {axis} (Begin{axis} {b:g} to "
+                             f"End{axis} {e:g} by {s:g}); at most {MAX_POINTS:,}")
+        counts.append(n)
+    return _grid_points(begin, step, counts, where, "POINTSENDLIST")
 
 
 # ---------------------------------------------------------------------------------
@@ -592,17 +671,43 @@ def _body_table_columns(names, is2d, links=()):
     return cols, units
 
 
+BODY_LOG_COLUMNS = ("time", "body", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz", "wx", "wy", "wz",
+                    "cfx", "cfy", "cfz", "ctx", "cty", "ctz")
+LINK_LOG_COLUMNS = ("time", "link", "fx", "fy", "fz", "tx", "ty", "tz")
+
+
 def _read_body_logs(outdir: str):
-    """Rows (dicts) of a run's bodies.csv and links.csv (no links.csv: none)."""
-    import csv
-    with open(os.path.join(outdir, "bodies.csv"), newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    links = []
+    """Rows (dicts) of a run's bodies.csv and links.csv (no links.csv: none), their numbers
+    as floats; a file without the columns measure reads, or with a value that is not a
+    number, is an InputError naming it (a damaged or foreign file)."""
+    rows = _read_log(os.path.join(outdir, "bodies.csv"), BODY_LOG_COLUMNS)
     lpath = os.path.join(outdir, "links.csv")
-    if os.path.exists(lpath):
-        with open(lpath, newline="") as fh:
-            links = list(csv.DictReader(fh))
+    links = _read_log(lpath, LINK_LOG_COLUMNS) if os.path.exists(lpath) else []
     return rows, links
+
+
+def _read_log(path: str, columns) -> list:
+    """The rows of a run's body or link log ``path`` with ``columns`` (the second a name, the
+    others numbers)."""
+    import csv
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            reader = csv.DictReader(fh)
+            missing = [c for c in columns if c not in (reader.fieldnames or [])]
+            if missing:
+                raise InputError(f"{path} is not a readable {os.path.basename(path)} of a sphdvi run (damaged?): no "
+                                 f"column {', '.join(missing[:3])}{', ...' if len(missing) > 3 else ''}; expected "
+                                 f"the columns {','.join(columns)}")
+            rows = []
+            for r in reader:
+                try:
+                    rows.append({c: (r[c] if k == 1 else float(r[c])) for k, c in enumerate(columns)})
+                except (TypeError, ValueError):
+                    raise InputError(f"{path}:{reader.line_num}: not a readable {os.path.basename(path)} row "
+                                     f"(damaged?): expected numbers in {','.join(columns[:1] + columns[2:])}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path} cannot be read ({exc.__class__.__name__}: {exc})") from None
+    return rows
 
 
 def _time_index(times, t, rel=1e-8):

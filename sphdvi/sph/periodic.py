@@ -41,6 +41,18 @@ class Periodicity:
             for m, key in zip(others, inc[k]):
                 self.shift[k, m] = -float(params.get(key) or 0.0)
 
+    def check_length(self, support):
+        """ValueError when a periodic length is below the kernel support ``support`` (2h): the
+        ghosts (one copy per side, as JSphCpuSingle::PeriodicMakeList) then miss the images
+        beyond one period that lie within the support."""
+        for k in self.axes:
+            if self.length[k] < support:
+                a = "xyz"[k]
+                raise ValueError(f"the periodic length along {a}, L = {self.length[k]:.6g} m (the particles' extent "
+                                 f"plus dp, as DualSPHysics), is shorter than the kernel support 2h = {support:.6g} m: "
+                                 f"the periodic images beyond one period are not made; make the domain at least 2h "
+                                 f"long along {a}")
+
     def wrap(self, pos):
         """Bring particles that left the periodic box back in (in place), as
         JSphCpu::UpdatePos: above the box pos - S_k, below it pos + S_k."""

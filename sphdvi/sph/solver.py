@@ -411,6 +411,7 @@ class SPHSolver:
             return None
         p = {**{k: v for k, v in self.params.items() if k not in PERIODIC_KEYS}, **incs}
         per = Periodicity(axes, self.state.pos, self.dp, p)
+        per.check_length(2.0 * self.h)
         if self._domain is not None:
             for k in per.axes:      # no exclusion along a periodic axis
                 self._domain[0][k] = -np.inf
@@ -1025,7 +1026,9 @@ class SPHSolver:
         return events
 
     # ------------------------------------------------------------------ checkpoints
-    CHECKPOINT_SCALARS = ("time", "nstep", "n_dtmin", "_verlet_count", "dt_pre", "last_dt")
+    CHECKPOINT_SCALARS = ("time", "nstep", "n_dtmin", "_verlet_count", "dt_pre", "last_dt", "dt_error")
+    # what an older sphdvi's checkpoint may lack, and the value it then starts from
+    CHECKPOINT_DEFAULTS = {"dt_error": -np.inf}
 
     def get_checkpoint(self) -> dict:
         """What a resumed run needs to go on bitwise: the particle state, the integrator's
@@ -1052,7 +1055,9 @@ class SPHSolver:
             setattr(self, name, np.zeros((n,) + cur.shape[1:], cur.dtype))
             missing.append(name)
         for name in self.CHECKPOINT_SCALARS:
-            value = ck["scalars"][name]
+            value = ck["scalars"].get(name, self.CHECKPOINT_DEFAULTS.get(name))
+            if value is None:
+                raise KeyError(name)
             setattr(self, name, value.item() if isinstance(value, np.generic) else value)
         # a reason added since the checkpoint was written ("movement") starts from 0
         self.n_excluded = {**{name: 0 for name in REASON_NAMES.values()}, **dict(ck["n_excluded"])}

@@ -87,10 +87,20 @@ def test_wavemaker_pattern_keeps_fluid_drawn_before(tmp_path):
     assert fluid_y.min() < 0.1 and fluid_y.max() > 1.9     # no y caps (faces 1, 2) over it
 
 
-def test_mask_numbers_beyond_the_faces_are_ignored(tmp_path):
-    # a 6-face prism with mask="7" (CasePointAbsorber copies the 7 of a 7-face prism) is closed
-    assert len(draw(tmp_path, PRISM.format(mode="full", mask="7")).pos) == 45
-    assert len(draw(tmp_path, CYL.format(mode="full", mask="4")).pos) == 45
+def test_mask_numbers_beyond_the_faces_are_ignored_and_warned(tmp_path):
+    # a 6-face prism with mask="7" (CasePointAbsorber copies the 7 of a 7-face prism) is closed;
+    # the face that does not exist is warned about (mask="96" passed silently before)
+    for mask in ("7", "96", "1 | 96"):
+        d, w = warnings_of(tmp_path, PRISM.format(mode="face", mask=mask))
+        assert any(f"mask names face {mask.split()[-1]} but this <drawprism> has faces 1 to 5 only"
+                   in m for m in w), w
+    d, w = warnings_of(tmp_path, PRISM.format(mode="full", mask="7"))
+    assert len(d.pos) == 45
+    d, w = warnings_of(tmp_path, CYL.format(mode="full", mask="4 | 5"))
+    assert len(d.pos) == 45 and any("mask names faces 4, 5 but this <drawcylinder> has faces 1 to 3"
+                                    in m for m in w)
+    d, w = warnings_of(tmp_path, PRISM.format(mode="full", mask="1 | 2"))
+    assert w == []
 
 
 @pytest.mark.parametrize("mode,mask,count", [
@@ -169,12 +179,67 @@ def test_resetdraw_clears_the_pen(tmp_path):
     assert e.value.element == "drawbox"
 
 
-def test_resetdraw_keeps_what_was_drawn_and_warns(tmp_path):
+def test_resetdraw_keeps_what_was_drawn(tmp_path):
+    # a plain state command (GenCase_CaseTemplate.xml): no warning for what was drawn before
     body = ('<setmkbound mk="2"/><drawpoint x="1" y="1" z="1"/><matrixsave/><resetdraw/>'
             '<matrixload/><setmkfluid mk="0"/><drawpoint x="2" y="2" z="2"/>')
     d, w = warnings_of(tmp_path, body)
     assert nodes(d) == {(1, 1, 1), (2, 2, 2)}
-    assert any("particles were drawn before <resetdraw>" in m for m in w)
+    assert w == []
+
+
+# ---------------------------------------------------------------- commands that draw nothing
+WALL_2D = ('<setmkfluid mk="0"/><drawbox><boxfill>solid</boxfill><point x="0.1" y="-1" z="0.1"/>'
+           '<size x="0.2" y="2" z="0.2"/></drawbox><setmkbound mk="3"/>')
+KW_2D = dict(dp=0.1, pmax=(1, 0, 1))
+
+
+def test_2d_shape_off_the_plane_is_warned(tmp_path):
+    """A 2D wall box from y=0.2 to 0.7 (posy 0) or a point at y=0.3 creates no particle: warned
+    with the command's line, mk and y range (it vanished silently, and the fluid with it)."""
+    body = (WALL_2D + '<drawbox><boxfill>solid</boxfill><point x="0" y="0.2" z="0"/>'
+            '<size x="1" y="0.5" z="0.2"/></drawbox><drawpoint x="0.5" y="0.3" z="0.5"/>')
+    d, w = warnings_of(tmp_path, body, **KW_2D)
+    assert d.count_bound == 0 and d.count_fluid == 9
+    assert len(w) == 2
+    assert "<drawbox>: this <drawbox> (mkbound 3) creates no particles: it spans y = 0.2..0.7 and misses " \
+           "the 2D plane y = 0" in w[0] and w[0].startswith(str(tmp_path / "case.xml") + ":1:")
+    assert "<drawpoint> (mkbound 3) creates no particles: it spans y = 0.3..0.3" in w[1]
+
+
+def test_shape_outside_the_domain_is_warned(tmp_path):
+    d, w = warnings_of(tmp_path, '<setmkfluid mk="1"/><drawsphere radius="1"><point x="20" y="5" z="5"/>'
+                                 '</drawsphere>')
+    assert len(d.pos) == 0 and len(w) == 1
+    assert "(mkfluid 1) creates no particles: it lies outside the domain pointmin" in w[0]
+
+
+def test_commands_that_may_draw_nothing_are_not_warned(tmp_path):
+    """Void drawing, fills into a filled region (already warned by the fill itself), hidden
+    points (setactive) and an open shape in solid mode (its own warning) are not warned twice."""
+    body = (WALL_2D + '<setmkvoid/><drawpoint x="0.5" y="0.3" z="0.5"/><setmkbound mk="3"/>'
+            '<setactive drawpoints="false"/><drawpoint x="0.5" y="0.3" z="0.5"/>'
+            '<setactive drawpoints="true"/><setmkfluid mk="0"/><fillbox x="0.2" y="0" z="0.2">'
+            '<modefill>void</modefill><point x="0" y="0" z="0"/><size x="1" y="0" z="1"/></fillbox>')
+    d, w = warnings_of(tmp_path, body, **KW_2D)
+    assert len(w) == 1 and "<fillbox>: the seed node is not of a kind listed in <modefill>" in w[0]
+    d, w = warnings_of(tmp_path, PRISM.format(mode="solid", mask="2"))
+    assert len(w) == 1 and "open shape has no inside" in w[0]
+
+
+def test_false_printf_and_abort_read_their_text(tmp_path):
+    """<printf>/<abort> whose if= is false: no "unknown attribute 'text'" warning."""
+    from lxml import etree
+
+    from sphdvi.case.draw import run_geometry
+    from sphdvi.case.xmldoc import CaseReader
+    from test_draw import geometry_xml
+    el = etree.fromstring(geometry_xml('<printf if="Dp&gt;2" text="never"/><abort if="Dp&gt;2" text="no"/>'
+                                       '<setmkfluid mk="0"/><drawpoint x="1" y="1" z="1"/>'))
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    run_geometry(reader, el, casename="case", outdir=None)
+    reader.warn_unread_attributes(el)
+    assert list(reader.warnings) == []
 
 
 # ---------------------------------------------------------------- setboxlimitmode

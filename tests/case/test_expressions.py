@@ -1,5 +1,6 @@
 import math
 
+import numpy as np
 import pytest
 
 from sphdvi.case.expressions import ExpressionError, Variables
@@ -38,6 +39,63 @@ def v():
 ])
 def test_expression_values(v, text, value):
     assert v.evaluate(text) == pytest.approx(value)
+
+
+@pytest.mark.parametrize("text, value", [
+    # C, not Python: comparisons do not chain, < <= > >= bind tighter than == !=, ! is unary
+    ("Dp!=0.1==(true||false)", True),       # GenCase_CaseTemplate.xml: (Dp!=0.1)==true
+    ("Dp==0.1==(true||false)", False),
+    ("1<2<1.5", True),                      # (1<2)<1.5 = 1<1.5
+    ("3>2>1", False),                       # (3>2)>1 = 1>1
+    ("2==2==2", False),                     # (2==2)==2 = 1==2
+    ("1==1==1", True),
+    ("1<2==3>2", True),                     # (1<2)==(3>2)
+    ("0==1<2", False),                      # 0==(1<2)
+    ("!2==1", False),                       # (!2)==1 = 0==1
+    ("!0==1", True),
+    ("!x1<5", True),                        # (!11)<5
+    ("!1+1", 1.0),                          # (!1)+1
+    ("(2||0)==1", True),                    # || gives 0 or 1
+    ("1 || 0 && 0", True),                  # && before ||
+    ("x1!=11 || !(x2>21)", False),
+])
+def test_c_operator_precedence(v, text, value):
+    assert v.evaluate(text) == value
+
+
+def test_roundpos(v):
+    """roundpos(pos,posmin,dp) (GenCase_CaseTemplate.xml): the nearest posmin + k*dp."""
+    assert v.number("roundpos(0.37, 0, 0.1)") == pytest.approx(0.4)
+    assert v.number("roundpos(0.34, 0.05, 0.1)") == pytest.approx(0.35)
+    assert v.number("roundpos(-0.26, 0, 0.1)") == pytest.approx(-0.3)
+    assert v.number("roundpos(0.25, 0, 0.1)") == pytest.approx(0.3)     # halves up
+    with pytest.raises(ExpressionError, match="dp > 0"):
+        v.number("roundpos(1, 0, 0)")
+    # roundposx/y/z need the lattice of <definition>
+    with pytest.raises(ExpressionError, match=r"roundposx\(\) needs the particle lattice"):
+        v.number("roundposx(0.3)")
+    v.lattice = ((0.025, 0.0, -0.01), 0.05)
+    assert v.number("roundposx(0.1)") == pytest.approx(0.125)
+    assert v.number("roundposy(0.1)") == pytest.approx(0.1)
+    assert v.number("roundposz(0.1)") == pytest.approx(0.09)
+    assert v.copy().number("roundposz(0)") == pytest.approx(-0.01)
+    with pytest.raises(ExpressionError, match="takes one argument"):
+        v.number("roundposx(1, 2)")
+
+
+def test_roundpos_in_a_case(tmp_path):
+    """roundposx/z in the commands use the <definition> lattice (pointref-aligned here); in
+    <predefinition> they are an error naming why."""
+    from test_draw import draw
+
+    from sphdvi.errors import CaseError
+    body = ('<newvar X="roundposx(2.4)" Z="roundposz(3.6)"/><setmkfluid mk="0"/>'
+            '<drawpoint x="#X" y="0" z="#Z"/><printf text="[X] [Z]"/>')
+    d = draw(tmp_path, body, pointref=(0.5, 0, 0.5))
+    assert d.messages == ["2.5 3.5"] and np.allclose(d.pos, [[2.5, 0, 3.5]])
+    with pytest.raises(CaseError, match="needs the particle lattice"):
+        draw(tmp_path, '<setmkfluid mk="0"/><drawpoint x="0" y="0" z="0"/>',
+             predef='<predefinition><newvar X="roundposx(2.4)"/></predefinition>')
 
 
 def test_wavelength_satisfies_dispersion(v):

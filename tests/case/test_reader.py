@@ -351,9 +351,11 @@ def test_collision_modelfile(tmp_path):
 
 def test_misspelt_property_value_is_warned(tmp_path):
     """A property value spelt like one sphdvi reads (Kfrik) is warned (the contact would take the
-    default friction); a user's own key (colour) is not."""
+    default friction); a user's own key (colour) is not. (Collisions off: a colliding body's
+    material without Kfric is an error, tests/case/test_chrono_checks.py.)"""
     props = PROPS.replace("<Kfric", '<Kfrik').replace('name="steel"', 'name="steel" colour="red"')
-    r = build(tmp_path, commands=TANK_2D + CHRONO_BODIES, casedef_extra=FLOATINGS + props, special=chrono())
+    r = build(tmp_path, commands=TANK_2D + CHRONO_BODIES, casedef_extra=FLOATINGS + props,
+              special=chrono().replace('activate="true"', 'activate="false"'))
     assert [w for w in r.warnings if "property value" in w] == [
         w for w in r.warnings if "'Kfrik' is not read (did you mean 'Kfric'?)" in w and "<Kfrik>" in w]
     assert len([w for w in r.warnings if "property value" in w]) == 1

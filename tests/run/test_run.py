@@ -753,14 +753,15 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
     assert [x.split(" of")[0] for x in lines] == ["more than 2%", "more than 10%"]
     assert "particles were excluded (t=0.4 s, step 40)" in lines[1]
     assert ExclusionWarnings(False, 1000, 1200).check(500, 500, 500, 0.1, 1) == []
-    # from a run: densities above RhopOutMax exclude ~7 % of the column's deepest particles
+    # from a run: densities above RhopOutMax exclude some of the column's deepest particles (the
+    # initial densities reach 1002.48: a window that excludes them is an input error)
     case = small_case(tmp_path)
     for flag, expect in (("1", True), ("0", False)):
         out = tmp_path / f"o{flag}"
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             r = invoke(["run", case, "-o", out, "--tmax", "0.04", "--tout", "0.02", "--threads", "1", "-q",
-                        "--set", "RhopOutMax=1002.3", "--set", f"WrnPartsOut={flag}"])
+                        "--set", "RhopOutMax=1002.6", "--set", f"WrnPartsOut={flag}"])
         assert r.exit_code == 0, r.output
         log = (out / "run.log").read_text()
         assert ("WARNING: more than 1% of the fluid particles were excluded" in log) == expect
@@ -771,12 +772,13 @@ def test_exclusion_warnings_as_dualsphysics(tmp_path):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         r = invoke(["run", case, "-o", out, "--tmax", "0.02", "--tout", "0.01", "--threads", "1", "-q",
-                    "--set", "RhopOutMax=1002.0"])
+                    "--set", "RhopOutMin=999.7"])
     assert r.exit_code == 0, r.output
     assert any("more than 10% of the particles were excluded" in str(w.message) for w in caught)
     with h5py.File(out / "restart.h5", "r") as f:
         levels = int(f["scalars"].attrs["excl_part_pct"]), int(f["scalars"].attrs["excl_total_pct"])
-    assert levels == (2, 20)          # 252 of 1,501 particles went by 0.01 s: 1 % and 10 % warned
+    # 229 of 1,501 particles excluded by 0.01 s (1 % and 10 % warned), 369 by 0.02 s (2 % and 20 %)
+    assert levels == (5, 30)
     with h5py.File(out / "restart.h5", "r+") as f:        # as if the next levels had been passed
         f["scalars"].attrs["excl_part_pct"], f["scalars"].attrs["excl_total_pct"] = 200, 200
     with warnings.catch_warnings(record=True) as caught:
@@ -793,10 +795,9 @@ def test_excluded_particles_file_and_resume(tmp_path):
     the run; a run stopped at an output and resumed writes the same file, bitwise; a run that
     excludes nothing writes none."""
     case = small_case(tmp_path)
-    common = ["--tout", "0.01", "--threads", "1", "-q", "--set", "RhopOutMax=1002.3"]
+    common = ["--tout", "0.01", "--threads", "1", "-q", "--set", "RhopOutMax=1002.6"]
     a, b, c = tmp_path / "a", tmp_path / "b", tmp_path / "c"
-    with pytest.warns(UserWarning, match="fluid particles were excluded since the previous output"), \
-            pytest.warns(UserWarning, match="start with a density outside RhopOutMin/RhopOutMax"):
+    with pytest.warns(UserWarning, match="fluid particles were excluded since the previous output"):
         assert invoke(["run", case, "-o", a, "--tmax", "0.04"] + common).exit_code == 0
         assert invoke(["run", case, "-o", b, "--tmax", "0.02"] + common).exit_code == 0
     with open(b / "excluded.csv", "a") as fh:          # a row after the restart output, as a killed run leaves

@@ -52,11 +52,11 @@ def test_min_fluid_stop_is_a_normal_end(drawn, tmp_path):
     fluid particles (N) was reached.", the data of that instant saved, TimeMax = TimeStep, a normal
     end.  sphdvi ended "diverged", exit 3, without that output."""
     out = tmp_path / "o"
-    with warnings.catch_warnings(record=True) as rec:
-        warnings.simplefilter("always")
-        r = run(drawn, out, "RhopOutMax=1001.9", "MinFluidStop=0.9")
+    with pytest.warns(UserWarning, match="fluid particles were excluded"):
+        # the surface's densities fall below 999.7 as the column collapses (an initial density
+        # outside the window is an input error)
+        r = run(drawn, out, "RhopOutMin=999.7", "MinFluidStop=0.9")
     assert r.exit_code == 0, r.output
-    assert any("density outside RhopOutMin" in str(w.message) for w in rec)
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "completed"
     assert meta["message"].startswith("The minimum number of fluid particles (1125) was reached")
@@ -96,19 +96,29 @@ def test_dtmin_adjustments_are_warned_and_named(drawn, tmp_path):
 
 
 def test_a_density_window_that_excludes_the_initial_fluid(drawn, tmp_path):
-    """RhopOutMin above part of the still water's hydrostatic density: warned at start-up, and the
-    divergence names the window and the initial densities, not the time step."""
+    """RhopOutMin above part of the still water's hydrostatic density: an input error (exit 2) before
+    any step, with the count, the densities' span and the window, as DualSPHysics's
+    JSph::CheckRhoLimits ("Initial fluid density is out of limits ... modify the value of 'RhopOutMin'
+    and 'RhopOutMax'"); sphdvi warned, ran, and excluded them in its first steps."""
     out = tmp_path / "o"
-    with pytest.warns(UserWarning, match=r"750 of 1250 fluid particles start with a density outside "
-                                         r"RhopOutMin/RhopOutMax \[1001.5, 1300\]"):
-        r = run(drawn, out, "RhopOutMin=1001.5")
-    assert r.exit_code == 3
-    msg = json.loads((out / "run.json").read_text())["message"]
-    assert "RhopOutMin/RhopOutMax [1001.5, 1300] exclude the initial fluid" in msg
-    assert "time step" not in msg
-    # the start-up warning is in run.log too, at its head (it went to stderr only)
+    r = run(drawn, out, "RhopOutMin=1001.5")
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert ("750 of 1250 fluid particles start with a density outside RhopOutMin/RhopOutMax [1001.5, 1300] "
+            "(the initial fluid densities span [1000, 1002.48] kg/m3)") in text
+    assert "Initial fluid density is out of limits" in text and "RhopOutMin and RhopOutMax" in text
+    assert "Traceback" not in r.output and not (out / "particles.vtkhdf").exists()
+
+
+def test_a_startup_warning_of_the_solver_heads_run_log(drawn, tmp_path):
+    """A warning of the run's start-up (here the solver's DtFixed below DtMin) is in run.log too, at its
+    head (it went to stderr only)."""
+    out = tmp_path / "o"
+    with pytest.warns(UserWarning, match=r"DtFixed \(1e-05 s\) is below DtMin"):
+        r = run(drawn, out, "DtFixed=1e-5", tmax="0.0002")
+    assert r.exit_code == 0, r.output
     first = (out / "run.log").read_text().splitlines()[0]
-    assert first.startswith("WARNING: 750 of 1250 fluid particles start with a density outside")
+    assert first.startswith("WARNING: DtFixed (1e-05 s) is below DtMin")
 
 
 def test_startup_warnings_are_logged_once_and_again_on_resume(drawn, tmp_path):

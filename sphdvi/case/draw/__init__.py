@@ -47,7 +47,7 @@ Surfaces (see :mod:`.raster`)
 Masks (``drawprism``, ``drawpyramid``, ``drawcylinder``)
     ``mask`` lists the numbers (from 1) of the faces left out, joined by ``|``
     (``mask="1 | 2 | 6 | 7"`` leaves out faces 1, 2, 6 and 7; ``0`` none;
-    numbers beyond the shape's faces are ignored). Prism (first polygon, then
+    numbers beyond the shape's faces hide nothing and are warned about). Prism (first polygon, then
     second polygon): 1 = first polygon, 2 = second polygon, 3, 4, ... = sides
     (side k joins points k-2 and k-1 of each polygon, the last one closes it).
     Pyramid (apex, then base points): 1 = base, 2, 3, ... = sides apex-P1P2,
@@ -92,8 +92,14 @@ Layers (``<layers vdp="0,1,-0.5*">`` in drawbox, drawsphere, drawcylinder)
 ``resetdraw``
     Back to the initial drawing configuration: no mk selected, ``full`` mode,
     identity matrix, points and shapes active (``setactive``), no line start. Variables, lists, saved stacks (``matrixsave``,
-    ``statesave``, ``mksave``) and the particles drawn so far are kept (a
-    warning when there are some: GenCase's treatment is not documented).
+    ``statesave``, ``mksave``) and the particles drawn so far are kept
+    (GenCase_CaseTemplate.xml lists it as a plain state command).
+
+Commands that draw nothing
+    A fluid or boundary drawing command none of whose nodes lies in the
+    domain (a 2D shape that misses the plane y = posy, a shape outside
+    pointmin..pointmax) is warned about with its line and mk; fills and void
+    drawing are not (they may rightly change nothing).
 
 ``setboxlimitmode``
     ``full`` (GenCase's default, the box rules above) is accepted; ``inner``

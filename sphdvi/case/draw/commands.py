@@ -24,6 +24,7 @@ MAX_SHAPE_TRIANGLES = 5_000_000  # triangles kept for <shapeout>
 DRAW_MODES = {"full", "face", "solid", "wire"}
 BOX_TOKENS = {"solid", "all", "bottom", "top", "left", "right", "front", "back"}
 FILL_TOKENS = {"void", "border", "fluid", "bound"}
+FILLS = {"fillpoint", "fillbox"}    # _record shapes of the fill commands
 SKIPPED_ATTRS = {"comment", "units_comment", "comment2", "rem", "active"}
 
 #: commands of GenCase that sphdvi does not implement
@@ -124,6 +125,7 @@ class GeometryRunner:
         self.shape_files: list = []
         self.shape_sets: dict = {}
         self.messages: list = []
+        self._empty_warned = None     # element already warned to draw nothing (open shape, solid)
         self.handlers = self._handler_table()
 
     # ------------------------------------------------------------ dispatch
@@ -215,6 +217,8 @@ class GeometryRunner:
                 "mk": int(s.mk) if s.kind in ("fluid", "bound") else -1, "solid": bool(solid),
                 "mode": s.mode, "nodes": nodes, "line": el.sourceline, "params": params}
         self.primitives.append(prim)
+        if nodes == 0 and s.draw_points and s.kind in ("fluid", "bound") and shape not in FILLS:
+            self._warn_nothing_drawn(el, tris, params)
         if s.draw_shapes and tris is not None and self.keep_shapes:
             tris = np.asarray(tris)
             if self.shape_triangles + len(tris) > MAX_SHAPE_TRIANGLES:
@@ -224,6 +228,32 @@ class GeometryRunner:
                 return
             self.shape_triangles += len(tris)
             self.shapes.append({"triangles": tris, "mk": prim["mk"], "fluid": prim["fluid"]})
+
+    def _warn_nothing_drawn(self, el, tris, params: dict) -> None:
+        """A fluid or boundary drawing command that creates no particle at all (its shape misses
+        the domain, or in 2D the plane y = posy, or lies between the lattice nodes) is warned
+        about: its wall or fluid silently vanished before (warn_no_fluid caught only a case with
+        no fluid at all). Fills and void drawing are left out: they may rightly change nothing."""
+        if self._empty_warned is el:
+            return
+        s, lat = self.state, self.lat
+        msg = f"this <{el.tag}> (mk{s.kind} {s.mk}) creates no particles: "
+        pts = tris if tris is not None and len(tris) else params.get("points", params.get("point"))
+        lo = hi = None
+        if pts is not None and np.size(pts):
+            p = np.asarray(pts, dtype=np.float64).reshape(-1, 3)
+            lo, hi = p.min(axis=0), p.max(axis=0)
+        tol = 1e-6 * lat.dp
+        if lat.is2d and lo is not None and not lo[1] - tol <= lat.pointmin[1] <= hi[1] + tol:
+            msg += (f"it spans y = {lo[1]:g}..{hi[1]:g} and misses the 2D plane y = "
+                    f"{lat.pointmin[1]:g} (a shape of a 2D case must cross it)")
+        elif lo is not None and (np.any(hi < lat.pointmin - tol) or np.any(lo > lat.pointmax + tol)):
+            msg += (f"it lies outside the domain pointmin {lat.pointmin.tolist()} .. pointmax "
+                    f"{lat.pointmax.tolist()}")
+        else:
+            msg += ("no lattice node of it lies in the domain" + (" or its mask leaves every face out"
+                                                                  if params.get("mask") else ""))
+        self.reader.warn(el, msg)
 
     def _mask(self, el) -> frozenset:
         """The ``mask`` attribute: the numbers (from 1) of the faces left out, joined by ``|``.
@@ -248,6 +278,16 @@ class GeometryRunner:
                 hidden.add(int(v))
         return frozenset(hidden)
 
+    def _warn_missing_faces(self, el, hidden: frozenset, nfaces: int) -> None:
+        """A mask that names a face the shape does not have hides nothing there: warned (GenCase's
+        ``mask`` lists face numbers 1..nfaces; ``mask="96"`` on a prism passed silently before)."""
+        extra = sorted(f for f in hidden if f > nfaces)
+        if extra:
+            self.reader.warn(el, f"mask names face{'s' if len(extra) > 1 else ''} "
+                                 f"{', '.join(map(str, extra))} but this <{el.tag}> has faces 1 to "
+                                 f"{nfaces} only: {'they hide' if len(extra) > 1 else 'it hides'} "
+                                 "nothing (mask lists face numbers joined by |, e.g. mask=\"1 | 2\")")
+
     def _open_shape_flags(self, el, hidden: frozenset, nfaces: int):
         """(solid, faces, wire) of a shape with ``nfaces`` faces of which ``hidden`` are left out.
 
@@ -259,6 +299,7 @@ class GeometryRunner:
             if self.state.mode == "solid":
                 self.reader.warn(el, f"mask leaves faces {sorted(f for f in hidden if f <= nfaces)} "
                                      "out: an open shape has no inside, nothing drawn in solid mode")
+                self._empty_warned = el
             solid = False
         return solid, surface, wire
 
@@ -320,8 +361,10 @@ class GeometryRunner:
         self.vars.constant = set(saved.constant)
 
     def _condition(self, el) -> bool:
+        """The ``if`` of <printf>/<abort>; ``text`` is marked read here too, as a false
+        condition skips the command with both attributes valid (GenCase_CaseTemplate.xml)."""
         cond = el.get("if")
-        self.reader.mark(el, "if")
+        self.reader.mark(el, "if", "text")
         if cond is None:
             return True
         c = cond.strip()
@@ -390,10 +433,8 @@ class GeometryRunner:
     def cmd_resetdraw(self, el):
         """Back to the initial drawing configuration: no mk selected, ``full`` mode, identity
         matrix, points and shapes active, no line start. Variables, lists,
-        the saved stacks and everything drawn so far are kept."""
-        if self.state.draw_points and self.canvas is not None and self.canvas.codes.any():
-            self.reader.warn(el, "particles were drawn before <resetdraw>; sphdvi keeps them "
-                                 "(GenCase's treatment of them is not documented)")
+        the saved stacks and everything drawn so far are kept (GenCase_CaseTemplate.xml lists it
+        as a plain state command; nothing there says it touches what was drawn)."""
         self.state = DrawState()
         self.line_begin = None
 
@@ -718,6 +759,7 @@ class GeometryRunner:
         r0 = self.reader.num(el, "radius", positive=True)
         p = self._points(el, exact=2)
         mask = self._mask(el)
+        self._warn_missing_faces(el, mask, 3)
         solid, shell = self._curved_flags()
         if any(1 <= f <= 3 for f in mask):
             # an open cylinder (a cover or the tube left out) has no inside: its faces only
@@ -746,6 +788,7 @@ class GeometryRunner:
     # ------------------------------------------------------------ polyhedra
     def _draw_polyhedron(self, el, verts, faces, shape):
         mask = self._mask(el)
+        self._warn_missing_faces(el, mask, len(faces))
         solid, surface, wire = self._open_shape_flags(el, mask, len(faces))
         pieces, params, tris = shapes.draw_polyhedron(self.lat, self.state.matrix, verts, faces,
                                                       solid=solid, surface=surface, wire=wire,
@@ -978,6 +1021,7 @@ def _run_geometry(reader, geometry_el, casename, outdir, max_nodes) -> Drawing:
     runner.lat = lat
     runner.canvas = Canvas(lat)
     v = reader.vars
+    v.lattice = (lat.origin.copy(), dp)      # roundposx/y/z
     _define_builtin(v, "Dp", dp)
     for i, ax in enumerate("xyz"):
         _define_builtin(v, f"PosMin_{ax}", float(pmin[i]))
