@@ -85,9 +85,10 @@ def _table(v):
 
 def _material_for(mkbound, case_json, body_property=None):
     """(name, contact spec) of an mkbound's property: the floating's own ``property`` or
-    the ``<link>`` naming the mkbound.  A combination ``"steel + userdef01"`` merges the
-    named properties in order, each value of a later one replacing the earlier one's
-    (DualSPHysics's combined properties)."""
+    the ``<link>`` naming the mkbound.  A combination ``"steel + userdef01"`` is read as
+    DualSPHysics reads it (JCaseProperties::GetPropsSort, JSph::LoadDemData): the names sorted
+    (as written, repeats dropped), each value taken from the first of them that has it, except
+    that a ``*_User`` value of any of them wins over the plain ones."""
     mats = case_json.get("materials", {})
     combo = body_property
     if combo is None:
@@ -96,19 +97,26 @@ def _material_for(mkbound, case_json, body_property=None):
                 combo = link["property"]
     if combo is None:
         return None, None
-    names = [n.strip() for n in combo.split("+") if n.strip()]
+    names = sorted({n.strip() for n in combo.split("+") if n.strip()})
     if not names or any(n not in mats for n in names):
         return None, None
-    merged = {}
-    for n in names:
-        merged.update({k: v for k, v in mats[n].items() if v is not None})
     name = " + ".join(names)
     spec = {"name": name}
     for key, out in (("kfric", "friction"), ("restitution", "restitution"), ("young", "young"),
                      ("poisson", "poisson")):
-        if merged.get(key) is not None:
-            spec[out] = merged[key]
+        value = _first_value(key, [mats[n] for n in names])
+        if value is not None:
+            spec[out] = value
     return name, spec
+
+
+def _first_value(key, props):
+    """``key`` of the first property giving it as ``*_User``, else of the first giving it."""
+    for user in (True, False):
+        for m in props:
+            if m.get(key) is not None and (key in m.get("user", ())) == user:
+                return m[key]
+    return None
 
 
 def mechanism_from_case(data: dict, motions=None) -> dict:

@@ -65,6 +65,7 @@ class Material:
     kfric: float | None = None
     sfric: float | None = None
     extra: dict = field(default_factory=dict)
+    user: list = field(default_factory=list)    # the values given as *_User (they win in a combination)
 
 
 @dataclass

@@ -658,6 +658,7 @@ def _read_material(reader, el) -> Material:
             reader.mark(el, k)
     for attr, value in {**plain, **user}.items():
         setattr(mat, attr, value)
+    mat.user = sorted(user)
     if mat.poisson is not None and not (0.0 <= mat.poisson < 0.5):
         raise reader.error(el, f"PoissonRatio {mat.poisson} out of range", "0 <= nu < 0.5")
     if mat.restitution is not None and mat.restitution > 1.0:

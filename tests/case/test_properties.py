@@ -67,8 +67,8 @@ def test_combined_property_names_and_floating(tmp_path):
     from sphdvi.mechanism import _material_for
     case_json = {"materials": {k: vars(v) for k, v in r.case.materials.items()},
                  "material_links": r.case.material_links}
-    name, spec = _material_for(0, case_json)
-    assert name == "steel + UserDef01" and spec["restitution"] == 0.65 and spec["friction"] == 0.45
+    name, spec = _material_for(0, case_json)      # sorted, as GetPropsSort
+    assert name == "UserDef01 + steel" and spec["restitution"] == 0.65 and spec["friction"] == 0.45
 
 
 def test_undefined_property_still_refused(tmp_path):
@@ -91,3 +91,21 @@ def test_value_names_are_matched_exactly(tmp_path):
     r = build(tmp_path, props)
     assert r.case.materials["steel"].young is None
     assert any("'young_modulus' is not read (did you mean 'Young_Modulus'?)" in w for w in r.warnings)
+
+
+def test_combined_properties_take_values_as_dualsphysics():
+    """JCaseProperties::GetPropsSort + JSph::LoadDemData: the names sorted, each value from the
+    first property that gives it, a *_User value of any of them first (sphdvi merged in document
+    order, the later replacing the earlier)."""
+    from sphdvi.mechanism import _material_for
+    mats = {"steel": {"kfric": 0.35, "restitution": 0.8, "user": []},
+            "userdef01": {"kfric": 0.1, "restitution": 0.2, "young": 2e9, "user": []},
+            "SetKfric": {"kfric": 0.5, "user": ["kfric"]}}
+    js = {"materials": mats}
+    name, spec = _material_for(0, js, "userdef01 + steel")
+    assert name == "steel + userdef01"
+    assert (spec["friction"], spec["restitution"], spec["young"]) == (0.35, 0.8, 2e9)
+    _, spec = _material_for(0, js, "steel+SetKfric")
+    assert spec["friction"] == 0.5 and spec["restitution"] == 0.8
+    _, spec = _material_for(0, {"materials": {"a": {"kfric": 0.2}, "b": {"kfric": 0.4}}}, "b+a")
+    assert spec["friction"] == 0.2          # an older case file (no "user" list) reads too
