@@ -994,6 +994,11 @@ def read_chrono(reader, el) -> dict:
         out["solver"] = {k: s.get(k) for k in s.keys()}
         reader.mark(s, *s.keys())
     _read_chrono_timestepper(reader, reader.child(el, "timestepper"))
+    grav = reader.child(el, "gravity")
+    if grav is not None:      # in older DualSPHysics templates; v5.4's JChronoObjects::ReadXml does not read it
+        reader.mark(grav, *grav.keys())
+        reader.warn(grav, "<chrono><gravity> is not read (as DualSPHysics v5.4): the bodies feel the case's "
+                          "<constantsdef><gravity>")
     out["collision"] = _read_chrono_collision(reader, reader.child(el, "collision"), out["collision"])
     ids = _read_chrono_bodies(reader, el, out)
     for ln in reader.children(el):

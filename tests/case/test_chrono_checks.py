@@ -192,3 +192,11 @@ def test_scaleforce_mkbounds(tmp_path):
         build(tmp_path / "c", '<scaleforce><body mkbound="0" x="0" y="0" z="0"/></scaleforce>')
     with pytest.raises(CaseError, match=r"missing attribute"):
         build(tmp_path / "d", '<bodyfloating id="A" mkbound="1"/><scaleforce><body mkbound="1" x="0"/></scaleforce>')
+
+
+def test_chrono_gravity_is_said_once(tmp_path):
+    """<chrono><gravity x y z> (older templates; not read by v5.4): one warning naming the gravity
+    that applies, not three "unknown attribute" ones."""
+    r = build(tmp_path, '<gravity x="0" y="0" z="-9.81"/><bodyfloating id="A" mkbound="1"/>')
+    w = chrono_warnings(r)
+    assert len(w) == 1 and "<chrono><gravity> is not read" in w[0], w
