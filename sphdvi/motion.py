@@ -21,9 +21,14 @@ Movements (DualSPHysics ``JMotion``; times τ measured from the start of the mov
   outside the file's times); ``fieldtime``, ``fieldx``... are 0-based column indices
   (DualSPHysics's JMotionDataFile).
 
-A movement ends after ``duration`` (−1: never) and continues with ``next``; the
-chain starts at ``begin start`` and stops at ``finish``. Movements of enclosing
-``<obj>`` elements are applied after the object's own.
+A movement ends after ``duration`` and continues with ``next``; the chain starts at
+``begin start`` and stops at ``finish``. A negative duration is DualSPHysics's "flash"
+(JMotionMovActive's Flash, JMotion::MovAddTeleport): the displacement |duration| seconds of the
+movement would make, applied at once at its start, taking no time. A circular movement keeps the
+point its ``ref`` reached (JMotion::AxisAdd's own Ref axis, moved by every step): entered again
+through ``next`` it goes on round the circle. Movements of enclosing ``<obj>`` elements are
+applied after the object's own. The walk along a chain is kept between evaluations
+(:class:`_Walk`), so that a loop costs the same per step at any time.
 
 Wave paddles (regular waves, Biesel transfer functions, Dean & Dalrymple 1991 §6):
 piston H/S = 2 (cosh 2kd − 1)/(sinh 2kd + 2kd); flap H/S = 4 sinh kd/kd ·
@@ -115,7 +120,7 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
         angle = w0 * tau + 0.5 * al * tau * tau
         w = w0 + al * tau
         state.update(carried, w=w)
-        return _rotational(m, angle, w, circular=kind.startswith("mvcir"))
+        return _rotational(m, angle, w, circular=kind.startswith("mvcir"), state=state)
     if kind == "mvrectsinu":
         f, A = np.asarray(m["freq"], float), np.asarray(m["ampl"], float)
         ph = (np.asarray(m["phase"], float) * _angle_units(m) if "phase" in m
@@ -132,28 +137,37 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
         angle = A * (math.sin(arg) - math.sin(ph))
         w = A * 2 * math.pi * f * math.cos(arg)
         state.update(carried, phase=arg)
-        return _rotational(m, angle, w, circular=kind == "mvcirsinu")
+        return _rotational(m, angle, w, circular=kind == "mvcirsinu", state=state)
     if kind in ("mvrectfile", "mvrotfile"):
         state.update(carried)
         return _from_file(m, tau)
     raise ValueError(f"unsupported movement {kind}")
 
 
-def _rotational(m, angle, w, circular) -> Rigid:
+def _rotational(m, angle, w, circular, state=None) -> Rigid:
     """A rotation by ``angle`` (rate ``w``) about the axis through axisp1 and axisp2, in
     DualSPHysics's sense: its JMatrix4::MatrixRot(ang, p1, p2), which JMotionPos::Rotate applies,
     turns by −ang in the right-hand sense about p1 → p2 (MatrixRotY(ang), the right-hand
     rotation about +y, is MatrixRot(ang, 0, (0, −1, 0)) there); so a positive angle turns
     right-handed about p2 → p1.  (The SPHERIC Test 10 roll record, a positive angle about
     (0, −1, 0) → (0, 1, 0), then throws the water at the left wall when the experiment's
-    sensor there records the impacts.)"""
+    sensor there records the impacts.)
+
+    A circular movement translates the object by the turn of its reference point, which starts
+    where the movement's last pass left it (``state["refs"]``, by movement id; the XML ``ref`` on
+    the first pass): DualSPHysics's JMotionObj::ProcesTime turns the movement's own Ref axis and
+    stores it back every step, so a circular movement looped by ``next`` closes its circle.  The
+    moved point is stored in a new ``state["refs"]`` (the caller's copies are not changed)."""
     p1, p2 = np.asarray(m["axisp1"], float), np.asarray(m["axisp2"], float)
     axis = _unit(p1 - p2, f"{m['type']} id={m.get('id')}: axisp1 and axisp2")
     R = _rotation(axis, angle)
     if not circular:
         return Rigid(R=R, d=p1 - R @ p1, W=w * axis, c=p1)
-    ref = np.asarray(m["ref"], float)
+    refs = state.get("refs", {}) if state is not None else {}
+    ref = refs.get(m.get("id"), np.asarray(m["ref"], float))
     moved = R @ (ref - p1) + p1
+    if state is not None:
+        state["refs"] = {**refs, m.get("id"): moved}
     vel = np.cross(w * axis, moved - p1)
     return Rigid(d=moved - ref, V=vel)
 
@@ -221,64 +235,159 @@ def _from_file(m, tau) -> Rigid:
     return _rotational(m, angle * units, w * units, circular=False)
 
 
-def chain_transform(chain: dict, t: float) -> Rigid:
+def chain_transform(chain: dict, t: float, walks: dict | None = None) -> Rigid:
     """Accumulated transform of an object's movements at time t: each of its events (``<begin>``,
-    DualSPHysics's JMotionEvent) runs its own chain (:func:`_event_transform`), and their transforms
+    DualSPHysics's JMotionEvent) runs its own chain (:class:`_Walk`), and their transforms
     compose in order of their start (the reader admits several events only where that is
-    DualSPHysics's motion: times that do not overlap, or overlapping translations)."""
+    DualSPHysics's motion: times that do not overlap, or overlapping translations).  ``walks``
+    keeps each event's walk between calls (:class:`MotionSet`'s); without it the chains are walked
+    from their start.  An event starts from the reference points of circular movements where the
+    events before it left them (DualSPHysics's movements, and their Ref axes, belong to the object)."""
     events = chain.get("events") or ([chain["begin"]] if chain.get("begin") else [])
+    walks = {} if walks is None else walks
     total = Rigid()
-    for begin in sorted(events, key=lambda e: e["start"]):
-        total = total.then(_event_transform(chain, begin, t))
+    refs: dict = {}
+    for k, begin in sorted(enumerate(events), key=lambda e: e[1]["start"]):
+        key = (id(chain), k)
+        walk = walks.get(key) or walks.setdefault(key, _Walk(chain, begin))
+        total = total.then(walk.at(t, refs))
+        refs = walk.refs()
     return total
 
 
 def _event_transform(chain: dict, begin: dict, t: float) -> Rigid:
-    """Transform of the chain of movements that the event ``begin`` (mov, start, finish) starts, at
-    time t (JMotionObj::ProcesTime for one active movement and those that follow it by next=)."""
-    movs = {m["id"]: m for m in chain["movements"]}
-    start, finish = begin["start"], begin.get("finish")
-    if t <= start:
-        return Rigid()
-    t_end = t if finish is None else min(t, finish)
-    total = Rigid()
-    state: dict = {}
-    current, t0 = movs.get(begin["mov"]), start
-    stalled = 0          # movements in a row that took no time
-    for _ in range(1_000_000):
-        if current is None:
-            break
-        dur = current["duration"]
-        stalled = stalled + 1 if dur == 0 else 0
-        if stalled > len(movs):
-            from .errors import CaseError
-            raise CaseError(f"motion of mkbound {chain.get('ref', '?')}: the movements loop through next= "
-                            "without advancing time (their durations add up to 0)",
-                            expected="a positive duration in every loop of movements")
-        t1 = math.inf if dur < 0 else t0 + dur
-        if t_end < t1:
-            seg = _segment(current, t_end - t0, state)
-            total = total.then(seg)
-            if finish is not None and t >= finish:
-                total = Rigid(total.R, total.d, c=total.c)
-            return total
-        seg = _segment(current, t1 - t0, state)
-        total = total.then(Rigid(seg.R, seg.d, c=seg.c))
-        t0 = t1
-        current = movs.get(current["next"]) if current.get("next") is not None else None
-    if current is not None:
+    """Transform of the chain of movements that the event ``begin`` starts, at time t, walked from
+    its start (:class:`_Walk`)."""
+    return _Walk(chain, begin).at(t)
+
+
+def _static(r: Rigid) -> Rigid:
+    """The placement of ``r`` without its velocity (a movement that is over)."""
+    return Rigid(r.R, r.d, c=r.c)
+
+
+class _Walk:
+    """Where the chain of movements of one event (``begin``: mov, start, finish) stands: the movement
+    under way, its start ``t0``, the transform of the movements done before it and what they carried
+    into it (:func:`_segment`'s ``state``, with the circular movements' reference points) -
+    DualSPHysics's JMotionMovActive, advanced by JMotionObj::ProcesTime and NextMov.
+
+    :meth:`at` goes on from there (a loop of movements costs the same per step at any time); for a
+    time before the movement under way (a multibody substep, a predictor) it goes back to the last
+    of the recent movement starts before that time, or to the event's start.  The walk is a
+    function of t alone (the same sums in the same order whether it is walked at once or step by
+    step), so a resumed run places the particles bitwise as the run it continues.  A movement of
+    negative duration is a flash (JMotionMovActive::Flash): the displacement of |duration| seconds
+    of it applied once t has passed its start, taking no time (the next movement starts then)."""
+
+    MAX_MOVES = 1_000_000       # movements walked in one evaluation: a loop of vanishing durations
+    HISTORY = 16                # recent movement starts kept to go back to
+
+    def __init__(self, chain: dict, begin: dict):
+        self.chain = chain
+        self.movs = {m["id"]: m for m in chain["movements"]}
+        self.start, self.finish = begin["start"], begin.get("finish")
+        self.first = self.movs.get(begin["mov"])
+        self.begun = False
+        self.initial = None             # the walk at the event's start (set when it begins)
+        self.history: list = []
+        self._restore((self.first, self.start, Rigid(), {}, 0))
+
+    def _snapshot(self) -> tuple:
+        return (self.current, self.t0, self.done, self.state, self.stalled)
+
+    def _restore(self, snap: tuple) -> None:
+        self.current, self.t0, self.done, self.state, self.stalled = snap
+        self.state = dict(self.state)
+        self.seen = self.t0             # the latest t_end walked to
+        self.final = None               # (transform, state, set by the finish) once the walk is over
+
+    def refs(self) -> dict:
+        """The reference points of the circular movements as the walk leaves them."""
+        state = self.final[1] if self.final is not None else self.state
+        return state.get("refs", {})
+
+    def _t_end(self, t: float) -> float:
+        return t if self.finish is None else min(t, self.finish)
+
+    def _go_back(self, t: float, t_end: float) -> None:
+        """Go back to a movement start before ``t_end`` where the walk stands after it (a time
+        before the movement under way, or before the finish that ended the walk)."""
+        if self.final is not None and self.final[2]:
+            if t >= self.finish:
+                return
+        elif t_end >= self.seen or t_end > self.t0:
+            return
+        while self.history and not t_end > self.history[-1][1]:
+            self.history.pop()
+        self._restore(self.history[-1] if self.history else self.initial)
+
+    def at(self, t: float, refs: dict | None = None) -> Rigid:
+        """The event's transform at time t (at rest before its start, static after its chain or its
+        ``finish`` is over); ``refs``: the circular movements' reference points where the object's
+        earlier events leave them, taken when this event begins."""
+        if t <= self.start:
+            return Rigid()
+        if not self.begun:
+            self.begun = True
+            self.state = {"refs": dict(refs)} if refs else {}
+            self.initial = self._snapshot()
+            self.state = dict(self.state)   # the snapshot keeps its own
+        t_end = self._t_end(t)
+        self._go_back(t, t_end)
+        self.seen = max(self.seen, t_end)
+        if self.final is not None:
+            return self.final[0]
+        over = self.finish is not None and t >= self.finish
+        for _ in range(self.MAX_MOVES):
+            cur = self.current
+            if cur is None:
+                self.final = (_static(self.done), self.state, False)
+                return self.final[0]
+            dur = cur["duration"]
+            if dur < 0:                 # flash: applied once t has passed its start
+                if t_end <= self.t0:
+                    if over:
+                        self.final = (_static(self.done), self.state, True)
+                    return _static(self.done)
+                self._advance(_segment(cur, -dur, self.state), self.t0, dur)
+                continue
+            t1 = self.t0 + dur
+            if t_end < t1:
+                state = dict(self.state)
+                total = self.done.then(_segment(cur, t_end - self.t0, state))
+                if over:
+                    self.final = (_static(total), state, True)
+                    return self.final[0]
+                return total
+            self._advance(_segment(cur, dur, self.state), t1, dur)
+        raise self._error(f"more than a million movements before t={t:g} s (a loop of very short durations)",
+                          "loops of movements lasting a reasonable time")
+
+    def _advance(self, seg: Rigid, t1: float, dur: float) -> None:
+        """Movement ``current`` done (its whole transform ``seg``): on to its next at t1."""
+        self.done = self.done.then(_static(seg))
+        self.t0 = t1
+        self.stalled = self.stalled + 1 if dur <= 0 else 0
+        if self.stalled > len(self.movs):
+            raise self._error("the movements loop through next= without advancing time (their durations "
+                              "add up to 0)", "a positive duration in every loop of movements")
+        nxt = self.current.get("next")
+        self.current = self.movs.get(nxt) if nxt is not None else None
+        self.history.append(self._snapshot())
+        del self.history[:-self.HISTORY]
+        self.state = dict(self.state)   # the snapshot keeps its own
+
+    def _error(self, what: str, expected: str):
         from .errors import CaseError
-        raise CaseError(f"motion of mkbound {chain.get('ref', '?')}: more than a million movements "
-                        f"before t={t:g} s (a loop of very short durations)",
-                        expected="loops of movements lasting a reasonable time")
-    return Rigid(total.R, total.d, c=total.c)   # chain over: at rest
+        return CaseError(f"motion of mkbound {self.chain.get('ref', '?')}: {what}", expected=expected)
 
 
-def motion_transform(motion: dict, t: float) -> Rigid:
+def motion_transform(motion: dict, t: float, walks: dict | None = None) -> Rigid:
     """Transform of one ``objreal`` including its parent ``<obj>`` chains."""
-    total = chain_transform(motion, t)
+    total = chain_transform(motion, t, walks)
     for parent in reversed(motion.get("parents", [])):
-        total = total.then(chain_transform(parent, t))
+        total = total.then(chain_transform(parent, t, walks))
     return total
 
 
@@ -664,6 +773,7 @@ class MotionSet:
 
     def __init__(self, motions: list, wavepaddles: list | None = None, g: float = 9.81):
         self.motions = {m["ref"]: m for m in motions}
+        self._walks: dict = {}          # each event's walk along its chain (chain_transform)
         self.paddles = {p["mkbound"]: make_paddle(p, g) for p in (wavepaddles or [])}
 
     @property
@@ -671,7 +781,7 @@ class MotionSet:
         return sorted(set(self.motions) | set(self.paddles))
 
     def transform(self, mkbound: int, t: float) -> Rigid:
-        base = motion_transform(self.motions[mkbound], t) if mkbound in self.motions else Rigid()
+        base = motion_transform(self.motions[mkbound], t, self._walks) if mkbound in self.motions else Rigid()
         if mkbound in self.paddles:
             base = base.then(self.paddles[mkbound].transform(t))
         return base

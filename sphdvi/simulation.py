@@ -91,7 +91,10 @@ def absolute_file_sets(sets) -> tuple:
     """``--set ViscoTime=FILE`` / ``--set DtFixedFile=FILE``: FILE, like every path on the command
     line, is relative to the current directory; it is made absolute here, so that run.json keeps
     a path that ``--resume`` finds from any directory (in the XML the value is relative to the
-    case's folder, as DualSPHysics's DirCase)."""
+    case's folder, as DualSPHysics's DirCase).  Without ``--set`` nothing to do: the XML case
+    reader (lxml, the schema; ~40 ms) is imported only when there are keys to look at."""
+    if not sets:
+        return ()
     from .case.reader import DATA_FILE_KEYS
     out = []
     for item in sets or ():
@@ -839,7 +842,7 @@ class SPHRun:
         for absorber in self.absorbers:      # the gauge in front of the piston where it stands
             absorber.update(t, dt, absorber.measure(solver.state, t - dt) if absorber.absorbs(t, dt) else math.nan)
         if self.moving is not None:
-            self.moving.apply(solver, t)
+            self.moving.apply(solver, t, dt)
             self._check_moving_in_domain(solver)
         if self.floating is not None:
             self.floating.step(solver, dt)
@@ -1328,7 +1331,9 @@ def _warm_up(sph: "SPHRun") -> float:
     the copy is the whole SPHRun, so that its solver's hook is the copy's: imposed motions, the floating
     bodies' multibody step (31 s of JIT inside a 31.2 s hinged-flap run before) and the damping
     zones compile too, and nothing of the run itself moves; then the kernels of a first contact
-    between bodies."""
+    between bodies.  What switches on later in the run is switched on in the copy: the bodies
+    move from its first step (FtPause set to 0 there; 21 s of JIT at the pause's end before) and
+    each ``<accinput>`` is evaluated once at its start time."""
     import copy
     t0 = _time.perf_counter()
     # without a hook the solver alone (a copy of the run would copy the case's arrays too)
@@ -1337,12 +1342,31 @@ def _warm_up(sph: "SPHRun") -> float:
     else:
         run = copy.deepcopy(sph)
         clone, bodies = run.solver, run.bodies
+        if run.floating is not None:
+            run.floating.ftpause = 0.0
     with contextlib.suppress(DivergenceError):      # a wall or body leaving the domain: the run says it
         clone.step()
         clone.step()
+    for inp in clone.acc_inputs:                    # an input active only later (<time start>)
+        clone.time = inp.start
+        clone._add_acc_inputs()
     if bodies is not None:
         bodies.compile_contact_kernels()
     return _time.perf_counter() - t0
+
+
+def _warm_up_gauges(gauges, sol) -> None:
+    """Compile (or load) the run-time gauges' kernels: every gauge computed once on the current
+    state (the solver's arrays, as :meth:`RunGauges.after_step` passes them), the rows thrown
+    away.  RunGauges measures at start-up only the gauges due at t=0 of a new run: without this a
+    gauge whose ``<computetime>`` starts later, or any gauge after ``--resume``, compiled inside
+    the time loop instead of in startup_s.  The gauges read the state and change nothing."""
+    from .measure.gauges import StateView
+    st = sol.state
+    view = StateView(float(sol.time), st.pos, st.vel, st.rhop, st.mass, sol.press, st.ptype, st.mk, gauges.spec,
+                     gauges.periodicity)
+    for slot in gauges.slots:
+        slot.gauge.compute(view)
 
 
 def _run_sph(data, params, out_times, outdir, files, meta, threads, resume, quiet, t_start, stop=None) -> RunResult:
@@ -1419,6 +1443,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
             # compilation counts in startup_s, not in runtime_s
             gauges = _make_gauges(data, params, outdir, resume, float(sol.time), sol.periodicity,
                                   extra.get("gauges") if resume else None)
+            if gauges is not None:
+                _warm_up_gauges(gauges, sol)
     finally:
         notice.done()
     if stopped is not None:

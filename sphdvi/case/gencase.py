@@ -568,14 +568,32 @@ def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody)
 # ---------------------------------------------------------------------------
 # domain and checks
 # ---------------------------------------------------------------------------
+# DualSPHysics's BORDER_MAP (DualSphDef.h): the map's margin around the particles, in h
+BORDER_MAP = 0.05
+
+
 def resolve_domain(case: Case, particles: dict, consts: Constants, reader) -> dict:
-    """Simulation domain: particle bounding box modified by ``<simulationdomain>``."""
+    """Simulation domain as JSph::LoadCaseParticles builds MapRealPos: the particles' bounding
+    box widened by BORDER_MAP*h (0.05 h) on each side of a non-periodic axis and by dp/2 on a
+    periodic one (JPartsLoad4::CalculeLimits), then ``<simulationdomain>`` applied to that
+    widened box (JSph::ResizeMapLimits: "default" is the widened limit, "default + x%" x % of
+    the widened extent; a periodic axis keeps its widened box, whatever the rule)."""
+    from ..sph.periodic import periodic_config
     pos = particles["pos"]
     lo, hi = pos.min(axis=0), pos.max(axis=0)
+    periodic = periodic_config(case.parameters_set, case.parameters, consts.is2d)[0]
+    border = np.array([0.5 * consts.dp if a in periodic else BORDER_MAP * consts.h for a in "xyz"])
+    lo, hi = lo - border, hi + border
     extent = hi - lo
     posmin, posmax = lo.copy(), hi.copy()
     spec = case.simulationdomain
-    for i in range(3):
+    for i, a in enumerate("xyz"):
+        if a in periodic:
+            if any(spec[k][i].replace(" ", "").lower() != "default" for k in ("posmin", "posmax")):
+                reader.warn(reader.root.find("execution/parameters/simulationdomain"),
+                            f"<simulationdomain> limits along the periodic axis {a} are ignored: the domain "
+                            "there is the particles' extent plus dp/2 each side (as DualSPHysics)")
+            continue
         posmin[i] = parse_domain_spec(spec["posmin"][i], lo[i], extent[i])
         posmax[i] = parse_domain_spec(spec["posmax"][i], hi[i], extent[i])
     if consts.is2d:
@@ -790,7 +808,8 @@ def summary(result: GenCaseResult) -> str:
     d = result.domain
     lo = ", ".join(f"{v:.6g}" for v in d["posmin"])
     hi = ", ".join(f"{v:.6g}" for v in d["posmax"])
-    lines.append(f"Domain: ({lo}) - ({hi})")
+    lines.append(f"Domain: ({lo}) - ({hi})   (particles + {BORDER_MAP:g} h each side, dp/2 on a periodic axis, "
+                 "then <simulationdomain>)")
     for b in result.bodies:
         centre = ", ".join(f"{v:.6g}" for v in b.center)
         diag = ", ".join(f"{b.inertia[i][i]:.6g}" for i in range(3))

@@ -460,11 +460,12 @@ def read_motion(reader, casedef) -> list:
     if el is None:
         return out
     refs = {}
+    is2d = _definition_is_2d(reader, casedef)
 
     def walk(node, parents):
         for child in reader.children(node):
             if child.tag in ("objreal", "obj"):
-                chain = _read_movement_chain(reader, child)
+                chain = _read_movement_chain(reader, child, is2d)
                 if child.tag == "objreal":
                     ref = reader.integer(child, "ref", lo=0)
                     if ref in refs:
@@ -475,13 +476,21 @@ def read_motion(reader, casedef) -> list:
             elif child.tag in MOVEMENTS or child.tag in ("mvfile", "mvpredef", "begin"):
                 continue
             else:
+                _refuse_unsupported_movement(reader, child)
                 raise reader.error(child, f"unknown motion element <{child.tag}>",
                                    "objreal, obj, begin, " + ", ".join(sorted(MOVEMENTS)))
     walk(el, [])
     return out
 
 
-def _read_movement_chain(reader, obj):
+def _refuse_unsupported_movement(reader, m) -> None:
+    """DualSPHysics v5.4's file movements that sphdvi does not implement: a clear error."""
+    if m.tag in UNSUPPORTED_MOVEMENTS:
+        raise reader.error(m, f"<{m.tag}> ({UNSUPPORTED_MOVEMENTS[m.tag]}, DualSPHysics v5.4) is not supported by "
+                           "sphdvi", "mvrectfile for positions from a file, mvrotfile for an angle about one axis")
+
+
+def _read_movement_chain(reader, obj, is2d=False):
     from .datafiles import MOTION_FILE_ALIASES as aliases, read_motion_file
     begins = [b for b in reader.children(obj) if b.tag == "begin"]
     movs, elements = {}, {}
@@ -491,19 +500,14 @@ def _read_movement_chain(reader, obj):
         if tag not in MOVEMENTS:
             if m.tag in ("begin", "obj", "objreal"):
                 continue
+            _refuse_unsupported_movement(reader, m)
             raise reader.error(m, f"unknown motion element <{m.tag}>",
                                "objreal, obj, begin, " + ", ".join(sorted([*MOVEMENTS, *aliases])))
-        mid = reader.integer(m, "id", lo=0)
+        mid = reader.integer(m, "id", lo=1)        # JMotion::MovAdd: "The movement id must be greater than zero"
         if mid in movs:
             raise reader.error(m, f"movement id {mid} is used twice", "unique ids")
-        d = {"type": tag, "id": mid, "duration": reader.num(m, "duration", -1.0),
-             "next": reader.integer(m, "next", None, lo=0) if m.get("next") is not None else None}
-        if d["duration"] < 0 and d["duration"] != -1:
-            raise reader.error(m, "negative duration", "duration >= 0 or -1 (forever)")
-        units = "degrees"
-        if tag in _ANGULAR or tag in ("mvrectsinu",):
-            units = reader.text_attr(m, "anglesunits", "degrees", choices={"degrees", "radians"}).lower()
-        d["anglesunits"] = units
+        d = _movement_timing(reader, m, tag)
+        d.update(type=tag, id=mid)
         for part in MOVEMENTS[tag]:
             if part == "file":
                 d.update(read_motion_file(reader, m, tag))
@@ -525,6 +529,8 @@ def _read_movement_chain(reader, obj):
                 raise reader.error(reader.child(m, "axisp2"), f"<{m.tag}> id={mid}: axisp1 and axisp2 are the same "
                                    f"point {p1.tolist()}, so they define no rotation axis",
                                    "two distinct points on the axis")
+        if is2d:
+            _warn_dropped_y(reader, m, d)
         movs[mid] = d
         elements[mid] = m
         order.append(mid)
@@ -547,13 +553,56 @@ def _read_movement_chain(reader, obj):
     return chain
 
 
+UNSUPPORTED_MOVEMENTS = {"mvrotadvfile": "three Euler angles from a file",
+                         "mvpathfile": "positions and Euler angles from a file"}
+
+
+def _movement_timing(reader, m, tag) -> dict:
+    """``duration``, ``next`` and ``anglesunits`` of a movement as JMotion::ReadXml reads them:
+    duration required (a negative one is a flash: the displacement of |duration| seconds at once;
+    a wait's must be >= 0, JMotion::MovAddWait), next 0 or absent for none, anglesunits exactly
+    ``degrees`` or ``radians``; an ``mvnull`` reads none of them (no time, no next: the chain ends)."""
+    if tag == "mvnull":
+        return {"duration": 0.0, "next": None, "anglesunits": "degrees"}
+    duration = reader.num(m, "duration")
+    if tag == "wait" and duration < 0:
+        raise reader.error(m, f"<wait> with a negative duration ({duration:g})",
+                           "duration >= 0 (DualSPHysics refuses negative waiting times)")
+    nxt = reader.integer(m, "next", 0, lo=0)
+    units = reader.text_attr(m, "anglesunits", "degrees")
+    if units not in ("degrees", "radians"):
+        raise reader.error(m, f"anglesunits={units!r} is not recognised", "degrees or radians (lower case)")
+    return {"duration": duration, "next": nxt or None, "anglesunits": units}
+
+
+def _warn_dropped_y(reader, m, d) -> None:
+    """2D case: warn of a movement that would take the object out of the x-z plane; DualSPHysics
+    keeps the moving particles' y (JDsMotion::ProcesTime zeroes a translation's y, MoveMatBound
+    keeps y under a rotation), and so does sphdvi."""
+    tag = d["type"]
+    what = None
+    if tag in ("mvrect", "mvrectace", "mvrectsinu"):
+        parts = {"mvrect": ("vel",), "mvrectace": ("ace", "velini"), "mvrectsinu": ("ampl",)}[tag]
+        bad = [p for p in parts if p in d and d[p][1] != 0]
+        what = ", ".join(f"<{p}> y={d[p][1]:g}" for p in bad) or None
+    elif tag == "mvrectfile" and "fieldy" in d.get("fields", {}):
+        what = "the file's y column (fieldy)"
+    elif "axisp1" in d:
+        axis = np.asarray(d["axisp2"], float) - np.asarray(d["axisp1"], float)
+        if abs(axis[0]) > 1e-12 * np.linalg.norm(axis) or abs(axis[2]) > 1e-12 * np.linalg.norm(axis):
+            what = f"an axis not along y ({d['axisp1']} -> {d['axisp2']})"
+    if what:
+        reader.warn(m, f"2D case: <{m.tag}> id={d['id']} moves out of the x-z plane ({what}); its y component "
+                       "is dropped, the moving particles keep their y (as DualSPHysics)")
+
+
 def _read_begin(reader, begin, movs) -> dict:
     """One ``<begin mov start finish>`` of an object: an event starting the movement ``mov`` at
     ``start``, its chain stopped at ``finish`` (-1 or none: no end), as DualSPHysics's JMotion::EventAdd."""
     mov = reader.integer(begin, "mov", lo=0)
     if mov not in movs:
         raise reader.error(begin, f"mov={mov} names no movement", "an id of a movement of this object")
-    start = reader.num(begin, "start", 0.0, nonnegative=True)
+    start = reader.num(begin, "start", nonnegative=True)      # required, as JMotion::ReadXml
     finish = reader.num(begin, "finish", None) if begin.get("finish") is not None else None
     if finish is not None and finish < 0:
         finish = None            # DualSPHysics's finish="-1": no end
@@ -564,14 +613,15 @@ def _read_begin(reader, begin, movs) -> dict:
 
 
 def _check_zero_loop(reader, movs, elements, first) -> None:
-    """A loop of movements (next=) whose durations add up to 0 would never advance time: an error."""
+    """A loop of movements (next=) whose durations add up to 0 would never advance time: an error
+    (a flash, duration < 0, takes no time)."""
     path, cur = [], first
-    while cur is not None and cur not in path and movs[cur]["duration"] >= 0:
+    while cur is not None and cur not in path:
         path.append(cur)
         cur = movs[cur]["next"]
     if cur is not None and cur in path:
         loop = path[path.index(cur):]
-        if sum(movs[i]["duration"] for i in loop) <= 0:
+        if sum(max(movs[i]["duration"], 0.0) for i in loop) <= 0:
             ids = " -> ".join(str(i) for i in loop + [cur])
             raise reader.error(elements[loop[-1]], f"the movements {ids} loop forever without advancing time "
                                "(their durations add up to 0)",
@@ -582,13 +632,12 @@ _TURNING = {"mvrot", "mvrotace", "mvrotsinu", "mvrotfile"}
 
 
 def _event_span(movs, event) -> tuple[float, float, bool]:
-    """(start, end, turns) of an event: when its chain of movements runs (end: inf for a movement
-    of duration -1 or a loop) and whether one of its movements rotates the object."""
+    """(start, end, turns) of an event: when its chain of movements runs (end: inf for a loop; a
+    flash, duration < 0, takes no time) and whether one of its movements rotates the object."""
     path, cur, end = [], event["mov"], event["start"]
     while cur is not None and cur not in path:
         path.append(cur)
-        dur = movs[cur]["duration"]
-        end = np.inf if dur < 0 or end == np.inf else end + dur
+        end = end + max(movs[cur]["duration"], 0.0)
         cur = movs[cur]["next"]
     if cur is not None:
         end = np.inf

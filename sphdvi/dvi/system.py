@@ -737,7 +737,8 @@ class System:
     def _build_link_rows(self, h, R, vel6=None, invm3=None, invI=None):
         """Joint, spring, damper, pulley and imposed-velocity rows.  vel6 and
         the DOF-masked inverse masses serve the explicit spring-damper rows
-        (:func:`rows._soft_row`); without them every spring is implicit."""
+        (:func:`rows._soft_row`); without them every spring is implicit.  Only the builders of
+        the link types the system has are called (a lone free body: none)."""
         scheme = _SPRING_SCHEMES[self.spring_integration]
         if vel6 is None:
             nb = self.nb
@@ -746,20 +747,25 @@ class System:
             invm3 = np.zeros((nb, 3))
             invI = np.zeros((nb, 3, 3))
         nr = 0
-        nr = rw.build_mate_rows(nr, h, self.recovery_speed, self.pos, R, self.m_b1, self.m_b2,
-                                self.m_p1, self.m_p2, self.m_T1, self.m_T2, self.m_Q1, self.m_Q2,
-                                self.m_mask, self.m_k, self.m_c, self.m_rest, self.m_mmode,
-                                self.m_mval, self.m_mdval, self.m_angle, self.m_lid, self.m_P1w,
-                                scheme, vel6, invm3, invI, *self._row_args())
-        nr = rw.build_spring_rows(nr, h, self.pos, R, self.s_b1, self.s_b2, self.s_p1, self.s_p2,
-                                  self.s_k, self.s_c, self.s_l0, self.s_f0, self.s_lid,
-                                  self.s_P1w, self.s_len, scheme, vel6, invm3, invI,
-                                  *self._row_args())
-        nr = rw.build_coulomb_rows(nr, h, self.pos, R, self.d_b1, self.d_b2, self.d_p1,
-                                   self.d_p2, self.d_F, self.d_lid, self.d_P1w, *self._row_args())
-        nr = rw.build_pulley_rows(nr, self.pos, R, self.p_b1, self.p_b2, self.p_a1, self.p_a2,
-                                  self.p_r1, self.p_r2, self.p_lid, self.p_P1w, *self._row_args())
-        nr = rw.build_imposed_rows(nr, R, self._imposed_now, *self._row_args())
+        if self.m_b1.shape[0]:
+            nr = rw.build_mate_rows(nr, h, self.recovery_speed, self.pos, R, self.m_b1, self.m_b2,
+                                    self.m_p1, self.m_p2, self.m_T1, self.m_T2, self.m_Q1, self.m_Q2,
+                                    self.m_mask, self.m_k, self.m_c, self.m_rest, self.m_mmode,
+                                    self.m_mval, self.m_mdval, self.m_angle, self.m_lid, self.m_P1w,
+                                    scheme, vel6, invm3, invI, *self._row_args())
+        if self.s_b1.shape[0]:
+            nr = rw.build_spring_rows(nr, h, self.pos, R, self.s_b1, self.s_b2, self.s_p1, self.s_p2,
+                                      self.s_k, self.s_c, self.s_l0, self.s_f0, self.s_lid,
+                                      self.s_P1w, self.s_len, scheme, vel6, invm3, invI,
+                                      *self._row_args())
+        if self.d_b1.shape[0]:
+            nr = rw.build_coulomb_rows(nr, h, self.pos, R, self.d_b1, self.d_b2, self.d_p1,
+                                       self.d_p2, self.d_F, self.d_lid, self.d_P1w, *self._row_args())
+        if self.p_b1.shape[0]:
+            nr = rw.build_pulley_rows(nr, self.pos, R, self.p_b1, self.p_b2, self.p_a1, self.p_a2,
+                                      self.p_r1, self.p_r2, self.p_lid, self.p_P1w, *self._row_args())
+        if self._imposed_fn_idx or not np.isnan(self._imposed_now).all():
+            nr = rw.build_imposed_rows(nr, R, self._imposed_now, *self._row_args())
         return nr
 
     def _max_link_rows(self):
@@ -918,14 +924,18 @@ class System:
             _scatter_warm(g, c_row, c_mu, g3)
             self._c_row = c_row
             self._c_mu = c_mu
-        prepare_rows(nr, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
-                     self.r_MiJ, self.r_g)
-        dead = self.r_g[:nr] >= 1e300  # rows that cannot act (no dynamic body)
-        if dead.any():
-            self.r_bias[:nr][dead] = 0.0
-            g[:nr][dead] = 0.0
         vout = np.empty((nb, 6))
-        if self.solver.lower() == "direct":
+        if nr:
+            prepare_rows(nr, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
+                         self.r_MiJ, self.r_g)
+            dead = self.r_g[:nr] >= 1e300  # rows that cannot act (no dynamic body)
+            if dead.any():
+                self.r_bias[:nr][dead] = 0.0
+                g[:nr][dead] = 0.0
+        if not nr:                      # no link, no contact: v = v_free (what the solvers return)
+            vout[:] = vfree
+            it, res = 0, 0.0
+        elif self.solver.lower() == "direct":
             it, res = solve_direct(nr, nb, self.r_a, self.r_b, self.r_J, self.r_MiJ, self.r_bias,
                                    self.r_E, self.r_kind, self.r_mu, self.r_lo, self.r_hi,
                                    self.r_g, g, vfree, vout, self.max_iter, self.tol)

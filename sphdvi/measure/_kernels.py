@@ -337,7 +337,9 @@ def column_lowest(points, pos, radius, is2d, out):
 @njit(cache=True)
 def column_max_z(points, zhi, pos, radius, is2d, out, idx):
     """Highest particle (of ``pos``) within horizontal distance ``radius`` of each
-    point with point_z <= z <= zhi[p] (the maxz gauge); NaN / -1 when none."""
+    point with point_z <= z <= zhi[p] (the maxz gauge); NaN / -1 when none.  The window
+    is strict: JGaugeMaxZ::CalculeCpu searches whole cells instead, so it also sees fluid
+    up to a cell or more below point_z or above zhi (:class:`MaxZGauge`)."""
     r2 = radius * radius
     for p in range(points.shape[0]):
         best = -np.inf

@@ -201,6 +201,13 @@ class SwlGauge(Gauge):
 
 
 class MaxZGauge(Gauge):
+    """JGaugeMaxZ: the highest fluid particle within ``distlimit`` (horizontal distance) of the
+    vertical line from ``point0`` up ``height``.  sphdvi's window is strict, point0.z <= z <=
+    point0.z + height, and ``distlimit`` defaults to 1.5 dp; DualSPHysics searches whole cells
+    (GetInteractionCellsMaxZ: ceil(distlimit/Scell) cells below point0's cell to as many above
+    the cell of point0.z + height), so it also counts fluid up to a cell or more beyond either
+    end, and requires ``<distlimit>``.  They differ only where the water comes within a cell
+    of the window's ends."""
     prefix = "MaxZ"
     header = ("zmax [m]", "posx [m]", "posy [m]", "posz [m]")
 

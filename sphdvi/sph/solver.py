@@ -739,33 +739,64 @@ class SPHSolver:
             w = self._tvel_work = np.zeros((max(n, 1), 3))
         return w
 
+    def _periodic_work(self, name, n, tail=(), dtype=np.float64, zero=True):
+        """The first ``n`` rows of a work array of the periodic extended set, kept between steps
+        in ``_bufs`` (as the reorder's) and grown when the set outgrows it (with a quarter more
+        room: the number of ghosts changes from step to step); zeroed when ``zero``."""
+        key = "periodic_" + name
+        buf = self._bufs.get(key)
+        if buf is None or buf.shape[0] < n or buf.shape[1:] != tuple(tail) or buf.dtype != dtype:
+            buf = self._bufs[key] = np.empty((n + n // 4 + 1,) + tuple(tail), dtype)
+        view = buf[:n]
+        if zero:
+            view.fill(0)
+        return view
+
+    def _periodic_rows(self, n):
+        """0, 1, ..., n - 1 (kept between steps)."""
+        buf = self._bufs.get("periodic_rows")
+        if buf is None or buf.shape[0] < n:
+            buf = self._bufs["periodic_rows"] = np.arange(n + n // 4 + 1, dtype=np.int64)
+        return buf[:n]
+
     def _compute_rates_periodic(self):
         """Rates with ghost copies across the periodic boundaries (no reordering
-        of the real particles; the extended set is sorted by cell instead)."""
+        of the real particles; the extended set is sorted by cell instead).  The
+        extended set's arrays are work arrays kept between steps (_periodic_work)."""
         self._check_state_arrays()
         s = self.state
         per = self.periodicity
         per.wrap(s.pos)
         n = s.n
         src, disp = per.ghosts(s.pos, 2.0 * self.h)
-        pos_e = np.concatenate([s.pos, s.pos[src] + disp])
-        order = self.cells.build(pos_e, parallel=self._use_parallel(light=True))
-        idx = np.concatenate([np.arange(n), src])[order]     # real source of each sorted row
-        pos_e = np.ascontiguousarray(pos_e[order])
-        vel_e = np.ascontiguousarray(s.vel[idx])
-        rhop_e = np.ascontiguousarray(s.rhop[idx])
-        mass_e = np.ascontiguousarray(s.mass[idx])
-        ptype_e = np.ascontiguousarray(s.ptype[idx])
-        ne = pos_e.shape[0]
-        cell_e = np.ascontiguousarray(self.cells.cell[order])
-        nb = np.zeros((ne, self.nb.shape[1]))
-        ace = np.zeros((ne, 3))
-        ar = np.zeros(ne)
-        viscdt = np.zeros(ne)
-        shiftpos = np.zeros((ne, 3)) if self.shift else self.shiftpos
-        shiftdet = np.zeros(ne) if self.shift else self.shiftdet
-        tau = np.ascontiguousarray(self.tau[idx]) if self.visco_kind == 2 else self.tau
-        gradvel = np.zeros((ne, 6)) if self.visco_kind == 2 else self.gradvel
+        ne = n + src.shape[0]
+        w = self._periodic_work
+        unsorted = w("pos_x", ne, (3,), zero=False)     # the real particles', then the ghosts'
+        unsorted[:n] = s.pos
+        np.add(s.pos[src], disp, out=unsorted[n:])
+        order = self.cells.build(unsorted, parallel=self._use_parallel(light=True))
+        source = w("source", ne, (), np.int64, zero=False)
+        source[:n] = self._periodic_rows(n)
+        source[n:] = src
+        # the real source of each sorted row, and the gathers in cell order
+        idx = np.take(source, order, out=w("idx", ne, (), np.int64, zero=False), mode="clip")
+        pos_e = np.take(unsorted, order, axis=0, out=w("pos", ne, (3,), zero=False), mode="clip")
+        vel_e = np.take(s.vel, idx, axis=0, out=w("vel", ne, (3,), zero=False), mode="clip")
+        rhop_e = np.take(s.rhop, idx, out=w("rhop", ne, zero=False), mode="clip")
+        mass_e = np.take(s.mass, idx, out=w("mass", ne, zero=False), mode="clip")
+        ptype_e = np.take(s.ptype, idx, out=w("ptype", ne, (), s.ptype.dtype, zero=False), mode="clip")
+        cell_e = np.take(self.cells.cell, order, out=w("cell", ne, (), self.cells.cell.dtype, zero=False),
+                         mode="clip")
+        nb = w("nb", ne, self.nb.shape[1:])
+        ace = w("ace", ne, (3,))
+        ar = w("ar", ne)
+        viscdt = w("viscdt", ne)
+        shiftpos = w("shiftpos", ne, (3,)) if self.shift else self.shiftpos
+        shiftdet = w("shiftdet", ne) if self.shift else self.shiftdet
+        tau = (np.take(self.tau, idx, axis=0, out=w("tau", ne, self.tau.shape[1:], zero=False), mode="clip")
+               if self.visco_kind == 2 else self.tau)
+        gradvel = w("gradvel", ne, (6,)) if self.visco_kind == 2 else self.gradvel
+        rows_e = self._periodic_rows(ne)
         par = self._use_parallel()
         k = self._kernels(par)
         k["pack"](self.is2d, pos_e, vel_e, rhop_e, mass_e, self.cst, nb)
@@ -777,7 +808,7 @@ class SPHSolver:
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             normals_e = np.ascontiguousarray(self.normals[idx])
             wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
-            fn(self.kernel, self.is2d, nb, ptype_e, np.arange(ne), normals_e, self.cells.cell_start,
+            fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
                self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
             # a copy's ghost node sees a truncated extended set: it takes its real particle's result
@@ -788,48 +819,48 @@ class SPHSolver:
             bound = real_e & (ptype_e != 3)
             s.rhop[order[bound]] = rhop_e[bound]
             if self.nopen and self._need_nopen:
-                ar_e = np.arange(ne)
-                npshift = np.zeros((ne, self.npshift.shape[1]))
-                self._nopen_detect(par, nb, ptype_e, cell_e, ar_e, normals_e, vel_e, pos_e, npshift)
-                real_rows = order < n
-                self.npshift[order[real_rows]] = npshift[real_rows]
+                npshift = w("npshift", ne, self.npshift.shape[1:])
+                self._nopen_detect(par, nb, ptype_e, cell_e, rows_e, normals_e, vel_e, pos_e, npshift)
+                real_rows = np.flatnonzero(order < n)
+                _copy_rows_2d(npshift, real_rows, self.npshift, order[real_rows])
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
         real = order < n
         dst = order[real]
+        rr = np.flatnonzero(real)       # the real particles' rows of the extended set, at dst
+        back = _copy_rows_2d, _copy_rows_1d
         if self.shift == 4 and self._need_shift_adv:
-            fstype = np.zeros(ne, np.int8)
-            fsnormal = np.zeros((ne, 3))
-            nctype = np.zeros(ne if self.adv else 1, np.int8)
+            fstype = w("fstype", ne, (), np.int8)
+            fsnormal = w("fsnormal", ne, (3,))
+            nctype = w("nctype", ne if self.adv else 1, (), np.int8)
             row_of = np.empty(n, np.int64)
-            row_of[order[real]] = np.flatnonzero(real)
-            self._advanced_shift(par, nb, ptype_e, cell_e, np.arange(ne), shiftpos, fstype, fsnormal,
-                                 self._shift_adv_work(ne),
+            row_of[dst] = rr
+            work = tuple(w(f"shift_adv{k}", ne, a.shape[1:], a.dtype) for k, a in enumerate(self._fs_work))
+            self._advanced_shift(par, nb, ptype_e, cell_e, rows_e, shiftpos, fstype, fsnormal, work,
                                  src_row=row_of[idx], nctype=nctype)
-            self.fstype[dst] = fstype[real]
-            self.fsnormal[dst] = fsnormal[real]
-            self.shiftpos[dst] = shiftpos[real]
-            if self.adv:
-                self.nctype[dst] = nctype[real]
+            for a, out in ((fstype, self.fstype), (fsnormal, self.fsnormal), (shiftpos, self.shiftpos)) + (
+                    ((nctype, self.nctype),) if self.adv else ()):
+                back[a.ndim == 1](a, rr, out, dst)
         shiftpos_r = shiftpos
         nctype_r = self.nctype
         if self.adv:
             # the interaction reads the shift (ALE) and type (NCPress) of every row: a periodic
             # copy takes its real particle's, as DualSPHysics does
-            shiftpos_r = np.ascontiguousarray(self.shiftpos[idx])
-            nctype_r = np.ascontiguousarray(self.nctype[idx])
+            shiftpos_r = np.take(self.shiftpos, idx, axis=0, out=w("shiftpos_r", ne, (3,), zero=False), mode="clip")
+            nctype_r = np.take(self.nctype, idx, out=w("nctype_r", ne, (), self.nctype.dtype, zero=False), mode="clip")
         k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag,
-                   self.ftmode, nb, ptype_e, cell_e, np.arange(ne), self.cells.cell_start, *geo, self.cst, tau,
+                   self.ftmode, nb, ptype_e, cell_e, rows_e, self.cells.cell_start, *geo, self.cst, tau,
                    ace, ar, viscdt,
-                   shiftpos_r, shiftdet, gradvel, self._tvel(ne), np.zeros(((ne + _ia.CHUNK - 1) // _ia.CHUNK, 3)),
+                   shiftpos_r, shiftdet, gradvel, self._tvel(ne), w("dtmax", (ne + _ia.CHUNK - 1) // _ia.CHUNK, (3,)),
                    nctype_r)
-        self.ace[dst] = ace[real]
-        self.ar[dst] = ar[real]
-        self.viscdt[dst] = viscdt[real]
+        # the real rows back to their particles
+        _copy_rows_2d(ace, rr, self.ace, dst)
+        _copy_rows_1d(ar, rr, self.ar, dst)
+        _copy_rows_1d(viscdt, rr, self.viscdt, dst)
         if self.rates_shift:
-            self.shiftpos[dst] = shiftpos[real]
-            self.shiftdet[dst] = shiftdet[real]
+            _copy_rows_2d(shiftpos, rr, self.shiftpos, dst)
+            _copy_rows_1d(shiftdet, rr, self.shiftdet, dst)
         if self.visco_kind == 2:
-            self.gradvel[dst] = gradvel[real]
+            _copy_rows_2d(gradvel, rr, self.gradvel, dst)
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
         # time-step terms of the real particles only (a ghost at the edge of the
         # extended set misses neighbours and has a meaningless acceleration)
@@ -1089,3 +1120,20 @@ class SPHSolver:
     def particle_forces(self):
         """m_a a_a for every particle (for floating bodies: fluid force, no gravity)."""
         return self.state.mass[:, None] * self.ace
+
+
+@numba.njit(cache=True)
+def _copy_rows_2d(src, rows, out, dst):
+    """out[dst[k]] = src[rows[k]]: the periodic extended set's real rows back to their particles
+    (numpy's 2D fancy indexing costs ~100 us per array at a few thousand rows)."""
+    for k in range(rows.shape[0]):
+        for j in range(src.shape[1]):
+            out[dst[k], j] = src[rows[k], j]
+
+
+@numba.njit(cache=True)
+def _copy_rows_1d(src, rows, out, dst):
+    """out[dst[k]] = src[rows[k]] (1D arrays)."""
+    for k in range(rows.shape[0]):
+        out[dst[k]] = src[rows[k]]
+

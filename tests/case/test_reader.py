@@ -151,9 +151,10 @@ def test_verlet_steps_zero_is_accepted(tmp_path):
 def test_simulation_domain(tmp_path):
     r = build(tmp_path, parameters='<simulationdomain><posmin x="default - 10%" z="-0.5"/>'
                                    '<posmax z="default + 50%"/></simulationdomain>')
-    assert r.domain["posmin"][0] == pytest.approx(-0.4)
+    b = 0.05 * r.constants.h          # the particles (0..4, 0..3) widened by 0.05 h (BORDER_MAP)
+    assert r.domain["posmin"][0] == pytest.approx(-b - 0.1 * (4 + 2 * b))
     assert r.domain["posmin"][2] == pytest.approx(-0.5)
-    assert r.domain["posmax"][2] == pytest.approx(4.5)
+    assert r.domain["posmax"][2] == pytest.approx(3 + b + 0.5 * (3 + 2 * b))
 
 
 def test_checks_after_reading_name_the_line(tmp_path):
@@ -384,7 +385,7 @@ def test_wavepaddle_needs_motion(tmp_path):
 
 def test_motion_chain(tmp_path):
     motion = ('<motion><objreal ref="0"><begin mov="1" start="0"/><mvrect id="1" duration="0.5" next="2">'
-              '<vel x="1" y="0" z="0"/></mvrect><mvrotsinu id="2" duration="-1" anglesunits="degrees">'
+              '<vel x="1" y="0" z="0"/></mvrect><mvrotsinu id="2" duration="100" anglesunits="degrees">'
               '<freq v="1"/><ampl v="10"/><phase v="0"/><axisp1 x="0" y="0" z="0"/><axisp2 x="0" y="1" z="0"/>'
               '</mvrotsinu></objreal></motion>')
     r = build(tmp_path, casedef_extra=motion)
@@ -395,7 +396,7 @@ def test_motion_chain(tmp_path):
 
 
 def test_motion_next_missing(tmp_path):
-    motion = ('<motion><objreal ref="0"><begin mov="1"/><mvrect id="1" duration="1" next="7">'
+    motion = ('<motion><objreal ref="0"><begin mov="1" start="0"/><mvrect id="1" duration="1" next="7">'
               '<vel x="1" y="0" z="0"/></mvrect></objreal></motion>')
     with pytest.raises(CaseError, match="next=7, which does not exist"):
         build(tmp_path, casedef_extra=motion)

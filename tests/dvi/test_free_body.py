@@ -89,3 +89,35 @@ def test_euler_angles_convention():
         Ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
         Rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
         np.testing.assert_allclose(Rz @ Ry @ Rx, np_quat_to_mat(q), atol=1e-10)
+
+
+def test_only_the_link_types_present_are_built(monkeypatch):
+    """A body without links or contacts: System.step calls no row builder, nor prepare_rows nor
+    the CCP solver (v = v_free, what the solvers return on zero rows); a system with one spring
+    builds its row and no mate's."""
+    import pytest
+    from sphdvi.dvi import rows as rw
+    from sphdvi.dvi import system as system_module
+
+    def free():
+        s = System(gravity=(0, 0, -9.81))
+        s.add_body(2.0, (1.0, 1.0, 1.0), pos=(0, 0, 1), vel=(1.0, 0.0, 0.5))
+        return s
+
+    for name in ("build_mate_rows", "build_spring_rows", "build_coulomb_rows", "build_pulley_rows",
+                 "build_imposed_rows"):
+        monkeypatch.setattr(rw, name, lambda *a, _n=name: pytest.fail(f"{_n} called"))
+    for name in ("prepare_rows", "solve_ccp", "solve_direct"):
+        monkeypatch.setattr(system_module, name, lambda *a, _n=name: pytest.fail(f"{_n} called"))
+    s = free()
+    F = np.array([[0.4, 0.0, 0.0]])
+    for _ in range(10):
+        s.step(1e-2, forces=F)
+    assert s.n_rows == 0 and s.last_iterations == 0
+    np.testing.assert_allclose(s.vel[0], [1.0 + 0.2 * 0.1, 0.0, 0.5 - 9.81 * 0.1], rtol=0, atol=1e-12)
+    monkeypatch.undo()
+    monkeypatch.setattr(rw, "build_mate_rows", lambda *a: pytest.fail("build_mate_rows called"))
+    s = free()
+    s.add_spring(0, -1, point1=(0, 0, 1), point2=(0, 0, 2), stiffness=50.0, damping=1.0, rest_length=1.0)
+    s.step(1e-3)
+    assert s.n_rows == 1

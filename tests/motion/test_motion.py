@@ -26,7 +26,7 @@ def test_rect_chain_with_next_and_start():
 
 
 def test_finish_stops_motion():
-    c = chain([rect(1, -1, [2, 0, 0])], start=0.0, finish=1.0)
+    c = chain([rect(1, 100.0, [2, 0, 0])], start=0.0, finish=1.0)
     x, v = chain_transform(c, 3.0).apply(np.zeros((1, 3)))
     assert x[0, 0] == pytest.approx(2.0) and v[0, 0] == 0
 
@@ -51,8 +51,8 @@ def test_what_a_movement_carries_into_the_next_is_dualsphysics_s():
     after = chain_transform(chain([rect(1, 1.0, [1, 0, 0], 2), rot, ace]), 3.0).apply(np.zeros((1, 3)))
     assert after[0] == pytest.approx(before, abs=1e-12) and after[1] == pytest.approx(np.zeros((1, 3)), abs=1e-12)
     sinu = {"type": "mvrectsinu", "freq": [1, 0, 0], "ampl": [0.1, 0, 0], "anglesunits": "degrees"}
-    halves = chain([dict(sinu, id=1, duration=0.3, next=2), dict(sinu, id=2, duration=-1, next=None)])
-    whole = chain([dict(sinu, id=1, duration=-1, next=None)])
+    halves = chain([dict(sinu, id=1, duration=0.3, next=2), dict(sinu, id=2, duration=100.0, next=None)])
+    whole = chain([dict(sinu, id=1, duration=100.0, next=None)])
     for t in (0.2, 0.45, 0.8):
         xh, vh = chain_transform(halves, t).apply(np.zeros((1, 3)))
         xw, vw = chain_transform(whole, t).apply(np.zeros((1, 3)))
@@ -61,7 +61,7 @@ def test_what_a_movement_carries_into_the_next_is_dualsphysics_s():
 
 
 def test_rotation_quarter_turn_about_axis():
-    m = {"type": "mvrot", "id": 1, "duration": -1, "next": None, "vel": 90.0, "anglesunits": "degrees",
+    m = {"type": "mvrot", "id": 1, "duration": 100.0, "next": None, "vel": 90.0, "anglesunits": "degrees",
          "axisp1": [1, 0, 0], "axisp2": [1, 1, 0]}
     x, v = chain_transform(chain([m]), 1.0).apply(np.array([[2.0, 0, 0]]))
     # DualSPHysics's sense (JMatrix4::MatrixRot): +90 degrees about the axis (1,0,0) -> (1,1,0)
@@ -90,13 +90,13 @@ def test_rotation_sense_is_dualsphysics_matrixrot():
         rz[:2, :2] = [[math.cos(rad), math.sin(rad)], [-math.sin(rad), math.cos(rad)]]
         return rx @ ry @ rz @ rym1 @ rxm1
     for p2 in ([0, 1, 0], [0, -1, 0], [1, 0, 0], [0, 0, 1], [0.3, 0.5, 0.8]):
-        m = {"type": "mvrot", "id": 1, "duration": -1, "next": None, "vel": 30.0, "anglesunits": "degrees",
+        m = {"type": "mvrot", "id": 1, "duration": 100.0, "next": None, "vel": 30.0, "anglesunits": "degrees",
              "axisp1": [0, 0, 0], "axisp2": p2}
         assert chain_transform(chain([m]), 1.0).R == pytest.approx(matrixrot(30.0, [0, 0, 0], p2), abs=1e-12)
 
 
 def test_sinusoid_velocity_is_derivative():
-    m = {"type": "mvrectsinu", "id": 1, "duration": -1, "next": None, "freq": [1.5, 0, 0], "ampl": [0.1, 0, 0],
+    m = {"type": "mvrectsinu", "id": 1, "duration": 100.0, "next": None, "freq": [1.5, 0, 0], "ampl": [0.1, 0, 0],
          "phase": [30, 0, 0], "anglesunits": "degrees"}
     c = chain([m])
     t, h = 0.37, 1e-6
@@ -108,8 +108,8 @@ def test_sinusoid_velocity_is_derivative():
 
 
 def test_parent_hierarchy():
-    child = chain([rect(1, -1, [0, 0, 1])])
-    child["parents"] = [chain([rect(1, -1, [1, 0, 0])])]
+    child = chain([rect(1, 100.0, [0, 0, 1])])
+    child["parents"] = [chain([rect(1, 100.0, [1, 0, 0])])]
     ms = MotionSet([child])
     x, v = ms.transform(0, 2.0).apply(np.zeros((1, 3)))
     assert x[0] == pytest.approx([2, 0, 2]) and v[0] == pytest.approx([1, 0, 1])

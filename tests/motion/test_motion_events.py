@@ -27,7 +27,7 @@ def read(tmp_path, body):
 def test_each_begin_starts_its_own_chain(tmp_path):
     """The auditor's case: +0.1 m/s from 0 to 0.5 s (finish), then -0.1 m/s from 1 s on."""
     body = ('<begin mov="1" start="0" finish="0.5"/><begin mov="2" start="1"/>'
-            + RECT.format(1, -1, "", 0.1, 0) + RECT.format(2, -1, "", -0.1, 0))
+            + RECT.format(1, 100, "", 0.1, 0) + RECT.format(2, 100, "", -0.1, 0))
     motions, reader = read(tmp_path, body)
     assert list(reader.warnings) == []
     assert [e["start"] for e in motions[0]["events"]] == [0.0, 1.0]
@@ -41,7 +41,7 @@ def test_overlapping_translations_add_up(tmp_path):
     """Two events at once, each moving along its own axis (translations commute: their sum is
     DualSPHysics's per-step composition); a chain of the second one ends after its duration."""
     body = ('<begin mov="1" start="0"/><begin mov="2" start="0.5"/>'
-            + RECT.format(1, -1, "", 0.1, 0) + RECT.format(2, 1, "", 0, 0.2))
+            + RECT.format(1, 100, "", 0.1, 0) + RECT.format(2, 1, "", 0, 0.2))
     ms = MotionSet(read(tmp_path, body)[0])
     for t, d, v in ((0.25, (0.025, 0), (0.1, 0)), (1.0, (0.1, 0.1), (0.1, 0.2)), (2.0, (0.2, 0.2), (0.1, 0))):
         r = ms.transform(1, t)
@@ -51,8 +51,8 @@ def test_overlapping_translations_add_up(tmp_path):
 def test_a_rotation_after_a_translation_event_turns_the_moved_object(tmp_path):
     """Events one after the other: the second one's rotation about its (fixed) axis acts on where the
     first one left the object."""
-    body = '<begin mov="1" start="0" finish="1"/><begin mov="2" start="2"/>' + RECT.format(1, -1, "", 1, 0) + \
-        ROT.format(2, -1)
+    body = '<begin mov="1" start="0" finish="1"/><begin mov="2" start="2"/>' + RECT.format(1, 100, "", 1, 0) + \
+        ROT.format(2, 100)
     ms = MotionSet(read(tmp_path, body)[0])
     x, v = ms.transform(1, 3.0).apply(np.zeros((1, 3)))       # moved to (1, 0, 0), then turned 90 degrees
     assert np.linalg.norm(x[0]) == pytest.approx(1.0) and abs(x[0, 0]) < 1e-12
@@ -69,7 +69,7 @@ def test_concurrent_events_with_a_rotation_are_a_case_error(tmp_path):
 def test_an_object_without_begin_does_not_move(tmp_path):
     """JMotion runs a movement only from an event: movements without a <begin> leave the object
     where it is (sphdvi started the first one at t = 0), and gencase says so."""
-    motions, reader = read(tmp_path, RECT.format(1, -1, "", 0.1, 0))
+    motions, reader = read(tmp_path, RECT.format(1, 100, "", 0.1, 0))
     assert any("without a <begin" in str(w) for w in reader.warnings)
     r = MotionSet(motions).transform(1, 1.0)
     assert np.allclose(r.d, 0.0) and np.allclose(r.V, 0.0)

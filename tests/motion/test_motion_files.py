@@ -18,13 +18,13 @@ def write(path, rows):
 
 
 def rect_chain(file, start=0.0):
-    m = {"type": "mvrectfile", "id": 1, "duration": -1, "next": None, "file": file,
+    m = {"type": "mvrectfile", "id": 1, "duration": 100.0, "next": None, "file": file,
          "fields": {"fieldtime": 0, "fieldx": 1}, "ncols": 2}
     return {"ref": 1, "movements": [m], "begin": {"mov": 1, "start": start, "finish": None}, "parents": []}
 
 
 def rot_chain(file):
-    m = {"type": "mvrotfile", "id": 1, "duration": -1, "next": None, "file": file,
+    m = {"type": "mvrotfile", "id": 1, "duration": 100.0, "next": None, "file": file,
          "fields": {"fieldtime": 0, "fieldang": 1}, "ncols": 2, "axisp1": [0, 0, 0], "axisp2": [0, 1, 0],
          "anglesunits": "degrees"}
     return {"ref": 1, "movements": [m], "begin": {"mov": 1, "start": 0.0, "finish": None}, "parents": []}

@@ -29,7 +29,7 @@ def read(tmp_path, body, files=None, begin='<begin mov="1" start="0"/>'):
 
 
 def rectfile(attrs='fields="4" fieldtime="0" fieldx="1" fieldy="2" fieldz="3"', tag="mvrectfile"):
-    return f'<{tag} id="1" duration="-1"><file name="m.csv" {attrs}/></{tag}>'
+    return f'<{tag} id="1" duration="100"><file name="m.csv" {attrs}/></{tag}>'
 
 
 DSPH_FILE = "#Time(s);X(m);Y(m);Z(m)\r\n0.0;0.0;0.0;0.0\r\n1.0;0.5;0.1;-0.2\r\n2.0;0.5;0.3;-0.2\r\n"
@@ -66,12 +66,12 @@ def test_dualsphysics_aliases_of_mvrectfile(tmp_path, alias):
 
 def test_rotfile_default_and_explicit_columns(tmp_path):
     axis = '<axisp1 x="0" y="0" z="0"/><axisp2 x="0" y="1" z="0"/>'
-    body = f'<mvrotfile id="1" duration="-1"><file name="a.csv"/>{axis}</mvrotfile>'
+    body = f'<mvrotfile id="1" duration="100"><file name="a.csv"/>{axis}</mvrotfile>'
     (m,), _ = read(tmp_path, body, {"a.csv": "#time;angle\n0;0\n1;90\n"})
     x = chain_transform(m, 1.0).apply(np.array([[1.0, 0, 0]]))[0]
     # DualSPHysics's sense: +90 degrees about (0,0,0) -> (0,1,0) takes +x to +z
     assert x[0] == pytest.approx([0, 0, 1], abs=1e-12)
-    body = f'<mvrotfile id="1" duration="-1"><file name="a.csv" fields="3" fieldtime="1" fieldang="2"/>{axis}</mvrotfile>'
+    body = f'<mvrotfile id="1" duration="100"><file name="a.csv" fields="3" fieldtime="1" fieldang="2"/>{axis}</mvrotfile>'
     (m,), _ = read(tmp_path, body, {"a.csv": "5;0;0\n5;1;90\n"})
     assert chain_transform(m, 1.0).apply(np.array([[1.0, 0, 0]]))[0][0] == pytest.approx([0, 0, 1], abs=1e-12)
 
@@ -156,7 +156,7 @@ def test_zero_duration_loop_is_an_error(tmp_path, body, ids):
 
 @pytest.mark.parametrize("body", [
     '<mvrect id="1" duration="0.5" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0" next="1"/>',
-    '<mvrect id="1" duration="-1" next="1"><vel x="1" y="0" z="0"/></mvrect>',              # forever: never loops
+    '<mvrect id="1" duration="100" next="1"><vel x="1" y="0" z="0"/></mvrect>',              # loops every 100 s
     '<mvrect id="1" duration="0" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0"/>',   # ends
 ])
 def test_loops_that_advance_are_accepted(tmp_path, body):
@@ -172,7 +172,7 @@ def test_zero_loop_at_run_time_is_a_case_error():
 
 
 def test_begin_finish(tmp_path):
-    body = '<mvrect id="1" duration="-1"><vel x="1" y="0" z="0"/></mvrect>'
+    body = '<mvrect id="1" duration="100"><vel x="1" y="0" z="0"/></mvrect>'
     (m,), _ = read(tmp_path, body, begin='<begin mov="1" start="0.5" finish="-1"/>')
     assert m["begin"]["finish"] is None      # DualSPHysics: -1 = no end
     with pytest.raises(CaseError, match="finish=0.2 comes before start=0.5") as e:
@@ -185,13 +185,13 @@ SAME = '<axisp1 x="1" y="2" z="3"/><axisp2 x="1" y="2" z="3"/>'
 
 
 @pytest.mark.parametrize("body", [
-    f'<mvrot id="1" duration="-1"><vel ang="10"/>{SAME}</mvrot>',
-    f'<mvrotace id="1" duration="-1"><ace ang="10"/>{SAME}</mvrotace>',
-    f'<mvrotsinu id="1" duration="-1"><freq v="1"/><ampl v="10"/>{SAME}</mvrotsinu>',
-    f'<mvcir id="1" duration="-1"><vel ang="10"/><ref x="2" y="0" z="0"/>{SAME}</mvcir>',
-    f'<mvcirace id="1" duration="-1"><ace ang="10"/><ref x="2" y="0" z="0"/>{SAME}</mvcirace>',
-    f'<mvcirsinu id="1" duration="-1"><freq v="1"/><ampl v="10"/><ref x="2" y="0" z="0"/>{SAME}</mvcirsinu>',
-    f'<mvrotfile id="1" duration="-1"><file name="a.csv"/>{SAME}</mvrotfile>',
+    f'<mvrot id="1" duration="100"><vel ang="10"/>{SAME}</mvrot>',
+    f'<mvrotace id="1" duration="100"><ace ang="10"/>{SAME}</mvrotace>',
+    f'<mvrotsinu id="1" duration="100"><freq v="1"/><ampl v="10"/>{SAME}</mvrotsinu>',
+    f'<mvcir id="1" duration="100"><vel ang="10"/><ref x="2" y="0" z="0"/>{SAME}</mvcir>',
+    f'<mvcirace id="1" duration="100"><ace ang="10"/><ref x="2" y="0" z="0"/>{SAME}</mvcirace>',
+    f'<mvcirsinu id="1" duration="100"><freq v="1"/><ampl v="10"/><ref x="2" y="0" z="0"/>{SAME}</mvcirsinu>',
+    f'<mvrotfile id="1" duration="100"><file name="a.csv"/>{SAME}</mvrotfile>',
 ])
 def test_rotation_axis_of_two_equal_points(tmp_path, body):
     with pytest.raises(CaseError, match="axisp1 and axisp2 are the same point") as e:
@@ -355,3 +355,84 @@ def test_breaking_and_second_order_range_are_warned(tmp_path, inner, expect):
     assert len(reader.warnings) == len(expect)
     for name in expect:
         assert name in text and "case.xml:2: warning: <piston>" in text
+
+
+# -- JMotion::ReadXml's rules -----------------------------------------------------------
+RECT1 = '<mvrect id="1" duration="1"{}><vel x="1" y="0" z="0"/></mvrect>'
+
+
+def test_next_zero_is_no_next(tmp_path):
+    """next="0" is DualSPHysics's "no next" (JMotionObj::LinkMovs: if(NextId)); it was refused."""
+    (m,), _ = read(tmp_path, RECT1.format(' next="0"'))
+    assert m["movements"][0]["next"] is None
+    assert chain_transform(m, 2.0).d == pytest.approx([1, 0, 0])
+
+
+@pytest.mark.parametrize("body, begin, match, element", [
+    (RECT1.format("").replace('id="1"', 'id="0"'), '<begin mov="0" start="0"/>', "id='0' is below 1", "mvrect"),
+    ('<mvrect id="1"><vel x="1" y="0" z="0"/></mvrect>', None, "missing attribute 'duration'", "mvrect"),
+    ('<wait id="1" duration="-1" next="2"/>' + RECT1.format("").replace('id="1"', 'id="2"'), None,
+     "<wait> with a negative duration", "wait"),
+    (RECT1.format(""), '<begin mov="1"/>', "missing attribute 'start'", "begin"),
+    (RECT1.format(' anglesunits="Degrees"'), None, "anglesunits='Degrees' is not recognised", "mvrect"),
+    ('<mvrot id="1" duration="1" anglesunits="RADIANS"><vel ang="1"/><axisp1 x="0" y="0" z="0"/>'
+     '<axisp2 x="0" y="1" z="0"/></mvrot>', None, "anglesunits='RADIANS' is not recognised", "mvrot"),
+])
+def test_what_dualsphysics_refuses_is_a_case_error(tmp_path, body, begin, match, element):
+    """JMotion: movement ids > 0 (MovAdd), duration and <begin start> required (GetAttributeFloat
+    without a default), no negative wait (MovAddWait), anglesunits exactly degrees or radians
+    (ErrReadAtrib); sphdvi accepted each of them."""
+    with pytest.raises(CaseError, match=match) as e:
+        read(tmp_path, body, begin=begin or '<begin mov="1" start="0"/>')
+    assert e.value.element == element
+
+
+def test_a_negative_duration_is_read_as_a_flash(tmp_path):
+    """duration="-0.5" (refused before; -1 was sphdvi's "forever"): the displacement of 0.5 s at once."""
+    (m,), _ = read(tmp_path, '<mvrect id="1" duration="-0.5"><vel x="1" y="0" z="0"/></mvrect>')
+    assert chain_transform(m, 0.01).d == pytest.approx([0.5, 0, 0])
+    assert chain_transform(m, 10.0).d == pytest.approx([0.5, 0, 0])
+
+
+def test_mvnull_reads_no_duration_and_no_next(tmp_path):
+    """JMotion::ReadXml reads neither duration nor next of an <mvnull>: the chain ends there."""
+    (m,), reader = read(tmp_path, '<mvnull id="1"/>')
+    assert m["movements"][0]["duration"] == 0.0 and m["movements"][0]["next"] is None
+
+
+@pytest.mark.parametrize("tag", ["mvrotadvfile", "mvpathfile"])
+@pytest.mark.parametrize("nested", [False, True])
+def test_v54_file_movements_are_reported_as_not_supported(tmp_path, tag, nested):
+    """<mvrotadvfile>/<mvpathfile> were refused as an "unknown motion element"."""
+    body = f'<{tag} id="1" duration="1"><file name="a.csv"/></{tag}>'
+    begin = '<begin mov="1" start="0"/>'
+    if nested:
+        body, begin = f'<obj>{begin}{body}</obj>', ""
+    with pytest.raises(CaseError, match=f"<{tag}> .*DualSPHysics v5.4.* is not supported by sphdvi") as e:
+        read(tmp_path, body, begin=begin)
+    assert e.value.element == tag
+
+
+MOTION_2D = ('<casedef>\n<geometry><definition dp="0.1"><pointmin x="0" y="0" z="0"/><pointmax x="1" y="{y}" z="1"/>'
+             '</definition></geometry>\n<motion><objreal ref="1"><begin mov="1" start="0"/>\n{body}\n</objreal></motion>\n'
+             '</casedef>')
+
+
+@pytest.mark.parametrize("body, what", [
+    ('<mvrect id="1" duration="1"><vel x="0.1" y="0.3" z="0"/></mvrect>', "<vel> y=0.3"),
+    ('<mvrectsinu id="1" duration="1"><freq x="1" y="1" z="1"/><ampl x="0" y="0.1" z="0"/></mvrectsinu>', "<ampl> y=0.1"),
+    ('<mvrot id="1" duration="1"><vel ang="10"/><axisp1 x="0" y="0" z="0"/><axisp2 x="1" y="0" z="0"/></mvrot>',
+     "an axis not along y"),
+    ('<mvcir id="1" duration="1"><vel ang="10"/><ref x="1" y="0" z="0"/><axisp1 x="0" y="0" z="0"/>'
+     '<axisp2 x="0" y="0" z="1"/></mvcir>', "an axis not along y"),
+])
+def test_a_2d_motion_out_of_the_plane_is_warned(tmp_path, body, what):
+    """2D: DualSPHysics drops a translation's y (JDsMotion::ProcesTime) and keeps y under a matrix
+    (MoveMatBound); gencase says so."""
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    read_motion(reader, etree.fromstring(MOTION_2D.format(y=0, body=body)))
+    (w,) = list(reader.warnings)
+    assert "2D case" in w and what in w and "keep their y" in w and ":4:" in w
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    read_motion(reader, etree.fromstring(MOTION_2D.format(y=1, body=body)))      # 3D: nothing to say
+    assert list(reader.warnings) == []

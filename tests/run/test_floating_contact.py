@@ -54,7 +54,10 @@ def test_heavy_box_comes_to_rest_on_the_floor(tmp_path):
     gap); before, it passed through the floor at t ~ 0.9 s and fell on at g."""
     r, out, d = run_tank(tmp_path, "sink", (0.6, 0.2), (0.24, 0.1), 1, 1.2)
     assert r.exit_code == 0, r.output
-    bottom = d["z"] - 0.04
+    # its lowest particle centre (the box's centres span 0.12 x 0.08 m): the box may land tilted
+    # (round-off decides how: 3 or 19 degrees as the domain's origin moved by 0.05 h)
+    tilt = np.radians(d["pitch"])
+    bottom = d["z"] - 0.06 * np.abs(np.sin(tilt)) - 0.04 * np.abs(np.cos(tilt))
     assert bottom.min() > 0.5 * DP                      # never through the floor
     late = d["time"] >= 0.9
     assert np.all((bottom[late] > 1.0 * DP) & (bottom[late] < 2.5 * DP))

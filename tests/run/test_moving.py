@@ -59,9 +59,13 @@ TANK = """<?xml version="1.0" encoding="UTF-8" ?>
 """
 
 
-def run_case(tmp_path, motion, special=""):
+def run_case(tmp_path, motion, special="", dtfixed=None):
     case = tmp_path / "CaseMoving_Def.xml"
-    case.write_text(TANK.replace("MOTION", motion).replace("SPECIAL", special))
+    text = TANK.replace("MOTION", motion).replace("SPECIAL", special)
+    if dtfixed:
+        text = text.replace('<parameter key="TimeMax"', f'<parameter key="DtFixed" value="{dtfixed}" />'
+                            '<parameter key="TimeMax"')
+    case.write_text(text)
     out = tmp_path / "out"
     r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q"])
     assert r.exit_code == 0, r.output
@@ -82,7 +86,7 @@ def moving_positions(out):
 
 
 def test_rectilinear_motion_is_exact_and_pushes_fluid(tmp_path):
-    out = run_case(tmp_path, '<mvrect id="1" duration="-1"><vel x="0.5" y="0" z="0" /></mvrect>')
+    out = run_case(tmp_path, '<mvrect id="1" duration="100"><vel x="0.5" y="0" z="0" /></mvrect>')
     p0, res = moving_positions(out)
     for t, x, v, _ in res:
         assert np.allclose(x, p0 + [0.5 * t, 0, 0], atol=1e-12)
@@ -112,11 +116,13 @@ def test_piston_wave_paddle_follows_stroke(tmp_path):
                                         ("flap_spectrum", '<flapaxis0 x="0" y="-1" z="0"/><flapaxis1 x="0" y="1" z="0"/>')])
 def test_spectrum_paddle_follows_its_series(tmp_path, tag, extra):
     """An irregular-wave paddle moves its particles with SpectrumPaddle's stroke (a flap: turned
-    about its hinge by atan(X / depth)), velocities included, through the run."""
+    about its hinge by atan(X / depth)) through the run, their velocity the step's displacement
+    over dt (DualSPHysics's MoveLinBound / MoveMatBound), not the stroke's velocity at the step's end."""
     special = (f'<wavepaddles><{tag}><mkbound value="10"/><depth value="0.3"/><spectrum value="jonswap"/>'
                f'<waveheight value="0.02"/><waveperiod value="1.0"/><waves value="20"/><randomseed value="4"/>'
                f'{extra}</{tag}></wavepaddles>')
-    out = run_case(tmp_path, '<mvnull id="1" />', special)
+    dt = 2e-4
+    out = run_case(tmp_path, '<mvnull id="1" />', special, dtfixed=dt)
     p0, res = moving_positions(out)
     from sphdvi.validation.runs import case_data
     paddle = MotionSet([], case_data(out)["json"]["special"]["wavepaddles"]).paddles[10]
@@ -125,7 +131,11 @@ def test_spectrum_paddle_follows_its_series(tmp_path, tag, extra):
         rigid = paddle.transform(t)
         expect = p0 @ rigid.R.T + rigid.d
         assert np.allclose(x, expect, atol=1e-12)
-        assert np.allclose(v, rigid.V + np.cross(rigid.W, x - rigid.c), atol=1e-9)
+        if t > 0:
+            before = paddle.transform(t - dt)
+            mean = (expect - (p0 @ before.R.T + before.d)) / dt
+            assert np.allclose(v, mean, rtol=1e-6, atol=1e-7)
+            assert not np.allclose(v, rigid.V + np.cross(rigid.W, x - rigid.c), rtol=1e-6, atol=1e-7)
         moved = max(moved, float(np.abs(x - p0).max()))
     assert moved > 1e-3
 
@@ -152,7 +162,7 @@ def test_resume_from_a_checkpoint_without_wall_acceleration(tmp_path):
     import h5py
     import json
     case = tmp_path / "CaseMoving_Def.xml"
-    case.write_text(TANK.replace("MOTION", '<mvrect id="1" duration="-1"><vel x="0.5" y="0" z="0" /></mvrect>')
+    case.write_text(TANK.replace("MOTION", '<mvrect id="1" duration="100"><vel x="0.5" y="0" z="0" /></mvrect>')
                     .replace("SPECIAL", ""))
     out = tmp_path / "out"
     opts = ["--threads", "1", "-q", "--set", "Boundary=2", "--set", "SlipMode=2"]
@@ -235,3 +245,20 @@ def test_absorber_reads_the_still_water_and_warns_of_a_wrong_swl(tmp_path):
     assert "from <swl> 0.5" in text
     level = float(text.split("is at z = ")[1].split(" m")[0])
     assert 0.3 < level < 0.32            # the water drawn up to z = 0.3 (particles every 0.02): its edge at 0.31
+
+
+def test_2d_moving_wall_keeps_its_plane_and_its_step_velocity(tmp_path):
+    """A 2D case whose wall accelerates with a y component: DualSPHysics drops the y of a
+    translation (JDsMotion::ProcesTime), so the wall stays in the plane and the run goes to its end
+    (it stopped at t = 0.09 s "left the simulation domain through its y-max face"); the wall's
+    velocity is the step's displacement over dt (MoveLinBound), v0 + a (t - dt/2), not v0 + a t."""
+    dt = 2e-4
+    motion = ('<mvrectace id="1" duration="100"><ace x="2" y="3" z="0" /><velini x="0.1" y="0.3" z="0" />'
+              '</mvrectace>')
+    out = run_case(tmp_path, motion, dtfixed=dt)
+    p0, res = moving_positions(out)
+    assert res[-1][0] == pytest.approx(0.2)
+    for t, x, v, _ in res[1:]:
+        assert np.array_equal(x[:, 1], p0[:, 1]) and not v[:, 1].any()
+        assert np.allclose(x[:, 0], p0[:, 0] + 0.1 * t + t * t, atol=1e-12)
+        assert np.allclose(v[:, 0], 0.1 + 2 * (t - dt / 2), rtol=1e-6)

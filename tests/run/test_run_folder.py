@@ -412,3 +412,24 @@ def test_sigterm_during_startup_ends_interrupted(tmp_path):
     assert "Traceback" not in err and "interrupted: stopped by signal" in err
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "interrupted" and "stopped by signal" in meta["message"]
+
+
+def test_run_and_resume_without_set_do_not_import_the_case_reader(tmp_path):
+    """`sphdvi run <gencase folder>` and `sphdvi run <run folder> --resume` without --set do not
+    import the XML case reader (lxml, the schema): they read only the case file; with --set of a
+    data-file key the reader's key list is needed, and imported then."""
+    g, out = tmp_path / "g", tmp_path / "out"
+    assert invoke(["gencase", DAMBREAK, "-o", g, "--dp", "0.1", "-q"]).exit_code == 0
+    code = ("import sys\nfrom sphdvi.cli import main\n"
+            "try:\n    main(sys.argv[1:], standalone_mode=False)\n"
+            "finally:\n    print('READER', 'sphdvi.case.reader' in sys.modules)\n")
+    for args in ([g, "-o", out, "--tmax", "0.002", "--tout", "0.002"], [out, "--resume", "--tmax", "0.004"]):
+        res = subprocess.run([sys.executable, "-c", code, "run"] + [str(a) for a in args] + ["--threads", "1", "-q"],
+                             cwd=REPO, capture_output=True, text=True, timeout=300)
+        assert res.returncode == 0, res.stderr
+        assert "READER False" in res.stdout, (args, res.stdout, res.stderr)
+    assert nsteps(out / "particles.vtkhdf") == 3
+    from sphdvi.simulation import absolute_file_sets
+    assert absolute_file_sets(()) == ()
+    assert absolute_file_sets(["DtFixedFile=dt.csv", "Visco=0.1"]) == (f"DtFixedFile={os.path.abspath('dt.csv')}",
+                                                                       "Visco=0.1")

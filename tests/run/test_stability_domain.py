@@ -58,7 +58,7 @@ def test_a_moving_wall_that_leaves_the_domain_stops_the_run(tmp_path):
     meta = json.loads((tmp_path / "o" / "run.json").read_text())
     msg = meta["message"]
     assert meta["status"] == "diverged" and 0.12 <= meta["physical_time"] < 0.13
-    assert "moving boundary mkbound 10 left the simulation domain (0, -0.070711, 0) - (2, 0.070711, 1)" in msg
+    assert "moving boundary mkbound 10 left the simulation domain (-0.0035355, -0.070711, -0.0035355) - (2.0035, 0.070711, 1.0035)" in msg
     assert "through its x-max face: its particle" in msg and "moving particles out" in msg
     assert "Fixed, moving or floating particles were excluded" in msg
 
@@ -79,7 +79,7 @@ def test_walls_cut_by_the_simulation_domain_are_an_input_error(tmp_path):
     r = run(g, tmp_path / "o")
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
-    assert "boundary particles lie outside the simulation domain (0, -0.070711, 0) - (1, 0.070711, 1)" in text
+    assert "boundary particles lie outside the simulation domain (-0.0035355, -0.070711, -0.0035355) - (1, 0.070711, 1.0035)" in text
     assert "mkbound 0 (fixed): " in text and "enlarge <simulationdomain> to hold the walls" in text
     assert "Traceback" not in r.output
 
