@@ -128,8 +128,8 @@ def test_roll_follows_the_experiment_at_box_over_dp_10(run_dp_01):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S16: roll amplitude within 10-15 %; measured −30.5 % rms, "
-                                       "−39.0 % crest to trough at box/dp 10")
+@pytest.mark.xfail(strict=True, reason="TOLERANCES S16: roll amplitude within 10-15 %; measured −27.1 % rms, "
+                                       "−34.8 % crest to trough at box/dp 10 (session 35; −30.5 / −39.0 % before session 34)")
 def test_roll_amplitude_within_15_percent_at_box_over_dp_10(run_dp_01):
     assert abs(run_dp_01["roll_rms"]) <= 0.15 and abs(run_dp_01["roll_range"]) <= 0.15
 
