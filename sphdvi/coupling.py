@@ -50,16 +50,111 @@ def body_labels(mk: np.ndarray, fluidcount: int) -> np.ndarray:
     return mk.astype(np.int64) - fluidcount - 1
 
 
+@njit(cache=True)
+def place_moving(ptype, idp, pos, vel, normals, slot, group, active, x, y0, nrm, V, W, c, dt, flat,
+                 paxes, plen, pshift):
+    """Put each moving particle (type 1, its slot by idp) of an ``active`` mkbound at ``x`` (its
+    motion applied to its initial position; in 2D its y kept, ``y0``'s) with the velocity
+    (new − old position)/dt - DualSPHysics's MoveLinBound/MoveMatBound - the step taken as its
+    shortest periodic image along ``paxes`` (Periodicity.min_image); ``dt`` 0: the motion's
+    velocity V + W × (x − c) of its mkbound.  Turned mDBC normals ``nrm`` where ``normals`` has
+    rows.  Returns the number of moving rows found (all the slots when the map is current)."""
+    found = 0
+    has_normals = normals.shape[0] == pos.shape[0]
+    step = np.empty(3)
+    for r in range(ptype.shape[0]):
+        if ptype[r] != 1:
+            continue
+        k = slot[idp[r]]
+        if k < 0:
+            continue
+        found += 1
+        g = group[k]
+        if not active[g]:
+            continue
+        p0 = x[k, 0]
+        p1 = x[k, 1]
+        p2 = x[k, 2]
+        if dt > 0.0:
+            if flat:
+                p1 = y0[k, 1]
+            step[0] = p0 - pos[r, 0]
+            step[1] = p1 - pos[r, 1]
+            step[2] = p2 - pos[r, 2]
+            _min_image(step, paxes, plen, pshift)   # a particle the periodic box wrapped in between
+            v0 = step[0] / dt
+            v1 = step[1] / dt
+            v2 = step[2] / dt
+        else:
+            t0 = p0 - c[g, 0]
+            t1 = p1 - c[g, 1]
+            t2 = p2 - c[g, 2]
+            v0 = V[g, 0] + (W[g, 1] * t2 - W[g, 2] * t1)
+            v1 = V[g, 1] + (W[g, 2] * t0 - W[g, 0] * t2)
+            v2 = V[g, 2] + (W[g, 0] * t1 - W[g, 1] * t0)
+            if flat:
+                p1 = y0[k, 1]
+                v1 = 0.0
+        pos[r, 0] = p0
+        pos[r, 1] = p1
+        pos[r, 2] = p2
+        vel[r, 0] = v0
+        vel[r, 1] = v1
+        vel[r, 2] = v2
+        if has_normals:
+            normals[r, 0] = nrm[k, 0]
+            normals[r, 1] = nrm[k, 1]
+            normals[r, 2] = nrm[k, 2]
+    return found
+
+
 class ImposedMotions:
     """Boundary particles moved by their mk's imposed motion: each moving particle at
     ``motion(t)`` applied to its initial position (by idp), its velocity the motion's;
-    mDBC normals turn with it."""
+    mDBC normals turn with it.
+
+    The moving particles are grouped once by mkbound in idp order (``_build``): each step
+    turns each mkbound's initial positions (and normals) as a block and :func:`place_moving`
+    writes them to the rows where the solver's cell order has put them (by idp).  An mkbound
+    whose placement has not changed for two steps (at rest: before its motion starts, after
+    it ends, a null movement) is left as it is: its particles are already there at rest."""
 
     def __init__(self, motions, pos0: np.ndarray, fluidcount: int, normals0: np.ndarray | None = None):
         self.motions = motions
         self.pos0 = pos0                    # initial positions, indexed by idp
         self.fluidcount = fluidcount
         self.normals0 = normals0            # initial mDBC normals, indexed by idp
+        self._slot = None                   # the moving particles' slot by idp (built at the first call)
+
+    def _build(self, s) -> None:
+        """Group the moving particles by mkbound, in idp order: slot of each idp, mkbound of each
+        slot, their initial positions (and normals) by mkbound, and the work arrays."""
+        sel = np.flatnonzero(s.ptype == 1)
+        idp = s.idp[sel].astype(np.int64)
+        label = body_labels(s.mk[sel], self.fluidcount)
+        order = np.lexsort((idp, label))
+        idp, label = idp[order], label[order]
+        mkbs, starts = np.unique(label, return_index=True)
+        self.mkbounds = [int(m) for m in mkbs]
+        self._bounds = list(zip(starts.tolist(), np.append(starts[1:], idp.size).tolist()))
+        self._slot = np.full(max(self.pos0.shape[0], int(idp.max(initial=-1)) + 1), -1, np.int64)
+        self._slot[idp] = np.arange(idp.size)
+        self._count = idp.size
+        self._group = np.repeat(np.arange(mkbs.size), np.diff(np.append(starts, idp.size)))
+        self._x0 = [self.pos0[idp[a:b]] for a, b in self._bounds]
+        self._y0 = self.pos0[idp]                   # (their y, kept in 2D)
+        self._x0all = self._y0 + 0.0                # (x0 @ I: a zero's sign as the product's)
+        self._x = np.empty((idp.size, 3))
+        self._vwc = np.zeros((3, mkbs.size, 3))
+        self._active = np.ones(mkbs.size, np.bool_)
+        self._last = [None] * mkbs.size             # the placement each mkbound was last put at
+        self._rest = [False] * mkbs.size            # ... and left at rest there
+        if self.normals0 is not None:
+            self._n0 = [self.normals0[idp[a:b]] for a, b in self._bounds]
+            self._n0all = self.normals0[idp] + 0.0
+            self._n = np.empty((idp.size, 3))
+        else:
+            self._n = np.zeros((0, 3))
 
     def apply(self, solver, t: float, dt: float | None = None) -> None:
         """Place the moving particles (type 1) at time ``t``, the end of a step of ``dt``.
@@ -71,27 +166,49 @@ class ImposedMotions:
         zeroes a translation's y, MoveMatBound keeps y under a matrix).  Without ``dt`` (a placement
         outside the time loop) the velocity is the motion's at t."""
         s = solver.state
-        sel = np.flatnonzero(s.ptype == 1)
-        label = body_labels(s.mk[sel], self.fluidcount)
-        flat = bool(getattr(solver, "is2d", False))
+        if self._slot is None:
+            self._build(s)
         per = getattr(solver, "periodicity", None)
-        for mkb in np.unique(label):
-            rows = sel[label == mkb]
-            rig = self.motions.transform(int(mkb), t)
-            x0 = self.pos0[s.idp[rows]]
-            x, v = rig.apply(x0)
-            if flat:
-                x[:, 1] = x0[:, 1]
-                v[:, 1] = 0.0
-            if dt:
-                step = x - s.pos[rows]
-                if per is not None:
-                    per.min_image(step)      # a particle the periodic box wrapped in between
-                v = step / dt
-            s.pos[rows] = x
-            s.vel[rows] = v
-            if self.normals0 is not None:
-                solver.normals[rows] = self.normals0[s.idp[rows]] @ rig.R.T
+        normals = solver.normals if self.normals0 is not None else self._n
+        flat = bool(getattr(solver, "is2d", False))
+        if self._place(s, t, dt, per, normals, flat) != self._count:
+            self._build(s)                          # the moving particles changed: group them again
+            self._place(s, t, dt, per, normals, flat)
+
+    def _place(self, s, t: float, dt, per, normals, flat: bool) -> int:
+        """Evaluate each mkbound's motion at t (skipping those at rest) and place its particles."""
+        active = self._active
+        for g, mkb in enumerate(self.mkbounds):
+            rig = self.motions.transform(mkb, t)
+            key = (rig.R.tobytes(), rig.d.tobytes())
+            if dt and per is None and key == self._last[g]:
+                if self._rest[g]:                   # placed there at rest already
+                    active[g] = False
+                    continue
+                self._rest[g] = True                # placed again where it was: at rest from now on
+            else:
+                self._rest[g] = False
+            self._last[g] = key if dt else None
+            active[g] = True
+            a, b = self._bounds[g]
+            if rig.rot:
+                np.matmul(self._x0[g], rig.R.T, out=self._x[a:b])
+                self._x[a:b] += rig.d
+                if self.normals0 is not None:
+                    np.matmul(self._n0[g], rig.R.T, out=self._n[a:b])
+            else:
+                np.add(self._x0all[a:b], rig.d, out=self._x[a:b])
+                if self.normals0 is not None:
+                    self._n[a:b] = self._n0all[a:b]
+            if not dt:
+                self._vwc[0, g], self._vwc[1, g], self._vwc[2, g] = rig.V, rig.W, rig.c
+        if not active.any():
+            return self._count
+        paxes, _lo, plen, pshift = _periodic_args(per)
+        return place_moving(s.ptype, s.idp, s.pos, s.vel, normals, self._slot, self._group, active,
+                            self._x, self._y0, self._n, self._vwc[0], self._vwc[1], self._vwc[2],
+                            float(dt) if dt else 0.0, flat,
+                            paxes, plen, pshift)
 
 
 class FloatingBodies:

@@ -45,35 +45,74 @@ import warnings
 import numpy as np
 
 
+_EYE = np.eye(3)
+_EYE.flags.writeable = False
+_ZERO = np.zeros(3)
+_ZERO.flags.writeable = False
+_SKEW: dict = {}        # axis bytes -> (its cross-product matrix [k]x, [k]x²), built once per axis
+
+
 def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rotation matrix about a unit axis (Rodrigues)."""
-    k = axis / np.linalg.norm(axis)
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * (kx @ kx)
+    """Rotation matrix about a unit axis (Rodrigues), I + sin θ [k]x + (1 − cos θ) [k]x²."""
+    key = axis.tobytes()
+    skew = _SKEW.get(key)
+    if skew is None:
+        k = axis / np.linalg.norm(axis)
+        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        skew = _SKEW.setdefault(key, (kx, kx @ kx))
+    kx, kx2 = skew
+    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx2
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b of two 3-vectors in plain float arithmetic: np.cross's products and differences in
+    its order (the same bits), without its per-call overhead."""
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 class Rigid:
-    """x ↦ R x + d, with the velocity field v(x) = V + Ω × (x − c) at the current time."""
+    """x ↦ R x + d, with the velocity field v(x) = V + Ω × (x − c) at the current time.
 
-    __slots__ = ("R", "d", "V", "W", "c")
+    ``rot``: R may differ from the identity (False for a translation: R is I, Ω is 0);
+    ``ident``: the identity at rest, ``Rigid()``.  The arrays are never changed in place (a
+    composition shares them)."""
 
-    def __init__(self, R=None, d=None, V=None, W=None, c=None):
-        self.R = np.eye(3) if R is None else R
-        self.d = np.zeros(3) if d is None else d
-        self.V = np.zeros(3) if V is None else V
-        self.W = np.zeros(3) if W is None else W
-        self.c = np.zeros(3) if c is None else c
+    __slots__ = ("R", "d", "V", "W", "c", "rot", "ident")
+
+    def __init__(self, R=None, d=None, V=None, W=None, c=None, rot=None):
+        self.R = _EYE if R is None else R
+        self.d = _ZERO if d is None else d
+        self.V = _ZERO if V is None else V
+        self.W = _ZERO if W is None else W
+        self.c = _ZERO if c is None else c
+        self.rot = (R is not None or W is not None) if rot is None else rot
+        self.ident = R is None and d is None and V is None and W is None and c is None
 
     def then(self, other: "Rigid") -> "Rigid":
-        """Apply ``self`` first, then ``other`` (velocities combine as frames in motion)."""
-        R = other.R @ self.R
-        d = other.R @ self.d + other.d
+        """Apply ``self`` first, then ``other`` (velocities combine as frames in motion).
+
+        The identity and translations skip the products with R = I and the Ω × r of Ω = 0
+        (the same values, up to the sign of a zero)."""
+        if other.ident:
+            return self
         # velocity of a point x = T_other(y), y moving with self: v = R_o v_self(y) + v_other(x)
         # expressed as V' + W' × (x − c'), with c' = T_other(c_self)
-        c = other.R @ self.c + other.d
-        W = other.R @ self.W + other.W
-        V = other.R @ self.V + other.V + np.cross(other.W, c - other.c)
-        return Rigid(R, d, V, W, c)
+        if self.ident:
+            if not other.rot:
+                return Rigid(other.R, other.d, other.V, other.W, other.d, rot=False)
+            return Rigid(other.R, other.d, other.V + _cross(other.W, other.d - other.c), other.W, other.d,
+                         rot=True)
+        if other.rot:
+            Ro = other.R
+            R = Ro @ self.R
+            d = Ro @ self.d + other.d
+            c = Ro @ self.c + other.d
+            W = Ro @ self.W + other.W
+            V = Ro @ self.V + other.V + _cross(other.W, c - other.c)
+            return Rigid(R, d, V, W, c, rot=True)
+        return Rigid(self.R, self.d + other.d, self.V + other.V, self.W, self.c + other.d, rot=self.rot)
 
     def apply(self, x0: np.ndarray):
         """Positions and velocities of points with initial positions x0."""
@@ -96,7 +135,7 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
     zero there (a mvrectace without <velini> after a rotation starts from rest, not from the last
     rectilinear speed; a mvrectsinu without <phase> after another goes on from its phase)."""
     kind = m["type"]
-    carried = {"v": np.zeros(3), "w": 0.0, "phase3": np.zeros(3), "phase": 0.0}
+    carried = {"v": _ZERO, "w": 0.0, "phase3": _ZERO, "phase": 0.0}
     if kind in ("wait", "mvnull"):
         state.update(carried)
         return Rigid()
@@ -158,8 +197,7 @@ def _rotational(m, angle, w, circular, state=None) -> Rigid:
     the first pass): DualSPHysics's JMotionObj::ProcesTime turns the movement's own Ref axis and
     stores it back every step, so a circular movement looped by ``next`` closes its circle.  The
     moved point is stored in a new ``state["refs"]`` (the caller's copies are not changed)."""
-    p1, p2 = np.asarray(m["axisp1"], float), np.asarray(m["axisp2"], float)
-    axis = _unit(p1 - p2, f"{m['type']} id={m.get('id')}: axisp1 and axisp2")
+    p1, p2, axis = _of_movement(m, "axis", _axis)
     R = _rotation(axis, angle)
     if not circular:
         return Rigid(R=R, d=p1 - R @ p1, W=w * axis, c=p1)
@@ -170,6 +208,23 @@ def _rotational(m, angle, w, circular, state=None) -> Rigid:
         state["refs"] = {**refs, m.get("id"): moved}
     vel = np.cross(w * axis, moved - p1)
     return Rigid(d=moved - ref, V=vel)
+
+
+def _axis(m) -> tuple:
+    """(p1, p2, unit vector p2 → p1) of a rotation's axisp1 and axisp2."""
+    p1, p2 = np.asarray(m["axisp1"], float), np.asarray(m["axisp2"], float)
+    return p1, p2, _unit(p1 - p2, f"{m['type']} id={m.get('id')}: axisp1 and axisp2")
+
+
+_OF_MOVEMENT: dict = {}     # (what, id(movement)) -> (movement, value): what a movement's XML fixes
+
+
+def _of_movement(m: dict, what: str, make):
+    """``make(m)``, made once per movement (its XML does not change during a run)."""
+    entry = _OF_MOVEMENT.get((what, id(m)))
+    if entry is None or entry[0] is not m:
+        entry = _OF_MOVEMENT[(what, id(m))] = (m, make(m))
+    return entry[1]
 
 
 def _unit(v: np.ndarray, what: str) -> np.ndarray:
@@ -193,7 +248,12 @@ def file_columns(m) -> tuple[int, dict]:
 
 
 def _load_table(m):
-    """(times, {field: values}) of a file movement, read once per file."""
+    """(times, {field: values}) of a file movement, read once per file (looked up once per movement)."""
+    return _of_movement(m, "table", _read_table)
+
+
+def _read_table(m):
+    """(times, {field: values}) of a file movement, from the file's cache."""
     ncols, cols = file_columns(m)
     key = (m["file"], ncols, tuple(sorted(cols.items())))
     if key not in _FILE_CACHE:
@@ -263,7 +323,9 @@ def _event_transform(chain: dict, begin: dict, t: float) -> Rigid:
 
 def _static(r: Rigid) -> Rigid:
     """The placement of ``r`` without its velocity (a movement that is over)."""
-    return Rigid(r.R, r.d, c=r.c)
+    if r.ident:
+        return r
+    return Rigid(r.R, r.d, c=r.c, rot=r.rot)
 
 
 class _Walk:
