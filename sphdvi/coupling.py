@@ -116,8 +116,9 @@ class ImposedMotions:
     The moving particles are grouped once by mkbound in idp order (``_build``): each step
     turns each mkbound's initial positions (and normals) as a block and :func:`place_moving`
     writes them to the rows where the solver's cell order has put them (by idp).  An mkbound
-    whose placement has not changed for two steps (at rest: before its motion starts, after
-    it ends, a null movement) is left as it is: its particles are already there at rest."""
+    placed twice in a row at the same R and d (at rest: before its motion starts, after it
+    ends, a null movement) is left as it is from then on, its particles already there with zero
+    velocity (not with periodic boundaries, whose wrap moves them, nor in a placement without dt)."""
 
     def __init__(self, motions, pos0: np.ndarray, fluidcount: int, normals0: np.ndarray | None = None):
         self.motions = motions
