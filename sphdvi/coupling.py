@@ -300,6 +300,7 @@ class FloatingBodies:
         state :meth:`predict` left the bodies in, the one at the step's start."""
         sel, body = self.rows(solver)
         F, T = self.loads(solver, sel, body)
+        self.system.fluid_force, self.system.fluid_torque = F.copy(), T.copy()    # bodies.csv ffx.. ftz
         if self.paused(solver.time - dt):
             self.system.time = solver.time     # frozen bodies (FtPause): the clock still runs
             self.hold(F, T)

@@ -26,7 +26,7 @@ from ._math import quat_to_euler_deg
 from .system import System
 
 BODIES_HEADER = ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
-                 "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz")
+                 "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz,ffx,ffy,ffz,ftx,fty,ftz")
 LINKS_HEADER = "time,link,fx,fy,fz,tx,ty,tz"
 
 _BODY_KEYS = ("mass", "inertia", "pos", "quat", "vel", "omega", "kind", "translation_dof",
@@ -113,7 +113,8 @@ class StepSchedule:
 
 
 # the columns of bodies.csv after time and body, and of links.csv after time and link
-BODY_FIELDS = ("pos", "quat", "euler", "vel", "omega", "force", "torque", "contact_force", "contact_torque")
+BODY_FIELDS = ("pos", "quat", "euler", "vel", "omega", "force", "torque", "contact_force", "contact_torque",
+               "fluid_force", "fluid_torque")
 LINK_FIELDS = ("link_force", "link_torque")
 RECORD_FIELDS = BODY_FIELDS + LINK_FIELDS
 
@@ -121,12 +122,14 @@ RECORD_FIELDS = BODY_FIELDS + LINK_FIELDS
 def body_record(s):
     """The arrays of one bodies.csv/links.csv row block: per body ``pos``, ``quat`` (w x y z),
     ``euler`` (roll, pitch, yaw in degrees), ``vel``, ``omega`` (world), ``force``, ``torque``
-    (total, about the centre), ``contact_force``, ``contact_torque``; per link ``link_force``,
-    ``link_torque`` (reaction on body 1).  Copies."""
+    (total, about the centre), ``contact_force``, ``contact_torque``, ``fluid_force``,
+    ``fluid_torque`` (the fluid's load of the last step, as DualSPHysics's FloatingInfo gives it;
+    0 without fluid); per link ``link_force``, ``link_torque`` (reaction on body 1).  Copies."""
     return {"pos": s.pos.copy(), "quat": s.quat.copy(), "euler": quat_to_euler_deg(s.quat),
             "vel": s.vel.copy(), "omega": s.omega_world, "force": s.total_force.copy(),
             "torque": s.total_torque.copy(), "contact_force": s.contact_force.copy(),
-            "contact_torque": s.contact_torque.copy(), "link_force": s.link_force.copy(),
+            "contact_torque": s.contact_torque.copy(), "fluid_force": s.fluid_force.copy(),
+            "fluid_torque": s.fluid_torque.copy(), "link_force": s.link_force.copy(),
             "link_torque": s.link_torque.copy()}
 
 

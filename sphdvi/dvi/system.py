@@ -209,6 +209,8 @@ class System:
         self._cap_pairs = 1024
         self.contact_force = np.zeros((0, 3))
         self.contact_torque = np.zeros((0, 3))
+        self.fluid_force = np.zeros((0, 3))     # the fluid's load of the last step (set by the coupling)
+        self.fluid_torque = np.zeros((0, 3))
         self.total_force = np.zeros((0, 3))
         self.total_torque = np.zeros((0, 3))
         self.link_force = np.zeros((0, 3))
@@ -274,7 +276,7 @@ class System:
         self._motion.append(motion)
         self._packed = False
         self.names.append(name if name is not None else f"body{self.nb - 1}")
-        for a in ("contact_force", "contact_torque"):
+        for a in ("contact_force", "contact_torque", "fluid_force", "fluid_torque"):
             setattr(self, a, np.vstack([getattr(self, a), np.zeros((1, 3))]))
         # before the first step the total load is the applied one
         f0 = np.asarray(force, float) + (float(mass) * self.gravity if dyn else 0.0)

@@ -175,6 +175,16 @@ def _rows_until(path: str, resume_time: float | None) -> list[str]:
     return [line + "\n" for line in complete_lines(path)[1:] if line and float(line.split(",", 1)[0]) <= limit]
 
 
+def _pad_rows(rows: list[str], ncols: int) -> list[str]:
+    """Rows of a file an older sphdvi wrote with fewer columns (bodies.csv before its fluid-load
+    columns) filled up with nan to the present header, so that a resumed run's file stays one table."""
+    out = []
+    for row in rows:
+        missing = ncols - (row.count(",") + 1)
+        out.append(row[:-1] + ",nan" * missing + "\n" if missing > 0 else row)
+    return out
+
+
 class BodyLog:
     """``bodies.csv`` and ``links.csv`` of a run with bodies (one row per body
     and per link at every output time, and at TimeOutExtra between outputs): the rows are
@@ -187,7 +197,8 @@ class BodyLog:
         self.headers = (BODIES_HEADER, LINKS_HEADER)
         self.rows: tuple[list, list] = ([], [])        # rows not yet written
         for path, header in zip(self.paths, self.headers):
-            write_text_atomic(path, header + "\n" + "".join(_rows_until(path, resume_time)))
+            rows = _pad_rows(_rows_until(path, resume_time), header.count(",") + 1)
+            write_text_atomic(path, header + "\n" + "".join(rows))
 
     def record(self, flush: bool = True) -> None:
         """Add a row per body and link at the current time; append the pending rows to the

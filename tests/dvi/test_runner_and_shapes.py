@@ -26,7 +26,7 @@ def test_run_bodies_records(tmp_path, monkeypatch):
                    materials=mats, gravity=(0, 0, -G), solver="bb", max_iter=100)
     assert list(tmp_path.iterdir()) == []
     assert BODIES_HEADER == ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
-                             "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz")
+                             "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz,ffx,ffy,ffz,ftx,fty,ftz")
     assert LINKS_HEADER == "time,link,fx,fy,fz,tx,ty,tz"
     assert h.names == ["ground", "ball", "flap"] and len(h.link_names) == 1
     np.testing.assert_allclose(h.time, [0, 0.05, 0.1, 0.15, 0.2], atol=1e-12)

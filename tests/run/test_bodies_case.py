@@ -28,7 +28,7 @@ def test_pendulum_case_period(tmp_path):
     rows = read_rows(out / "bodies.csv")
     header = open(out / "bodies.csv").readline().strip()
     assert header == ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
-                      "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz")
+                      "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz,ffx,ffy,ffz,ftx,fty,ftz")
     assert open(out / "links.csv").readline().strip() == "time,link,fx,fy,fz,tx,ty,tz"
     t = np.array([float(x["time"]) for x in rows])
     x = np.array([float(x["x"]) for x in rows])

@@ -23,7 +23,7 @@ from sphdvi.errors import InputError
 REPO = Path(__file__).resolve().parents[2]
 PENDULUM = (REPO / "cases" / "pendulum" / "CasePendulum_Def.xml").read_text()
 BODIES_HEADER = ("time,body,x,y,z,qw,qx,qy,qz,roll,pitch,yaw,vx,vy,vz,wx,wy,wz,"
-                 "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz")
+                 "fx,fy,fz,tx,ty,tz,cfx,cfy,cfz,ctx,cty,ctz,ffx,ffy,ffz,ftx,fty,ftz")
 
 
 def case_file(tmp_path, text=PENDULUM, name="CasePendulum_Def.xml"):
@@ -117,7 +117,8 @@ def test_run_bodies_arrays_match_the_run_files(tmp_path):
     mech = mechanism_from_case(read_case_h5(str(next(out.glob("*.h5")))))
     h = run_bodies(mech["bodies"], mech["links"], tmax=0.1, tout=0.02, dt=1e-3, materials=mech["materials"],
                    tout_extra=0.005, **mech["system"])
-    fields = ("pos", "quat", "euler", "vel", "omega", "force", "torque", "contact_force", "contact_torque")
+    fields = ("pos", "quat", "euler", "vel", "omega", "force", "torque", "contact_force", "contact_torque",
+              "fluid_force", "fluid_torque")
     expect = [f"{t:.9g},pend," + ",".join(f"{v:.9g}" for v in np.concatenate([getattr(h, f)[k, 0]
                                                                               for f in fields]))
               for k, t in enumerate(h.time)]

@@ -16,3 +16,16 @@ def test_resume_keeps_the_row_written_at_the_restart_time(tmp_path):
     for name in ("bodies.csv", "links.csv"):
         lines = (tmp_path / name).read_text().splitlines()
         assert [ln.split(",")[0] for ln in lines[1:]] == [csv_time(0.1), csv_time(t_restart)]
+
+
+def test_resume_of_an_older_bodies_csv_pads_its_rows(tmp_path):
+    """bodies.csv written before the fluid-load columns (ffx..ftz): a resume keeps one table,
+    the older rows filled with nan under the new columns."""
+    old_header = BODIES_HEADER.rsplit(",ffx", 1)[0]
+    row = "0.1,b," + ",".join(["1"] * (old_header.count(",") - 1))
+    (tmp_path / "bodies.csv").write_text(old_header + "\n" + row + "\n")
+    (tmp_path / "links.csv").write_text(LINKS_HEADER + "\n")
+    BodyLog(str(tmp_path), None, ["b"], resume_time=0.1)
+    lines = (tmp_path / "bodies.csv").read_text().splitlines()
+    assert lines[0] == BODIES_HEADER
+    assert lines[1].split(",")[-6:] == ["nan"] * 6 and lines[1].count(",") == BODIES_HEADER.count(",")

@@ -10,6 +10,7 @@ whose particles leave the simulation domain stops the run as DualSPHysics's JSph
 import json
 
 import numpy as np
+import pytest
 from case.casetext import case_xml, write_case      # tests/case (tests/ is on the path: conftest)
 from click.testing import CliRunner
 
@@ -63,6 +64,12 @@ def test_heavy_box_comes_to_rest_on_the_floor(tmp_path):
     assert np.all((bottom[late] > 1.0 * DP) & (bottom[late] < 2.5 * DP))
     assert np.abs(d["vz"][late]).max() < 0.05           # at rest
     assert np.ptp(bottom[late]) < 0.25 * DP
+    # bodies.csv's fluid load (ffx..ftz; under RigidAlgorithm 1 it holds the walls' terms too): the
+    # total load less the weight, the body having no other load
+    np.testing.assert_allclose(d["ffx"], d["fx"], rtol=1e-12, atol=1e-9)
+    weight = d["fz"] - d["ffz"]
+    assert np.ptp(weight) < 1e-8 * abs(weight[0]) and weight[0] < 0      # to the 9 printed digits
+    assert d["ffz"][late].mean() == pytest.approx(-weight[0], rel=0.05)     # resting: the loads balance
 
 
 def test_without_contact_the_box_leaves_the_domain_and_the_run_stops(tmp_path):
