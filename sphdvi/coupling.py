@@ -50,16 +50,21 @@ def body_labels(mk: np.ndarray, fluidcount: int) -> np.ndarray:
     return mk.astype(np.int64) - fluidcount - 1
 
 
+_NO_BOX = (np.full(3, -np.inf), np.full(3, np.inf))
+
+
 @njit(cache=True)
 def place_moving(ptype, idp, pos, vel, normals, slot, group, active, x, y0, nrm, V, W, c, dt, flat,
-                 paxes, plen, pshift):
+                 paxes, plen, pshift, lo, hi):
     """Put each moving particle (type 1, its slot by idp) of an ``active`` mkbound at ``x`` (its
     motion applied to its initial position; in 2D its y kept, ``y0``'s) with the velocity
     (new − old position)/dt - DualSPHysics's MoveLinBound/MoveMatBound - the step taken as its
     shortest periodic image along ``paxes`` (Periodicity.min_image); ``dt`` 0: the motion's
     velocity V + W × (x − c) of its mkbound.  Turned mDBC normals ``nrm`` where ``normals`` has
-    rows.  Returns the number of moving rows found (all the slots when the map is current)."""
+    rows.  Returns the number of moving rows found (all the slots when the map is current) and
+    the first row it placed outside the box [lo, hi] (the simulation domain), or -1."""
     found = 0
+    first_out = -1
     has_normals = normals.shape[0] == pos.shape[0]
     step = np.empty(3)
     for r in range(ptype.shape[0]):
@@ -95,6 +100,8 @@ def place_moving(ptype, idp, pos, vel, normals, slot, group, active, x, y0, nrm,
             if flat:
                 p1 = y0[k, 1]
                 v1 = 0.0
+        if first_out < 0 and (p0 < lo[0] or p0 > hi[0] or p1 < lo[1] or p1 > hi[1] or p2 < lo[2] or p2 > hi[2]):
+            first_out = r
         pos[r, 0] = p0
         pos[r, 1] = p1
         pos[r, 2] = p2
@@ -105,7 +112,7 @@ def place_moving(ptype, idp, pos, vel, normals, slot, group, active, x, y0, nrm,
             normals[r, 0] = nrm[k, 0]
             normals[r, 1] = nrm[k, 1]
             normals[r, 2] = nrm[k, 2]
-    return found
+    return found, first_out
 
 
 class ImposedMotions:
@@ -126,6 +133,7 @@ class ImposedMotions:
         self.fluidcount = fluidcount
         self.normals0 = normals0            # initial mDBC normals, indexed by idp
         self._slot = None                   # the moving particles' slot by idp (built at the first call)
+        self.first_outside = -1             # the first moving row placed outside the domain (apply), or -1
 
     def _build(self, s) -> None:
         """Group the moving particles by mkbound, in idp order: slot of each idp, mkbound of each
@@ -172,12 +180,16 @@ class ImposedMotions:
         per = getattr(solver, "periodicity", None)
         normals = solver.normals if self.normals0 is not None else self._n
         flat = bool(getattr(solver, "is2d", False))
-        if self._place(s, t, dt, per, normals, flat) != self._count:
+        dom = getattr(solver, "_domain", None)
+        box = _NO_BOX if dom is None else (np.asarray(dom[0], float), np.asarray(dom[1], float))
+        found, self.first_outside = self._place(s, t, dt, per, normals, flat, box)
+        if found != self._count:
             self._build(s)                          # the moving particles changed: group them again
-            self._place(s, t, dt, per, normals, flat)
+            _, self.first_outside = self._place(s, t, dt, per, normals, flat, box)
 
-    def _place(self, s, t: float, dt, per, normals, flat: bool) -> int:
-        """Evaluate each mkbound's motion at t (skipping those at rest) and place its particles."""
+    def _place(self, s, t: float, dt, per, normals, flat: bool, box) -> tuple[int, int]:
+        """Evaluate each mkbound's motion at t (skipping those at rest) and place its particles;
+        (rows found, the first row placed outside ``box`` or -1: a wall at rest did not move)."""
         active = self._active
         for g, mkb in enumerate(self.mkbounds):
             rig = self.motions.transform(mkb, t)
@@ -204,12 +216,12 @@ class ImposedMotions:
             if not dt:
                 self._vwc[0, g], self._vwc[1, g], self._vwc[2, g] = rig.V, rig.W, rig.c
         if not active.any():
-            return self._count
+            return self._count, -1
         paxes, _lo, plen, pshift = _periodic_args(per)
         return place_moving(s.ptype, s.idp, s.pos, s.vel, normals, self._slot, self._group, active,
                             self._x, self._y0, self._n, self._vwc[0], self._vwc[1], self._vwc[2],
                             float(dt) if dt else 0.0, flat,
-                            paxes, plen, pshift)
+                            paxes, plen, pshift, box[0], box[1])
 
 
 class FloatingBodies:

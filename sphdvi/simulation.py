@@ -855,7 +855,7 @@ class SPHRun:
         (JSphCpuSingle::RunCellDivide -> JSph::AbortBoundOut, "Fixed, moving or floating particles
         were excluded"); sphdvi's cells would clamp it into the edge cells and go on."""
         dom = solver._domain
-        if dom is None:
+        if dom is None or self.moving.first_outside < 0:    # found while placing them (place_moving)
             return
         s = solver.state
         sel = np.flatnonzero(s.ptype == 1)
