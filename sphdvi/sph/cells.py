@@ -197,6 +197,7 @@ class CellList:
         self.is2d = bool(is2d)
         self.cell = np.empty(0, np.int64)
         self.order = np.empty(0, np.int64)
+        self._room = None
         self.cell_start = np.empty(1, np.int64)
         self.shape = (1, 1, 1)
         self.pmin = np.zeros(3)
@@ -215,8 +216,12 @@ class CellList:
         self.shape = grid_shape(self.pmin, pmax, self.cellsize, self.is2d)
         ncells = self.shape[0] * self.shape[1] * self.shape[2]
         if self.cell.shape[0] != n:
-            self.cell = np.empty(n, np.int64)
-            self.order = np.empty(n, np.int64)
+            # views of work arrays kept with room to spare: the periodic extended set's size
+            # changes from step to step
+            if getattr(self, "_room", None) is None or self._room[0].shape[0] < n:
+                self._room = (np.empty(n + n // 4 + 1, np.int64), np.empty(n + n // 4 + 1, np.int64))
+            self.cell = self._room[0][:n]
+            self.order = self._room[1][:n]
         if self.cell_start.shape[0] != ncells + 1:
             self.cell_start = np.empty(ncells + 1, np.int64)
         sort = counting_sort_cells_parallel if parallel else counting_sort_cells

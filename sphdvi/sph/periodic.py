@@ -1,4 +1,4 @@
-"""Periodic boundaries by ghost copies (numpy bookkeeping, kernels unchanged).
+"""Periodic boundaries by ghost copies (compiled bookkeeping, kernels unchanged).
 
 A periodic axis k has a period vector S_k: S_k[k] = L_k and, on the other two
 axes, minus DualSPHysics's ``*PeriodicInc*`` offsets, i.e. S_k is minus
@@ -19,6 +19,7 @@ state and its length is the extent of the particles along the axis plus dp
 boundary), as DualSPHysics defines it.
 """
 import numpy as np
+from numba import njit
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -33,6 +34,7 @@ class Periodicity:
         self.shift = np.zeros((3, 3))
         inc = {0: ("XPeriodicIncY", "XPeriodicIncZ"), 1: ("YPeriodicIncX", "YPeriodicIncZ"),
                2: ("ZPeriodicIncX", "ZPeriodicIncY")}
+        self._axes = np.array(self.axes, np.int64)
         for k in self.axes:
             self.lo[k] = pos[:, k].min()
             self.length[k] = pos[:, k].max() - self.lo[k] + dp
@@ -56,28 +58,30 @@ class Periodicity:
     def wrap(self, pos):
         """Bring particles that left the periodic box back in (in place), as
         JSphCpu::UpdatePos: above the box pos - S_k, below it pos + S_k."""
-        for k in self.axes:
-            lo, hi = self.lo[k], self.lo[k] + self.length[k]
-            below = pos[:, k] < lo
-            above = pos[:, k] >= hi
-            if below.any():
-                pos[below] += self.shift[k]
-            if above.any():
-                pos[above] -= self.shift[k]
+        _wrap_into_box(pos, self._axes, self.lo, self.length, self.shift)
 
-    def ghosts(self, pos, width):
-        """(source index, displacement) of the ghost copies of ``pos``."""
-        src = np.arange(pos.shape[0])
-        disp = np.zeros((pos.shape[0], 3))
-        for k in self.axes:
-            p = pos[src, k] + disp[:, k]
-            lo, hi = self.lo[k], self.lo[k] + self.length[k]
-            low = np.flatnonzero(p < lo + width)
-            high = np.flatnonzero(p >= hi - width)
-            src = np.concatenate([src, src[low], src[high]])
-            disp = np.concatenate([disp, disp[low] + self.shift[k], disp[high] - self.shift[k]])
+    def ghosts(self, pos, width, bufs=None):
+        """(source index, displacement) of the ghost copies of ``pos``: along each periodic
+        axis in turn, the copies of the particles (and of the ghosts made so far) within
+        ``width`` of the low end displaced by +S_k, then those within ``width`` of the high end
+        by -S_k (JSphCpuSingle::PeriodicMakeList).  ``bufs``: a dict whose "src"/"disp" work
+        arrays are kept between calls (grown as needed); the returned arrays are then views
+        of them, valid until the next call."""
         n = pos.shape[0]
-        return src[n:], disp[n:]
+        own = bufs is None
+        bufs = {} if own else bufs
+        src, disp = bufs.get("src"), bufs.get("disp")
+        if src is None:
+            src, disp = np.empty(n // 4 + 16, np.int64), np.empty((n // 4 + 16, 3))
+        m = _make_ghosts(pos, self._axes, self.lo, self.length, self.shift, width, src, disp)
+        while m > src.shape[0]:
+            cap = 2 * m + 16
+            src, disp = np.empty(cap, np.int64), np.empty((cap, 3))
+            m = _make_ghosts(pos, self._axes, self.lo, self.length, self.shift, width, src, disp)
+        bufs["src"], bufs["disp"] = src, disp
+        if own:
+            return src[:m].copy(), disp[:m].copy()
+        return src[:m], disp[:m]
 
     def min_image(self, r):
         """The shortest periodic image of the separations ``r`` (N, 3), in place:
@@ -120,3 +124,54 @@ def periodic_config(written, params, is2d):
         raise ValueError(f"{why}: cannot use periodic conditions in Y with 2D simulations "
                          "(DualSPHysics refuses it too)")
     return sorted(axes), incs
+
+
+@njit(cache=True)
+def _wrap_into_box(pos, axes, lo, length, shift):
+    """Periodicity.wrap's loop: per particle and periodic axis k in turn, + S_k below the
+    box, - S_k at or above its high end (JSphCpu::UpdatePos)."""
+    for i in range(pos.shape[0]):
+        for a in range(axes.shape[0]):
+            k = axes[a]
+            p = pos[i, k]
+            if p < lo[k]:
+                for m in range(3):
+                    pos[i, m] += shift[k, m]
+            elif p >= lo[k] + length[k]:
+                for m in range(3):
+                    pos[i, m] -= shift[k, m]
+
+
+@njit(cache=True)
+def _make_ghosts(pos, axes, lo, length, shift, width, src, disp):
+    """Periodicity.ghosts's loop into ``src``/``disp``; returns the number of ghosts.  When
+    that exceeds their length (the capacity) the ghosts beyond it are counted, not stored,
+    and the count is a lower bound: the caller calls again with larger arrays.  A ghost of a
+    ghost keeps the real source and adds the displacements, as numpy's concatenation did
+    (the same sums, so bitwise)."""
+    n = pos.shape[0]
+    cap = src.shape[0]
+    m = 0
+    for a in range(axes.shape[0]):
+        k = axes[a]
+        hi = lo[k] + length[k]
+        m0 = min(m, cap)
+        for side in range(2):
+            sgn = 1.0 if side == 0 else -1.0
+            for e in range(n + m0):
+                if e < n:
+                    p = pos[e, k]
+                else:
+                    p = pos[src[e - n], k] + disp[e - n, k]
+                if (p < lo[k] + width) if side == 0 else (p >= hi - width):
+                    if m < cap:
+                        if e < n:
+                            src[m] = e
+                            for c in range(3):
+                                disp[m, c] = sgn * shift[k, c]
+                        else:
+                            src[m] = src[e - n]
+                            for c in range(3):
+                                disp[m, c] = disp[e - n, c] + sgn * shift[k, c]
+                    m += 1
+    return m

@@ -475,6 +475,7 @@ class SPHSolver:
             self.npshift = np.zeros((n, NCOL))
         self.dtmax = np.zeros(((n + _ia.CHUNK - 1) // _ia.CHUNK, 3))
         self._bufs = {}
+        self._ghost_bufs = {}      # Periodicity.ghosts's work arrays
 
     # ------------------------------------------------------------------ kernels
     def _use_parallel(self, light=False):
@@ -768,12 +769,13 @@ class SPHSolver:
         per = self.periodicity
         per.wrap(s.pos)
         n = s.n
-        src, disp = per.ghosts(s.pos, 2.0 * self.h)
+        src, disp = per.ghosts(s.pos, 2.0 * self.h, self._ghost_bufs)
         ne = n + src.shape[0]
         w = self._periodic_work
         unsorted = w("pos_x", ne, (3,), zero=False)     # the real particles', then the ghosts'
         unsorted[:n] = s.pos
-        np.add(s.pos[src], disp, out=unsorted[n:])
+        np.take(s.pos, src, axis=0, out=unsorted[n:], mode="clip")
+        unsorted[n:] += disp
         order = self.cells.build(unsorted, parallel=self._use_parallel(light=True))
         source = w("source", ne, (), np.int64, zero=False)
         source[:n] = self._periodic_rows(n)
@@ -1113,7 +1115,7 @@ class SPHSolver:
                 a = getattr(obj, name, None)
                 if isinstance(a, np.ndarray):
                     seen[id(a)] = a.nbytes
-        for a in self._bufs.values():
+        for a in list(self._bufs.values()) + list(self._ghost_bufs.values()):
             seen[id(a)] = a.nbytes
         return int(sum(seen.values()))
 

@@ -89,3 +89,49 @@ def test_periodic_work_arrays_are_kept_and_carry_nothing_over(params):
         return np.concatenate([st.pos.ravel(), st.vel.ravel(), st.rhop, sol.ace.ravel()])
     a, b = run(False), run(True)
     assert np.isfinite(a).all() and np.array_equal(a, b)
+
+
+def _numpy_ghosts(per, pos, width):
+    """The numpy formulation of JSphCpuSingle::PeriodicMakeList that Periodicity.ghosts had
+    until session 36 (the reference of the compiled loop)."""
+    src = np.arange(pos.shape[0])
+    disp = np.zeros((pos.shape[0], 3))
+    for k in per.axes:
+        p = pos[src, k] + disp[:, k]
+        lo, hi = per.lo[k], per.lo[k] + per.length[k]
+        low = np.flatnonzero(p < lo + width)
+        high = np.flatnonzero(p >= hi - width)
+        src = np.concatenate([src, src[low], src[high]])
+        disp = np.concatenate([disp, disp[low] + per.shift[k], disp[high] - per.shift[k]])
+    n = pos.shape[0]
+    return src[n:], disp[n:]
+
+
+@pytest.mark.parametrize("axes,incs", [(["x"], {"XPeriodicIncZ": 0.013}),
+                                       (["x", "z"], {"XPeriodicIncZ": 0.0, "ZPeriodicIncX": 0.0}),
+                                       (["x", "y", "z"], {"XPeriodicIncY": 0.004, "YPeriodicIncZ": -0.007})])
+def test_compiled_ghosts_and_wrap_equal_the_numpy_formulation(axes, incs):
+    """The compiled ghost list (corner ghosts of ghosts included, the room grown from too
+    small) and wrap give bitwise what the numpy formulation gives."""
+    from sphdvi.sph.periodic import Periodicity
+    rng = np.random.default_rng(3)
+    pos = rng.uniform(0.0, 0.3, (2000, 3))
+    per = Periodicity(axes, pos, 0.01, incs)
+    width = 0.05
+    ref_src, ref_disp = _numpy_ghosts(per, pos, width)
+    bufs = {"src": np.empty(3, np.int64), "disp": np.empty((3, 3))}      # far too small: grown
+    for _ in range(2):                                # and again with the grown room kept
+        src, disp = per.ghosts(pos, width, bufs)
+        assert ref_src.size > 500 and np.array_equal(src, ref_src) and np.array_equal(disp, ref_disp)
+    assert bufs["src"].shape[0] >= ref_src.size
+    src, disp = per.ghosts(pos, width)            # without kept arrays: copies
+    assert np.array_equal(src, ref_src) and np.array_equal(disp, ref_disp)
+    moved = pos + rng.uniform(-0.05, 0.05, pos.shape)
+    ref = moved.copy()
+    for k in per.axes:                            # JSphCpu::UpdatePos, axis by axis
+        lo, hi = per.lo[k], per.lo[k] + per.length[k]
+        below, above = ref[:, k] < lo, ref[:, k] >= hi
+        ref[below] += per.shift[k]
+        ref[above] -= per.shift[k]
+    per.wrap(moved)
+    assert np.array_equal(moved, ref) and not np.array_equal(ref, pos + 0)
