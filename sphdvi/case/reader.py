@@ -681,30 +681,38 @@ def _warn_near_material_key(reader, el, key: str) -> None:
                         f"the default for it")
 
 
-def _read_material(reader, el) -> Material:
+def _read_material(reader, el, merge_into=None) -> Material:
     """A ``<property>``: values as child elements (``<Kfric value="0.3"/>``) or attributes
     (``Restitution_Coefficient_User="0.65"``); as in DualSPHysics, a ``*_User`` value
-    overrides the plain one, wherever each is written."""
+    overrides the plain one, wherever each is written.  ``merge_into``: an earlier property of
+    the same name, whose values this one's join (JCaseProperties::ReadXmlProperty adds the
+    values of a second <property> of a name to the first; a value both give is DualSPHysics's
+    "Value already exists", a case error here)."""
     mat = Material(name=reader.text_attr(el, "name").replace(" ", ""))   # stored without spaces
-    plain, user = {}, {}
-    for c in reader.children(el):
-        key = c.tag.removesuffix("_User")
-        if key in MATERIAL_KEYS:
-            (user if c.tag.endswith("_User") else plain)[MATERIAL_KEYS[key]] = reader.num(c, "value", nonnegative=True)
+    plain, user, given = {}, {}, {}
+    if merge_into is not None:
+        mat, plain, user, given = (merge_into, merge_into._plain, merge_into._user_values,
+                                   merge_into._given)
+    values = [(c, c.tag) for c in reader.children(el)] + [(el, k) for k in el.keys() if k != "name"]
+    for owner, key in values:
+        if key.lower() in given:
+            raise reader.error(owner, f"property '{mat.name}' gives '{key}' a second time (first at line "
+                                      f"{given[key.lower()]})",
+                               "each value once in the <property> elements of one name")
+        given[key.lower()] = owner.sourceline
+        base = key.removesuffix("_User")
+        if base in MATERIAL_KEYS:
+            num = (reader.num(owner, "value", nonnegative=True) if owner is not el
+                   else reader.num(el, key, nonnegative=True))
+            (user if key.endswith("_User") else plain)[MATERIAL_KEYS[base]] = num
         else:
-            _warn_near_material_key(reader, c, c.tag)
-            mat.extra[c.tag] = {k: c.get(k) for k in c.keys()}
-            reader.mark(c, *c.keys())
-    for k in el.keys():
-        if k == "name":
-            continue
-        key = k.removesuffix("_User")
-        if key in MATERIAL_KEYS:
-            (user if k.endswith("_User") else plain)[MATERIAL_KEYS[key]] = reader.num(el, k, nonnegative=True)
-        else:
-            _warn_near_material_key(reader, el, k)
-            mat.extra[k] = el.get(k)
-            reader.mark(el, k)
+            _warn_near_material_key(reader, owner, key)
+            if owner is el:
+                mat.extra[key] = el.get(key)
+                reader.mark(el, key)
+            else:
+                mat.extra[key] = {k: owner.get(k) for k in owner.keys()}
+                reader.mark(owner, *owner.keys())
     for attr, value in {**plain, **user}.items():
         setattr(mat, attr, value)
     mat.user = sorted(user)
@@ -712,6 +720,8 @@ def _read_material(reader, el) -> Material:
         raise reader.error(el, f"PoissonRatio {mat.poisson} out of range", "0 <= nu < 0.5")
     if mat.restitution is not None and mat.restitution > 1.0:
         raise reader.error(el, f"Restitution_Coefficient {mat.restitution} above 1", "0 <= e <= 1")
+    # what the next <property> of this name merges with (not stored in the case file)
+    mat._plain, mat._user_values, mat._given = plain, user, given
     return mat
 
 
@@ -724,13 +734,11 @@ def read_properties(reader, casedef, fluidcount: int = 9):
         return materials, links
     for c in reader.children(el):
         if c.tag == "property":
-            m = _read_material(reader, c)
-            _add_material(materials, m)
+            _read_property_into(reader, c, materials)
         elif c.tag == "propertyfile":
             path = reader.resolve_path(c, "file")
             section = reader.text_attr(c, "path", "")
-            for m in _read_property_file(reader, c, path, section).values():
-                _add_material(materials, m)
+            _read_property_file(reader, c, path, section, materials)
         elif c.tag == "links":
             for link in reader.children(c):
                 if link.tag != "link":
@@ -743,11 +751,14 @@ def read_properties(reader, casedef, fluidcount: int = 9):
     return materials, links
 
 
-def _add_material(materials: dict, m) -> None:
-    """Store a property under its name; one of the same name in another case replaces it."""
-    for key in [k for k in materials if k.lower() == m.name.lower()]:
-        del materials[key]
-    materials[m.name] = m
+def _read_property_into(reader, el, materials: dict) -> None:
+    """Read a ``<property>`` into ``materials``: a new name is stored (without spaces), one
+    already there (whatever the case of its letters, as JCaseProperties::GetIndexProperty)
+    takes this one's values as well, under its first spelling."""
+    name = reader.text_attr(el, "name").replace(" ", "").lower()
+    first = next((m for k, m in materials.items() if k.lower() == name), None)
+    m = _read_material(reader, el, merge_into=first)
+    materials.setdefault(m.name, m)
 
 
 def _read_link_mks(reader, link, fluidcount: int) -> dict:
@@ -795,7 +806,8 @@ def _check_property_names(reader, combo: str, materials: dict, line: int, elemen
     return "+".join(names)
 
 
-def _read_property_file(reader, el, path, section):
+def _read_property_file(reader, el, path, section, materials):
+    """The ``<property>`` items of a ``<propertyfile>`` (under its dotted ``path``) into ``materials``."""
     sub_root, _ = load_xml_any(path, reader)
     strip_disabled(sub_root, path)
     node = sub_root
@@ -809,12 +821,9 @@ def _read_property_file(reader, el, path, section):
                                "a dotted path of elements holding <property> items")
         node = nxt
     sub_reader = CaseReader(path, reader.vars, reader.warnings)
-    out = {}
     for c in node.iter("property"):
         sub_reader.mark(c)
-        m = _read_material(sub_reader, c)
-        out[m.name] = m
-    return out
+        _read_property_into(sub_reader, c, materials)
 
 
 def load_xml_any(path, reader):

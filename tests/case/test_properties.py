@@ -76,11 +76,30 @@ def test_undefined_property_still_refused(tmp_path):
         build(tmp_path, STEEL + '<links><link mkbound="0" property="Steel + wood"/></links>')
 
 
-def test_property_redefined_in_another_case_replaces(tmp_path):
-    r = build(tmp_path, STEEL + '<property name="STEEL"><Kfric value="0.1"/></property>'
-                                '<links><link mkbound="0" property="steel"/></links>')
-    assert set(r.case.materials) == {"STEEL"} and r.case.materials["STEEL"].kfric == 0.1
-    assert r.case.material_links[0]["property"] == "STEEL"
+def test_property_of_the_same_name_adds_its_values(tmp_path):
+    """A second <property> of a name (whatever the case of its letters) adds its values to the
+    first, as JCaseProperties::ReadXmlProperty (AddProperty finds the first; sphdvi replaced it,
+    losing the first's values), and a value both give is refused, as its "Value already exists"."""
+    r = build(tmp_path / "a", STEEL + '<property name="STEEL" Sfric="0.2"><Kfric_User value="0.1"/></property>'
+                                      '<links><link mkbound="0" property="steel"/></links>')
+    assert set(r.case.materials) == {"steel"}
+    m = r.case.materials["steel"]
+    assert (m.kfric, m.sfric, m.young, m.restitution, m.user) == (0.1, 0.2, 2.1e11, 0.8, ["kfric"])
+    assert r.case.material_links[0]["property"] == "steel"
+    with pytest.raises(CaseError, match=r"property 'steel' gives 'Kfric' a second time \(first at line \d+\)"):
+        build(tmp_path / "b", STEEL + '<property name="STEEL"><Kfric value="0.1"/></property>'
+                                      '<links><link mkbound="0" property="steel"/></links>')
+
+
+def test_property_file_merges_with_the_case(tmp_path):
+    """<propertyfile> items join the case's properties the same way (one store, as DualSPHysics)."""
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    (tmp_path / "props.xml").write_text('<data><materials><property name="steel" Sfric="0.25"/>'
+                                        '<property name="wood"><Kfric value="0.6"/></property></materials></data>')
+    r = build(tmp_path, STEEL + '<propertyfile file="props.xml" path="data.materials"/>'
+                                '<links><link mkbound="0" property="steel + wood"/></links>')
+    assert set(r.case.materials) == {"steel", "wood"}
+    assert (r.case.materials["steel"].kfric, r.case.materials["steel"].sfric) == (0.45, 0.25)
 
 
 def test_value_names_are_matched_exactly(tmp_path):
