@@ -4,10 +4,12 @@ DualSPHysics's ``<special><chrono>`` section names the bodies (``bodyfixed``,
 ``bodyfloating``, ``bodymoving``) by mkbound; masses, centres and inertias come
 from ``<floatings>`` (resolved by gencase from the particles). With
 ``<collision activate="true">`` a body with a ``modelfile`` collides through a
-sphere cloud built from its own boundary particles (what DualSPHysics builds
-from ``modelfile="AutoActual"``): spheres of radius dp/2 at the particle
-centres, so two bodies touch where their particle layers are one dp apart,
-with a collision envelope of ``distancedp``·dp.
+cloud of its own boundary particles, as the smooth surface DualSPHysics's Chrono
+collides (the triangle mesh of ``modelfile="AutoActual"``): the surface
+particles' tangent planes dp/2 in front of them on flat faces, spheres of radius
+dp/2 at edges and corners (:func:`sphdvi.dvi.collision.cloud_surface`), so two
+flat faces touch where their particle layers are one dp apart whatever the
+particles' lateral alignment, with a collision envelope of ``distancedp``·dp.
 
 Links map one to one: ``link_hinge`` → hinge, ``link_spheric`` → spherical,
 ``link_pointline`` → point-line (``rotvector``/``rotvector2`` lock rotations),
@@ -167,7 +169,10 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
             if spec is not None and name not in materials:
                 materials[name] = spec
             centre = np.asarray(body["pos"], float)
-            shapes.append({"shape": "cloud", "points": pts - centre, "radius": 0.5 * dp, "material": name})
+            shape = {"shape": "cloud", "points": pts - centre, "radius": 0.5 * dp, "material": name}
+            if is2d:
+                shape["plane_normal"] = (0.0, 1.0, 0.0)     # surface normals in the x-z plane
+            shapes.append(shape)
         body["shapes"] = shapes
         bodies.append(body)
         mkbounds.append(mkb)

@@ -28,8 +28,9 @@ h = 1e-3); Coulomb dampers are boxed rows.
 Public API
 ----------
 ``System(gravity=(0,0,-9.81), solver="bb", max_iter=100, tol=1e-10, omega=1.0,
-recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.01, contactmethod="nsc",
-smc_model="hertz", position_projection=False)``
+recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.15, contactmethod="nsc",
+smc_model="hertz", position_projection=False, spring_integration="auto", sliding_passes=4,
+sliding_tol=1e-4, residual_warning=0.1)``
 
 * solver: "psor" (projected Gauss–Seidel), "apgd" (Nesterov, adaptive step,
   restart), "bb" (Barzilai–Borwein spectral projected gradient, non-monotone;
@@ -38,11 +39,20 @@ smc_model="hertz", position_projection=False)``
   stiff or badly scaled mechanisms; "minres" is an alias).  ``tol`` is a
   velocity residual (m/s, see :mod:`sphdvi.dvi.solvers`).
 * contactmethod: "nsc" (complementarity: Coulomb cone, Newton restitution
-  above ``min_bounce_speed``) or "smc" (penalty: Hertz or Hooke with Young's
-  modulus, Poisson ratio, restitution); DualSPHysics's 0/1 are accepted.
-* envelope: contacts are created for gaps below it.  Note the convexified CCP
-  lets a sliding contact separate by about h·μ·v_t per step; keep the
-  envelope above that.
+  where the rebound speed e·|v_n| exceeds ``min_bounce_speed``, Chrono's 0.15 m/s
+  default) or "smc" (penalty: Hertz or Hooke with Young's modulus, Poisson ratio,
+  restitution); DualSPHysics's 0/1 are accepted.
+* envelope: contacts are created for gaps below it.
+* sliding_passes, sliding_tol: the convexified CCP alone (Chrono NSC's) makes a
+  sliding contact separate at a *speed* μ‖v_t‖/(1 + μ²) whatever h (a box at rest on
+  a plane given v0 hops (0.4 v0)²/2g at μ = 0.5; in steady sliding it rides h·μ·v_t
+  above the surface); each normal row therefore gets + μ‖v_t⁺‖ (De Saxcé's
+  correction, Chrono::Multicore's SLIDING mode), v_t⁺ predicted from the warm start
+  and refined by warm-started re-solves until it changes by less than sliding_tol
+  m/s (at most sliding_passes solves; 0 = the plain CCP).  A sliding box stays on
+  the plane (lift < 1e-6 m).
+* residual_warning: a solver residual above it (m/s) for 10 steps in a row is
+  warned about once per episode (``take_warnings()``; run.log in a CLI run).
 * position_projection: project positions onto the joint constraints after
   each step (drift-free closed loops).
 
@@ -60,8 +70,10 @@ Bodies, materials, shapes:
 * ``add_shape(body, shape, size, pos, quat, material, points, radius, local=True) -> int``
   with shape "sphere" (r), "box" (half extents), "capsule" (r, half length,
   axis z), "cylinder" (r, half length, axis z), "plane", "hull" (convex hull of
-  ``points``), "cloud" (sphere cloud: ``points`` + ``radius``, e.g. a body's
-  particles with r = dp/2).  Shortcuts: ``add_sphere``, ``add_box``,
+  ``points``), "cloud" (a body's particles: ``points`` + ``radius``, r = dp/2; its
+  flat faces collide as their tangent planes dp/2 in front of the surface particles,
+  edges, corners and curved parts as spheres: ``collision.cloud_surface``;
+  ``plane_normal`` for a 2D cloud).  Shortcuts: ``add_sphere``, ``add_box``,
   ``add_capsule``, ``add_cylinder``, ``add_hull``, ``add_cloud``,
   ``add_plane(point, normal, body=-1, material)``.
 
@@ -93,8 +105,12 @@ Stepping and state:
   contacts and joint reactions, world, about the centre), ``contact_force``/
   ``contact_torque`` (contact part), ``link_force``/``link_torque`` (nlinks,3):
   reaction on body 1 in the world frame, torque about the link point on body
-  1 (for springs/dampers the element force on body 1).
-* ``last_iterations``, ``last_residual``, ``n_contacts``, ``n_rows``,
+  1 (for springs/dampers the element force on body 1, a preload included).  The
+  opposite sign of Chrono's ChLink::GetReaction2 (and of the ADAMS Rforce its joint
+  tests compare with: the wrench on body 2) and in the world frame, not link frame 2:
+  to compare with DSPH+Chrono's ChronoLink_forces.csv or ADAMS, negate it and rotate.
+* ``last_iterations`` (all passes), ``last_residual``, ``n_contacts``, ``n_rows``,
+  ``take_warnings()``,
   ``constraint_violation()``, ``kinetic_energy()``, ``potential_energy()``,
   ``set_velocity(body, vel, omega)``, ``set_external_load(body, force, torque)``,
   ``get_state()``/``set_state(st)`` (predictor–corrector couplings),

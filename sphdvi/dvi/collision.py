@@ -14,7 +14,8 @@ PLANE      -                                           half-space z_local ≤ 0 
                                                        solid, normal = local +z
 HULL       -                                           convex hull of vertices:
                                                        vertices + facet planes
-CLOUD      (r, -, -)                                   sphere cloud (particles)
+CLOUD      (r, lattice spacing, -)                     particle cloud: smooth
+                                                       surface (cloud_surface)
 =========  =========================================  ===========================
 
 Generic narrow phase ("samples against signed distance"): every shape has body
@@ -28,10 +29,16 @@ axes + clipping of the incident face, ≤ 4 points), cylinder–plane (exact rim
 support point per cap), and box/hull pairs (separating-axis test over face
 normals and edge cross products: culls separated pairs and adds the edge–edge
 contact when an edge pair is the axis of least penetration; skipped above
-4096 edge pairs).  Sphere clouds are searched through a body-frame cell grid
-(O(1) per query).  Limitations: cylinder–box/hull and cylinder–cylinder rely on
-16 rim samples per cap (no exact rim–edge contact); no rolling/spinning
-friction.
+4096 edge pairs).  Particle clouds are searched through a body-frame cell grid
+(O(1) per query) and collided as a smooth surface, not a union of spheres (DualSPHysics's
+Chrono collides a triangle mesh): only surface particles are kept; a flat face's particle
+is its tangent plane r in front of it, an edge or corner particle its sphere
+(:func:`_cloud_query`); of two clouds, every sample of the smaller is tested against the
+other's surface and the other's edge and corner particles against the smaller's faces.
+A cloud against a sphere uses the sphere's exact SDF.  Limitations:
+cylinder–box/hull and cylinder–cylinder rely on 16 rim samples per cap (no
+exact rim–edge contact); a cloud's staircase (sloping or curved lattice
+surface) is collided as spheres; no rolling/spinning friction.
 """
 import math
 
@@ -202,11 +209,12 @@ def broad_phase(lo, hi, sh_body, sh_type, body_active, pairs, w_pos, w_R, env):
 # ---------------------------------------------------------- signed distances
 @njit(cache=True)
 def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes,
-              cg_meta, cg_start, reach):
+              cg_meta, cg_start, reach, samp_nrm, xflag, plane_only):
     """Signed distance and outward unit gradient (tuple) of shape s at the
-    local point q (tuple).  For a sphere cloud only centres closer than
-    ``reach`` are searched (body-frame cell grid); beyond, ``reach − r`` is
-    returned."""
+    local point q (tuple).  A particle cloud is its smooth surface
+    (:func:`_cloud_query`, for a sample of flag ``xflag``); only particles
+    near ``reach`` are searched (body-frame cell grid); beyond, ``reach − r``
+    is returned."""
     if t == SPHERE:
         n = math.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2)
         if n < 1e-14:
@@ -263,20 +271,27 @@ def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, plane
                 best = d
                 g = (planes[p, 0], planes[p, 1], planes[p, 2])
         return best, g
-    # CLOUD: union of spheres, searched in the body-frame cell grid
+    # CLOUD: the smooth particle surface (see _cloud_query)
+    return _cloud_query(q, s, dims, samp_off, samp_pts, samp_nrm, cg_meta, cg_start, reach,
+                        xflag, plane_only)
+
+
+@njit(cache=True)
+def _scan_cells(q, s, samp_off, samp_pts, cg_meta, cg_start, kin, kout, best, bj):
+    """Nearest particle of cloud s to q over the grid cells whose Chebyshev distance
+    from q's cell lies in (kin, kout] (kin = -1: all of them); returns (d², index)."""
     ox, oy, oz, cs = cg_meta[s, 0], cg_meta[s, 1], cg_meta[s, 2], cg_meta[s, 3]
     nx, ny, nz = int(cg_meta[s, 4]), int(cg_meta[s, 5]), int(cg_meta[s, 6])
     base = int(cg_meta[s, 7])
-    kr = int(math.ceil(reach / cs))
     ix = int(math.floor((q[0] - ox) / cs))
     iy = int(math.floor((q[1] - oy) / cs))
     iz = int(math.floor((q[2] - oz) / cs))
-    best = reach * reach
-    g = (0.0, 0.0, 1.0)
     off = samp_off[s]
-    for cx in range(max(ix - kr, 0), min(ix + kr, nx - 1) + 1):
-        for cy in range(max(iy - kr, 0), min(iy + kr, ny - 1) + 1):
-            for cz in range(max(iz - kr, 0), min(iz + kr, nz - 1) + 1):
+    for cx in range(max(ix - kout, 0), min(ix + kout, nx - 1) + 1):
+        for cy in range(max(iy - kout, 0), min(iy + kout, ny - 1) + 1):
+            for cz in range(max(iz - kout, 0), min(iz + kout, nz - 1) + 1):
+                if max(abs(cx - ix), max(abs(cy - iy), abs(cz - iz))) <= kin:
+                    continue
                 cell = base + (cx * ny + cy) * nz + cz
                 for p in range(off + cg_start[cell], off + cg_start[cell + 1]):
                     v0 = q[0] - samp_pts[p, 0]
@@ -285,12 +300,62 @@ def sdf_local(t, dims, q, s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, plane
                     d2 = v0 * v0 + v1 * v1 + v2 * v2
                     if d2 < best:
                         best = d2
-                        n = math.sqrt(d2)
-                        if n < 1e-14:
-                            g = (0.0, 0.0, 1.0)
-                        else:
-                            g = (v0 / n, v1 / n, v2 / n)
-    return math.sqrt(best) - dims[0], g
+                        bj = p
+    return best, bj
+
+
+@njit(cache=True)
+def _cloud_query(q, s, dims, samp_off, samp_pts, samp_nrm, cg_meta, cg_start, reach, xflag,
+                 plane_only):
+    """Signed distance and outward unit normal of a particle cloud's surface at the local
+    point q (in place of the triangle mesh DualSPHysics's Chrono collides, JChronoObjects:
+    modelfile AutoActual): the nearest surface particle j (interior particles are not in the
+    cloud) gives the surface.  Flat j (``samp_nrm[j, 3]`` 1 = one-sided, 2 = two-sided sheet):
+    its tangent plane, dims[0] (r) in front of the particle along its normal n_j, so that two
+    flat faces touch at a layer distance of exactly r1 + r2 whatever the lateral alignment of
+    the particles, with a constant normal; beyond the particle's patch (lateral distance over
+    dims[1]/√2, only past the rim of a face) it is rounded.  Feature j (edge, corner, curved or
+    irregular particle): its sphere of radius r, taken only when the querying sample is itself
+    a feature (``xflag`` 0) and not ``plane_only``; a flat sample against a feature is the
+    reverse query's (feature sample against the other body's plane).  No contact: reach − r."""
+    r = dims[0]
+    sp = dims[1] if dims[1] > 0.0 else 2.0 * r
+    R = reach + sp
+    cs = cg_meta[s, 3]
+    kr = int(math.ceil(R / cs))
+    k0 = min(kr, 2)
+    best, bj = _scan_cells(q, s, samp_off, samp_pts, cg_meta, cg_start, -1, k0, R * R, -1)
+    if k0 < kr and best > (k0 * cs) ** 2:
+        best, bj = _scan_cells(q, s, samp_off, samp_pts, cg_meta, cg_start, k0, kr, best, bj)
+    none = (reach - r, (0.0, 0.0, 1.0))
+    if bj < 0:
+        return none
+    v0 = q[0] - samp_pts[bj, 0]
+    v1 = q[1] - samp_pts[bj, 1]
+    v2 = q[2] - samp_pts[bj, 2]
+    fl = samp_nrm[bj, 3]
+    if fl > 0.5:
+        n0, n1, n2 = samp_nrm[bj, 0], samp_nrm[bj, 1], samp_nrm[bj, 2]
+        h = v0 * n0 + v1 * n1 + v2 * n2
+        if fl > 1.5 and h < 0.0:
+            n0, n1, n2, h = -n0, -n1, -n2, -h
+        if h <= 0.0:
+            return h - r, (n0, n1, n2)
+        lat = math.sqrt(max(best - h * h, 0.0))
+        e = lat - sp * 0.7072
+        if e <= 0.0:
+            return h - r, (n0, n1, n2)
+        t0 = (v0 - h * n0) / lat
+        t1 = (v1 - h * n1) / lat
+        t2 = (v2 - h * n2) / lat
+        d = math.sqrt(h * h + e * e)
+        return d - r, ((h * n0 + e * t0) / d, (h * n1 + e * t1) / d, (h * n2 + e * t2) / d)
+    if plane_only or xflag > 0.5:
+        return none
+    d = math.sqrt(best)
+    if d < 1e-14:
+        return -r, (0.0, 0.0, 1.0)
+    return d - r, (v0 / d, v1 / d, v2 / d)
 
 
 # ------------------------------------------------------------- contact output
@@ -579,10 +644,12 @@ def _closest_segments_t(p1, q1, p2, q2):
 def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
                     sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
                     pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo, hi, sh_body,
-                    c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+                    c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, samp_nrm, features_only):
     """Samples of shape sp (radius ρ) against the SDF of shape so.  The contact
     normal is −∇φ_so (from sp to so); ``swap`` reverses the pair order so that
-    the normal is always from the pair's first shape to its second."""
+    the normal is always from the pair's first shape to its second.
+    ``features_only``: only the feature samples of a cloud (edges, corners),
+    against the flat surface of the other cloud (the reverse query)."""
     cP = row3(w_pos, sp)
     RP = w_R[sp]
     cO = row3(w_pos, so)
@@ -592,6 +659,9 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
     dims = sh_dims[so]
     reach = rho + dims[0] + max(env, 0.0) + 1e-12
     for p in range(samp_off[sp], samp_off[sp] + samp_cnt[sp]):
+        xflag = samp_nrm[p, 3]
+        if features_only and xflag > 0.5:
+            continue
         x = v_add(cP, mat_vec(RP, row3(samp_pts, p)))
         # AABB cull against the other shape
         out = False
@@ -603,7 +673,8 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
             continue
         ql = mat_t_vec(RO, v_sub(x, cO))
         phi, gl = sdf_local(to, dims, ql, so, samp_off, samp_cnt, samp_pts,
-                            pl_off, pl_cnt, planes, cg_meta, cg_start, reach)
+                            pl_off, pl_cnt, planes, cg_meta, cg_start, reach, samp_nrm, xflag,
+                            features_only)
         gap = phi - rho
         if gap >= env:
             continue
@@ -756,9 +827,12 @@ def _point_like(t):
 @njit(cache=True)
 def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cnt,
                  samp_pts, samp_rad, pl_off, pl_cnt, planes, cg_meta, cg_start, edges, ed_off,
-                 ed_cnt, w_pos, w_R, lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+                 ed_cnt, w_pos, w_R, lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key,
+                 samp_nrm):
     """All contacts of the candidate pairs with gap < env.  Returns the count
-    (which may exceed the capacity: the caller then grows and calls again)."""
+    (which may exceed the capacity: the caller then grows and calls again).
+    ``samp_nrm``: per sample, a cloud particle's outward normal and flag
+    (:func:`cloud_surface`; zero for other shapes' samples)."""
     cap = c_a.shape[0]
     nc = 0
     ns = sh_type.shape[0]
@@ -825,30 +899,36 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                                          w_R, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
         pl1 = _point_like(t1)
         pl2 = _point_like(t2)
+        rev_a = False
+        rev_b = False
         if pl1 and pl2:
-            # two point-like shapes: sample the cloud against the sphere's O(1)
-            # SDF, or the smaller cloud against the other cloud's grid
+            # the cloud's samples against the sphere's exact SDF; of two clouds,
+            # every sample of the smaller against the other's smooth surface, and
+            # the other's feature samples (edges, corners) against the smaller's
+            # flat faces
             if t1 == SPHERE or (t2 == CLOUD and samp_cnt[s1] > samp_cnt[s2]):
                 dir_a = False
                 dir_b = True
+                rev_a = t1 == CLOUD and t2 == CLOUD
             else:
                 dir_a = True
                 dir_b = False
+                rev_b = t1 == CLOUD and t2 == CLOUD
         else:
             dir_a = t1 != PLANE and (pl1 or not pl2)
             dir_b = t2 != PLANE and (pl2 or not pl1)
-        if dir_a:
+        if dir_a or rev_a:
             nc = _samples_vs_sdf(s1, s2, b1, b2, False, nc, cap, env, keybase,
                                  sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
                                  pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo,
                                  hi, sh_body,
-                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-        if dir_b:
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, samp_nrm, rev_a)
+        if dir_b or rev_b:
             nc = _samples_vs_sdf(s2, s1, b2, b1, True, nc, cap, env, keybase,
                                  sh_type, sh_dims, samp_off, samp_cnt, samp_pts, samp_rad,
                                  pl_off, pl_cnt, planes, cg_meta, cg_start, w_pos, w_R, lo,
                                  hi, sh_body,
-                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, samp_nrm, rev_b)
     return nc
 
 
@@ -946,3 +1026,103 @@ def smc_forces(nc, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, sh_mat, sh_rad, mat_m
         if a >= 0:
             force[a] -= F
             torque_w[a] -= cross(P - pos[a], F)
+
+
+# ------------------------------------------------------------ cloud surface
+FLAT_TOL = 0.05      # flat: the lattice neighbours lie within this × spacing of the tangent plane
+SHIFT_MIN = 0.15     # surface: the neighbours' centroid is off the particle by this × spacing
+
+
+def _pair_sums(i, w, n):
+    """Per particle sums of the rows of w (pairs (i, ·)): bincount per column."""
+    w = w.reshape(w.shape[0], -1)
+    return np.stack([np.bincount(i, weights=w[:, k], minlength=n) for k in range(w.shape[1])], axis=1)
+
+
+def cloud_surface(points, radius, plane_normal=None):
+    """Surface particles of a particle cloud and their outward normals (set-up, once).
+
+    DualSPHysics's Chrono collides a body as a triangle mesh of its surface (JChronoObjects,
+    modelfile AutoActual/AutoDp): flat faces, whatever the particles' lateral alignment.  This
+    gives a cloud the same smooth surface, from the particles alone (s = the lattice spacing,
+    the median nearest-neighbour distance):
+
+    - surface: the centroid of the neighbours within 1.8 s is more than SHIFT_MIN·s off the
+      particle (a face, edge or corner of a filled body), or the neighbours within 1.2 s form a
+      single layer (a one-layer wall or floor); the other particles are interior and are dropped;
+    - flat: the surface neighbours within 1.2 s (a lattice's first neighbours; a face's particle
+      next to an edge keeps only those of its face), less those more than s/2 along the centroid
+      offset (the layer behind a plate's particle), span a plane through the particle within
+      FLAT_TOL·s: its normal n (least eigenvector of their covariance) is the face's;
+      and the neighbours' centroid is not off the particle along the face (the rim of a
+      one-layer sheet is not flat);
+    - side: n points to the side with no particle along the normal line (within 0.5 s of it,
+      0.5..1.5 s away); open on both sides: a two-sided sheet; on neither: a feature;
+    - the rest (edges, corners, curved or irregular surfaces) are features, collided as spheres.
+
+    ``plane_normal``: the normal of a 2-D case's plane (all particles in it): normals are then
+    taken in that plane.  Returns (surface points (m, 3), (m, 4): normal and flag, s), flag
+    1 = flat one-sided, 2 = flat two-sided, 0 = feature (normal unused)."""
+    from scipy.spatial import cKDTree
+    P = np.asarray(points, float).reshape(-1, 3)
+    n = P.shape[0]
+    out = np.zeros((n, 4))
+    if n < 4:
+        return P.copy(), out, 2.0 * radius
+    tree = cKDTree(P)
+    dnn = tree.query(P, k=2)[0][:, 1]
+    s = float(np.median(dnn[dnn > 0])) if np.any(dnn > 0) else 2.0 * radius
+    pr = tree.query_pairs(1.8 * s, output_type="ndarray")
+    if pr.shape[0] == 0:
+        return P.copy(), out, s
+    I = np.concatenate([pr[:, 0], pr[:, 1]])
+    J = np.concatenate([pr[:, 1], pr[:, 0]])
+    D = P[J] - P[I]
+    dist = np.sqrt((D * D).sum(axis=1))
+    aug = np.zeros((3, 3))
+    if plane_normal is not None:
+        g = np.asarray(plane_normal, float)
+        g = g / np.linalg.norm(g)
+        aug = 100.0 * s * s * np.outer(g, g)     # normals in the plane
+
+    def fit(mask):
+        """Least-eigenvector normal of the offsets D[mask] per particle, eigenvalues."""
+        Dm, Im = D[mask], I[mask]
+        M = np.empty((n, 3, 3))
+        for a in range(3):
+            for b in range(a, 3):
+                M[:, a, b] = M[:, b, a] = np.bincount(Im, weights=Dm[:, a] * Dm[:, b], minlength=n)
+        lam, vec = np.linalg.eigh(M + aug)
+        return lam, vec[:, :, 0]
+
+    cnt = np.bincount(I, minlength=n)
+    shift = _pair_sums(I, D, n) / np.maximum(cnt, 1)[:, None]
+    near = dist < 1.2 * s
+    lam, _ = fit(near)
+    sheet = (lam[:, 0] < 1e-3 * s * s) & (lam[:, 1] > 0.5 * s * s)
+    surf = ((np.sqrt((shift * shift).sum(axis=1)) > SHIFT_MIN * s) | sheet | (cnt < 4)
+            | (lam[:, 1] < 1e-3 * s * s))
+    # flatness of the surface neighbourhood: off a sheet, only the neighbours across the
+    # centroid's direction (not the layer behind the particle: a two-layer plate stays flat)
+    smag = np.sqrt((shift * shift).sum(axis=1))
+    nc = shift / np.maximum(smag, 1e-300)[:, None]
+    across = (smag[I] <= SHIFT_MIN * s) | (np.abs((D * nc[I]).sum(axis=1)) < 0.5 * s)
+    ns = near & surf[J] & across
+    lam, nrm = fit(ns)
+    dev = np.zeros(n)
+    np.maximum.at(dev, I[ns], np.abs((D[ns] * nrm[I[ns]]).sum(axis=1)))
+    tang = shift - (shift * nrm).sum(axis=1)[:, None] * nrm      # off-centre along the face: a rim
+    flat = (surf & (np.bincount(I[ns], minlength=n) >= 2) & (lam[:, 1] > 0.5 * s * s) & (dev < FLAT_TOL * s)
+            & (np.sqrt((tang * tang).sum(axis=1)) < SHIFT_MIN * s))
+    # sidedness: a particle on the normal line 0.5..1.5 s away closes that side
+    h = (D * nrm[I]).sum(axis=1)
+    lat2 = dist * dist - h * h
+    online = (lat2 < 0.25 * s * s) & (np.abs(h) > 0.5 * s) & (np.abs(h) < 1.5 * s)
+    plus = np.bincount(I[online & (h > 0)], minlength=n) > 0
+    minus = np.bincount(I[online & (h < 0)], minlength=n) > 0
+    sign = np.where(minus & ~plus, 1.0, np.where(plus & ~minus, -1.0, 1.0))
+    out[:, :3] = nrm * sign[:, None]
+    out[:, 3] = np.where(flat & (plus ^ minus), 1.0, np.where(flat & ~plus & ~minus, 2.0, 0.0))
+    out[out[:, 3] == 0.0, :3] = 0.0
+    return P[surf].copy(), out[surf].copy(), s
+

@@ -213,6 +213,56 @@ def _natural_residual(z, g, s, kind, mu, lo, hi, tmp):
     return res
 
 
+# ------------------------------------------------------- sliding correction
+@njit(cache=True)
+def sliding_speeds(nr, ra, rb, J, kind, mu, gdiag, v, s):
+    """De Saxcé's sliding term of each friction triplet, ``s_k = μ_k ‖(J_u v, J_w v)‖`` on its
+    normal row k (0 elsewhere and on rows that cannot act), at the velocities ``v``: Chrono::
+    Multicore's ChConstraintRigidRigid::Build_s (``fric · sqrt(s_v² + s_w²)`` of ``D_tᵀ v``).
+    Added to the normal row's right-hand side it cancels the separation speed ``u_n = μ‖u_t‖``
+    that the convexified (associated) Coulomb law of the CCP gives a sliding contact."""
+    for k in range(nr):
+        s[k] = 0.0
+    k = 0
+    while k < nr:
+        if kind[k] != FRIC_N:
+            k += 1
+            continue
+        if gdiag[k] < 1e300:
+            a = ra[k]
+            bb = rb[k]
+            su = 0.0
+            sw = 0.0
+            if a >= 0:
+                for c in range(6):
+                    su += J[k + 1, c] * v[a, c]
+                    sw += J[k + 2, c] * v[a, c]
+            if bb >= 0:
+                for c in range(6):
+                    su += J[k + 1, 6 + c] * v[bb, c]
+                    sw += J[k + 2, 6 + c] * v[bb, c]
+            s[k] = mu[k] * math.sqrt(su * su + sw * sw)
+        k += 3
+
+
+@njit(cache=True)
+def row_residuals(nr, ra, rb, J, b, E, kind, mu, lo, hi, gdiag, gamma, v, out):
+    """Per-row natural-map residual (velocity units, as the solvers' ``res``) of the impulses
+    ``gamma`` with the velocities ``v = v_free + M⁻¹ Dᵀ γ``: ``u = J v + b + E γ``, then
+    ``s_k |z − Π(z − u/s)|_k`` with ``z = s γ``, ``s = √diag``."""
+    u = np.empty(nr)
+    rows_times_v(nr, ra, rb, J, v, u)
+    s = np.sqrt(gdiag[:nr])
+    z = np.empty(nr)
+    tmp = np.empty(nr)
+    for k in range(nr):
+        z[k] = gamma[k] * s[k]
+        tmp[k] = z[k] - (u[k] + b[k] + E[k] * gamma[k]) / s[k]
+    project_all(tmp, kind[:nr], mu[:nr], lo[:nr], hi[:nr], s)
+    for k in range(nr):
+        out[k] = abs(z[k] - tmp[k]) * s[k] if gdiag[k] < 1e300 else 0.0
+
+
 # ----------------------------------------------------------------------- PSOR
 @njit(cache=True)
 def solve_psor(nr, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, v,

@@ -21,12 +21,19 @@ from . import rows as rw
 from ._math import (body_rotations, frame_from_axis, integrate_bodies, np_mat_to_quat,
                     np_quat_to_mat)
 from ._kernels import apply_dof_masks, free_velocity, link_point_torques
-from .solvers import SOLVER_ALIASES, SOLVER_NAMES, prepare_rows, solve_ccp, solve_direct
+from .solvers import (SOLVER_ALIASES, SOLVER_NAMES, prepare_rows, row_residuals, scatter_impulses,
+                      sliding_speeds, solve_ccp, solve_direct)
 
 FLOATING = 0
 FIXED = 1
 MOVING = 2
 _BODY_KINDS = {"floating": FLOATING, "free": FLOATING, "fixed": FIXED, "moving": MOVING}
+
+# consecutive steps with the solver's residual above System.residual_warning before it warns
+RESIDUAL_WARN_STEPS = 10
+# a change of the sliding term below this many times the solver's residual ends the sliding
+# passes (System._solve_rows): it is the unconverged solve's noise, not sliding
+SLIDING_RES_FACTOR = 2.0
 
 _MATE_MASKS = {
     # (tx, ty, tz, rx, ry, rz) constrained = 1; the free axis of a joint is z
@@ -110,19 +117,37 @@ class System:
     omega : PSOR relaxation.
     recovery_speed : max penetration/violation recovery speed (m/s).
     envelope : collision envelope (m): contacts are created for gaps below it.
-    min_bounce_speed : restitution applies only above this approach speed (m/s).
+    min_bounce_speed : restitution applies only where the rebound speed e·|v_n| exceeds it
+        (m/s; Chrono's ChSystem default 0.15, compared as ChContactNSC does).
+    sliding_passes : CCP solves per step at most for the sliding correction (0: none, the
+        plain convexified CCP of Chrono NSC, whose sliding contacts lift off at μ‖v_t‖/(1+μ²)):
+        each contact's normal row gets ``+ μ‖v_t‖`` (De Saxcé; Chrono::Multicore's Build_s),
+        ``v_t`` first the smaller of the warm start's prediction and the pre-step value,
+        then the previous pass's solution (warm-started re-solve) until it changes by less
+        than ``sliding_tol`` (m/s) or twice the solver's residual (:meth:`_solve_rows`).
+    residual_warning : a solver residual (m/s) above this for RESIDUAL_WARN_STEPS steps in a
+        row (an unconverged or infeasible problem: imposed velocities driving into a wall,
+        conflicting joints) is warned about once per such episode (``take_warnings``).
     contactmethod : "nsc" (complementarity) or "smc" (penalty, Hertz/Hooke).
     smc_model : "hertz" or "hooke".
     position_projection : after each step, project the positions back onto
         the rigid joint constraints (minimum mass-weighted displacement,
         Chrono's EULER_IMPLICIT_PROJECTED idea; one extra solve).  Removes
         the O(h²v²/L) drift of the velocity-level stabilisation.
+
+    After a step, ``link_force``/``link_torque`` (nlinks, 3) hold each link's reaction on body
+    1 in the world frame, the torque about the link point on body 1 (a spring's or damper's
+    element force on body 1, its preload included): the opposite sign of Chrono's
+    ChLink::GetReaction2 (the wrench on body 2, in link frame 2) and of the ADAMS Rforce that
+    Chrono's joint tests compare it with (audit g: Revolute_Case01 at t = 0.96 s, ADAMS
+    (−9.110, 0, −25.679), sphdvi (9.094, 0, 25.693)).  links.csv writes them as they are.
     """
 
     def __init__(self, gravity=(0.0, 0.0, -9.81), solver="bb", max_iter=100, tol=1e-10,
-                 omega=1.0, recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.01,
+                 omega=1.0, recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.15,
                  contactmethod="nsc", smc_model="hertz", position_projection=False,
-                 spring_integration="auto"):
+                 spring_integration="auto", sliding_passes=4, sliding_tol=1e-4,
+                 residual_warning=0.1):
         self.gravity = np.asarray(gravity, dtype=np.float64)
         key = str(solver).lower().replace("_", "").replace("-", "")
         if key not in SOLVER_ALIASES:
@@ -134,6 +159,14 @@ class System:
         self.recovery_speed = float(recovery_speed)
         self.envelope = float(envelope)
         self.min_bounce_speed = float(min_bounce_speed)
+        self.sliding_passes = int(sliding_passes)
+        self.sliding_tol = float(sliding_tol)
+        self.residual_warning = float(residual_warning)
+        self.pending_warnings = []      # lines for run.log (take_warnings)
+        self.defer_warnings = False     # True: only queued (a run loop logs and prints them)
+        self._res_high = 0              # consecutive steps with the residual above residual_warning
+        self._res_warned = False
+        self._preload_links = []        # (link, force on body 1, torque about its centre) of preload-only springs
         if isinstance(contactmethod, (int, np.integer)):  # DualSPHysics: 0 = NSC, 1 = SMC
             contactmethod = ("nsc", "smc")[int(contactmethod)]
         self.contactmethod = str(contactmethod)
@@ -184,6 +217,7 @@ class System:
         self.samp_cnt = np.zeros(0, np.int32)
         self.samp_rad = np.zeros(0)
         self.samp_pts = np.zeros((0, 3))
+        self.samp_nrm = np.zeros((0, 4))     # cloud particles: outward normal, flag (col.cloud_surface)
         self.pl_off = np.zeros(0, np.int32)
         self.pl_cnt = np.zeros(0, np.int32)
         self.planes = np.zeros((0, 4))
@@ -239,6 +273,10 @@ class System:
         torque) replacing them at each step's end time (DualSPHysics's
         <linearforce>/<angularforce> tables)."""
         k = _BODY_KINDS[kind] if isinstance(kind, str) else int(kind)
+        if k == FIXED and (np.any(np.asarray(vel, float) != 0) or np.any(np.asarray(omega, float) != 0)):
+            raise ValueError(f"body {name if name is not None else self.nb}: a fixed body cannot have a "
+                             f"velocity (vel={tuple(vel)}, omega={tuple(omega)}); use kind='moving' "
+                             "for a body that moves on its own")
         I = np.asarray(inertia, dtype=np.float64)
         if I.ndim == 1:
             I = np.diag(I)
@@ -312,15 +350,17 @@ class System:
 
     # -------------------------------------------------------------- shapes
     def add_shape(self, body, shape, size=(0, 0, 0), pos=(0, 0, 0), quat=(1, 0, 0, 0),
-                  material=None, points=None, radius=0.0, local=True):
+                  material=None, points=None, radius=0.0, local=True, plane_normal=None):
         """Attach a collision shape to ``body`` (-1: the world).
 
         shape: "sphere" (size=(r,)), "box" (size = half extents), "capsule"
         (r, half length along local z), "cylinder" (r, half length along z),
         "plane" (solid below local z = 0; use :meth:`add_plane`), "hull"
         (``points`` = vertices of a mesh, convex hull taken), "cloud"
-        (``points`` = sphere centres, ``radius``).  pos/quat: shape pose in
-        the body frame (``local=True``) or in the world frame."""
+        (``points`` = sphere centres, ``radius``; collided as their smooth
+        surface, :func:`collision.cloud_surface`; ``plane_normal``: the plane of
+        a 2-D case).  pos/quat: shape pose in the body frame (``local=True``)
+        or in the world frame."""
         t = col.SHAPE_NAMES[shape] if isinstance(shape, str) else int(shape)
         size = np.atleast_1d(np.asarray(size, float)).ravel()[:3]
         dims = np.zeros(3)
@@ -368,11 +408,12 @@ class System:
             edges = self._hull_edges(hull)
             crad = 0.5 * float(np.min(samples.max(0) - samples.min(0)))
         elif t == col.CLOUD:
-            samples = np.asarray(points, float).reshape(-1, 3)
             dims[0] = radius if radius > 0 else dims[0]
+            samples, snrm, dims[1] = col.cloud_surface(points, dims[0], plane_normal)
             srad = dims[0]
             crad = dims[0]
-            samples, meta, starts = self._cloud_grid(samples, dims[0])
+            samples, meta, starts = self._cloud_grid(np.hstack([samples, snrm]), dims[0])
+            samples, snrm = samples[:, :3].copy(), samples[:, 3:].copy()
         else:
             raise ValueError(f"unknown shape {shape!r}")
         self.sh_body = np.append(self.sh_body, np.int32(body)).astype(np.int32)
@@ -386,6 +427,7 @@ class System:
         self.samp_cnt = np.append(self.samp_cnt, np.int32(samples.shape[0])).astype(np.int32)
         self.samp_rad = np.append(self.samp_rad, srad)
         self.samp_pts = np.vstack([self.samp_pts, samples])
+        self.samp_nrm = np.vstack([self.samp_nrm, snrm if t == col.CLOUD else np.zeros((samples.shape[0], 4))])
         self.pl_off = np.append(self.pl_off, np.int32(self.planes.shape[0])).astype(np.int32)
         self.pl_cnt = np.append(self.pl_cnt, np.int32(planes.shape[0])).astype(np.int32)
         self.planes = np.vstack([self.planes, planes])
@@ -419,10 +461,11 @@ class System:
     @staticmethod
     def _cloud_grid(pts, r):
         """Body-frame cell grid of a sphere cloud (cell = 2r): points sorted by
-        cell, meta = (origin xyz, cell size, nx, ny, nz, base), cell starts."""
+        cell, meta = (origin xyz, cell size, nx, ny, nz, base), cell starts.
+        Columns past the third (per-point data) are sorted along."""
         cs = max(2.0 * r, 1e-12)
-        org = pts.min(axis=0) - 1e-9
-        ijk = np.floor((pts - org) / cs).astype(np.int64)
+        org = pts[:, :3].min(axis=0) - 1e-9
+        ijk = np.floor((pts[:, :3] - org) / cs).astype(np.int64)
         nxyz = ijk.max(axis=0) + 1
         cid = (ijk[:, 0] * nxyz[1] + ijk[:, 1]) * nxyz[2] + ijk[:, 2]
         order = np.argsort(cid, kind="stable")
@@ -703,8 +746,17 @@ class System:
         for i, k in self._mate_timedep:
             self.m_k[i, k] = _eval(M[i]["k"][k], t_next)
             self.m_c[i, k] = _eval(M[i]["c"][k], t_next)
+        h = t_next - self.time
         for i, k in self._motors:
-            self.m_mval[i, k] = _eval(M[i]["mtarget"][k], t_next)
+            target = M[i]["mtarget"][k]
+            if self.m_mmode[i, k] == rw.MOTOR_POSITION:
+                # error against the target now, the target's rate over the step apart
+                # (ChLinkMotorRotationAngle: C clamped by the recovery speed, Ct unclamped)
+                now = _eval(target, self.time)
+                self.m_mval[i, k] = now
+                self.m_mdval[i, k] = (_eval(target, t_next) - now) / h if h > 0 else 0.0
+            else:
+                self.m_mval[i, k] = _eval(target, t_next)
         for j, s in enumerate(self._springs):
             if callable(s["k"]):
                 self.s_k[j] = s["k"](t_next)
@@ -806,7 +858,7 @@ class System:
                                   self.samp_rad, self.pl_off, self.pl_cnt, self.planes,
                                   self.cg_meta, self.cg_start, self.edges, self.ed_off,
                                   self.ed_cnt, w_pos, w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
-                                  c["n"], c["gap"], c["key"])
+                                  c["n"], c["gap"], c["key"], self.samp_nrm)
             if nc <= cap:
                 break
             self._cap_contacts = int(nc * 1.5)
@@ -937,18 +989,12 @@ class System:
         if not nr:                      # no link, no contact: v = v_free (what the solvers return)
             vout[:] = vfree
             it, res = 0, 0.0
-        elif self.solver.lower() == "direct":
-            it, res = solve_direct(nr, nb, self.r_a, self.r_b, self.r_J, self.r_MiJ, self.r_bias,
-                                   self.r_E, self.r_kind, self.r_mu, self.r_lo, self.r_hi,
-                                   self.r_g, g, vfree, vout, self.max_iter, self.tol)
         else:
-            it, res = solve_ccp(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
-                                self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind,
-                                self.r_mu, self.r_lo, self.r_hi, self.r_g, g, vfree, vout,
-                                self.max_iter, self.tol, self.omega)
+            it, res = self._solve_rows(nr, nb, g, vel6, vfree, vout, ncr > 0 and bool((c_mu > 0).any()))
         self.last_iterations = int(it)
         self.last_residual = float(res)
         self.n_rows = nr
+        self._check_residual(nr, g, vout, h)
         # warm-start caches
         self._prev_link_gamma = g[:nl_rows].copy()
         self._prev_h = h
@@ -971,6 +1017,105 @@ class System:
         if self.position_projection and self._mates:
             self._project_positions(invm3, invI)
         return self.pos, self.quat, self.vel, self.omega_world
+
+    def _solve_once(self, nr, nb, g, vfree, vout):
+        """One CCP solve of the rows (warm start and result in ``g``, v⁺ in ``vout``)."""
+        if self.solver.lower() == "direct":
+            return solve_direct(nr, nb, self.r_a, self.r_b, self.r_J, self.r_MiJ, self.r_bias,
+                                self.r_E, self.r_kind, self.r_mu, self.r_lo, self.r_hi,
+                                self.r_g, g, vfree, vout, self.max_iter, self.tol)
+        return solve_ccp(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
+                         self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind,
+                         self.r_mu, self.r_lo, self.r_hi, self.r_g, g, vfree, vout,
+                         self.max_iter, self.tol, self.omega)
+
+    def _solve_rows(self, nr, nb, g, vel6, vfree, vout, friction):
+        """The step's CCP with the sliding correction (De Saxcé's fixed point) on frictional
+        contacts.
+
+        The convexified CCP makes a sliding contact separate at ``u_n = μ‖u_t‖``: a box resting
+        on a plane and pushed at v_t leaves it at μ v_t/(1 + μ²) whatever h (hop (0.4 v_t)²/2g
+        at μ = 0.5).  Each normal row therefore gets ``b_n + s``, ``s = μ‖u_t⁺‖`` (Chrono::
+        Multicore's SLIDING mode, ChConstraintRigidRigid::Build_s; ContactBench's De Saxcé
+        correction): with the exact ``s`` a sliding contact keeps ``J_n v⁺ + b_n = 0`` and the
+        solution is Coulomb's (non-associated) law; where the contact sticks (u_t = 0) nothing
+        changes.  ``s`` is first the smaller of two guesses of μ‖u_t⁺‖: at the velocities the
+        warm start predicts, ``v_free + M⁻¹ Dᵀ γ_warm`` (Multicore's ``v_new = M_invk + M_invD γ``:
+        in steady sliding γ_warm already holds the friction, so that guess is right to O(Δγ)),
+        and at the pre-step velocities (right to O(h) wherever the warm start is poor: in a
+        resting pile solved by 50 PSOR sweeps the first guess reads tangential speeds of 5 cm/s
+        where the solution has 3 mm/s, and took 3 solves a step where this takes 1).  A guess
+        too large lets the normal row approach at the excess, one too small lifts; while the
+        solution's ``μ‖u_t⁺‖`` differs from ``s`` by more than ``sliding_tol`` and
+        SLIDING_RES_FACTOR times the solver's residual (an unconverged solve's u_t is no better:
+        in a resting pile solved by BB with 100 iterations Δs ≈ 1.1–1.6 × residual, and each
+        further pass chased that noise at the cost of a whole solve), the CCP is solved again with it,
+        warm started (a convex problem each time; for one contact the map contracts by
+        μ²/(1+μ²)), at most ``sliding_passes`` solves in all.  A residual error Δs leaves a
+        normal speed Δs, i.e. a hop of Δs²/2g."""
+        if self.sliding_passes <= 0 or not friction:
+            return self._solve_once(nr, nb, g, vfree, vout)
+        args = (nr, self.r_a, self.r_b, self.r_J, self.r_kind, self.r_mu, self.r_g)
+        b0 = self.r_bias[:nr].copy()
+        s = np.empty(nr)
+        vpred = vfree.copy()
+        scatter_impulses(nr, self.r_a, self.r_b, self.r_MiJ, g, vpred)
+        sliding_speeds(*args, vpred, s)
+        s_new = np.empty(nr)
+        sliding_speeds(*args, vel6, s_new)
+        np.minimum(s, s_new, out=s)
+        its = 0
+        for _ in range(self.sliding_passes):
+            self.r_bias[:nr] = b0 + s
+            it, res = self._solve_once(nr, nb, g, vfree, vout)
+            its += it
+            sliding_speeds(*args, vout, s_new)
+            if np.abs(s_new - s).max() <= max(self.sliding_tol, SLIDING_RES_FACTOR * res):
+                break
+            s, s_new = s_new, s
+        return its, res
+
+    def _check_residual(self, nr, g, vout, h):
+        """Warn (once per episode) when the solver's residual has stayed above
+        ``residual_warning`` for RESIDUAL_WARN_STEPS steps: the forces are then not a solution
+        (1e7–1e14 N against a wall that an imposed velocity drives a body into).  The line names
+        the time, the residual and the bodies of the worst rows; it is queued for run.log
+        (:meth:`take_warnings`) and, unless ``defer_warnings``, warned about at once."""
+        if self.last_residual <= self.residual_warning or not nr:
+            self._res_high = 0
+            self._res_warned = False
+            return
+        self._res_high += 1
+        if self._res_high < RESIDUAL_WARN_STEPS or self._res_warned:
+            return
+        self._res_warned = True
+        rr = np.empty(nr)
+        row_residuals(nr, self.r_a, self.r_b, self.r_J, self.r_bias, self.r_E, self.r_kind,
+                      self.r_mu, self.r_lo, self.r_hi, self.r_g, g, vout, rr)
+        worst = np.argsort(rr)[::-1][:8]
+        bodies = []
+        for k in worst:
+            if rr[k] <= self.residual_warning:
+                break
+            for i in (self.r_a[k], self.r_b[k]):
+                name = self.names[i] if i >= 0 else "ground"
+                if name not in bodies:
+                    bodies.append(name)
+        f = np.abs(g[:nr]).max() / h
+        line = (f"multibody solver not converged at t={self.time + h:.6g} s for "
+                f"{self._res_high} steps: residual {self.last_residual:.3g} m/s (above "
+                f"{self.residual_warning:g}) after {self.last_iterations} iterations, largest "
+                f"row force {f:.3g} N; bodies {', '.join(bodies) or '?'}: the constraints conflict "
+                "(an imposed velocity into a wall or a joint, redundant or contradicting links) or "
+                "the solver needs more iterations; the forces are not a solution")
+        self.pending_warnings.append(line)
+        if not self.defer_warnings:
+            warnings.warn(line)
+
+    def take_warnings(self):
+        """The warning lines of the steps since the last call (for run.log)."""
+        lines, self.pending_warnings = self.pending_warnings, []
+        return lines
 
     def _project_positions(self, invm3, invI):
         """Solve  D M⁻¹ Dᵀ λ = −C  on the rigid joint rows at the new pose and
@@ -1010,6 +1155,10 @@ class System:
         integrate_bodies(self.pos, self.quat, d[:, :3].copy(), d[:, 3:].copy(), self.kind, 1.0)
 
     def _spring_preloads(self, R, F, T):
+        """Preloads of springs without stiffness and damping (no row carries them): applied as
+        explicit forces, and kept for the springs' link_force (force on body 1) and link torque
+        (the torque about body 1's centre, so that about the link point it is 0)."""
+        self._preload_links = []
         for s in self._springs:
             if _eval(s["k"], self.time) > 0 or _eval(s["c"], self.time) > 0 or s["f0"] == 0:
                 continue
@@ -1020,6 +1169,7 @@ class System:
             d = P1 - P2
             n = d / max(np.linalg.norm(d), 1e-300)
             f = s["f0"] * n
+            self._preload_links.append((s["lid"], f, np.cross(P1 - x1, f)))
             if s["b1"] >= 0:
                 F[s["b1"]] += f
                 T[s["b1"]] += np.cross(P1 - x1, f)
@@ -1038,6 +1188,9 @@ class System:
         ltc = np.zeros((nl, 3))
         rw.accumulate_row_forces(nr, self.r_a, self.r_b, self.r_J, self.r_gamma, 1.0 / h, R,
                                  self.r_link, nl, cf, ct, lf, ltc, nb, bf, bt)
+        for lid, f, tc in self._preload_links:
+            lf[lid] += f
+            ltc[lid] += tc
         self.contact_force = cf + self._smc_f
         self.contact_torque = ct + self._smc_t
         self.total_force = self._applied_F + bf
@@ -1096,7 +1249,11 @@ class System:
         return np.einsum("nij,nj->ni", R, self.omega_b)
 
     def set_velocity(self, body, vel=None, omega=None):
-        """Set a body's linear and/or angular velocity (world frame)."""
+        """Set a body's linear and/or angular velocity (world frame); a fixed body's stays 0
+        (a non-zero one is refused)."""
+        if self.kind[body] == FIXED and any(v is not None and np.any(np.asarray(v, float) != 0)
+                                            for v in (vel, omega)):
+            raise ValueError(f"body {self.names[body]} is fixed: it cannot be given a velocity")
         if vel is not None:
             self.vel[body] = vel
         if omega is not None:

@@ -55,9 +55,11 @@ def test_coulomb_damper_linear_decay():
         x[i] = s.pos[b, 0] - 1.0
     peaks = [x[i] for i in range(1, n - 1) if x[i] > x[i - 1] and x[i] >= x[i + 1] and x[i] > 0.02]
     drops = -np.diff(peaks)
-    # 4F/k = 0.04 per cycle; backward Euler adds a small proportional decay
+    # 4F/k = 0.04 per cycle, the analytic decrement of a Coulomb-damped oscillator (Den Hartog
+    # 1930): measured within 3.3e-7 of it at h = 1e-4 (the peaks are step samples), so a damper
+    # force off by more than ~0.01 % fails
     assert len(drops) >= 2
-    np.testing.assert_allclose(drops, 4 * F / k, rtol=0.05)
+    np.testing.assert_allclose(drops, 4 * F / k, rtol=1e-4)
     # x0 = 0.3 -> peaks 0.26, 0.22, ...; stops within |x| <= F/k
     for _ in range(int(6.0 / h)):
         s.step(h)

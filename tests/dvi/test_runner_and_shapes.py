@@ -178,11 +178,17 @@ def test_hull_hull_stack_rest():
     s.add_hull(a, cube)
     b = s.add_body(1.0, (h * h * 2 / 3,) * 3, pos=(0.03, 0.02, 3 * h + 0.001))
     s.add_hull(b, cube)
+    Fz = []
     for _ in range(1000):
         s.step(1e-3)
+        Fz.append(s.contact_force[:, 2].sum())
     assert abs(s.pos[a, 2] - h) < 1e-3
     assert abs(s.pos[b, 2] - 3 * h) < 2e-3
-    assert abs(s.contact_force[:, 2].sum() / (2 * G) - 1) < 1e-2
+    # the weight on average over the last 0.2 s: the hull-hull manifold of this offset face
+    # contact has two (diagonal) points, so the top box rocks on that line and the force of a
+    # single step chatters (with or without the sliding correction: 63 % / 84 % of the steps off
+    # by more than 1 %: the single-step check this replaces passed by the luck of the last step)
+    assert abs(np.mean(Fz[-200:]) / (2 * G) - 1) < 1e-2
 
 
 def test_add_after_stepping_and_names():
