@@ -42,6 +42,10 @@ def main():
       sphdvi gencase cases/dambreak2d/CaseDambreakVal2D_Def.xml -o out/dambreak2d
       sphdvi run out/dambreak2d --tmax 0.5
       sphdvi measure points out/dambreak2d --points "0.5,0,0.1" --vars vel,press
+
+    \b
+    Exit codes of every command: 0 success, 1 runtime failure or interruption
+    (SIGINT, SIGTERM, SIGHUP), 2 bad input, 3 a run that diverged.
     """
     import functools
     import warnings
@@ -56,7 +60,7 @@ def main():
 @click.option("--max-nodes", type=click.IntRange(min=1), default=200_000_000, show_default=True,
               help="Refuse drawing domains with more lattice nodes than this.")
 @click.option("--dp", type=FiniteFloat(min=0, min_open=True), default=None,
-              help="Override the particle spacing of <definition dp>.")
+              help="Particle spacing [m], overriding <definition dp> (default: the case's).")
 @click.option("--overwrite", is_flag=True,
               help="Write into an OUT that holds a run's results: they are deleted (a run of another case).")
 @click.option("-q", "--quiet", is_flag=True, help="Print only warnings and errors.")
@@ -73,16 +77,18 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
     from .errors import CaseError
     if not os.path.isfile(case_xml):
         raise CaseError("case file not found", file=case_xml, expected="an existing XML case file")
-    from .io.runfolder import check_new_run_folder, check_other_case, clear_earlier_results, delete_files
+    from .io.runfolder import (check_new_run_folder, check_other_case, clear_earlier_results, delete_files,
+                               run_lock)
     if outdir is None:
         outdir = f"{case_name_from_path(case_xml)}_out"
-    check_new_run_folder(outdir, overwrite, command="gencase")
-    others = check_other_case(outdir, case_name_from_path(case_xml), overwrite)
-    result = build_case(case_xml, outdir, max_nodes=max_nodes, dp=dp)
-    # what --overwrite replaces goes only once the case is built (bad input deletes nothing)
-    delete_files(outdir, others)
-    clear_earlier_results(outdir)
-    files = write_outputs(result, outdir)
+    with run_lock(outdir, "gencase"):       # no run writes into OUT meanwhile
+        check_new_run_folder(outdir, overwrite, command="gencase")
+        others = check_other_case(outdir, case_name_from_path(case_xml), overwrite)
+        result = build_case(case_xml, outdir, max_nodes=max_nodes, dp=dp)
+        # what --overwrite replaces goes only once the case is built (bad input deletes nothing)
+        delete_files(outdir, others)
+        clear_earlier_results(outdir)
+        files = write_outputs(result, outdir)
     print_warnings(result.warnings)
     if not quiet:
         click.echo(summary(result))
@@ -93,14 +99,19 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
 @click.argument("source", type=click.Path())
 @click.option("-o", "--out", "outdir", type=click.Path(file_okay=False), default=None,
               help="Output folder (default: SOURCE when it is a gencase output, else ./<casename>_out).")
-@click.option("--tmax", type=FiniteFloat(min=0), default=None, help="Simulated time [s] (overrides TimeMax).")
+@click.option("--tmax", type=FiniteFloat(min=0), default=None,
+              help="Simulated time [s] (default: the case's TimeMax; not with a --set TimeMax of another value).")
 @click.option("--tout", type=FiniteFloat(min=0, min_open=True), default=None,
-              help="Output interval [s] (overrides TimeOut).")
+              help="Output interval [s] (default: the case's TimeOut or <special><timeout>; not with a --set "
+                   "TimeOut of another value).")
 @click.option("--threads", type=click.IntRange(min=1), default=None,
               help="Threads (default: SLURM_CPUS_PER_TASK or the CPU affinity).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE",
-              help="Override any <parameters> key, e.g. --set Visco=0.05 (repeatable). A file of ViscoTime or "
-                   "DtFixedFile is relative to the current directory (in the XML: to the case's folder).")
+              help="Override an execution parameter, e.g. --set Visco=0.05 (repeatable): any <parameters> key "
+                   "(case-sensitive, as in the XML) and CFLnumber; not the other <constantsdef> constants, "
+                   "the DomainFixed* keys or nested keys (<special>, gauges), which shape what gencase draws "
+                   "(edit the XML). A file of ViscoTime or DtFixedFile is relative to the current directory "
+                   "(in the XML: to the case's folder).")
 @click.option("--resume", is_flag=True,
               help="Continue an interrupted run from its last output, with the --tmax/--tout/--set it was "
                    "started with (--tmax may be raised to extend it).")
@@ -108,9 +119,11 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
               help="Start a new run into an OUT that holds an earlier run's results: they are deleted first, "
                    "with what 'sphdvi export' made of them in OUT's sub-folders.")
 @click.option("--dp", type=FiniteFloat(min=0, min_open=True), default=None,
-              help="With a case XML: override <definition dp> (gencase runs with it). With a gencase folder "
-                   "or --resume, where gencase does not run, only the case's own dp is accepted.")
-@click.option("-q", "--quiet", is_flag=True, help="No progress output.")
+              help="Particle spacing [m]. With a case XML: override <definition dp> (gencase runs with it). "
+                   "With a gencase folder or --resume, where gencase does not run, only the case's own dp is "
+                   "accepted.")
+@click.option("-q", "--quiet", is_flag=True,
+              help="No progress bar or lines, no summary; warnings and errors still print.")
 @report_errors
 def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet):
     """Run a case: SOURCE is a case XML (gencase runs first) or a gencase output folder.
@@ -121,8 +134,15 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
     runs that exclude fluid particles excluded.csv (one row per particle),
     cases with <special><savedt> DtInfo.csv (and DtAllInfo.csv); <special>
     <outputparts> chooses the particles particles.vtkhdf holds.
-    A new run into an OUT holding an earlier run's results needs --overwrite.
-    Exit codes: 0 completed, 1 failed or interrupted, 2 bad input, 3 diverged.
+    A new run into an OUT holding an earlier run's results needs --overwrite;
+    a run holds OUT/.sphdvi.lock while it runs (a second run into OUT is
+    refused). particles.vtkhdf can be read (ParaView, measure, export) while
+    the run writes it. run.json status: running (started, not ended; also
+    what a SIGKILLed run leaves), completed, diverged, interrupted, failed.
+    Progress: a bar on a terminal, else a line every 30 s (t, steps, dt,
+    particles, wall, eta).
+    Exit codes: 0 completed, 1 failed or interrupted (SIGINT, SIGTERM, SIGHUP:
+    resumable), 2 bad input, 3 diverged.
     """
     from .errors import InputError
     from .simulation import _Stop
@@ -135,6 +155,26 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
 
 
 def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
+    """OUT from SOURCE and -o, locked for the command's life (:func:`~sphdvi.io.runfolder.run_lock`:
+    a second run into it is refused), then :func:`_run_locked`."""
+    from .errors import InputError
+    from .io.runfolder import run_command, run_lock
+    is_xml = os.path.isfile(source) and source.lower().endswith(".xml")
+    if outdir is None and is_xml:
+        from .case.reader import case_name_from_path
+        outdir = f"{case_name_from_path(source)}_out"
+    elif outdir is None and os.path.isdir(source):
+        outdir = source
+    if outdir is None or not (is_xml or os.path.isdir(source)):
+        raise InputError(f"{source}: not a case XML file or a gencase output folder")
+    if resume and not os.path.isdir(outdir):
+        raise InputError(f"--resume: {outdir} does not exist: there is no run to continue; start one without "
+                         f"--resume: {run_command(source, outdir, tmax=tmax, tout=tout, sets=sets)}")
+    with run_lock(outdir):
+        _run_locked(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop)
+
+
+def _run_locked(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
     from .errors import InputError
     from .io.runfolder import (SetAside, case_outputs, check_new_run_folder, check_other_case, earlier_exports,
                                earlier_results, restored_on_bad_input)
@@ -144,11 +184,7 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
     if os.path.isfile(source) and source.lower().endswith(".xml"):
         from .case.gencase import build_case, write_outputs
         from .case.reader import case_name_from_path
-        outdir = outdir or f"{case_name_from_path(source)}_out"
         if resume:
-            if not os.path.isdir(outdir):
-                raise InputError(f"--resume: {outdir} does not exist: there is no run to continue; start one "
-                                 "without --resume")
             case_h5 = find_case_file(outdir)
             _check_resume_source(source, case_h5, outdir)
             drawn_dp = dp
@@ -213,9 +249,9 @@ def _check_resume_source(case_xml: str, case_h5: str, outdir: str) -> None:
               help="Write the free surface (kernel-sum isosurface) of every output time instead: "
                    "Iso_XXXX.vtp + isosurface.pvd (needs vtk).")
 @click.option("--iso-spacing", type=FiniteFloat(min=0, min_open=True), default=None,
-              help="Isosurface grid spacing (default dp/2).")
+              help="Isosurface grid spacing [m] (default dp/2).")
 @click.option("--iso-threshold", type=FiniteFloat(min=0, min_open=True), default=None,
-              help="Kernel-sum level of the surface (default 0.5 in 3D, 0.4 in 2D).")
+              help="Kernel-sum level of the surface, no unit (default 0.5 in 3D, 0.4 in 2D).")
 @report_errors
 def export(outdir, fmt, subdir, isosurface, iso_spacing, iso_threshold):
     """Export particles.vtkhdf as Part_XXXX.vtp files and a .pvd for older ParaView."""

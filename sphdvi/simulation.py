@@ -45,7 +45,7 @@ from .io.runfiles import BodyLog, ExcludedLog, Progress, RunFiles, startup_warni
 from .io.dtinfo import DTINFO_FILE, DtLog
 from .sph.periodic import PERIODIC_KEYS as PERIODIC_PARAM_KEYS      # numpy only
 from .io.runfolder import (NORMALS_FILE, OVERWRITTEN_DIR, SetAside, check_new_run_folder, earlier_exports,
-                           earlier_results, restored_on_bad_input, stored_overrides)
+                           earlier_results, restored_on_bad_input, run_command, run_lock, stored_overrides)
 from .sph.damping import damping_zones
 from .output_parts import OutputParts
 from .output_schedule import OutputSchedule
@@ -106,8 +106,40 @@ def absolute_file_sets(sets) -> tuple:
     return tuple(out)
 
 
+# <constantsdef> constants that only the time stepping reads (the particles gencase draws do not
+# depend on them): ``--set`` takes them; key (any letter case) -> the name in the parameters
+RUN_CONSTANTS = {"cflnumber": "CFLnumber"}
+
+
+def _run_constant(key: str, value: str) -> float:
+    """``--set CFLnumber=V``: the case reader's check of <cflnumber> (a finite number, > 0, <= 10)."""
+    try:
+        number = float(value)
+    except ValueError:
+        raise InputError(f"--set {key}: '{value}' is not a number; expected a number > 0 (DualSPHysics's cases "
+                         "use 0.2)") from None
+    if not (math.isfinite(number) and 0 < number <= 10):
+        raise InputError(f"--set {key}: {value}: expected a finite number > 0 and <= 10 (DualSPHysics's cases use 0.2)")
+    return number
+
+
+def conflicting_options(sets, tmax, tout) -> None:
+    """--tmax with --set TimeMax (or --tout with --set TimeOut) of another value: InputError naming both
+    (the option won silently before, and run.json's ``set`` still listed the other value)."""
+    for option, key, value in (("--tmax", "TimeMax", tmax), ("--tout", "TimeOut", tout)):
+        if value is None:
+            continue
+        for item in sets or ():
+            name, _, given = (x.strip() for x in str(item).partition("="))
+            with contextlib.suppress(ValueError):
+                if name == key and float(given) != float(value):
+                    raise InputError(f"{option} {float(value):g} and --set {key}={given} give {key} two values; "
+                                     f"expected one of them")
+
+
 def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
-    """``--set KEY=VALUE`` (any parameter), ``--tmax``, ``--tout``; raises InputError.
+    """``--set KEY=VALUE`` (a <parameters> key, or CFLnumber: :data:`RUN_CONSTANTS`), ``--tmax``,
+    ``--tout``; raises InputError.
 
     The checks and warnings are the case reader's: each value as in the XML, then the
     checks across parameters (RhopOutMin < RhopOutMax) on the result; deprecated keys and
@@ -120,10 +152,15 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
         if "=" not in item:
             raise InputError(f"--set {item!r}: expected KEY=VALUE")
         key, value = (s.strip() for s in item.split("=", 1))
+        if key.lower() in RUN_CONSTANTS:
+            out[RUN_CONSTANTS[key.lower()]] = _run_constant(key, value)
+            given.append(RUN_CONSTANTS[key.lower()])
+            continue
         if key not in PARAMETERS:
             const = constant_hint(key)
             if const:
-                raise InputError(f"--set {key}: {const}")
+                raise InputError(f"--set {key}: {const} (gencase draws the particles with it: their masses, initial "
+                                 "densities, h, B, c0; --set takes the <parameters> keys and CFLnumber)")
             hint = closest_key(key)
             raise InputError(f"--set: unknown parameter '{key}'" + (f"; did you mean '{hint}'?" if hint else ""))
         if key in DOMAIN_KEYS:
@@ -155,6 +192,26 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
     except ValueError as exc:
         raise InputError(("--set: " if given else "case parameters: ") + str(exc)) from None
     return out
+
+
+def resolved_parameters(params: dict, constants: dict, sph: bool) -> dict:
+    """run.json's ``parameters`` (the values the run uses), ``parameters_auto`` and ``constants``:
+    DtIni and DtMin given as 0 resolved as DualSPHysics's JSph (DtIni = h/c0, DtMin =
+    CoefDtMin h/c0; its Run.out prints those) and named in ``parameters_auto``; the earlier spelling
+    MdbcFastSingle left out beside MDBCFastSingle; the case's constants (dp, h, B, c0, gamma, rhop0,
+    masses, 2D, ...) with the CFLnumber the run uses (``--set CFLnumber``)."""
+    out = {k: v for k, v in params.items() if k != "MdbcFastSingle"}
+    auto = {}
+    consts = dict(constants)
+    if "CFLnumber" in params:
+        consts["cflnumber"] = params["CFLnumber"]
+    h, c0 = float(consts.get("h") or 0.0), float(consts.get("cs0") or 0.0)
+    if sph and h > 0 and c0 > 0:
+        for key, formula, value in (("DtIni", "h/c0", h / c0),
+                                    ("DtMin", "CoefDtMin*h/c0", float(params.get("CoefDtMin") or 0.0) * h / c0)):
+            if not float(params.get(key) or 0.0):
+                out[key], auto[key] = value, formula
+    return {"parameters": out, "parameters_auto": auto, "constants": consts}
 
 
 # ---------------------------------------------------------------------------------
@@ -345,7 +402,7 @@ def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(
     installed before its own start-up work (a signal then interrupts the run cleanly).  The
     start-up's warnings go to run.log too (:func:`startup_warnings_logged`)."""
     files = RunFiles(outdir)
-    with startup_warnings_logged(files):
+    with run_lock(outdir), startup_warnings_logged(files):    # no second run into OUT meanwhile
         return _run(files, case_h5, outdir, tmax=tmax, tout=tout, threads=threads, sets=sets, resume=resume,
                     quiet=quiet, expect_dp=expect_dp, overwrite=overwrite, stop=stop, set_aside=set_aside)
 
@@ -358,11 +415,14 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
     if expect_dp is not None:
         _check_dp(expect_dp, data, case_h5, resume)
     base = special_parameters(data)
+    conflicting_options(sets, tmax, tout)
     if resume and not os.path.exists(os.path.join(outdir, RESTART_FILE)):
         started = os.path.exists(os.path.join(outdir, "run.json"))
+        again = run_command(os.path.dirname(case_h5) or ".", outdir, tmax=tmax, tout=tout, sets=sets,
+                            extra="--overwrite" if started else "")
         raise InputError(f"--resume: {outdir} holds no run to continue (no {RESTART_FILE}"
-                         + ("; its run stopped before its first output" if started else "") + "); start it with "
-                         f"'sphdvi run {outdir}'" + (" --overwrite" if started else ""))
+                         + ("; its run stopped before its first output" if started else "") + f"); start it with "
+                         f"{again}")
     sets = absolute_file_sets(sets)
     if resume:
         if tmax is not None:
@@ -387,7 +447,8 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
         files.on_start = set_aside.discard     # the new run's start-up passed its checks
     base_meta = {
         "version": __version__, "case": data["casename"], "case_file": os.path.abspath(case_h5),
-        "parameters": params, "overrides": {"tmax": tmax, "tout": tout, "set": list(sets or ())},
+        **resolved_parameters(params, data["constants"], nfluid > 0),
+        "overrides": {"tmax": tmax, "tout": tout, "set": list(sets or ())},
         "threads": threads, "particles": int(data["particles"]["type"].size),
         "fluid_particles": nfluid, "python": sys.version.split()[0], "numpy": np.__version__,
     }
@@ -406,8 +467,11 @@ def _stopped_at_startup(stop, files: RunFiles, meta: dict, outdir: str, resume: 
     if os.path.exists(os.path.join(outdir, RESTART_FILE)) and resume:
         message = (f"stopped by signal {stop.signal} during start-up; resume with 'sphdvi run {outdir} --resume'")
     else:
+        given = meta.get("overrides") or {}
+        again = run_command(os.path.dirname(meta.get("case_file") or outdir) or ".", outdir, tmax=given.get("tmax"),
+                            tout=given.get("tout"), sets=given.get("set"), extra="--overwrite")
         message = (f"stopped by signal {stop.signal} during start-up, before the first output: nothing to resume; "
-                   f"run again with 'sphdvi run {outdir} --overwrite'")
+                   f"run again with {again}")
     if resume and not files.meta:
         with contextlib.suppress(OSError, ValueError):
             with open(files.json_path) as fh:
@@ -443,6 +507,9 @@ def _usable_threads(threads) -> int:
         if given:
             warnings.warn(f"--threads {wanted}: numba runs at most {limit} threads here (NUMBA_NUM_THREADS); "
                           f"using {limit}")
+        elif os.environ.get("SLURM_CPUS_PER_TASK") == str(wanted):
+            warnings.warn(f"SLURM_CPUS_PER_TASK={wanted}: numba runs at most {limit} threads here "
+                          f"(NUMBA_NUM_THREADS, the CPUs this process may use); using {limit}")
         wanted = limit
     return wanted
 
@@ -599,6 +666,7 @@ class BodiesOnlyRun:
 
     def run(self, tmax: float, quiet: bool, stop=None) -> RunResult:
         s, sch, files = self.system, self.schedule, self.files
+        s.defer_warnings = True
         self.body_log = BodyLog(self.outdir, s, self.names, float(s.time) if self.resumed else None)
         progress = Progress(tmax, quiet, counts="bodies")
         wall_prev = self.runtime
@@ -613,6 +681,10 @@ class BodiesOnlyRun:
                     s.step(sch.dt)
                     self.step += 1
                     stepped = True
+                    for line in s.take_warnings():          # an unconverged solve: run.log and stderr
+                        files.log("WARNING: " + line)
+                        if not quiet:
+                            warnings.warn(line)
                     _check_bodies(s, self.names, self.step)
                     if sch.is_output(self.step):
                         self.part += 1
@@ -621,7 +693,7 @@ class BodiesOnlyRun:
                         stepped = False
                     elif sch.is_row(self.step):
                         self.body_log.record(flush=False)      # TimeOutExtra rows wait for the output
-                    progress.update(s.time, self.step, len(self.names))
+                    progress.update(s.time, self.step, len(self.names), dt=sch.dt)
                     if stop.signal is not None:
                         status, code, message = "interrupted", 1, _interrupted(stop.signal, s.time, self.outdir,
                                                                                self.part)
@@ -631,14 +703,14 @@ class BodiesOnlyRun:
             except BaseException as exc:
                 self.runtime = wall_prev + (_time.perf_counter() - t_loop)
                 _clean_up_after_failure(
-                    self._checkpoint,
+                    self._checkpoint, progress.close,
                     lambda: files.write_json(status="failed", message=f"{type(exc).__name__}: {exc}",
                                              steps=self.step, physical_time=float(s.time), runtime_s=self.runtime))
                 _raise_if_disk_full(exc, self.outdir, float(s.time), self.step, self.part)
                 raise
         self._checkpoint()           # the latest output, if the throttle held it back
         self.runtime = wall_prev + (_time.perf_counter() - t_loop)
-        progress.update(s.time, self.step, len(self.names), force=True)
+        progress.update(s.time, self.step, len(self.names), force=True, dt=sch.dt)
         progress.close()
         files.log(f"{status}: t={s.time:.6g} s, {self.step} steps, runtime {self.runtime:.2f} s"
                   + (f" -- {message}" if message else ""))
@@ -725,6 +797,8 @@ class SPHRun:
         self.outdir = outdir
         p = data["particles"]
         c = dict(data["constants"])
+        if "CFLnumber" in params:           # --set CFLnumber: only the time step reads it
+            c["cflnumber"] = float(params["CFLnumber"])
         self.consts = c
         fluidcount = int(data["json"]["mkconfig"]["fluidcount"])
         if not resume:          # the initial state's densities (a resumed run's are its own)
@@ -781,6 +855,8 @@ class SPHRun:
         self.floating = (FloatingBodies(data, motions, fluidcount, normals0, float(params.get("FtPause", 0.0)))
                          if (p["type"] == 2).any() else None)
         self.bodies = self.floating.system if self.floating is not None else None
+        if self.bodies is not None:
+            self.bodies.defer_warnings = True        # its lines come through take_step_warnings
         self.body_names = self.floating.names if self.floating is not None else None
         self.damping = damping_zones(js.get("special", {}).get("damping", []))
         from .wave_absorption import piston_absorbers
@@ -1057,8 +1133,11 @@ class SPHRun:
             f"DtMin {sol.dtmin:.4g} s is above the dt the CFL and force conditions ask for")
 
     def take_step_warnings(self) -> list:
-        """The warning lines :meth:`check` found since the last call."""
+        """The warning lines :meth:`check` found since the last call, and the multibody
+        System's (an unconverged solve, :meth:`System.take_warnings`)."""
         lines, self.step_warnings = self.step_warnings, []
+        if self.bodies is not None:
+            lines += self.bodies.take_warnings()
         return lines
 
     # -- snapshots and checkpoints ------------------------------------------------------
@@ -1559,7 +1638,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                     body_log.record(flush=False)
                     if extra:
                         next_extra = _next_multiple(sol.time, extra)
-                progress.update(sol.time, sol.nstep, sol.state.n)
+                progress.update(sol.time, sol.nstep, sol.state.n, dt=sol.last_dt)
                 if min_fluid:
                     status, code, message = "completed", 0, min_fluid
                     break
@@ -1576,6 +1655,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                 lambda: excluded_log.record(sol.take_excluded()),
                 gauges.close if gauges is not None else None,
                 dtlog.close if dtlog is not None else None,
+                progress.close,
                 lambda: files.write_json(status=status, message=message, steps=int(sol.nstep),
                                          physical_time=float(sol.time), runtime_s=runtime),
                 writer.close)
@@ -1587,7 +1667,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         gauges.close()
     if dtlog is not None:
         dtlog.close()
-    progress.update(sol.time, sol.nstep, sol.state.n, force=True)
+    progress.update(sol.time, sol.nstep, sol.state.n, force=True,
+                    dt=sol.last_dt if sol.nstep > steps_at_start else None)
     progress.close()
     writer.close()
     for line in step_lines:                         # those after the last output (a stopped run)
@@ -1599,8 +1680,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                      particles_final=int(sol.state.n), threads_used=sol.threads_in_use(),
                      **({"dtfixedfile_max_excess_s": float(sol.dt_error)}
                         if sol.dt_table is not None and np.isfinite(sol.dt_error) else {}),
-                     us_per_particle_step=(1e6 * (runtime - wall_prev)
-                                           / max(1, sol.nstep - steps_at_start) / max(1, sol.state.n)))
+                     us_per_particle_step=(1e6 * (runtime - wall_prev) / (sol.nstep - steps_at_start)
+                                           / max(1, sol.state.n) if sol.nstep > steps_at_start else None))
     return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)
 
 

@@ -866,7 +866,7 @@ def read_parameters(reader, execution):
                 raise reader.error(p, const)
             hint = closest_key(key)
             raise reader.error(p, f"unknown parameter key '{key}'",
-                               f"'{hint}'" if hint else "a DualSPHysics parameter key (see sphdvi parameters list)")
+                               f"'{hint}'" if hint else "a DualSPHysics parameter key (the list: sphdvi/case/parameters.py)")
         if key in set_keys:
             reader.warn(p, f"parameter '{key}' given twice; the last value is used")
         raw = reader.raw(p, "value")

@@ -25,6 +25,7 @@ from .atomic import append_text, complete_lines, write_text_atomic
 RUN_CSV_HEADER = "part,time,steps,particles,excluded,dtmin,dtmax,walltime"
 EXCLUDED_FILE = "excluded.csv"
 EXCLUDED_HEADER = "time,idp,x,y,z,vx,vy,vz,rhop,reason"
+PROGRESS_INTERVAL_S = 30.0      # between two progress lines when stderr is not a terminal
 
 
 class RunFiles:
@@ -124,19 +125,42 @@ def _jsonable(obj):
 
 
 class Progress:
-    """A progress line on a terminal; a log line every ``interval`` seconds otherwise."""
+    """A progress bar on a terminal (redrawn every 0.2 s); otherwise a line every ``interval``
+    seconds (PROGRESS_INTERVAL_S: ``progress: t=.. s (..%) steps=.. particles=.. dt=.. s wall=.. s
+    eta=.. s``, conventions.md's ``step t dt wall ETA particles``).  On a terminal a warning
+    printed while the bar is drawn starts on a line of its own (the bar's line is cleared first;
+    the next update draws the bar again below it)."""
 
-    def __init__(self, tmax: float, quiet: bool, stream=None, interval: float = 30.0, counts: str = "particles"):
+    def __init__(self, tmax: float, quiet: bool, stream=None, interval: float | None = None,
+                 counts: str = "particles"):
         self.tmax = tmax
         self.counts = counts            # what the count ``n`` of update() counts
         self.quiet = quiet
         self.stream = stream or sys.stderr
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
-        self.interval = interval
+        self.interval = PROGRESS_INTERVAL_S if interval is None else interval
         self.last = 0.0
         self.t0 = _time.perf_counter()
+        self.on_bar = False             # the cursor is at the end of the drawn bar
+        self._shown = None
+        if self.tty and not quiet:      # warnings clear the bar's line first
+            self._shown = warnings.showwarning
+            warnings.showwarning = self._show_warning
 
-    def update(self, t: float, steps: int, n: int, force: bool = False) -> None:
+    def _show_warning(self, *args, **kwargs):
+        self.clear_line()
+        (self._shown or warnings._showwarning_orig)(*args, **kwargs)
+
+    def clear_line(self) -> None:
+        """Clear the bar's line (a terminal), so that what is printed next starts on it."""
+        if self.on_bar:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+            self.on_bar = False
+
+    def update(self, t: float, steps: int, n: int, force: bool = False, dt: float | None = None) -> None:
+        """Show the progress at time ``t`` after ``steps`` steps with ``n`` particles (or bodies);
+        ``dt``: the last step's (None: no step yet)."""
         if self.quiet:
             return
         now = _time.perf_counter()
@@ -146,21 +170,26 @@ class Progress:
         frac = min(1.0, t / self.tmax) if self.tmax > 0 else 1.0
         wall = now - self.t0
         eta = wall * (1 - frac) / frac if frac > 0 else float("nan")
+        dt_text = f"dt={dt:.3g} s" if dt else "dt=-"
         if self.tty:
             bar = "#" * int(30 * frac)
             self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t={t:.4f} s  steps={steps}  "
-                              f"{self.counts}={n}  eta={eta:6.0f} s ")
-            self.stream.flush()
+                              f"{self.counts}={n}  {dt_text}  eta={eta:6.0f} s \033[K")
+            self.on_bar = True
         else:
             self.stream.write(f"progress: t={t:.5g} s ({100 * frac:.1f}%) steps={steps} {self.counts}={n} "
-                              f"wall={wall:.1f} s eta={eta:.0f} s\n")
-            self.stream.flush()
+                              f"{dt_text} wall={wall:.1f} s eta={eta:.0f} s\n")
+        self.stream.flush()
 
     def close(self):
-        if self.tty and not self.quiet:
+        """End the bar's line and put the warning display back (called again: nothing)."""
+        if self._shown is not None:
+            if warnings.showwarning == self._show_warning:
+                warnings.showwarning = self._shown
+            self._shown = None
+        if self.on_bar:
             self.stream.write("\n")
-
-
+            self.on_bar = False
 
 
 def _rows_until(path: str, resume_time: float | None) -> list[str]:

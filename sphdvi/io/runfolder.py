@@ -70,7 +70,9 @@ def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> 
             meta = json.load(fh)
         status = f", status '{meta['status']}' at t={float(meta['physical_time']):.6g} s"
         if meta["status"] == "running":      # run.json is written at the start and the end only
-            status = ", status 'running': it still runs, or it was killed"
+            holder = None if os.path.realpath(outdir) in _HELD else run_lock_holder(outdir)
+            status = (f", status 'running': it still runs ({holder})" if holder
+                      else ", status 'running' though no run holds the folder: it was killed (SIGKILL, a crash)")
             last = last_output_time(outdir)
             if last is not None:
                 status += f"; its last output at t={last:.6g} s"
@@ -81,6 +83,125 @@ def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> 
     raise InputError(f"{outdir} holds the results of an earlier run ({', '.join(found)}{status}); continue it with "
                      f"'sphdvi run {outdir} --resume', or start again with --overwrite (deletes those files) "
                      "or into another -o folder")
+
+
+def run_command(source, outdir, *, tmax=None, tout=None, sets=(), extra: str = "") -> str:
+    """The quoted command 'sphdvi run SOURCE [-o OUT] [--tmax T] [--tout T] [--set K=V]... EXTRA' that a
+    message suggests, built from what the user gave (-o left out where it is SOURCE itself)."""
+    import shlex
+    words = ["sphdvi", "run", str(source)]
+    if os.path.normpath(str(outdir)) != os.path.normpath(str(source)):
+        words += ["-o", str(outdir)]
+    words += [w for opt, v in (("--tmax", tmax), ("--tout", tout)) if v is not None for w in (opt, f"{float(v):g}")]
+    words += [w for item in sets or () for w in ("--set", str(item))]
+    return "'" + " ".join(shlex.quote(w) for w in words) + (f" {extra}" if extra else "") + "'"
+
+
+RUN_LOCK_FILE = ".sphdvi.lock"
+# OUT folders whose lock this process holds (real path -> [fd, depth, created OUT]): a run that
+# the command line locked before its gencase locks it again in :func:`sphdvi.simulation.run`
+_HELD: dict = {}
+
+
+def _lock_holder(path: str) -> str:
+    """'pid N on HOST' from a lock file's line (a holder that has not written it yet: '')."""
+    with contextlib.suppress(OSError, ValueError, IndexError):
+        with open(path) as fh:
+            pid, host = fh.read().split()[:2]
+        return f"pid {int(pid)} on {host}"
+    return ""
+
+
+def run_lock_holder(outdir: str) -> str | None:
+    """The holder of OUT's run lock ('pid N on HOST', or 'another process') while a command holds
+    it; None when none does (no lock file, or a stale one left by a killed run)."""
+    import fcntl
+    path = os.path.join(outdir, RUN_LOCK_FILE)
+    if os.path.realpath(outdir) in _HELD:
+        return f"pid {os.getpid()} on {_hostname()}"
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return _lock_holder(path) or "another process"
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+    return None
+
+
+def _hostname() -> str:
+    import socket
+    return socket.gethostname() or "localhost"
+
+
+@contextlib.contextmanager
+def run_lock(outdir: str, command: str = "run"):
+    """OUT/.sphdvi.lock held with ``flock`` while a run (or a gencase, ``command``) writes into OUT,
+    so that a second one into the same OUT (fresh, --resume or --overwrite) is refused (InputError,
+    exit 2, naming the pid and host of the first) instead of mixing its files with the first's.
+    DualSPHysics has no such lock (nothing stops two runs into one -dirout); sphdvi's particle file
+    is written without HDF5's own lock so that readers can open it during the run.  The OS releases
+    the lock when the process dies (SIGKILL included): a lock file left by a dead run blocks nothing.
+    OUT is created when missing (and removed again when it is left empty); the lock file goes at the
+    end.  Re-entrant within a process; a file system without locks gets a warning and no lock."""
+    import fcntl
+    import warnings
+    from .atomic import make_folder
+    key = os.path.realpath(outdir)
+    if key in _HELD:
+        _HELD[key][1] += 1
+        try:
+            yield
+        finally:
+            _HELD[key][1] -= 1
+        return
+    created = not os.path.exists(outdir)
+    make_folder(outdir)
+    path = os.path.join(outdir, RUN_LOCK_FILE)
+    fd = None
+    try:
+        for _ in range(10):
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = _lock_holder(path) or "another process"
+                os.close(fd)
+                fd = None
+                raise InputError(f"{outdir} is in use by a sphdvi command that is running ({holder}; lock file "
+                                 f"{path}): a second {command} into it would mix its files with that one's; wait "
+                                 "for it to end (a run stopped by SIGINT/SIGTERM goes on with 'sphdvi run "
+                                 f"{outdir} --resume'), or use another -o folder") from None
+            except OSError as exc:          # a file system without flock (some network mounts)
+                os.close(fd)
+                fd = None
+                warnings.warn(f"{path}: cannot lock it ({exc.strerror or exc}): nothing stops a second run into "
+                              f"{outdir} while this one runs")
+                break
+            with contextlib.suppress(FileNotFoundError):     # not unlinked by a holder that just ended
+                if os.path.samestat(os.fstat(fd), os.stat(path)):
+                    break
+            os.close(fd)
+            fd = None
+        if fd is not None:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()} {_hostname()} {command}\n".encode())
+            _HELD[key] = [fd, 1, created]
+        yield
+    finally:
+        if fd is not None:
+            _HELD.pop(key, None)
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+            os.close(fd)
+        if created:
+            with contextlib.suppress(OSError):
+                os.rmdir(outdir)            # only when left empty (a command refused on bad input)
 
 
 def last_output_time(outdir: str) -> float | None:

@@ -8,14 +8,23 @@ the vertex topology 0..Nmax-1 is stored once and reused by every step (CellOffse
 Crash safety: a step's arrays are appended first, then the ``Steps`` metadata
 that makes them visible, then the file is flushed. Rows written after the last
 complete step are ignored and cut on the next append (see :meth:`truncate_to`).
+
+Readers during the run: the writer opens the file without HDF5's file lock (h5py
+``locking=False``), so ParaView, h5py, ``sphdvi measure`` and ``sphdvi export`` can open it
+while the run goes on, as DualSPHysics users open the Part files of a running job; a reader
+opening it after an output's flush sees every step up to that output.  One that opens it while
+an output is being written may find it inconsistent: :func:`open_particles` then says so (exit
+2, read again).  Two runs writing one file are stopped by OUT's run lock instead
+(:func:`sphdvi.io.runfolder.run_lock`).
 """
 from __future__ import annotations
 
 import contextlib
+import os
 
 import numpy as np
 
-from ..errors import InputError, h5_reason
+from ..errors import InputError, SphdviError, h5_reason
 
 TOPOLOGIES = ("Vertices", "Lines", "Polygons", "Strips")
 _LAYOUT = ("VTKHDF/Points", "VTKHDF/NumberOfPoints", "VTKHDF/PointData", "VTKHDF/Steps/Values",
@@ -24,10 +33,25 @@ _LAYOUT = ("VTKHDF/Points", "VTKHDF/NumberOfPoints", "VTKHDF/PointData", "VTKHDF
 
 def _bad_file(path: str, exc: BaseException) -> InputError:
     reason = h5_reason(exc)
+    running = _writing_run(path)
+    if running:
+        return InputError(f"{path} could not be read ({reason}) while the run writing it ({running}) was in the "
+                          "middle of an output: the steps written before are intact; read it again (a reader that "
+                          "opens it between two outputs sees every step written so far)")
     if "unable to lock file" in reason or getattr(exc, "errno", None) == 11:
-        return InputError(f"{path} is locked by the run writing it (HDF5 file locking): read it once that run has "
-                          "ended or been stopped (a stopped run goes on with --resume)")
+        return InputError(f"{path} is locked by another program that holds it open for writing (HDF5 file locking; "
+                          "a sphdvi run does not lock it, an older sphdvi did): read it once that program has ended "
+                          "(a stopped run goes on with --resume)")
     return InputError(f"{path} is not a readable particle file ({reason}; truncated or corrupt?)")
+
+
+def _writing_run(path: str) -> str | None:
+    """'pid N on HOST' of the run that holds the run lock of the particle file's folder, if any."""
+    from .runfolder import run_lock_holder
+    try:
+        return run_lock_holder(os.path.dirname(os.path.abspath(path)))
+    except OSError:
+        return None
 
 
 def _check_layout(f, path: str) -> None:
@@ -58,9 +82,19 @@ def open_particles(path: str):
     except OSError as exc:
         raise _bad_file(path, exc) from None
     try:
-        _check_layout(f, path)
+        try:
+            _check_layout(f, path)
+        except InputError as exc:
+            if _writing_run(path):          # a new file whose layout is being written
+                raise _bad_file(path, exc) from None
+            raise
         yield f
     except (OSError, KeyError) as exc:
+        raise _bad_file(path, exc) from None
+    except (ValueError, IndexError, RuntimeError) as exc:
+        # an inconsistent view of a file an output is being written into (sizes past NSteps, ...)
+        if isinstance(exc, SphdviError) or not _writing_run(path):
+            raise
         raise _bad_file(path, exc) from None
     finally:
         f.close()
@@ -77,7 +111,9 @@ class VTKHDFParticleWriter:
         self.points_per_step = points_per_step      # sizes the point arrays' chunks of a new file
         mode = "a" if append else "w"
         try:
-            self.f = h5py.File(path, mode)
+            # no HDF5 file lock: readers (ParaView, measure, export) may open it during the run; OUT's run
+            # lock (io.runfolder.run_lock) keeps a second run out
+            self.f = h5py.File(path, mode, locking=False)
         except OSError as exc:
             if not append:
                 raise

@@ -17,11 +17,18 @@ CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 PLOT_FORMATS = ("png", "pdf", "svg", "svgz", "jpg", "jpeg", "tif", "tiff", "webp", "eps", "ps", "pgf")
 
 
-def _output_options(fn):
+SEP_HELP_POINTS = "Separator; ';' writes MeasureTool's layout (PosX/PosY/PosZ rows, Part column)."
+SEP_HELP = "Separator; ';' writes MeasureTool's layout (a Part column, ';' between the columns)."
+
+
+def _output_options(fn=None, *, sep_help: str = SEP_HELP_POINTS):
+    """The options every measure command shares (--first/--last/--every, --csv, --sep, --plot);
+    ``@_output_options(sep_help=SEP_HELP)`` for a command whose table has no rows of points."""
+    if fn is None:
+        return lambda f: _output_options(f, sep_help=sep_help)
     fn = click.option("--plot", "plot", type=click.Path(dir_okay=False), default=None,
                       help="Also draw the series into this PNG file (needs matplotlib).")(fn)
-    fn = click.option("--sep", type=click.Choice([",", ";"]), default=",", show_default=True,
-                      help="Separator; ';' writes the DualSPHysics layout (PosX/PosY/PosZ rows, Part column).")(fn)
+    fn = click.option("--sep", type=click.Choice([",", ";"]), default=",", show_default=True, help=sep_help)(fn)
     fn = click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
                       help="Write the table to this file (default: stdout).")(fn)
     fn = click.option("--every", type=click.IntRange(min=1), default=1, show_default=True,
@@ -163,7 +170,7 @@ def measure():
 @measure.command(context_settings=CONTEXT)
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
 @click.option("--points", "points", required=True, metavar='FILE|"x,y,z;..."',
-              help="Points: 'x,y,z;x,y,z' (2D: 'x,z' allowed) or a file with one point a line "
+              help="Points [m]: 'x,y,z;x,y,z' (2D: 'x,z' allowed) or a file with one point a line "
                    "(MeasureTool POINTS/POINTSLIST/POINTSENDLIST files too).")
 @click.option("--vars", "variables", default="vel,rhop,press", show_default=True,
               help="Comma-separated: vel, rhop, press, mass, vol (kernel averages of the particles' mass and "
@@ -227,11 +234,12 @@ def points(outdir, points, variables, kclimit, correction, trackmk, trackmkbound
 @measure.command(context_settings=CONTEXT)
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
 @click.option("--at", "at", required=True, metavar='"x[,y];..."',
-              help="Horizontal positions: 'x;x' (2D) or 'x,y;x,y' (3D), or a file.")
+              help="Horizontal positions [m]: 'x;x' (2D) or 'x,y;x,y' (3D), or a file.")
 @click.option("--threshold", type=FiniteFloat(min=0, min_open=True), default=None,
-              help="Kernel-sum threshold of the surface (default 0.5 in 3D, 0.4 in 2D).")
+              help="Kernel-sum threshold of the surface, no unit: about 1 inside the water, 0 outside "
+                   "(default 0.5 in 3D, 0.4 in 2D).")
 @click.option("--dz", type=FiniteFloat(min=0, min_open=True), default=None,
-              help="Sampling step along the vertical (default dp/4).")
+              help="Sampling step along the vertical [m] (default dp/4).")
 @_output_options
 @report_errors
 def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot):
@@ -262,11 +270,11 @@ def elevation(outdir, at, threshold, dz, first, last, every, csv_path, sep, plot
 @click.option("--mk", "mk", default=None, metavar="N[,M]", help="Global mk of the particles (mkbound+fluidcount+1).")
 @click.option("--mkbound", "mkbound", default=None, metavar="N[,M]", help="Or their mkbound.")
 @click.option("--point", "point", default=None, metavar="x,y,z",
-              help="Moment about this point (default: the centre of the selected particles).")
+              help="Moment about this point [m] (default: the centre of the selected particles).")
 @click.option("--axis", "axis", default=None, metavar="x1,y1,z1,x2,y2,z2",
-              help="Moment about the axis through two points (projected on it).")
+              help="Moment about the axis through two points [m] (projected on it).")
 @click.option("--no-visco", is_flag=True, help="Pressure term only (no viscous force).")
-@_output_options
+@_output_options(sep_help=SEP_HELP)
 @report_errors
 def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_path, sep, plot):
     """Fluid force and moment on boundary or floating particles (ComputeForces).
@@ -296,7 +304,7 @@ def forces(outdir, mk, mkbound, point, axis, no_visco, first, last, every, csv_p
 
 @measure.command(context_settings=CONTEXT)
 @click.argument("outdir", type=click.Path(exists=True, file_okay=False))
-@_output_options
+@_output_options(sep_help=SEP_HELP)
 @report_errors
 def bodies(outdir, first, last, every, csv_path, sep, plot):
     """Body motion and loads per body (FloatingInfo), and link forces.

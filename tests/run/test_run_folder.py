@@ -70,14 +70,15 @@ def test_new_run_into_earlier_results_is_refused_and_changes_nothing(done, tmp_p
 
 def test_refusal_of_a_killed_run_names_its_last_output(done, tmp_path):
     """run.json of a killed run still says 'running' at t = 0 (it is written at the start and the
-    end): the refusal says it still runs or was killed, with run.csv's last output time."""
+    end): the refusal says it was killed (no run holds the folder's lock), with run.csv's last output time."""
     out = copy_run(done, tmp_path / "o")
     meta = json.loads((out / "run.json").read_text())
     meta.update(status="running", physical_time=0.0)
     (out / "run.json").write_text(json.dumps(meta))
     r = invoke(["run", out] + RUN)
     assert r.exit_code == 2, r.output
-    assert "status 'running': it still runs, or it was killed; its last output at t=0.00" in r.output
+    assert "status 'running' though no run holds the folder: it was killed (SIGKILL, a crash); its last output " \
+        "at t=0.00" in r.output
     assert "at t=0 s" not in r.output
 
 

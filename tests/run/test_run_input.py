@@ -109,8 +109,9 @@ def test_set_warnings_as_the_case_reader():
 
 def test_set_of_a_constant_and_of_dem():
     from sphdvi.simulation import apply_overrides
-    with pytest.raises(InputError, match=r"'CFLnumber' is a constant of the case.*<cflnumber value=.*<constantsdef>"):
-        apply_overrides({"TimeOut": 0.1}, ["CFLnumber=5"])
+    with pytest.raises(InputError, match=r"'Gamma' is a constant of the case.*<gamma value=.*<constantsdef>"):
+        apply_overrides({"TimeOut": 0.1}, ["Gamma=5"])
+    assert apply_overrides({"TimeOut": 0.1}, ["CFLnumber=5"])["CFLnumber"] == 5.0   # read by the time step only
     with pytest.raises(InputError, match=r"RigidAlgorithm=2 \(DEM.*not implemented.*use 1.*or 3"):
         apply_overrides({"TimeOut": 0.1}, ["RigidAlgorithm=2"])
     with pytest.raises(InputError, match="unknown parameter 'Visc'; did you mean 'Visco'"):
@@ -330,7 +331,8 @@ def test_export_of_a_body_only_run_says_it_has_no_particles(tmp_path):
 
 
 def test_a_particle_file_locked_by_its_run_is_named_as_such(done, tmp_path):
-    """While a run writes particles.vtkhdf, HDF5's lock keeps readers out: measure and export say
+    """A program holding particles.vtkhdf open for writing with HDF5's lock (an older sphdvi run; a
+    run now writes it without, tests/cli/test_cli_audit9.py) keeps readers out: measure and export say
     so (they called the file 'truncated or corrupt?' before)."""
     import os
     import subprocess
@@ -346,7 +348,7 @@ def test_a_particle_file_locked_by_its_run_is_named_as_such(done, tmp_path):
         assert holder.stdout.readline().strip() == "open"
         for args in (["export", out], ["measure", "elevation", out, "--at", "0.2"]):
             r = invoke(args)
-            assert_input_error(r, "is locked by the run writing it", "--resume")
+            assert_input_error(r, "is locked by another program that holds it open for writing", "--resume")
             assert "corrupt" not in r.output
     finally:
         holder.kill()
