@@ -21,8 +21,14 @@ The run's box motion comes from bodies.csv (the floating body ``floating50``, ev
   small first waves of the group give the box, is not in the experiment's record).
 
 Each record is scored as the wave probes of W3 (:func:`flapwaves.probe_scores`): correlation,
-rms ratio − 1, the lag of best correlation and the range (crest to trough) ratio − 1, over the
-experiment's samples within the run.
+rms ratio − 1 and the lag of best correlation on a uniform time grid over the experiment's span
+within the run, the range (crest to trough) ratio − 1 over its samples.  The roll's rms at lag 0
+penalises the SPH box's phase lead (correlation 0.51 at box/dp 10, 0.91 at −0.105 s): its range
+is the steadier amplitude measure.  The experiment's roll may itself carry a ~0.1 s time-base
+offset: it correlates best with −d(heave)/dt (the surface slope at a box short against the wave)
+taken 0.10 s later (0.83; 0.50 at no lag), where the SPH roll is in phase with that slope; it was
+digitised apart from the heave (its times rounded to 10 ms, not monotone).  Not provable from the
+file: an observation, not corrected.
 """
 from __future__ import annotations
 

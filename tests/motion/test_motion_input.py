@@ -154,14 +154,23 @@ def test_zero_duration_loop_is_an_error(tmp_path, body, ids):
     assert e.value.line == 3 and e.value.element in ("mvrect", "wait")
 
 
-@pytest.mark.parametrize("body", [
-    '<mvrect id="1" duration="0.5" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0" next="1"/>',
-    '<mvrect id="1" duration="100" next="1"><vel x="1" y="0" z="0"/></mvrect>',              # loops every 100 s
-    '<mvrect id="1" duration="0" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0"/>',   # ends
+@pytest.mark.parametrize("body,x10,v10", [
+    ('<mvrect id="1" duration="0.5" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0" next="1"/>',
+     10.0, 1.0),                                                                            # 20 loops of 0.5 m
+    ('<mvrect id="1" duration="100" next="1"><vel x="1" y="0" z="0"/></mvrect>', 10.0, 1.0),  # loops every 100 s
+    ('<mvrect id="1" duration="0" next="2"><vel x="1" y="0" z="0"/></mvrect><wait id="2" duration="0"/>',
+     0.0, 0.0),                                                                             # ends, never moved
 ])
-def test_loops_that_advance_are_accepted(tmp_path, body):
+def test_loops_that_advance_are_accepted(tmp_path, body, x10, v10):
+    """Accepted, and walked as DualSPHysics's JMotion walks them: the loop of a 0.5 s move at 1 m/s
+    repeated with a zero wait keeps the body going at 1 m/s (x = 10 m at t = 10 s, 10.2 m at 10.2 s),
+    as does a 100 s move that loops onto itself; a zero-length move followed by a zero wait leaves
+    it where it was."""
     (m,), _ = read(tmp_path, body)
-    chain_transform(m, 10.0)
+    for t in (10.0, 10.2):
+        x, v = chain_transform(m, t).apply(np.zeros((1, 3)))
+        assert x[0] == pytest.approx([x10 * t / 10.0, 0, 0], abs=1e-9)
+        assert v[0] == pytest.approx([v10, 0, 0], abs=1e-12)
 
 
 def test_zero_loop_at_run_time_is_a_case_error():

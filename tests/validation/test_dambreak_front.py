@@ -34,8 +34,49 @@ def runs(tmp_path_factory):
         assert r.exit_code == 0, r.output
         t, x = front_history(str(d))
         meta = json.loads((d / "run.json").read_text())
+        meta["outdir"] = str(d)
         out[dp] = (t, x, meta)
     return out
+
+
+def corner_fall(outdir, until=0.25):
+    """(times, drop) of the fluid particle that starts at the column's top front corner, over
+    0 < t <= ``until``."""
+    from sphdvi.io.vtkhdf import read_step, step_times
+    path = str(Path(outdir) / "particles.vtkhdf")
+    times = step_times(path)
+    s = read_step(path, 0)
+    fluid = s["Type"] == 3
+    k0 = np.argmax(s["points"][fluid, 0] + s["points"][fluid, 2])
+    idp, z0 = s["Idp"][fluid][k0], s["points"][fluid][k0, 2]
+    steps = [k for k in range(1, times.size) if times[k] <= until + 1e-9]
+    drop = []
+    for k in steps:
+        s = read_step(path, k)
+        drop.append(z0 - s["points"][s["Idp"] == idp, 2][0])
+    return times[steps], np.array(drop)
+
+
+def test_the_top_corner_falls_freely_and_the_front_keeps_below_the_ideal_speed(runs):
+    """Two checks with their own sources, which pin g and the clock where the comparisons with the
+    experiment cannot (the run with g 5 % off is the same dam break on another time scale: its
+    front speed moves by 2.5 %, and a fitted start delay absorbs the rest).  At t = 0+ the
+    pressure of the released column is harmonic and vanishes on the top and on the front face, so
+    near their corner it goes as r² and its gradient vanishes there: the corner falls freely,
+    z0 − g t²/2 (the small-time solution of the incompressible dam break; it stays so while the
+    corner keeps its right angle).
+    Measured over t = 0.03-0.25 s (T ≤ 1.1): 0.984-0.993 of g t²/2 at a/dp 25, 0.991-0.995 at a/dp 50;
+    with g × 1.05 / 0.95 in the case 1.034-1.042 / 0.935-0.943 at a/dp 25.  And the front never outruns Ritter's ideal
+    shallow-water front 2 √(g·2a) (TOLERANCES S3's upper bound; measured 6.6 m/s against 8.9)."""
+    g, a = 9.81, 1.0
+    for dp, (t, x, meta) in runs.items():
+        tc, drop = corner_fall(meta["outdir"])
+        ratio = drop / (0.5 * g * tc ** 2)
+        sel = tc >= 0.03 - 1e-9
+        print(f"dp={dp}: top corner drop / (g t²/2) {ratio[sel].min():.3f}…{ratio[sel].max():.3f}; "
+              f"front speed at most {np.max(np.diff(x) / np.diff(t)):.2f} m/s")
+        assert sel.sum() >= 20 and np.all(np.abs(ratio[sel] - 1) <= 0.025), ratio
+        assert np.max(np.diff(x) / np.diff(t)) < 2 * np.sqrt(g * 2 * a)
 
 
 def test_front_speed_and_lead(runs):
@@ -85,7 +126,8 @@ def test_front_leads_every_record_of_the_experiment(runs):
             assert 0.15 <= delay <= 0.35 and err < 0.08, (name, dp)
 
 
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S3 ±5 % on Z(T): measured +8…+18 % at a/dp = 50")
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="TOLERANCES S3 ±5 % on Z(T): measured +8…+18 % at a/dp = 50")
 def test_front_within_5_percent_at_a_over_dp_50(runs):
     t, x, _ = runs[0.02]
     _, rel, _ = front_errors(t, x, load_martin_moyce(str(REFERENCE)))

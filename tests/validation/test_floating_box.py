@@ -50,7 +50,9 @@ def test_mdbc_box_keeps_the_water_out(tmp_path):
     res = draft_errors(str(out))
     print(f"mDBC box: {inside['max_count']} fluid particles inside; draft {res['draft_dp']:+.2f} dp")
     assert inside["max_count"] == 0
-    assert abs(res["draft_dp"]) <= 0.25
+    # the draft is 3 dp here, so 0.1 dp is 3 % of it (TOLERANCES S12's 0.5 dp is the ceiling for a
+    # DBC box): the fluid's force on the box scaled by 1.1 / 0.9 settles it at +0.15 / −0.23 dp
+    assert abs(res["draft_dp"]) <= 0.1
     assert res["tilt_deg"] < 0.5
 
 

@@ -19,6 +19,7 @@ from sphdvi.validation.runs import case_data
 
 REPO = Path(__file__).resolve().parents[2]
 CASE = REPO / "cases" / "flapwaves2d" / "CaseFloatingWavesHadzic2D_Def.xml"
+OUTLINE = REPO / "cases" / "flapwaves2d" / "CaseFloatingWavesHadzicOutline2D_Def.xml"
 REFERENCE = REPO.parent / "shared" / "reference"
 if not (REFERENCE / "floating_box_waves_hadzic_2005").is_dir():
     pytest.skip("reference data ../shared/reference not found", allow_module_level=True)
@@ -106,30 +107,41 @@ def run_dp_01(tmp_path_factory):
 
 @pytest.mark.slow
 def test_heave_and_sway_follow_the_experiment_at_box_over_dp_10(run_dp_01):
-    """dp 0.01 (box 10 x 5 particles, 25,141 particles, 13.7 min on 2 threads). Measured: heave
+    """dp 0.01 (box 10 x 5 particles, 25,141 particles, 13.7 min on 2 threads). Measured (rms as
+    a mean over the experiment's samples, before it was taken on a uniform time grid): heave
     correlation 0.940, rms +10.8 %, crest to trough −1.9 %, lag −0.005 s; sway (the drift the
     group's highest waves give the box, 0.11 m) correlation 0.976, range −22.8 %; the wave probes
-    0.955 / 0.959 (WP2 stands behind the box)."""
+    0.955 / 0.959 (WP2 stands behind the box). The sway's amplitude: see the xfail below."""
     e = run_dp_01
     assert e["heave_corr"] > 0.9 and abs(e["heave_lag"]) < 0.03
     assert abs(e["heave_rms"]) < 0.15 and abs(e["heave_range"]) < 0.15       # TOLERANCES S16: 10-15 %
-    assert e["sway_corr"] > 0.95 and -0.35 < e["sway_range"] < -0.10
+    assert e["sway_corr"] > 0.95
     assert e["wave_corr_min"] > 0.9
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="sway amplitude within 15 % (judgement: TOLERANCES S16 names heave and roll only; "
+                          "the same band for the box's third motion): measured range −22.8 % at box/dp 10 "
+                          "(−21.2 % session 35; −13.5 % at box/dp 20)")
+def test_sway_amplitude_within_15_percent_at_box_over_dp_10(run_dp_01):
+    assert abs(run_dp_01["sway_range"]) <= 0.15
 
 
 @pytest.mark.slow
 def test_roll_follows_the_experiment_at_box_over_dp_10(run_dp_01):
     """The roll (about −y) is in phase with the experiment's once 0.1 s is allowed (correlation
-    0.915 at that lag, 0.538 without) and short of it: rms −30.5 %, crest to trough −39.0 %
-    (dp 0.02: −41.5 / −48.9 %)."""
+    0.915 at that lag, 0.538 without; the experiment's roll may carry a ~0.1 s time-base offset:
+    see sphdvi.validation.floatingwaves). Its amplitude: see the xfail below."""
     e = run_dp_01
-    assert e["roll_corr_lag"] > 0.85 and -0.15 < e["roll_lag"] < 0
-    assert -0.40 < e["roll_rms"] < -0.20
+    assert e["roll_corr_lag"] > 0.85 and abs(e["roll_lag"]) <= 0.15
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="TOLERANCES S16: roll amplitude within 10-15 %; measured −27.1 % rms, "
-                                       "−34.8 % crest to trough at box/dp 10 (session 35; −30.5 / −39.0 % before session 34)")
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="TOLERANCES S16: roll amplitude within 10-15 %; measured −27.1 % rms (a mean over the "
+                          "experiment's samples, which the SPH box's 0.1 s lead flattered by ~10 points: about "
+                          "−36 % on a uniform time grid), −34.8 % crest to trough at box/dp 10 (session 35)")
 def test_roll_amplitude_within_15_percent_at_box_over_dp_10(run_dp_01):
     assert abs(run_dp_01["roll_rms"]) <= 0.15 and abs(run_dp_01["roll_range"]) <= 0.15
 
@@ -154,7 +166,9 @@ def test_mdbc_on_the_box_brings_heave_and_roll_within_15_percent_at_box_over_dp_
     rms +12.7 %, crest to trough −0.0 %, correlation 0.948; sway range −21.4 %; the wave probes
     0.957 / 0.964. The box rests at 0.3965 m, its Archimedes height (0.396). (With sphdvi's
     earlier clamp of the mDBC density to rho >= rho0 and the box's top rows' normals pointing
-    down through it: roll −8.6 / −8.7 %, heave +12.8 / −0.4 %.)"""
+    down through it: roll −8.6 / −8.7 %, heave +12.8 / −0.4 %.) These rms are means over the
+    experiment's samples; on the uniform time grid (2026-11-27) not rerun at this dp: the audit's
+    calibration puts session 35's roll rms, −12.2 % at a −0.07 s lead, at about −18 %."""
     e = run_dp_01_mdbc_box
     assert abs(e["roll_rms"]) <= 0.15 and abs(e["roll_range"]) <= 0.15     # TOLERANCES S16: 10-15 %
     assert e["roll_corr_lag"] > 0.9 and -0.1 < e["roll_lag"] <= 0
@@ -169,3 +183,36 @@ def test_no_water_inside_the_mdbc_box(run_dp_01_mdbc_box):
     the box's particles seen by the fluid with their share of its mass (0.68 rho0 dp^2, as
     DualSPHysics) 4-5 were lodged in its outer row from 1 s on and the box floated 6 mm low."""
     assert run_dp_01_mdbc_box["inside_max_count"] == 0
+
+
+@pytest.fixture(scope="module")
+def run_outline_dp_02(tmp_path_factory):
+    """S16O: mDBC on the box, its normals from its outline as GenCase's (norgeometry), at dp 0.02
+    (box 5 x 2 particles, 6,566 particles, ~2 min on 2 threads, 5-9 min on 1)."""
+    out = tmp_path_factory.mktemp("s16o") / "dp0.02"
+    r = CliRunner().invoke(main, ["run", str(OUTLINE), "-o", str(out), "--dp", "0.02", "--threads", "2", "-q"])
+    assert r.exit_code == 0, r.output
+    e = body_scores(str(out), str(REFERENCE))
+    print({k: round(v, 4) for k, v in e.items()})
+    return e
+
+
+@pytest.mark.slow
+def test_outline_normals_heave_within_15_percent_at_box_over_dp_5(run_outline_dp_02):
+    """S16O at box/dp 5 (2026-11-27, 1 thread, 518 s): heave correlation 0.888, rms +2.0 %, crest to
+    trough −10.1 %; roll correlation 0.538 (0.896 at −0.105 s); sway correlation 0.955; the wave
+    probes 0.928 / 0.983. (The box/dp 10 run, 14 min on 2 threads, is left to tools/validate.py S16O.)"""
+    e = run_outline_dp_02
+    assert abs(e["heave_rms"]) <= 0.15 and abs(e["heave_range"]) <= 0.15    # TOLERANCES S16: 10-15 %
+    assert e["heave_corr"] > 0.85 and abs(e["heave_lag"]) < 0.05
+    assert e["roll_corr_lag"] > 0.85 and abs(e["roll_lag"]) <= 0.15
+    assert e["sway_corr"] > 0.9 and e["wave_corr_min"] > 0.9
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="TOLERANCES S16: roll amplitude within 10-15 %; S16O at box/dp 5 measured rms −23.3 % "
+                          "(uniform time grid; −10.6 % as the mean over the experiment's samples), crest to trough "
+                          "−14.4 % (2026-11-27)")
+def test_outline_normals_roll_within_15_percent_at_box_over_dp_5(run_outline_dp_02):
+    assert abs(run_outline_dp_02["roll_rms"]) <= 0.15 and abs(run_outline_dp_02["roll_range"]) <= 0.15

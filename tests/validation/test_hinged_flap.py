@@ -26,8 +26,10 @@ def run(tmp_path_factory):
                 % (dp, e["settled_deg"], e["equilibrium_deg"], e["tilt_error"], e["phi0_deg"],
                    100 * e["reaction_error"], 100 * e["reaction_x"], 100 * e["torque_error"], e["particles"],
                    e["steps"], e["runtime_s"]))
-    serial = cached_runs(tmp_path_factory, HF.case_errors, report, threads=1)
-    threaded = cached_runs(tmp_path_factory, HF.case_errors, report, threads=2)
+    def score(out):
+        return dict(HF.case_errors(out), outdir=out)
+    serial = cached_runs(tmp_path_factory, score, report, threads=1)
+    threaded = cached_runs(tmp_path_factory, score, report, threads=2)
     return lambda dp, threads=1: (serial if threads == 1 else threaded)(dp, CASE)
 
 
@@ -45,13 +47,33 @@ def test_coupled_hinge_at_dp_0_04(run):
     """The coarse run (the flap 3 particles thick, 738 particles, ~20 s on 1 thread) as a check of
     the coupling through a joint: the hinge holds (the centroid keeps its distance from it to
     1e-6 m), the flap turns towards the vertical and settles (within 0.5 deg over the last
-    second), and the link's torque is its spring's K (φ0 − φ) within 2 % (measured −1.1 %).
+    second), and the link's torque is its spring's K (φ0 − φ) within 2 % (measured −0.7 %).
     The analytic equilibrium needs dp 0.02: here the water under the flap, two particles deep,
-    carries 39 % of the net buoyancy and the flap stays 3.5 deg short of it."""
+    carries part of the net buoyancy (the hinge holds 40 % of it) and the flap stays 3.4 deg short
+    of the balance (settled −11.27 deg against −7.90).
+
+    That shortfall is asserted as a coarse-resolution regression bound, −4.3 < error < −2.5 deg:
+    it is what makes the test see the size of the fluid's load on the flap (the fluid's force and
+    moment on the body scaled by 0.9 / 1.15 settle it at −5.0 / −2.3 deg from the balance, by
+    0.8 / 1.5 at −6.1 / −1.1 deg; none of the other checks notices).  And the settled flap is in
+    equilibrium under its three loads, the fluid's force (bodies.csv ff*), the link's (links.csv)
+    and its weight, within 1 % of the weight: a check of the body's books that does not depend on
+    the water under the flap."""
+    import numpy as np
+    from sphdvi.validation.runs import body_log, case_data
     e = run(0.04)
     assert e["hinge_drift"] < 1e-6
     assert abs(e["settled_deg"]) < abs(e["phi0_deg"]) and e["swing"] < 0.5
     assert abs(e["torque_error"]) < 0.02
+    assert -4.3 < e["tilt_error"] < -2.5, e["tilt_error"]
+    geo = HF.case_geometry(e["outdir"])
+    bodies, links = body_log(e["outdir"]), body_log(e["outdir"], "links")
+    late = np.asarray(bodies["time"], dtype=float) >= HF.SETTLED_FROM - 1e-9
+    assert np.array_equal(np.asarray(links["time"], dtype=float) >= HF.SETTLED_FROM - 1e-9, late)
+    weight = -geo["mass"] * float(np.asarray(case_data(e["outdir"])["constants"]["gravity"], dtype=float)[2])
+    fx = np.mean(np.asarray(bodies["ffx"])[late] + np.asarray(links["fx"])[late])
+    fz = np.mean(np.asarray(bodies["ffz"])[late] + np.asarray(links["fz"])[late]) - weight
+    assert abs(fx) < 0.01 * weight and abs(fz) < 0.01 * weight, (fx, fz, weight)
 
 
 @pytest.mark.slow

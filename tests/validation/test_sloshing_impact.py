@@ -20,21 +20,61 @@ CASE = REPO / "cases" / "sloshing2d" / "CaseSloshingTest10_2D_Def.xml"
 REFERENCE = REPO.parent / "shared" / "reference"
 
 
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """run(dp) -> (outdir, impact_errors) of the case at that dp, each run once."""
+    cache = {}
+
+    def get(dp):
+        if dp not in cache:
+            out = tmp_path_factory.mktemp(f"dp{dp}")
+            r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--dp", str(dp), "--threads", "2", "-q"])
+            assert r.exit_code == 0, r.output
+            e = impact_errors(out, REFERENCE)
+            print(f"dp {dp}:", {k: round(v, 4) for k, v in e.items()})
+            cache[dp] = (out, e)
+        return cache[dp]
+    return get
+
+
 @pytest.mark.slow
-def test_impacts_on_the_left_wall_come_when_the_experiment_records_them(tmp_path):
-    out = tmp_path / "dp0.008"
-    r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(out), "--dp", "0.008", "--threads", "2", "-q"])
-    assert r.exit_code == 0, r.output
-    e = impact_errors(out, REFERENCE)
-    print({k: round(v, 4) for k, v in e.items()})
-    # every impact within 7 % of the roll period (measured ≤ 6.1 %; the first within 0.3 %): the
-    # opposite roll sense puts them half a period (50 %) off
+def test_impacts_on_the_left_wall_come_when_the_experiment_records_them(run):
+    """dp 0.008 (2.3 min of CPU on 2 threads): the coarse run, a check of the roll and the probe."""
+    out, e = run(0.008)
+    # every impact within 7 % of the roll period (measured ≤ 6.1 %; the first within 0.3 %; on
+    # 2026-11-27 −0.05 / −4.0 / −2.4 / −6.1 %): the opposite roll sense puts them half a period (50 %)
+    # off; TOLERANCES S8's 3 % is asserted at dp 0.004 below
     assert e["dt_max"] < 0.07 and abs(e["dt1"]) < 0.02
-    # the pressure rises to impact levels in each window (peaks 2.3-10.6 kPa against 2.7-7.1 kPa)
-    assert all(e[f"p_sph{k}"] > 0.5 * e[f"p_exp{k}"] for k in range(1, 5))
+    # the pressure rises to impact levels in each window (peaks 2.1-11.4 kPa against 2.7-7.1 kPa),
+    # and not beyond 5 times the experiment's (measured at most 3.0 times: −43 / +106 / +200 / +59 %)
+    assert all(0.5 * e[f"p_exp{k}"] < e[f"p_sph{k}"] < 5.0 * e[f"p_exp{k}"] for k in range(1, 5))
     # between the windows the sensor sees no impact: the largest pressure outside them stays lower
     t, p = sensor_pressure(out)
     outside = np.ones(t.size, bool)
     for lo, hi in WINDOWS:
         outside &= ~((t >= lo - 0.1 * ROLL_PERIOD) & (t <= hi))
     assert p[outside].max() < min(e[f"p_sph{k}"] for k in range(1, 5))
+
+
+@pytest.mark.slow
+def test_impact_times_within_3_percent_at_dp_0_004(run):
+    """TOLERANCES S8, impact times within 3 % of the roll period, at dp 0.004 (depth/dp 23, 5,856
+    particles, about 11 min on 1 thread): measured +1.2 / −0.9 / −2.2 / −2.2 % (max 2.24 %), down from
+    6.06 % at dp 0.008 (order 1.4); the peaks within 5 times the experiment's (measured +159 / +87 /
+    +211 / +99 %: the WCSPH pressure spikes at the probe, see the strict xfail below)."""
+    _, fine = run(0.004)
+    _, coarse = run(0.008)
+    assert fine["dt_max"] <= 0.03
+    assert fine["dt_max"] < coarse["dt_max"]
+    assert all(0.5 * fine[f"p_exp{k}"] < fine[f"p_sph{k}"] < 5.0 * fine[f"p_exp{k}"] for k in range(1, 5))
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="TOLERANCES S8 peak pressure within 20-30 %: measured +159 / +87 / +211 / +99 % at "
+                   "dp 0.004 (-43 / +106 / +200 / +59 % at dp 0.008 on 2026-11-27): the raw SPH peaks are spikes "
+                   "1.9-3.1 times the experiment's, which samples every ~2.4 ms; averaged over 10 ms -10...+46 %, "
+                   "not scored")
+def test_impact_peaks_within_30_percent_at_dp_0_004(run):
+    _, e = run(0.004)
+    assert e["peak_max"] <= 0.30

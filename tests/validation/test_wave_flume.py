@@ -73,30 +73,48 @@ def test_the_height_deficit_falls_with_dp(tmp_path):
 IRREGULAR_CASE = REPO / "cases" / "waveflume2d" / "CaseWaveIrregular2D_Def.xml"
 
 
-@pytest.mark.slow
-@pytest.mark.xfail(strict=False, reason="W4 rms within 15 % (judgement): measured -11.2 / -14.5 / -17.0 % at "
-                   "dp 0.02 since Verlet's Euler step comes every VerletSteps steps as DualSPHysics's "
-                   "(-7.1 / -12.2 / -13.6 % with sphdvi's earlier count of VerletSteps + 1)")
-def test_irregular_waves_follow_the_linear_sum_of_the_sea_state(tmp_path):
-    """W4 (about 6 minutes on 2 threads): a piston makes a JONSWAP sea (Hs 0.04 m, Tp 1.4 s, 50 waves)
-    in d = 0.3 m; at the three gauges (0.6 / 1.2 / 1.8 m) the SPH surface is the linear sum of the sea
-    state's waves. Measured at dp 0.02 (session 34, Verlet's Euler step every VerletSteps steps as
-    DualSPHysics's): correlation 0.979 / 0.966 / 0.950, rms −11.2 / −14.5 / −17.0 % (WG3 outside the
-    15 %; the same code with the earlier Euler count −8.4 / −13.5 / −14.3 %: the figure moves by a few
-    per cent with any perturbation of a 98,000-step Verlet run). Before: 0.976 / 0.965 / 0.951, rms −7.1 / −12.2 / −13.6 %
-    (the coarse surface's height deficit, growing along the flume as W1's), best shifts −0.030 /
-    −0.035 / −0.045 s (the SPH wave runs ~2 % fast, as W1's) with correlations 0.990 / 0.985 / 0.982
-    there. The target is W3's judgement: correlation ≥ 0.9, rms within 15 %. With coefh 1.0 the same
-    run gave 0.971 / 0.900 / 0.822 and −14.3 / −16.2 / −17.4 % (−0.04 / −0.075 / −0.11 s), and at
-    dp 0.01 still 0.863 and −19.5 % at WG3."""
-    out = run_case(tmp_path, 0.02, IRREGULAR_CASE)
+@pytest.fixture(scope="module")
+def irregular(tmp_path_factory):
+    """irregular_errors of the W4 run at dp 0.02 (about 6 minutes on 2 threads), run once for the
+    two tests below."""
     from sphdvi.validation.waveflume import irregular_errors
+    out = run_case(tmp_path_factory.mktemp("w4"), 0.02, IRREGULAR_CASE)
     e = irregular_errors(out)
     print({k: round(v, 3) for k, v in e.items()})
-    assert e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15
+    return e
+
+
+@pytest.mark.slow
+def test_irregular_waves_follow_the_linear_sum_of_the_sea_state(irregular):
+    """W4: a piston makes a JONSWAP sea (Hs 0.04 m, Tp 1.4 s, 50 waves) in d = 0.3 m; at the three
+    gauges (0.6 / 1.2 / 1.8 m) the SPH surface is the linear sum of the sea state's waves. Measured
+    at dp 0.02 (session 34, Verlet's Euler step every VerletSteps steps as DualSPHysics's):
+    correlation 0.979 / 0.966 / 0.950, rms −11.2 / −14.5 / −17.0 % (the coarse surface's height
+    deficit, growing along the flume as W1's: the rms target is the strict xfail below; the same
+    code with the earlier Euler count gave −8.4 / −13.5 / −14.3 %, the figure moves by a few per
+    cent with any perturbation of a 98,000-step Verlet run). Before: 0.976 / 0.965 / 0.951, rms
+    −7.1 / −12.2 / −13.6 %, best shifts −0.030 / −0.035 / −0.045 s (the SPH wave runs ~2 % fast, as
+    W1's) with correlations 0.990 / 0.985 / 0.982 there. What holds is asserted here: W3's
+    judgement correlation ≥ 0.9, the correlation at the best shift ≥ 0.975, the shifts early by at
+    most 0.1 s and growing along the flume, and the rms deficit below 20 % (a regression bound on
+    the measured 17 %, stated as such: linear in the stroke, a paddle 10 % short would read about −25 %). With coefh 1.0
+    the same run gave 0.971 / 0.900 / 0.822 and −14.3 / −16.2 / −17.4 % (−0.04 / −0.075 / −0.11 s),
+    and at dp 0.01 still 0.863 and −19.5 % at WG3."""
+    e = irregular
     gauges = ("WG1", "WG2", "WG3")
+    assert e["corr_min"] >= 0.9
     assert min(e[f"{g}_corr_lag"] for g in gauges) >= 0.975
     assert all(-0.1 <= e[f"{g}_lag"] <= 0.0 for g in gauges) and e["WG3_lag"] <= e["WG1_lag"]
+    assert all(e[f"{g}_rms"] < 0.0 for g in gauges) and e["rms_max"] <= 0.20
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="W4 rms within 15 % (judgement, as W3): measured -11.2 / -14.5 / -17.0 % at dp 0.02 "
+                   "since Verlet's Euler step comes every VerletSteps steps as DualSPHysics's (-7.1 / -12.2 / "
+                   "-13.6 % with sphdvi's earlier count of VerletSteps + 1)")
+def test_irregular_waves_rms_within_15_percent_at_dp_0_02(irregular):
+    assert irregular["rms_max"] <= 0.15
 
 
 def test_fitted_wavenumber_recovers_the_waves_own_k():
