@@ -33,6 +33,7 @@ interleaves the thread counts on one solver and keeps the best of ``--rounds``.
 import argparse
 import math
 import os
+import resource
 import sys
 import time
 
@@ -88,18 +89,42 @@ def dambreak_3d(dp=0.02, coefh=0.866025):
 
 def count_interactions(state, h, is2d):
     """Neighbour pairs visited per step: sum over particles of their neighbours
-    (fluid: all; boundary: fluid/floating only), i != j, r < 2h."""
+    (fluid: all; boundary: fluid/floating only), i != j, r < 2h.  Counted in a compiled
+    loop, without a list of the pairs (which took ~5.9 KB per particle in 3D)."""
     cl = _cells.CellList(h, is2d)
     order = cl.build(state.pos)
-    pos = state.pos[order]
-    pt = state.ptype[order]
-    pairs = np.array(_cells._pairs_from_cells(pos, cl.cell[order], cl.cell_start, *cl.shape,
-                                              is2d, 2 * h), dtype=np.int64).reshape(-1, 2)
-    fi = pt[pairs[:, 0]] >= 2
-    fj = pt[pairs[:, 1]] >= 2
-    # a pair with at least one fluid particle is visited from both sides
+    pos = np.ascontiguousarray(state.pos[order])
+    pt = np.ascontiguousarray(state.ptype[order])
+    # a pair with at least one fluid (or floating) particle is visited from both sides
     # (boundary-boundary pairs are skipped)
-    return int(np.count_nonzero(fi | fj) * 2)
+    n = _cells.count_pairs_from_cells(pos, np.ascontiguousarray(cl.cell[order]), cl.cell_start, *cl.shape,
+                                      is2d, 2 * h, pt, 2)
+    return int(n) * 2
+
+
+def peak_rss_bytes():
+    """Peak resident memory of this process so far (Linux: ru_maxrss in KiB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def rss_bytes():
+    """Resident memory of this process now (Linux /proc/self/statm; elsewhere the peak)."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return peak_rss_bytes()
+
+
+def rss_growth_per_particle(state, c, cellmode, steps=20):
+    """Resident memory a new solver of ``state`` takes with ``steps`` steps run, per particle,
+    once the kernels are loaded (what the solver holds, not Python/numba/LLVM)."""
+    before = rss_bytes()
+    sol = SPHSolver(state.copy(), c, BENCH_PARAMS, cell_mode=cellmode)
+    sol.run(1e9, max_steps=steps)
+    grown = rss_bytes() - before
+    del sol
+    return grown / state.n
 
 
 def main():
@@ -151,8 +176,14 @@ def main():
                 t0 = time.perf_counter()
                 sols[t].run(1e9, max_steps=a.steps)
                 best[t] = min(best[t], (time.perf_counter() - t0) / a.steps)
-        print("  memory: %.0f bytes per particle in per-particle arrays"
-              % (sols[threads[0]].memory_bytes() / state.n))
+        # the <= 1 KB/particle target concerns what the solver holds: its arrays (memory_bytes)
+        # and the resident memory a new solver adds once the kernels are loaded; the process's
+        # peak RSS also holds Python, numba, LLVM and the compiled kernels (~165 MB)
+        numba.set_num_threads(min(threads))
+        print("  memory: %.0f bytes per particle in the solver's arrays (memory_bytes / n), RSS growth of a "
+              "new solver + 20 steps %.0f bytes per particle; process peak RSS %.0f MB"
+              % (sols[threads[0]].memory_bytes() / state.n, rss_growth_per_particle(state, c, a.cellmode),
+                 peak_rss_bytes() / 2**20))
         base = None
         for t in threads:
             dt_step, sol = best[t], sols[t]

@@ -127,11 +127,18 @@ def tait_pressure(rho, b, rhop0, gamma):
 @njit(cache=True, error_model="numpy")
 def _pack_row(k, i, is2d, pos, vel, rhop, mass, cst, nb):
     """Packed row k from particle i, with the pressure from Tait's EOS."""
+    _pack_row_at(k, i, i, is2d, pos, vel, rhop, mass, cst, nb)
+
+
+@njit(cache=True, error_model="numpy")
+def _pack_row_at(k, e, i, is2d, pos, vel, rhop, mass, cst, nb):
+    """Packed row k with the position of row e of ``pos`` and the rest from particle i (a
+    periodic copy: its displaced position, its real particle's values)."""
     rho = rhop[i]
     p = tait_pressure(rho, cst[16], cst[10], cst[17])
     if is2d:
-        nb[k, 0] = pos[i, 0]
-        nb[k, 1] = pos[i, 2]
+        nb[k, 0] = pos[e, 0]
+        nb[k, 1] = pos[e, 2]
         nb[k, 2] = vel[i, 0]
         nb[k, 3] = vel[i, 2]
         nb[k, 4] = rho
@@ -140,7 +147,7 @@ def _pack_row(k, i, is2d, pos, vel, rhop, mass, cst, nb):
         nb[k, 7] = 1.0 / rho
     else:
         for m in range(3):
-            nb[k, m] = pos[i, m]
+            nb[k, m] = pos[e, m]
             nb[k, 3 + m] = vel[i, m]
         nb[k, 6] = rho
         nb[k, 7] = p
@@ -203,11 +210,53 @@ def pack_parallel(is2d, pos, vel, rhop, mass, cst, nb):
 
 
 @njit(cache=True, error_model="numpy")
+def _periodic_pack_range(k0, k1, n, order, ghost_src, pos_x, is2d, cst, nb, vel, rhop, mass, ptype,
+                         ptype_e, cell, cell_e, idx, oi, tau, tau_e):
+    sps = tau_e.shape[0] == order.shape[0]
+    for k in range(k0, k1):
+        e = order[k]
+        i = e if e < n else ghost_src[e - n]
+        idx[k] = i
+        oi[k] = e if e < n else -1 - i
+        _pack_row_at(k, e, i, is2d, pos_x, vel, rhop, mass, cst, nb)
+        ptype_e[k] = ptype[i]
+        cell_e[k] = cell[e]
+        if sps:
+            for m in range(6):
+                tau_e[k, m] = tau[i, m]
+
+
+@njit(cache=True, error_model="numpy")
+def periodic_pack_serial(n, order, ghost_src, pos_x, is2d, cst, nb, vel, rhop, mass, ptype, ptype_e,
+                         cell, cell_e, idx, oi, tau, tau_e):
+    """The periodic extended set (the n particles, then the copies of particles
+    ``ghost_src``) packed in cell order, as :func:`sort_pack_serial`: row k is extended row
+    e = order[k], at position ``pos_x[e]`` (a copy's displaced one), with the velocity,
+    density, mass, type (and SPS stress, when tau_e has a row per packed row) of its real
+    particle ``idx[k]``, and the cell ``cell[e]``.  ``oi[k]``: the particle's row for a
+    real particle, -1 - idx[k] for a copy (the interaction computes the real rows only: as
+    DualSPHysics's periodic particles, a copy is a neighbour only)."""
+    _periodic_pack_range(0, order.shape[0], n, order, ghost_src, pos_x, is2d, cst, nb, vel, rhop, mass,
+                         ptype, ptype_e, cell, cell_e, idx, oi, tau, tau_e)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def periodic_pack_parallel(n, order, ghost_src, pos_x, is2d, cst, nb, vel, rhop, mass, ptype, ptype_e,
+                           cell, cell_e, idx, oi, tau, tau_e):
+    """Threaded :func:`periodic_pack_serial`."""
+    ne = order.shape[0]
+    for c in prange((ne + CHUNK - 1) // CHUNK):
+        _periodic_pack_range(c * CHUNK, min(ne, (c + 1) * CHUNK), n, order, ghost_src, pos_x, is2d, cst, nb,
+                             vel, rhop, mass, ptype, ptype_e, cell, cell_e, idx, oi, tau, tau_e)
+
+
+@njit(cache=True, error_model="numpy")
 def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst):
     """Time-step terms of rows i0..i1 (eq. 10; DualSPHysics ``DtVariable``):
     dtmax[c] = (max |a|^2 over fluid and floating particles without gravity (DualSPHysics's
     ComputeAceMax: the fluid's ace minus cst[12:15]; a floating ace has no gravity), max |v|^2
-    over ptype >= vel_type, max viscdt), read while the rows are in cache."""
+    over ptype >= vel_type, max viscdt), read while the rows are in cache.  Periodic copies
+    (oi < 0) do not count, as DualSPHysics's ComputeAceMax ignores periodic particles."""
     amax = 0.0
     vmax = 0.0
     cmax = 0.0
@@ -216,6 +265,8 @@ def _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst
     gz = cst[14]
     for i in range(i0, i1):
         o = oi[i]
+        if o < 0:
+            continue
         if viscdt[o] > cmax:
             cmax = viscdt[o]
         pt = ptype[i]
@@ -268,6 +319,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, pty
 
     for i in range(i0, i1):
         o = oi[i]   # row of particle i in the output arrays
+        if o < 0:
+            continue    # a periodic copy: a neighbour only (see periodic_pack_serial)
         xi = nb[i, 0]
         zi = nb[i, 1]
         vxi = nb[i, 2]
@@ -411,6 +464,8 @@ def _rates_range_2d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, pty
                     ds_b = 0.0
                     if ptj == 3:
                         oj = oi[j]
+                        if oj < 0:
+                            oj = -1 - oj    # a periodic copy: its particle's shift
                         ds_b = (shiftpos[oj, 0] * dx + shiftpos[oj, 2] * dz) * inv_dt * vf
                     s_a += ds_a
                     s_b += ds_b
@@ -586,6 +641,8 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, pty
 
     for i in range(i0, i1):
         o = oi[i]   # row of particle i in the output arrays
+        if o < 0:
+            continue    # a periodic copy: a neighbour only (see periodic_pack_serial)
         xi = nb[i, 0]
         yi = nb[i, 1]
         zi = nb[i, 2]
@@ -760,6 +817,8 @@ def _rates_range_3d(i0, i1, kern, visco, ddt, shift, adv, mdbc2, ftmode, nb, pty
                         ds_b = 0.0
                         if ptj == 3:
                             oj = oi[j]
+                            if oj < 0:
+                                oj = -1 - oj    # a periodic copy: its particle's shift
                             ds_b = ((shiftpos[oj, 0] * dx + shiftpos[oj, 1] * dy + shiftpos[oj, 2] * dz)
                                     * inv_dt * vf)
                         s_a += ds_a

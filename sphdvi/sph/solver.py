@@ -552,15 +552,25 @@ class SPHSolver:
 
     def _check_state_arrays(self):
         """Coerce the state arrays to the dtypes and C layout the compiled entry
-        points were specialised for (they do not check their arguments)."""
+        points were specialised for (they do not check their arguments).  Arrays already
+        checked (the same objects as at the last call) are not looked at again: what the
+        user, a motion hook, an exclusion or a checkpoint puts in their place is."""
         s = self.state
         n = s.pos.shape[0]
+        last = getattr(self, "_checked_arrays", None)
+        if (last is not None and last[0] is s.pos and last[1] is s.vel and last[2] is s.rhop
+                and last[3] is s.mass and last[4] is s.ptype and last[5] is s.idp and last[6] is s.mk):
+            if self.nb.shape[0] != n:
+                self._alloc()
+            return
         for name, dt in self._STATE_DTYPES.items():
             a = getattr(s, name)
             if a.dtype != dt or not a.flags.c_contiguous or a.shape[0] != n:
                 if a.shape[0] != n:
                     raise ValueError("state.%s has %d rows, pos has %d" % (name, a.shape[0], n))
                 setattr(s, name, np.ascontiguousarray(a, dtype=dt))
+        # kept (not only their ids) so that no other array can take an id of theirs
+        self._checked_arrays = (s.pos, s.vel, s.rhop, s.mass, s.ptype, s.idp, s.mk)
         if self.nb.shape[0] != n:
             self._alloc()
 
@@ -762,8 +772,12 @@ class SPHSolver:
 
     def _compute_rates_periodic(self):
         """Rates with ghost copies across the periodic boundaries (no reordering
-        of the real particles; the extended set is sorted by cell instead).  The
-        extended set's arrays are work arrays kept between steps (_periodic_work)."""
+        of the real particles; the extended set is sorted by cell instead).  One compiled
+        pass packs the extended set in cell order (:func:`interaction.periodic_pack_serial`);
+        the interaction computes the real rows only, straight into the particles' rows, and
+        their time-step terms (the copies are neighbours only, as DualSPHysics's periodic
+        particles).  The extended set's arrays are work arrays kept between steps
+        (_periodic_work)."""
         self._check_state_arrays()
         s = self.state
         per = self.periodicity
@@ -772,42 +786,31 @@ class SPHSolver:
         src, disp = per.ghosts(s.pos, 2.0 * self.h, self._ghost_bufs)
         ne = n + src.shape[0]
         w = self._periodic_work
+        light = self._use_parallel(light=True)
         unsorted = w("pos_x", ne, (3,), zero=False)     # the real particles', then the ghosts'
-        unsorted[:n] = s.pos
-        np.take(s.pos, src, axis=0, out=unsorted[n:], mode="clip")
-        unsorted[n:] += disp
-        order = self.cells.build(unsorted, parallel=self._use_parallel(light=True))
-        source = w("source", ne, (), np.int64, zero=False)
-        source[:n] = self._periodic_rows(n)
-        source[n:] = src
-        # the real source of each sorted row, and the gathers in cell order
-        idx = np.take(source, order, out=w("idx", ne, (), np.int64, zero=False), mode="clip")
-        pos_e = np.take(unsorted, order, axis=0, out=w("pos", ne, (3,), zero=False), mode="clip")
-        vel_e = np.take(s.vel, idx, axis=0, out=w("vel", ne, (3,), zero=False), mode="clip")
-        rhop_e = np.take(s.rhop, idx, out=w("rhop", ne, zero=False), mode="clip")
-        mass_e = np.take(s.mass, idx, out=w("mass", ne, zero=False), mode="clip")
-        ptype_e = np.take(s.ptype, idx, out=w("ptype", ne, (), s.ptype.dtype, zero=False), mode="clip")
-        cell_e = np.take(self.cells.cell, order, out=w("cell", ne, (), self.cells.cell.dtype, zero=False),
-                         mode="clip")
-        nb = w("nb", ne, self.nb.shape[1:])
-        ace = w("ace", ne, (3,))
-        ar = w("ar", ne)
-        viscdt = w("viscdt", ne)
-        shiftpos = w("shiftpos", ne, (3,)) if self.shift else self.shiftpos
-        shiftdet = w("shiftdet", ne) if self.shift else self.shiftdet
-        tau = (np.take(self.tau, idx, axis=0, out=w("tau", ne, self.tau.shape[1:], zero=False), mode="clip")
-               if self.visco_kind == 2 else self.tau)
-        gradvel = w("gradvel", ne, (6,)) if self.visco_kind == 2 else self.gradvel
+        _extend_positions(s.pos, src, disp, unsorted)
+        order = self.cells.build(unsorted, parallel=light)
+        # the gather into cell order: row k is extended row order[k], of real particle idx[k];
+        # oi[k] its row, or -1 - idx[k] for a copy
+        idx = w("idx", ne, (), np.int64, zero=False)
+        oi = w("oi", ne, (), np.int64, zero=False)
+        ptype_e = w("ptype", ne, (), s.ptype.dtype, zero=False)
+        cell_e = w("cell", ne, (), self.cells.cell.dtype, zero=False)
+        nb = w("nb", ne, self.nb.shape[1:], zero=False)
+        tau = w("tau", ne, self.tau.shape[1:], zero=False) if self.visco_kind == 2 else self.tau
+        pack = _ia.periodic_pack_parallel if light else _ia.periodic_pack_serial
+        pack(n, order, src, unsorted, self.is2d, self.cst, nb, s.vel, s.rhop, s.mass, s.ptype, ptype_e,
+             self.cells.cell, cell_e, idx, oi, self.tau, tau)
         rows_e = self._periodic_rows(ne)
         par = self._use_parallel()
         k = self._kernels(par)
-        k["pack"](self.is2d, pos_e, vel_e, rhop_e, mass_e, self.cst, nb)
         ncx, ncy, ncz = self.cells.shape
         if self._mdbc_now():
             # mDBC on the extended set: ghost copies see the fluid across the
             # periodic boundary; the real boundary particles keep their density
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
+            rhop_e = np.take(s.rhop, idx, out=w("rhop", ne, zero=False), mode="clip")
             normals_e = np.ascontiguousarray(self.normals[idx])
             wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
             fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
@@ -822,15 +825,18 @@ class SPHSolver:
             s.rhop[order[bound]] = rhop_e[bound]
             if self.nopen and self._need_nopen:
                 npshift = w("npshift", ne, self.npshift.shape[1:])
+                pos_e = np.take(unsorted, order, axis=0, out=w("pos", ne, (3,), zero=False), mode="clip")
+                vel_e = np.take(s.vel, idx, axis=0, out=w("vel", ne, (3,), zero=False), mode="clip")
                 self._nopen_detect(par, nb, ptype_e, cell_e, rows_e, normals_e, vel_e, pos_e, npshift)
                 real_rows = np.flatnonzero(order < n)
                 _copy_rows_2d(npshift, real_rows, self.npshift, order[real_rows])
         geo = (ncx, ncz) if self.is2d else (ncx, ncy, ncz)
-        real = order < n
-        dst = order[real]
-        rr = np.flatnonzero(real)       # the real particles' rows of the extended set, at dst
-        back = _copy_rows_2d, _copy_rows_1d
         if self.shift == 4 and self._need_shift_adv:
+            real = order < n
+            dst = order[real]
+            rr = np.flatnonzero(real)       # the real particles' rows of the extended set, at dst
+            back = _copy_rows_2d, _copy_rows_1d
+            shiftpos = w("shiftpos", ne, (3,))
             fstype = w("fstype", ne, (), np.int8)
             fsnormal = w("fsnormal", ne, (3,))
             nctype = w("nctype", ne if self.adv else 1, (), np.int8)
@@ -842,32 +848,16 @@ class SPHSolver:
             for a, out in ((fstype, self.fstype), (fsnormal, self.fsnormal), (shiftpos, self.shiftpos)) + (
                     ((nctype, self.nctype),) if self.adv else ()):
                 back[a.ndim == 1](a, rr, out, dst)
-        shiftpos_r = shiftpos
-        nctype_r = self.nctype
-        if self.adv:
-            # the interaction reads the shift (ALE) and type (NCPress) of every row: a periodic
-            # copy takes its real particle's, as DualSPHysics does
-            shiftpos_r = np.take(self.shiftpos, idx, axis=0, out=w("shiftpos_r", ne, (3,), zero=False), mode="clip")
-            nctype_r = np.take(self.nctype, idx, out=w("nctype_r", ne, (), self.nctype.dtype, zero=False), mode="clip")
+        # the real rows' rates straight into the particles' rows (oi), a copy's shift (ALE)
+        # read from its particle's row; the time-step terms of the real rows only (a ghost at
+        # the edge of the extended set misses neighbours)
+        self.dtmax = w("dtmax", (ne + _ia.CHUNK - 1) // _ia.CHUNK, (3,), zero=False)
         k["rates"](self.kernel, self.visco_kind, self.ddt, self.rates_shift, self.adv, self._mdbc2_flag,
-                   self.ftmode, nb, ptype_e, cell_e, rows_e, self.cells.cell_start, *geo, self.cst, tau,
-                   ace, ar, viscdt,
-                   shiftpos_r, shiftdet, gradvel, self._tvel(ne), w("dtmax", (ne + _ia.CHUNK - 1) // _ia.CHUNK, (3,)),
-                   nctype_r)
-        # the real rows back to their particles
-        _copy_rows_2d(ace, rr, self.ace, dst)
-        _copy_rows_1d(ar, rr, self.ar, dst)
-        _copy_rows_1d(viscdt, rr, self.viscdt, dst)
-        if self.rates_shift:
-            _copy_rows_2d(shiftpos, rr, self.shiftpos, dst)
-            _copy_rows_1d(shiftdet, rr, self.shiftdet, dst)
+                   self.ftmode, nb, ptype_e, cell_e, oi, self.cells.cell_start, *geo, self.cst, tau,
+                   self.ace, self.ar, self.viscdt, self.shiftpos, self.shiftdet, self.gradvel, self._tvel(ne),
+                   self.dtmax, self.nctype)
         if self.visco_kind == 2:
-            _copy_rows_2d(gradvel, rr, self.gradvel, dst)
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
-        # time-step terms of the real particles only (a ghost at the edge of the
-        # extended set misses neighbours and has a meaningless acceleration)
-        self.dtmax = np.array([_ts.dt_terms(self.ace, s.vel, self.viscdt, s.ptype, self.dt_vel_type,
-                                            *self.gravity)])
 
     def _fixed_dt(self, t):
         """DtFixed, or the DtFixedFile value at time t; 0 when dt is variable."""
@@ -891,7 +881,8 @@ class SPHSolver:
         fixed = self._fixed_dt(t)
         if fixed > 0.0 and self.dt_table is None and not self.keep_dt_terms:
             return fixed
-        a2, v2, cv = self.dtmax.max(axis=0)     # left by the interaction (dt_terms)
+        # left by the interaction, per chunk of rows (numpy's max(axis=0) costs ~20 us)
+        a2, v2, cv = _dtmax_columns(self.dtmax) if self.dtmax.shape[0] else self.dtmax.max(axis=0)
         dt1, dt2 = _ts.dt_conditions(a2, v2, cv, self.h, self.cs0)
         if self.keep_dt_terms:                  # <savedt>: CFL dt1, CFL dt2, AceMax, ViscDtMax, VelMax
             self.dt_terms = (self.cfl * dt1, self.cfl * dt2, math.sqrt(a2), float(cv), math.sqrt(v2))
@@ -1107,16 +1098,26 @@ class SPHSolver:
         return int(np.count_nonzero(self.state.ptype == FLUID))
 
     def memory_bytes(self):
-        """Bytes held in per-particle arrays by the state and the solver."""
+        """Bytes held in arrays by the state and the solver: its array attributes, those held in
+        tuples and lists (Shifting 4's work arrays, the cell list's spare room) and the work
+        buffers; each buffer counted once, whole (a view counts as the array it is a view of,
+        spare rows included)."""
         seen = {}
+
+        def add(a):
+            if isinstance(a, np.ndarray):
+                while isinstance(a.base, np.ndarray):
+                    a = a.base
+                seen[id(a)] = a.nbytes
+
         for obj in (self.state, self, self.cells):
             names = obj.__slots__ if hasattr(obj, "__slots__") else vars(obj)
             for name in names:
                 a = getattr(obj, name, None)
-                if isinstance(a, np.ndarray):
-                    seen[id(a)] = a.nbytes
+                for item in (a if isinstance(a, (tuple, list)) else (a,)):
+                    add(item)
         for a in list(self._bufs.values()) + list(self._ghost_bufs.values()):
-            seen[id(a)] = a.nbytes
+            add(a)
         return int(sum(seen.values()))
 
     def particle_forces(self):
@@ -1138,4 +1139,38 @@ def _copy_rows_1d(src, rows, out, dst):
     """out[dst[k]] = src[rows[k]] (1D arrays)."""
     for k in range(rows.shape[0]):
         out[dst[k]] = src[rows[k]]
+
+
+@numba.njit(cache=True)
+def _dtmax_columns(dtmax):
+    """The maxima of the three columns of the interaction's per-chunk time-step terms, as
+    numpy's dtmax.max(axis=0) (a NaN propagates) for a (k >= 1, 3) array."""
+    a = dtmax[0, 0]
+    v = dtmax[0, 1]
+    c = dtmax[0, 2]
+    for k in range(1, dtmax.shape[0]):
+        x = dtmax[k, 0]
+        if x > a or x != x:
+            a = x
+        x = dtmax[k, 1]
+        if x > v or x != x:
+            v = x
+        x = dtmax[k, 2]
+        if x > c or x != x:
+            c = x
+    return a, v, c
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _extend_positions(pos, src, disp, out):
+    """The periodic extended set's positions: out[:n] = pos, then out[n + g] = pos[src[g]] +
+    disp[g] for the ghost copies (JSphCpuSingle::PeriodicMakeList's displaced copies)."""
+    n = pos.shape[0]
+    for i in range(n):
+        for m in range(3):
+            out[i, m] = pos[i, m]
+    for g in range(src.shape[0]):
+        i = src[g]
+        for m in range(3):
+            out[n + g, m] = pos[i, m] + disp[g, m]
 
