@@ -155,52 +155,10 @@ def neighbour_pairs_bruteforce(pos, radius, is2d):
 
 
 @njit(cache=True, error_model="numpy")
-def _pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius):
-    """Pairs (i < j, sorted-order indices) found through the cell stencil."""
-    r2max = radius * radius
-    n = pos.shape[0]
-    out = []
-    for i in range(n):
-        c = cell[i]
-        cx = c % ncx
-        if is2d:
-            cz = c // ncx
-            cy = 0
-        else:
-            cy = (c // ncx) % ncy
-            cz = c // (ncx * ncy)
-        for dz in range(-1, 2):
-            z = cz + dz
-            if z < 0 or z >= ncz:
-                continue
-            for dy in range(-1, 2):
-                y = cy + dy
-                if is2d and dy != 0:
-                    continue
-                if y < 0 or y >= ncy:
-                    continue
-                row = (z * ncy + y) * ncx
-                j0 = cell_start[row + max(cx - 1, 0)]
-                j1 = cell_start[row + min(cx + 1, ncx - 1) + 1]
-                for j in range(j0, j1):
-                    if j <= i:
-                        continue
-                    d2 = 0.0
-                    for k in range(3):
-                        if is2d and k == 1:
-                            continue
-                        d = pos[i, k] - pos[j, k]
-                        d2 += d * d
-                    if d2 < r2max:
-                        out.append((i, j))
-    return out
-
-
-@njit(cache=True, error_model="numpy")
-def count_pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius, ptype, min_type):
-    """Number of the pairs :func:`_pairs_from_cells` finds (same loops, nothing stored) that
-    have a particle of ``ptype`` >= ``min_type`` (sorted-order arrays): a count that needs no
-    memory per pair (the list of a 3D scene of 1e5 particles takes ~0.5 GB)."""
+def _walk_pairs(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius, ptype, min_type, out, store):
+    """The pairs (i < j, sorted-order indices) closer than ``radius`` through the cell stencil
+    that have a particle of ``ptype`` >= ``min_type``: counted, and appended to ``out`` when
+    ``store``."""
     r2max = radius * radius
     n = pos.shape[0]
     count = 0
@@ -239,7 +197,29 @@ def count_pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius, p
                         d2 += d * d
                     if d2 < r2max:
                         count += 1
+                        if store:
+                            out.append((i, j))
     return count
+
+
+@njit(cache=True, error_model="numpy")
+def _pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius):
+    """Pairs (i < j, sorted-order indices) found through the cell stencil."""
+    out = [(0, 0)]
+    out.pop()
+    _walk_pairs(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius, np.zeros(pos.shape[0], np.int8),
+                np.int8(0), out, True)
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def count_pairs_from_cells(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius, ptype, min_type):
+    """Number of the pairs :func:`_pairs_from_cells` finds (nothing stored) that have a particle
+    of ``ptype`` >= ``min_type`` (sorted-order arrays): a count that needs no memory per pair
+    (the list of a 3D scene of 1e5 particles takes ~0.5 GB)."""
+    out = [(0, 0)]
+    out.pop()
+    return _walk_pairs(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius, ptype, min_type, out, False)
 
 
 class CellList:
