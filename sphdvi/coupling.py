@@ -19,8 +19,12 @@ Two kinds, as in DualSPHysics:
   from the step's start under the corrector's loads (:meth:`FloatingBodies.predict`,
   :meth:`FloatingBodies.step`); mDBC normals turn with the body at the half step too
   (DualSPHysics keeps them at t^n until the corrector's update).  With periodic boundaries the particles are kept in
-  the periodic box while the body's centre is not wrapped: r_k - R is taken as its
-  shortest periodic image (DualSPHysics's FtPeriodicDist).
+  the periodic box and so is a free body's centre after each whole step (DualSPHysics's FtUpdateFloatings:
+  ``center = UpdatePeriodicPos(fcenter)``); r_k - R is taken as its shortest periodic image
+  (DualSPHysics's FtPeriodicDist).  A body with links or a collision shape is integrated, as
+  DualSPHysics's Chrono integrates it, without the periodic conditions: its crossing a periodic
+  boundary stops the run (InputError, exit 2) rather than let its contacts and links act on the
+  wrong image (:meth:`FloatingBodies.wrap_centres`).
 
 The fluid side is the solver's arrays; nothing here writes files.
 """
@@ -33,7 +37,7 @@ import numpy as np
 from .sph import _env  # noqa: F401  (OMP_WAIT_POLICY before numba)
 from numba import njit
 
-from .errors import DivergenceError
+from .errors import DivergenceError, InputError
 from .sph.clock import time_reached
 
 
@@ -260,6 +264,7 @@ class FloatingBodies:
             self.body_of_idp[idp] = i
             self.local_of_idp[idp] = local
         self._R0 = np.array(self.R0).reshape(-1, 3, 3)
+        self._free_rows, self._tied_rows = _periodic_roles(self.system)
         self._sel = np.empty(p["idp"].size, np.int64)     # rows and bodies of the floating particles,
         self._body = np.empty(p["idp"].size, np.int64)    # refilled each call (the solver reorders)
 
@@ -288,8 +293,9 @@ class FloatingBodies:
         nb = self.system.nb
         F = np.zeros((nb, 3))
         T = np.zeros((nb, 3))
-        # the body's particles are wrapped at the periodic ends, its centre is not: the lever
-        # arm is the shortest periodic image (DualSPHysics's FtPeriodicDist)
+        # the body's particles and its centre are wrapped at the periodic ends each on its own
+        # (a body across an end has both): the lever arm is the shortest periodic image
+        # (DualSPHysics's FtPeriodicDist)
         bad = _sum_loads(sel, body, s.mass, solver.ace, s.pos, self.system.pos,
                          *_periodic_args(getattr(solver, "periodicity", None)), F, T)
         if bad >= 0:
@@ -319,6 +325,7 @@ class FloatingBodies:
             return
         self.system.step(dt, F, T)
         self.carry_particles(solver, sel, body)
+        self.wrap_centres(solver)
         self.check_in_domain(solver, sel, body)
 
     def predict(self, solver, dt_half: float) -> None:
@@ -345,6 +352,37 @@ class FloatingBodies:
         fl = (sys_.kind == FLOATING)[:, None]
         sys_.total_force = np.where(fl, F + sys_.mass[:, None] * sys_.gravity[None, :], sys_.total_force)
         sys_.total_torque = np.where(fl, T, sys_.total_torque)
+
+    def wrap_centres(self, solver) -> None:
+        """With periodic boundaries, bring the centre of each free floating body that left the
+        periodic box back in (as the fluid's particles: + S_k below it, - S_k at or above its high
+        end), as DualSPHysics's FtUpdateFloatings stores ``UpdatePeriodicPos(fcenter)`` after each
+        whole step; only its position moves (velocity, rotation and loads are unchanged: the lever
+        arms are minimum images).  A floating body with links or a collision shape (DualSPHysics
+        integrates it in Chrono, which knows nothing of the periodic box: its links and contacts
+        would act on the unwrapped body) is not wrapped: its centre leaving the box is an
+        InputError (exit 2)."""
+        per = getattr(solver, "periodicity", None)
+        if per is None:
+            return
+        pos = self.system.pos
+        if self._free_rows.size:
+            centres = pos[self._free_rows]
+            per.wrap(centres)
+            pos[self._free_rows] = centres
+        for i in self._tied_rows:
+            for k in per.axes:
+                x, lo, hi = float(pos[i, k]), float(per.lo[k]), float(per.lo[k] + per.length[k])
+                if lo <= x < hi:
+                    continue
+                what = _tied_reason(self.system, i)
+                raise InputError(
+                    f"t={solver.time:.6g} s: floating body mkbound {self.mkbounds[i]} ('{self.names[i]}') crossed the "
+                    f"periodic boundary along {'xyz'[k]} (centre {'xyz'[k]} = {x:.6g} m, periodic box [{lo:.6g}, "
+                    f"{hi:.6g}) m) but it has {what}: those are not periodic (DualSPHysics integrates such a body in "
+                    f"Chrono, without the periodic conditions), so its contacts and links would act on the wrong "
+                    f"image; expected a <chrono> body with links or a modelfile to stay inside the periodic box "
+                    f"(or a floating without <chrono> links and collisions to cross it)")
 
     def check_in_domain(self, solver, sel: np.ndarray, body: np.ndarray) -> None:
         """Stop the run (DivergenceError, exit 3) when a floating particle has left the simulation
@@ -386,6 +424,30 @@ class FloatingBodies:
 # ---------------------------------------------------------------------------------
 _NO_NORMALS = np.zeros((0, 3))
 _NO_AXES = (np.zeros(0, np.int64), np.zeros(3), np.zeros(3), np.zeros((3, 3)))
+
+
+def _periodic_roles(system) -> tuple[np.ndarray, np.ndarray]:
+    """(free, tied) floating bodies of a multibody system: a tied one has a collision shape or a
+    link (kept unwrapped, as DualSPHysics's Chrono bodies), a free one neither (its centre is
+    wrapped into the periodic box, as DualSPHysics's own floating update)."""
+    from .dvi.system import FLOATING
+    tied = np.zeros(system.nb, np.bool_)
+    tied[np.asarray(system.sh_body, np.int64)] = True
+    for rec in system.links:
+        for b in (rec.get("b1"), rec.get("b2")):
+            if b is not None and int(b) >= 0:
+                tied[int(b)] = True
+    floating = np.asarray(system.kind) == FLOATING
+    return np.flatnonzero(floating & ~tied), np.flatnonzero(floating & tied)
+
+
+def _tied_reason(system, i: int) -> str:
+    """What ties body ``i`` to the non-periodic multibody world: its links' names, a collision shape."""
+    links = [rec["name"] for rec in system.links if i in (rec.get("b1"), rec.get("b2"))]
+    parts = [f"link{'s' if len(links) > 1 else ''} " + ", ".join(f"'{n}'" for n in links)] if links else []
+    if np.any(np.asarray(system.sh_body) == i):
+        parts.append("a collision shape (<chrono> collision with a modelfile)")
+    return " and ".join(parts)
 
 
 def _periodic_args(per) -> tuple:

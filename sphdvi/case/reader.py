@@ -1058,11 +1058,11 @@ def read_chrono(reader, el) -> dict:
         reader.warn(grav, "<chrono><gravity> is not read (as DualSPHysics v5.4): the bodies feel the case's "
                           "<constantsdef><gravity>")
     out["collision"] = _read_chrono_collision(reader, reader.child(el, "collision"), out["collision"])
-    ids = _read_chrono_bodies(reader, el, out)
+    ids, empty = _read_chrono_bodies(reader, el, out)
     for ln in reader.children(el):
         if not ln.tag.startswith("link_"):
             continue
-        out["links"].append(_read_link(reader, ln, ids))
+        out["links"].append(_read_link(reader, ln, ids, empty))
     _name_chrono_links(reader, el, out["links"])
     scale = reader.child(el, "scaleforce")
     if scale is not None:
@@ -1103,16 +1103,23 @@ def _read_chrono_collision(reader, col, default: dict) -> dict:
             "contactmethod": int(reader.child_value(col, "contactmethod", 0, lo=0, hi=1))}
 
 
-def _read_chrono_bodies(reader, el, out: dict) -> dict:
+def _read_chrono_bodies(reader, el, out: dict) -> tuple[dict, dict]:
     """The ``<body*>`` elements into ``out["bodies"]`` (one per mkbound, named id+mk for a list);
-    returns {body id: line}. An id or an mkbound used twice is an error
-    (JChronoData::CheckAddBodyError); no body at all a warning (DualSPHysics refuses it)."""
-    ids, owner = {}, {}
+    returns ({body id: line}, {id of a body with mkbound="": line}). An id or an mkbound used twice
+    is an error (JChronoData::CheckAddBodyError); no body at all a warning (DualSPHysics refuses it);
+    mkbound="" a warning: DualSPHysics's JRangeFilter gives it no value, so ReadXml makes no body."""
+    ids, owner, empty = {}, {}, {}
     for b in reader.children(el):
         if not b.tag.startswith("body"):
             continue
         kind = b.tag[4:]
         bid = reader.text_attr(b, "id")
+        if b.get("mkbound") == "":
+            reader.mark(b, *b.keys())
+            reader.warn(b, f"body '{bid}' has an empty mkbound list: it defines no body and is skipped, as "
+                           "DualSPHysics skips it (its mkbound range has no value); a link naming it is an error")
+            empty[bid] = b.sourceline
+            continue
         mks = _mk_list(reader, b, "mkbound")
         names = [bid] if len(mks) == 1 else [f"{bid}{mk}" for mk in mks]
         for name, mk in zip(names, mks):
@@ -1138,7 +1145,7 @@ def _read_chrono_bodies(reader, el, out: dict) -> dict:
     if not out["bodies"]:
         reader.warn(el, "<chrono> defines no body: DualSPHysics refuses it (\"There are no defined bodies to use "
                         "Chrono.\"); sphdvi makes every <floating> a free body")
-    return ids
+    return ids, empty
 
 
 def _name_chrono_links(reader, el, links: list) -> None:
@@ -1269,14 +1276,23 @@ def _read_coef_file(reader, c, tag: str) -> dict:
     return {"times": a[:, 0].tolist(), "values": a[:, 1].tolist(), "file": path}
 
 
-def _read_link(reader, ln, ids) -> dict:
+def _read_link(reader, ln, ids, empty=None) -> dict:
+    """One ``<link_*>`` as JChronoObjects::ReadXml reads it: ``idbody1`` names a body, ``idbody2``
+    another or, absent or "NULL", the ground; a name of no body (an empty one, or one whose
+    mkbound list is empty: ``empty``) is an error there too ("idbody1 'x' is not found.")."""
     spec = LINK_SPECS[ln.tag]
     d = {"type": ln.tag[5:], "line": ln.sourceline, "name": reader.text_attr(ln, "name", None)}
     for which in ("idbody1", "idbody2"):
         v = reader.text_attr(ln, which, None)
+        if which == "idbody2" and v == "NULL":
+            v = None                    # DualSPHysics's default: body 1 linked to the ground
         if v is None:
             if which == "idbody1" or ln.tag in ("link_linearspring", "link_coulombdamping", "link_pulley"):
                 raise reader.error(ln, f"missing attribute '{which}'", "the id of a body defined in <chrono>")
+        elif v in (empty or {}):
+            raise reader.error(ln, f"{which}='{v}' names the body of line {empty[v]}, whose mkbound list is empty: "
+                                   f"it defines no body (DualSPHysics stops too: \"{which} '{v}' is not found.\")",
+                               "one of " + (", ".join(sorted(ids)) if ids else "(no bodies defined)"))
         elif v not in ids:
             raise reader.error(ln, f"{which}='{v}' names no body",
                                "one of " + (", ".join(sorted(ids)) if ids else "(no bodies defined)"))
