@@ -384,6 +384,36 @@ class FloatingBodies:
                     f"image; expected a <chrono> body with links or a modelfile to stay inside the periodic box "
                     f"(or a floating without <chrono> links and collisions to cross it)")
 
+    def check_radius(self, per, ignore: bool = False) -> None:
+        """DualSPHysics's JSph::CalcFloatingRadius at the start of a periodic run: a floating body's
+        radius is 1.2 times the largest distance of its particles from its centre, and a periodic
+        length (the period L_k, |PeriXinc.x| ...) not above the largest radius stops the run
+        (InputError, exit 2), or with ``ignore`` (the FtIgnoreRadius parameter) is warned about, as
+        DualSPHysics does: such a body can meet its own periodic image."""
+        if per is None or not self.particles:
+            return
+        from .dvi.system import FLOATING
+        radius = {i: FLOATING_OVERRADIUS * float(np.sqrt((local * local).sum(axis=1).max(initial=0.0)))
+                  for i, (_, local) in enumerate(self.particles) if int(self.system.kind[i]) == FLOATING}
+        if not radius:
+            return
+        i = max(radius, key=radius.get)
+        for k in per.axes:
+            length = float(per.length[k])
+            if length > radius[i]:
+                continue
+            text = (f"floating body mkbound {self.mkbounds[i]} ('{self.names[i]}'): its radius, {radius[i]:.6g} m "
+                    f"({FLOATING_OVERRADIUS:g} x the largest distance of its particles from its centre, as "
+                    f"DualSPHysics's CalcFloatingRadius), is not below the periodic length along {'xyz'[k]}, "
+                    f"{length:.6g} m: the body can meet its own periodic image (DualSPHysics: \"The floating body "
+                    f"radius ({radius[i]:g} [m]) is too large for periodic distance in {'XYZ'[k]} ({length:g} [m])\")")
+            if ignore:
+                warnings.warn(text + "; run on as FtIgnoreRadius asks")
+            else:
+                raise InputError(text + "; expected a periodic length above the body's radius (a longer periodic "
+                                        "domain or a smaller body), or FtIgnoreRadius=1 in <parameters> to run on "
+                                        "with a warning")
+
     def check_in_domain(self, solver, sel: np.ndarray, body: np.ndarray) -> None:
         """Stop the run (DivergenceError, exit 3) when a floating particle has left the simulation
         domain, naming the body, the time and the position: DualSPHysics excludes such a
@@ -424,6 +454,9 @@ class FloatingBodies:
 # ---------------------------------------------------------------------------------
 _NO_NORMALS = np.zeros((0, 3))
 _NO_AXES = (np.zeros(0, np.int64), np.zeros(3), np.zeros(3), np.zeros((3, 3)))
+# DualSPHysics's CalcFloatingRadius: a floating body's radius is this times its particles' largest
+# distance from its centre ("overradius")
+FLOATING_OVERRADIUS = 1.2
 
 
 def _periodic_roles(system) -> tuple[np.ndarray, np.ndarray]:

@@ -854,6 +854,10 @@ class SPHRun:
                        if (p["type"] == 1).any() else None)
         self.floating = (FloatingBodies(data, motions, fluidcount, normals0, float(params.get("FtPause", 0.0)))
                          if (p["type"] == 2).any() else None)
+        if self.floating is not None and periodic and not resume:   # DualSPHysics: not on a restart either
+            from .sph.periodic import Periodicity
+            self.floating.check_radius(Periodicity(periodic, p["pos"], float(c["dp"]), params),
+                                       ignore=int(params.get("FtIgnoreRadius", 0) or 0) != 0)
         self.bodies = self.floating.system if self.floating is not None else None
         if self.bodies is not None:
             self.bodies.defer_warnings = True        # its lines come through take_step_warnings

@@ -62,7 +62,8 @@ PARAMETERS: dict[str, Param] = {
     "ShiftAdvNCPress": Param("int", 0, "advanced shifting non-conservative pressure", (0, 1)),
     "RigidAlgorithm": Param("int", 1, "0:collision-free, 1:SPH, 2:DEM (not implemented), 3:Chrono", (0, 1, 3)),
     "FtPause": Param("float", 0.0, "time to freeze floatings at the start [s]", (), 0.0, 1e9),
-    "FtIgnoreRadius": Param("int", 0, "ignore floating radius with periodic conditions", (0, 1)),
+    "FtIgnoreRadius": Param("int", 0, "periodic run with a floating body whose radius (1.2 x its particles' "
+                            "largest distance from its centre) reaches a periodic length: 0 stops, 1 warns", (0, 1)),
     "FtSaveAce": Param("int", 0, "save floating accelerations (debug)", (0, 1)),
     "CoefDtMin": Param("float", 0.05, "DtMin = CoefDtMin*h/c0", (), 0.0, 1.0),
     "DtIni": Param("float", 0.0, "initial dt [s] (0: h/c0)", (), 0.0, 1e3),
@@ -113,7 +114,6 @@ DEPRECATED = {"PartsOutMax", "IncZ", "DomainFixed", "DeltaSPH", "PosDouble"} | {
 NO_EFFECT = {
     "FtSaveAce": "DualSPHysics's debug output of floating accelerations",
     "SaveExtraParts": "sphdvi's restart.h5 always holds the whole state, written at every output",
-    "FtIgnoreRadius": "the floating radius of DualSPHysics's periodic distance test; sphdvi does not use it",
     "DivCleanKp": "the coefficient of divergence cleaning, which sphdvi does not implement",
     "SavePosDouble": "sphdvi always keeps and writes positions in double precision",
     "BoundaryMethod": "it is not a DualSPHysics key: DualSPHysics reads 'Boundary' (1 DBC, 2 mDBC) and ignores "

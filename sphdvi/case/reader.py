@@ -1120,7 +1120,7 @@ def _read_chrono_bodies(reader, el, out: dict) -> tuple[dict, dict]:
                            "DualSPHysics skips it (its mkbound range has no value); a link naming it is an error")
             empty[bid] = b.sourceline
             continue
-        mks = _mk_list(reader, b, "mkbound")
+        mks = _range_filter_mks(reader, b, "mkbound")
         names = [bid] if len(mks) == 1 else [f"{bid}{mk}" for mk in mks]
         for name, mk in zip(names, mks):
             if name in ids:
@@ -1146,6 +1146,19 @@ def _read_chrono_bodies(reader, el, out: dict) -> tuple[dict, dict]:
         reader.warn(el, "<chrono> defines no body: DualSPHysics refuses it (\"There are no defined bodies to use "
                         "Chrono.\"); sphdvi makes every <floating> a free body")
     return ids, empty
+
+
+def _range_filter_mks(reader, el, attr: str) -> list:
+    """A ``<chrono>`` mkbound list, read by DualSPHysics with JRangeFilter: a list of blanks only
+    (``mkbound=" "``) is one item that atoi reads as 0, so it means mkbound 0; the same here, with a
+    warning (almost surely a typo). Anything else as :func:`_mk_list`."""
+    raw = el.get(attr)
+    if raw is not None and raw and not raw.strip():
+        reader.mark(el, attr)
+        reader.warn(el, f"{attr}=\"{raw}\" (blanks only) is read as mkbound 0, as DualSPHysics reads it (its mk "
+                        "list parser turns the blank item into 0); write the mkbound you mean")
+        return [0]
+    return _mk_list(reader, el, attr)
 
 
 def _name_chrono_links(reader, el, links: list) -> None:
@@ -1179,7 +1192,7 @@ def _read_scaleforce(reader, scale, bodies: list) -> list:
     known = {b["mkbound"] for b in bodies}
     out = []
     for b in reader.children(scale, "body"):
-        mks = _mk_list(reader, b, "mkbound")
+        mks = _range_filter_mks(reader, b, "mkbound")
         bad = [mk for mk in mks if known and mk not in known]
         if bad:
             raise reader.error(b, f"mkbound {bad[0]} is not a <chrono> body", "the mkbound of a <chrono> body "
@@ -1276,19 +1289,38 @@ def _read_coef_file(reader, c, tag: str) -> dict:
     return {"times": a[:, 0].tolist(), "values": a[:, 1].tolist(), "file": path}
 
 
+# links that join two bodies, and what DualSPHysics says of one given the ground (idbody2 "NULL")
+TWO_BODY_LINKS = {
+    "link_linearspring": "it stops at the start of the run: \"Link without two bodies reference.\"",
+    "link_coulombdamping": "it stops at the start of the run: \"Link without two bodies reference.\"",
+    "link_pulley": "\"Link-Pulley uses two bodies.\"",
+}
+
+
 def _read_link(reader, ln, ids, empty=None) -> dict:
     """One ``<link_*>`` as JChronoObjects::ReadXml reads it: ``idbody1`` names a body, ``idbody2``
     another or, absent or "NULL", the ground; a name of no body (an empty one, or one whose
-    mkbound list is empty: ``empty``) is an error there too ("idbody1 'x' is not found.")."""
+    mkbound list is empty: ``empty``) is an error there too ("idbody1 'x' is not found."). The
+    ground is an error for the links of two bodies (:data:`TWO_BODY_LINKS`): DualSPHysics's
+    SaveVtkScheme stops a spring or damper without a second body; a pulley's ReadXml check says it
+    "uses two bodies" (its code lets idbody2="NULL" through to its closed-source Chrono library)."""
     spec = LINK_SPECS[ln.tag]
     d = {"type": ln.tag[5:], "line": ln.sourceline, "name": reader.text_attr(ln, "name", None)}
     for which in ("idbody1", "idbody2"):
         v = reader.text_attr(ln, which, None)
-        if which == "idbody2" and v == "NULL":
+        null = which == "idbody2" and v == "NULL"
+        if null:
             v = None                    # DualSPHysics's default: body 1 linked to the ground
         if v is None:
-            if which == "idbody1" or ln.tag in ("link_linearspring", "link_coulombdamping", "link_pulley"):
+            if which == "idbody1":
                 raise reader.error(ln, f"missing attribute '{which}'", "the id of a body defined in <chrono>")
+            if ln.tag in TWO_BODY_LINKS:
+                given = ('idbody2="NULL" (the ground)' if null else
+                         'no idbody2 (DualSPHysics reads it as "NULL", the ground)')
+                raise reader.error(ln, f"<{ln.tag}> joins two bodies but has {given}, which it cannot take "
+                                       f"(DualSPHysics: {TWO_BODY_LINKS[ln.tag]})",
+                                   "idbody2 naming a second body defined in <chrono> (for one held to the ground, "
+                                   "a <bodyfixed> body): one of " + (", ".join(sorted(ids)) if ids else "(none)"))
         elif v in (empty or {}):
             raise reader.error(ln, f"{which}='{v}' names the body of line {empty[v]}, whose mkbound list is empty: "
                                    f"it defines no body (DualSPHysics stops too: \"{which} '{v}' is not found.\")",

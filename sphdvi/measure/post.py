@@ -561,14 +561,17 @@ def target_mask(snap: Snapshot, mks, fluidcount=0, mkbound=False):
     return np.isin(mk, np.asarray(mks, np.int64)) & (snap.ptype != core.FLUID)
 
 
-def step_force(run: RunOutput, snap: Snapshot, sel, grid=None, centre=None, axis=None, viscosity=True):
-    """Total fluid force and moment on the particles ``sel`` of one snapshot."""
+def step_force(run: RunOutput, snap: Snapshot, sel, grid=None, centre=None, axis=None, viscosity=True,
+               arm_pos=None):
+    """Total fluid force and moment on the particles ``sel`` of one snapshot; ``arm_pos``: the
+    positions the lever arms start from (default the particles', e.g. a body made whole across a
+    periodic end by :func:`unwrap_rigid`)."""
     spec = run.spec
     grid = grid or run.fluid_grid(snap)
     press = snap.press if snap.press is not None else spec.tait_pressure(snap.rhop)
     f = core.fluid_forces(grid, snap.pos[sel], snap.vel[sel], snap.rhop[sel], press[sel], snap.mass[sel],
                           spec, viscosity=viscosity, t=snap.time)
-    return core.force_and_moment(snap.pos[sel], f, centre=centre, axis=axis)
+    return core.force_and_moment(snap.pos[sel] if arm_pos is None else arm_pos, f, centre=centre, axis=axis)
 
 
 def measure_forces(run: RunOutput, mks, mkbound=False, point=None, axis=None, viscosity=True,
@@ -639,6 +642,20 @@ def rigid_fit(ref, cur, is2d=False):
         d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
         R = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
     return R, mc - R @ mr
+
+
+def unwrap_rigid(pos, anchor: int, per):
+    """The positions ``pos`` of a rigid body's particles as one piece when the run's periodic
+    boundaries (``per``, None: none) have wrapped part of it to the other end: each particle's
+    offset from the ``anchor`` particle taken as its shortest periodic image (the minimum image
+    DualSPHysics's FtPeriodicDist takes for the particle-to-centre distance). Exact while every
+    particle lies within half a period of the anchor along each periodic axis."""
+    pos = np.asarray(pos, float)
+    if per is None or pos.shape[0] == 0:
+        return pos
+    d = pos - pos[anchor]
+    per.min_image(d)
+    return pos[anchor] + d
 
 
 def rigid_velocity(pos, vel, centre, is2d=False):
@@ -790,7 +807,10 @@ def bodies_from_snapshots(run: RunOutput, first=0, last=None, every=1) -> Table:
     """Body motion of the floating bodies from the particle snapshots (rigid fit of
     each body's particles to their initial positions), and the fluid force and
     torque about the centre recomputed from the fluid (contact forces: left empty
-    here; :func:`with_logged_contacts` fills them from the run's bodies.csv)."""
+    here; :func:`with_logged_contacts` fills them from the run's bodies.csv). With periodic
+    boundaries a body across a periodic end is first made whole about its particle nearest the
+    centre (:func:`unwrap_rigid`), and its centre is given in the periodic box, as bodies.csv and
+    DualSPHysics's floating outputs give it (surge, sway, heave: that centre minus the initial one)."""
     data = run.data
     bodies = data.get("bodies") or {}
     if "mk" not in bodies or len(bodies["mk"]) == 0:
@@ -800,11 +820,14 @@ def bodies_from_snapshots(run: RunOutput, first=0, last=None, every=1) -> Table:
     names = [f"mkbound{int(v)}" for v in bodies["mkbound"]]
     centre0 = np.asarray(bodies["center"], float).reshape(-1, 3)
     p = data["particles"]
-    ref = {}
+    per = run.periodicity
+    ref, anchor = {}, {}
     for b, mk in enumerate(mks):
         sel = np.flatnonzero((p["mk"] == mk) & (p["type"] != core.FLUID))
         o = np.argsort(p["idp"][sel])
         ref[b] = (p["idp"][sel][o], p["pos"][sel][o])
+        # the particle nearest the centre: the body is made whole about it (unwrap_rigid)
+        anchor[b] = int(ref[b][0][np.argmin(np.linalg.norm(ref[b][1] - centre0[b], axis=1))]) if sel.size else -1
     cols, units = _body_table_columns(names, is2d)
     nb = len(BODY_COLUMNS)
     times, parts, rows = [], [], []
@@ -818,10 +841,16 @@ def bodies_from_snapshots(run: RunOutput, first=0, last=None, every=1) -> Table:
             sel = sel[np.argsort(snap.idp[sel])]
             ridp, rpos = ref[b]
             keep = np.isin(ridp, snap.idp[sel])
-            R, t = rigid_fit(rpos[keep], snap.pos[sel], is2d)
+            k = np.flatnonzero(snap.idp[sel] == anchor[b])
+            pos = unwrap_rigid(snap.pos[sel], int(k[0]) if k.size else 0, per)
+            R, t = rigid_fit(rpos[keep], pos, is2d)
             c = R @ centre0[b] + t
-            v, w = rigid_velocity(snap.pos[sel], snap.vel[sel].astype(float), c, is2d)
-            f, m = step_force(run, snap, sel, grid=grid, centre=c)
+            v, w = rigid_velocity(pos, snap.vel[sel].astype(float), c, is2d)
+            f, m = step_force(run, snap, sel, grid=grid, centre=c, arm_pos=pos)
+            if per is not None:             # the centre in the periodic box, as bodies.csv (FtUpdateFloatings)
+                c = c[None, :].copy()
+                per.wrap(c)
+                c = c[0]
             row[b * nb:(b + 1) * nb] = np.concatenate([c, c - centre0[b], rotation_to_euler_deg(R), v, w, f, m,
                                                        np.full(6, np.nan)])
         rows.append(row)
