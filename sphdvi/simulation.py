@@ -137,6 +137,26 @@ def conflicting_options(sets, tmax, tout) -> None:
                                      f"expected one of them")
 
 
+def nested_key_hint(key: str) -> str | None:
+    """A ``--set`` key with a dot or naming a <special> section (``special.shifting.mode``,
+    ``gauges``): the message that such settings are edited in the case file; None otherwise.
+    DualSPHysics's command line has no such keys either: its <special> sections are read from the XML."""
+    from .case.reader import SPECIAL_KNOWN
+    parts = [p for p in key.strip().lower().split(".") if p]
+    sections = [p for p in parts if p in SPECIAL_KNOWN]
+    if "." not in key and not sections and parts != ["special"]:
+        return None
+    where = f"<special><{sections[0]}>" if sections else ("<special>" if "special" in parts else "a nested element")
+    hint = ""
+    if "." not in key:
+        from .case.parameters import closest_key
+        close = closest_key(key)
+        hint = f"; did you mean the parameter '{close}'?" if close else ""
+    return (f"--set {key}: {where} is a section of the case file, not a --set key (--set takes the "
+            f"<parameters> keys and CFLnumber): edit it in the case file and run gencase again (or sphdvi run "
+            f"CASE.xml, which runs gencase){hint}")
+
+
 def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
     """``--set KEY=VALUE`` (a <parameters> key, or CFLnumber: :data:`RUN_CONSTANTS`), ``--tmax``,
     ``--tout``; raises InputError.
@@ -157,6 +177,9 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
             given.append(RUN_CONSTANTS[key.lower()])
             continue
         if key not in PARAMETERS:
+            nested = nested_key_hint(key)
+            if nested:
+                raise InputError(nested)
             const = constant_hint(key)
             if const:
                 raise InputError(f"--set {key}: {const} (gencase draws the particles with it: their masses, initial "
@@ -178,6 +201,9 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
         apply_delta_sph(out, given)
     except ValueError as exc:
         raise InputError(f"--set: {exc}") from None
+    if str(out.get("MdbcMkbound") or "").strip() and str(out.get("Boundary", 1)).strip() != "2":
+        warnings.warn(f"MdbcMkbound '{str(out['MdbcMkbound']).strip()}' does nothing: it picks the boundaries mDBC "
+                      f"acts on, and Boundary is {out.get('Boundary', 1)} (DBC), not 2 (mDBC); add --set Boundary=2")
     for option, key, value in (("--tmax", "TimeMax", tmax), ("--tout", "TimeOut", tout)):
         if value is not None:
             try:
@@ -913,7 +939,8 @@ class SPHRun:
                              "such as '0-3,7')") from None
         if missing:
             warnings.warn(f"MdbcMkbound '{mkbound_list}': no boundary particles of mkbound "
-                          f"{', '.join(map(str, missing))}")
+                          f"{', '.join(map(str, missing))} in this case: that entry does nothing (expected the "
+                          "mkbound of a wall or floating body of the case file)")
         return normals
 
     def _hook(self, solver, t, dt):

@@ -508,10 +508,22 @@ def fmt(spec: str, value) -> str:
     return spec.format(100 * value) if spec.endswith("%") else spec.format(value)
 
 
+def case_names(every) -> list[str]:
+    """The names the command line takes, in the order of ``cases()``; S2 is S1's run."""
+    return [n for c in every for n in ((c.name, "S2") if c.name == "S1" else (c.name,))]
+
+
+def slow_names(every) -> list[str]:
+    """The slow cases: left out by default, run by ``--all`` or by name."""
+    return [c.name for c in every if c.slow]
+
+
 def main(argv=None) -> int:
+    every = cases()
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("names", nargs="*", help="cases to run (S1 S3 S3M S4 S5 S5M S7 S8 S9 S10 S11 S12 S13 S16 S16M S16O S18 A1 W1 W2 W3 W4 W5 W6 C3); default: all but the slow S4, S8, S16, S16M, S16O, S18 and W4")
-    ap.add_argument("--all", action="store_true", help="every case, S4 included")
+    ap.add_argument("names", nargs="*", help=f"cases to run ({' '.join(case_names(every))}); "
+                                             f"default: all but the slow {', '.join(slow_names(every))}")
+    ap.add_argument("--all", action="store_true", help=f"also the slow cases {', '.join(slow_names(every))}")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
     ap.add_argument("--dp", type=float, action="append", metavar="DP",
@@ -525,7 +537,6 @@ def main(argv=None) -> int:
     constants = parse_constants(args.constant, ap)
     # a kill runs the finally clauses that delete the case copies (--constant)
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
-    every = cases()
     known = {c.name: c for c in every}
     known["S2"] = known["S1"]                      # S1 and S2 are one run of the hydrostatic tank
     unknown = [n for n in args.names if n.upper() not in known]

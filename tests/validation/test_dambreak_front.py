@@ -98,7 +98,8 @@ def test_front_runs_the_experiments_course_after_a_start_delay(runs):
     """The lead is an offset taken before T ≈ 1.2 (at T = 0.41 the fronts agree, Z = 1.11;
     by T = 1.19 the SPH one is 0.26 a ahead), not a faster front: with the experiment's
     clock started ΔT ≈ 0.2-0.25 late (12-14 ms at Martin & Moyce's a = 57 mm) every point
-    of T ∈ [1, 3] is within 2.6 % (a/dp 50; the TOLERANCES ±5 %)."""
+    of T ∈ [1, 3] is within 2.62 % (a/dp 50; 2.77 % at 25; session 34). Asserted: 5 % at each dp
+    (the TOLERANCES ±5 %), 3 % at a/dp 50."""
     ref = load_martin_moyce(str(REFERENCE))
     for dp, (t, x, _) in runs.items():
         delay, err = front_start_delay(t, x, ref)

@@ -71,3 +71,21 @@ def test_constant_option_writes_a_copy_beside_the_case_with_the_new_values(tmp_p
             assert e.code == 2
         else:
             raise AssertionError(bad)
+
+
+def test_help_lists_every_case_and_the_slow_ones_all_adds():
+    """The usage names every case the tool takes (S3M and S16O included) and ``--all`` names the
+    slow cases the default leaves out (its help said "every case, S4 included" while it also
+    added S8, S16, S16M, S16O, S18 and W4)."""
+    validate = _validate_module()
+    every = validate.cases()
+    r = subprocess.run([sys.executable, str(REPO / "tools" / "validate.py"), "--help"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    text = " ".join(r.stdout.split())
+    names = text.split("cases to run (")[1].split(")")[0].split()
+    assert set(names) == {c.name for c in every} | {"S2"} and {"S3M", "S16O"} <= set(names)
+    slow = [c.name for c in every if c.slow]
+    assert set(slow) == {"S4", "S8", "S16", "S16M", "S16O", "S18", "W4"}
+    assert "also the slow cases " + ", ".join(slow) in text
+    assert "default: all but the slow " + ", ".join(slow) in text
