@@ -35,7 +35,10 @@ Chrono collides a triangle mesh): only surface particles are kept; a flat face's
 is its tangent plane r in front of it, an edge or corner particle its sphere
 (:func:`_cloud_query`); of two clouds, every sample of the smaller is tested against the
 other's surface and the other's edge and corner particles against the smaller's faces.
-A cloud against a sphere uses the sphere's exact SDF.  Limitations:
+A sphere against a cloud is its centre against the cloud's surface (one contact: the tangent
+plane of a face, the sphere of an edge or corner particle; :func:`_sphere_vs_cloud`).
+Polytope pairs (box/hull, not box–box) with a face axis of least penetration get a
+clipped face-face manifold of ≤ 4 points (:func:`_polytope_manifold`).  Limitations:
 cylinder–box/hull and cylinder–cylinder rely on 16 rim samples per cap (no
 exact rim–edge contact); a cloud's staircase (sloping or curved lattice
 surface) is collided as spheres; no rolling/spinning friction.
@@ -327,6 +330,13 @@ def _cloud_query(q, s, dims, samp_off, samp_pts, samp_nrm, cg_meta, cg_start, re
     best, bj = _scan_cells(q, s, samp_off, samp_pts, cg_meta, cg_start, -1, k0, R * R, -1)
     if k0 < kr and best > (k0 * cs) ** 2:
         best, bj = _scan_cells(q, s, samp_off, samp_pts, cg_meta, cg_start, k0, kr, best, bj)
+    return _cloud_surface_at(q, bj, best, r, sp, reach, samp_pts, samp_nrm, xflag, plane_only)
+
+
+@njit(cache=True)
+def _cloud_surface_at(q, bj, best, r, sp, reach, samp_pts, samp_nrm, xflag, plane_only):
+    """The cloud surface of :func:`_cloud_query` at q given its nearest surface particle bj
+    (−1: none within reach) at the squared distance ``best``."""
     none = (reach - r, (0.0, 0.0, 1.0))
     if bj < 0:
         return none
@@ -356,6 +366,63 @@ def _cloud_query(q, s, dims, samp_off, samp_pts, samp_nrm, cg_meta, cg_start, re
     if d < 1e-14:
         return -r, (0.0, 0.0, 1.0)
     return d - r, (v0 / d, v1 / d, v2 / d)
+
+
+@njit(cache=True)
+def _sphere_vs_cloud(ssp, scl, bsp, bcl, swap, nc, cap, env, keybase, sh_dims, samp_off,
+                     samp_cnt, samp_pts, samp_nrm, cg_meta, cg_start, w_pos, w_R, lo, hi,
+                     c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """A sphere against a particle cloud's smooth surface (:func:`_cloud_query`): the
+    sphere's centre queries the cloud's nearest surface particle, whose tangent plane (a
+    flat face's particle) or sphere (an edge or corner) the sphere touches: one contact, as
+    a sphere on a plane over a face, whatever the lattice under it.  The nearest particle
+    is searched in the cloud's cell grid, or over its particles where that grid region
+    (the sphere's radius in cells) would hold more cells than the cloud has particles.
+    ``swap``: the sphere is the pair's second shape."""
+    c = row3(w_pos, ssp)
+    rad = sh_dims[ssp, 0]
+    for k in range(3):
+        if c[k] + rad < lo[scl, k] or c[k] - rad > hi[scl, k]:
+            return nc
+    RO = w_R[scl]
+    q = mat_t_vec(RO, v_sub(c, row3(w_pos, scl)))
+    dims = sh_dims[scl]
+    r = dims[0]
+    sp = dims[1] if dims[1] > 0.0 else 2.0 * r
+    reach = rad + r + max(env, 0.0) + 1e-12
+    Rq = reach + sp
+    cs = cg_meta[scl, 3]
+    kr = int(math.ceil(Rq / cs))
+    if (2.0 * kr + 1.0) ** 3 > samp_cnt[scl]:
+        best = Rq * Rq
+        bj = -1
+        for p in range(samp_off[scl], samp_off[scl] + samp_cnt[scl]):
+            d0 = q[0] - samp_pts[p, 0]
+            d1 = q[1] - samp_pts[p, 1]
+            d2 = q[2] - samp_pts[p, 2]
+            dd = d0 * d0 + d1 * d1 + d2 * d2
+            if dd < best:
+                best = dd
+                bj = p
+    else:
+        k0 = min(kr, 2)
+        best, bj = _scan_cells(q, scl, samp_off, samp_pts, cg_meta, cg_start, -1, k0, Rq * Rq,
+                               -1)
+        if k0 < kr and best > (k0 * cs) ** 2:
+            best, bj = _scan_cells(q, scl, samp_off, samp_pts, cg_meta, cg_start, k0, kr, best,
+                                   bj)
+    phi, gl = _cloud_surface_at(q, bj, best, r, sp, reach, samp_pts, samp_nrm, 0.0, False)
+    gap = phi - rad
+    if gap >= env:
+        return nc
+    gw = mat_vec(RO, gl)
+    pt = v_sub(c, v_scale(gw, 0.5 * (rad + phi)))
+    key = keybase + (1 if swap else 0)
+    if swap:
+        return _emit_t(nc, cap, bcl, bsp, scl, ssp, pt, gw, gap, key,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return _emit_t(nc, cap, bsp, bcl, ssp, scl, pt, v_scale(gw, -1.0), gap, key,
+                   c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
 
 
 # ------------------------------------------------------------- contact output
@@ -723,10 +790,13 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
                   ed_off, ed_cnt, w_pos, w_R, wa, wb):
     """Separating-axis test of two convex polytopes (box/hull) over the face
     normals of both and the cross products of their edges.  Returns
-    (separation, edge a, edge b, axis): the edge pair is set (≥ 0) when an
-    edge–edge axis is the axis of least penetration (its supporting edges),
-    the vertex–face contacts cover the face axes.  Edge pairs are skipped
-    for large hulls (> 4096 edge pairs)."""
+    (separation, edge a, edge b, axis, face side, face plane): the edge pair is set (≥ 0)
+    when an edge–edge axis is the axis of least penetration (its supporting edges); the
+    face (side 0: of sa, 1: of sb; its index in ``planes``) is the face axis of least
+    penetration (a face of sb only where it beats sa's best by a relative 1e-9, so that a
+    face-face rest does not swap the reference face with round-off), for the face-face
+    manifold (:func:`_polytope_manifold`).  Edge pairs are skipped for large hulls (> 4096
+    edge pairs)."""
     na = samp_cnt[sa]
     nbv = samp_cnt[sb]
     Ra = w_R[sa]
@@ -744,6 +814,8 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
         wb[i, 1] = x[1]
         wb[i, 2] = x[2]
     best_face = -1e300
+    fside = 0
+    fplane = -1
     for side in range(2):
         s = sa if side == 0 else sb
         R = Ra if side == 0 else Rb_
@@ -758,10 +830,12 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
                 d = n[0] * W[i, 0] + n[1] * W[i, 1] + n[2] * W[i, 2] - off
                 if d < m:
                     m = d
-            if m > best_face:
+            if m > best_face + (1e-9 * (1.0 + abs(best_face)) if side == 1 else 0.0):
                 best_face = m
+                fside = side
+                fplane = p
             if m > env:
-                return m, -1, -1, (0.0, 0.0, 0.0)
+                return m, -1, -1, (0.0, 0.0, 0.0), fside, fplane
     best_edge = -1e300
     bea = -1
     beb = -1
@@ -769,7 +843,7 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
     nea = ed_cnt[sa]
     neb = ed_cnt[sb]
     if nea * neb > 4096:
-        return best_face, -1, -1, bL
+        return best_face, -1, -1, bL, fside, fplane
     T = v_sub(cb, ca)
     scale = 1e300
     for i in range(na):
@@ -803,7 +877,7 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
                     minb = d
             sep = minb - maxa
             if sep > env:
-                return sep, -1, -1, L
+                return sep, -1, -1, L, fside, fplane
             # only the edges that actually support the axis
             if (abs(v_dot(L, row3(wa, a0)) - maxa) > tol or abs(v_dot(L, row3(wa, a1)) - maxa) > tol
                     or abs(v_dot(L, row3(wb, b0)) - minb) > tol
@@ -815,8 +889,245 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
                 beb = j
                 bL = L
     if bea >= 0 and best_edge > best_face + 0.05 * abs(best_face) + 1e-6 * (1.0 + scale):
-        return best_edge, bea, beb, bL
-    return max(best_face, best_edge), -1, -1, bL
+        return best_edge, bea, beb, bL, fside, fplane
+    return max(best_face, best_edge), -1, -1, bL, fside, fplane
+
+
+# contact keys of the face-face manifold (pair-local, below the edge-edge key 999999): a
+# vertex of either polytope, or the crossing of an edge of one with an edge of the other; the
+# same physical point keeps its key whichever face is the reference (warm start)
+_VKEY0 = 1 << 19
+_EKEY0 = _VKEY0 + (1 << 18)
+_EKEY_MOD = 200000
+
+
+@njit(cache=True)
+def _vertex_key(s, v, s_lo):
+    """Key of vertex v of shape s (s_lo: the pair's lower shape index)."""
+    return _VKEY0 + (0 if s == s_lo else 1 << 17) + (v & ((1 << 17) - 1))
+
+
+@njit(cache=True)
+def _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nref_v, fv_idx, fv_edge, ed_cnt):
+    """Key of a clipped point: the crossing of the current polygon edge (label ``lab``: ≥ 0
+    the incident face's edge lab, < 0 the reference face's edge −lab−1) with the reference
+    face's side plane j.  Two reference edges meet at a reference vertex."""
+    if lab < 0:
+        j1 = -lab - 1
+        if (j1 + 1) % nref_v == j:
+            return _vertex_key(sr, fv_idx[fr_off + j], s_lo)
+        if (j + 1) % nref_v == j1:
+            return _vertex_key(sr, fv_idx[fr_off + j1], s_lo)
+        return _EKEY0 + _EKEY_MOD + ((j1 * 61 + j) % 9973)
+    er = fv_edge[fr_off + j]
+    ei = fv_edge[fi_off + lab]
+    if er < 0 or ei < 0:
+        return _EKEY0 + _EKEY_MOD + 9973 + ((lab * 61 + j) % 9973)
+    if sr == s_lo:
+        return _EKEY0 + (np.int64(er) * ed_cnt[si] + ei) % _EKEY_MOD
+    return _EKEY0 + (np.int64(ei) * ed_cnt[sr] + er) % _EKEY_MOD
+
+
+@njit(cache=True)
+def _area_tri(a, b, c, n):
+    """Signed area of the triangle abc projected on the plane of unit normal n."""
+    return 0.5 * v_dot(v_cross(v_sub(b, a), v_sub(c, a)), n)
+
+
+@njit(cache=True)
+def _hull_area4(a, b, c, p, n):
+    """Area of the convex hull of four points projected on the plane of normal n: the
+    largest of the four triangles and of the three quadrilaterals' shoelace areas."""
+    t0 = _area_tri(a, b, c, n)
+    t1 = _area_tri(a, b, p, n)
+    t2 = _area_tri(a, p, c, n)
+    t3 = _area_tri(p, b, c, n)
+    best = max(max(abs(t0), abs(t1)), max(abs(t2), abs(t3)))
+    best = max(best, abs(t0 - t2))     # quadrilateral a b c p
+    best = max(best, abs(t1 + t2))     # a b p c
+    return max(best, abs(t0 - t1))     # a p b c
+
+
+@njit(cache=True)
+def _pick(score, keys, cand, ncand, used, tol):
+    """Index (into the point arrays) of the unused candidate of largest score; those within
+    ``tol`` of the best are tied and the lowest key wins (a choice that does not flip with
+    round-off, for the warm start)."""
+    best = -1e300
+    for m in range(ncand):
+        q = cand[m]
+        if not used[q] and score[q] > best:
+            best = score[q]
+    pick = -1
+    for m in range(ncand):
+        q = cand[m]
+        if used[q] or score[q] < best - tol:
+            continue
+        if pick < 0 or keys[q] < keys[pick]:
+            pick = q
+    return pick
+
+
+@njit(cache=True)
+def _reduce4(poly, gapb, pkey, cand, ncand, used, score, nref, ext):
+    """Contact reduction to four points (as Bullet's persistent manifold): the deepest point,
+    the one farthest from it, the one that maximises the triangle's area, then the one that
+    maximises the area of the four points' convex hull (all in the reference plane).
+    Marks them in ``used``."""
+    for m in range(ncand):
+        used[cand[m]] = False
+    for m in range(ncand):
+        score[cand[m]] = -gapb[cand[m]]
+    i0 = _pick(score, pkey, cand, ncand, used, 1e-5 * ext)
+    used[i0] = True
+    p0 = row3(poly, i0)
+    for m in range(ncand):
+        q = cand[m]
+        d = v_sub(row3(poly, q), p0)
+        h = v_dot(d, nref)
+        score[q] = v_dot(d, d) - h * h
+    i1 = _pick(score, pkey, cand, ncand, used, 1e-6 * ext * ext)
+    used[i1] = True
+    p1 = row3(poly, i1)
+    for m in range(ncand):
+        q = cand[m]
+        score[q] = abs(_area_tri(p0, p1, row3(poly, q), nref))
+    i2 = _pick(score, pkey, cand, ncand, used, 1e-6 * ext * ext)
+    used[i2] = True
+    p2 = row3(poly, i2)
+    for m in range(ncand):
+        q = cand[m]
+        score[q] = _hull_area4(p0, p1, p2, row3(poly, q), nref)
+    i3 = _pick(score, pkey, cand, ncand, used, 1e-6 * ext * ext)
+    used[i3] = True
+
+
+@njit(cache=True)
+def _polytope_manifold(s1, s2, b1, b2, fside, fplane, env, keybase, nc, cap,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key,
+                       planes, pl_off, pl_cnt, fv_off, fv_cnt, fv_idx, fv_edge, ed_cnt,
+                       w_pos, w_R, wa, wb, poly, tmp, pkey, tkey, plab, tlab, gapb, cand,
+                       used, score):
+    """Face-face contact manifold of two convex polytopes (box/hull), as Chrono's and
+    Bullet's polyhedral clipping (Bullet: btPolyhedralContactClipping::clipHullAgainstHull):
+    the reference face is the SAT face axis of least penetration (``fplane`` of side
+    ``fside``), the incident face the other polytope's face most anti-parallel to it; the
+    incident polygon is clipped against the reference face's side planes (Sutherland–
+    Hodgman), the points below the reference face plus the envelope are kept and reduced to
+    four (:func:`_reduce4`).  Each point is placed halfway between the faces and keyed by
+    what it is (a vertex, or an edge of one crossing an edge of the other:
+    :func:`_crossing_key`), so that its key persists from step to step.  Returns nc."""
+    if fside == 0:
+        sr = s1
+        si = s2
+        Wr = wa
+        Wi = wb
+    else:
+        sr = s2
+        si = s1
+        Wr = wb
+        Wi = wa
+    s_lo = min(s1, s2)
+    Rr = w_R[sr]
+    nref = mat_vec(Rr, (planes[fplane, 0], planes[fplane, 1], planes[fplane, 2]))
+    offr = v_dot(nref, row3(w_pos, sr)) - planes[fplane, 3]
+    Ri = w_R[si]
+    finc = -1
+    dbest = 1e300
+    for p in range(pl_off[si], pl_off[si] + pl_cnt[si]):
+        d = v_dot(mat_vec(Ri, (planes[p, 0], planes[p, 1], planes[p, 2])), nref)
+        if d < dbest:
+            dbest = d
+            finc = p
+    if finc < 0:
+        return nc
+    fr_off = fv_off[fplane]
+    nrv = fv_cnt[fplane]
+    fi_off = fv_off[finc]
+    niv = fv_cnt[finc]
+    for k in range(niv):
+        v = fv_idx[fi_off + k]
+        for c in range(3):
+            poly[k, c] = Wi[v, c]
+        pkey[k] = _vertex_key(si, v, s_lo)
+        plab[k] = k
+    npoly = niv
+    ext = 0.0
+    for j in range(nrv):
+        a = row3(Wr, fv_idx[fr_off + j])
+        e = v_sub(row3(Wr, fv_idx[fr_off + (j + 1) % nrv]), a)
+        ln_e = math.sqrt(v_dot(e, e))
+        ext = max(ext, ln_e)
+        pn = v_cross(e, nref)
+        ln = math.sqrt(v_dot(pn, pn))
+        if ln <= 1e-300:
+            continue
+        pn = v_scale(pn, 1.0 / ln)
+        off = v_dot(pn, a)
+        eps = 1e-9 * ln_e          # a vertex on a side plane within round-off counts as inside
+        nt = 0
+        for q in range(npoly):
+            if nt + 2 > poly.shape[0]:
+                break              # (only a degenerate polygon could outgrow n_inc + n_ref)
+            q2 = (q + 1) % npoly
+            dp = poly[q, 0] * pn[0] + poly[q, 1] * pn[1] + poly[q, 2] * pn[2] - off
+            dq = poly[q2, 0] * pn[0] + poly[q2, 1] * pn[1] + poly[q2, 2] * pn[2] - off
+            inp = dp <= eps
+            inq = dq <= eps
+            if inp:
+                for c in range(3):
+                    tmp[nt, c] = poly[q, c]
+                tkey[nt] = pkey[q]
+                tlab[nt] = plab[q]
+                nt += 1
+            if inp != inq:
+                f = min(max(dp / (dp - dq), 0.0), 1.0)
+                for c in range(3):
+                    tmp[nt, c] = poly[q, c] + (poly[q2, c] - poly[q, c]) * f
+                tkey[nt] = _crossing_key(plab[q], j, sr, si, s_lo, fr_off, fi_off, nrv, fv_idx,
+                                         fv_edge, ed_cnt)
+                tlab[nt] = -(j + 1) if inp else plab[q]
+                nt += 1
+        npoly = nt
+        for q in range(nt):
+            for c in range(3):
+                poly[q, c] = tmp[q, c]
+            pkey[q] = tkey[q]
+            plab[q] = tlab[q]
+        if npoly == 0:
+            return nc
+    # points below the reference face + envelope (coincident ones once)
+    ncand = 0
+    tol2 = (1e-9 * ext) ** 2
+    for q in range(npoly):
+        gapb[q] = v_dot(nref, row3(poly, q)) - offr
+        if gapb[q] >= env:
+            continue
+        dup = False
+        for m in range(ncand):
+            d = v_sub(row3(poly, q), row3(poly, cand[m]))
+            if v_dot(d, d) <= tol2:
+                dup = True
+                break
+        if not dup:
+            cand[ncand] = q
+            ncand += 1
+    if ncand > 4:
+        _reduce4(poly, gapb, pkey, cand, ncand, used, score, nref, ext)
+    else:
+        for m in range(ncand):
+            used[cand[m]] = True
+    nab = nref if fside == 0 else v_scale(nref, -1.0)
+    for m in range(ncand):
+        q = cand[m]
+        if not used[q]:
+            continue
+        g = gapb[q]
+        pt = (poly[q, 0] - 0.5 * g * nref[0], poly[q, 1] - 0.5 * g * nref[1],
+              poly[q, 2] - 0.5 * g * nref[2])
+        nc = _emit_t(nc, cap, b1, b2, s1, s2, pt, nab, g, keybase + pkey[q],
+                     c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return nc
 
 
 @njit(cache=True)
@@ -828,11 +1139,12 @@ def _point_like(t):
 def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cnt,
                  samp_pts, samp_rad, pl_off, pl_cnt, planes, cg_meta, cg_start, edges, ed_off,
                  ed_cnt, w_pos, w_R, lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key,
-                 samp_nrm):
+                 samp_nrm, fv_off, fv_cnt, fv_idx, fv_edge):
     """All contacts of the candidate pairs with gap < env.  Returns the count
     (which may exceed the capacity: the caller then grows and calls again).
     ``samp_nrm``: per sample, a cloud particle's outward normal and flag
-    (:func:`cloud_surface`; zero for other shapes' samples)."""
+    (:func:`cloud_surface`; zero for other shapes' samples); ``fv_*``: the face polygons
+    of the box/hull planes (System._face_polygons)."""
     cap = c_a.shape[0]
     nc = 0
     ns = sh_type.shape[0]
@@ -846,6 +1158,20 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
             maxv = samp_cnt[s]
     wa = np.empty((maxv, 3))
     wb = np.empty((maxv, 3))
+    maxf = 4
+    for p in range(fv_cnt.shape[0]):
+        maxf = max(maxf, fv_cnt[p])
+    mcl = 2 * maxf + 4               # a clipped polygon: ≤ incident + reference vertices
+    cpoly = np.empty((mcl, 3))
+    ctmp = np.empty((mcl, 3))
+    ckey = np.empty(mcl, np.int64)
+    ckey2 = np.empty(mcl, np.int64)
+    clab = np.empty(mcl, np.int64)
+    clab2 = np.empty(mcl, np.int64)
+    cgap = np.empty(mcl)
+    ccand = np.empty(mcl, np.int64)
+    cused = np.zeros(mcl, np.bool_)
+    cscore = np.empty(mcl)
     for q in range(npair):
         s1 = pairs[q, 0]
         s2 = pairs[q, 1]
@@ -880,11 +1206,21 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                           c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep)
             continue
         if (t1 == BOX or t1 == HULL) and (t2 == BOX or t2 == HULL):
-            sep, ea, eb, L = _polytope_sat(s1, s2, env, samp_off, samp_cnt, samp_pts, pl_off,
-                                           pl_cnt, planes, edges, ed_off, ed_cnt, w_pos, w_R,
-                                           wa, wb)
+            sep, ea, eb, L, fside, fplane = _polytope_sat(s1, s2, env, samp_off, samp_cnt,
+                                                          samp_pts, pl_off, pl_cnt, planes,
+                                                          edges, ed_off, ed_cnt, w_pos, w_R,
+                                                          wa, wb)
             if sep > env:
                 continue  # a separating axis: no contact (also removes SDF lower-bound ghosts)
+            if ea < 0 and fplane >= 0:
+                nc0 = nc
+                nc = _polytope_manifold(s1, s2, b1, b2, fside, fplane, env, keybase, nc, cap,
+                                        c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key,
+                                        planes, pl_off, pl_cnt, fv_off, fv_cnt, fv_idx, fv_edge,
+                                        ed_cnt, w_pos, w_R, wa, wb, cpoly, ctmp, ckey, ckey2,
+                                        clab, clab2, cgap, ccand, cused, cscore)
+                if nc > nc0:
+                    continue   # the face-face manifold (else: the vertex-face samples below)
             if ea >= 0:
                 pa0 = row3(wa, edges[ed_off[s1] + ea, 0])
                 pa1 = row3(wa, edges[ed_off[s1] + ea, 1])
@@ -897,16 +1233,23 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
         if t1 == CYLINDER and t2 == PLANE:
             nc = _cylinder_plane_support(s1, s2, b1, b2, nc, cap, env, keybase, sh_dims, w_pos,
                                          w_R, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+        if (t1 == SPHERE and t2 == CLOUD) or (t1 == CLOUD and t2 == SPHERE):
+            sw = t2 == SPHERE
+            nc = _sphere_vs_cloud(s2 if sw else s1, s1 if sw else s2, b2 if sw else b1,
+                                  b1 if sw else b2, sw, nc, cap, env, keybase, sh_dims,
+                                  samp_off, samp_cnt, samp_pts, samp_nrm, cg_meta, cg_start,
+                                  w_pos, w_R, lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap,
+                                  c_key)
+            continue
         pl1 = _point_like(t1)
         pl2 = _point_like(t2)
         rev_a = False
         rev_b = False
         if pl1 and pl2:
-            # the cloud's samples against the sphere's exact SDF; of two clouds,
-            # every sample of the smaller against the other's smooth surface, and
-            # the other's feature samples (edges, corners) against the smaller's
-            # flat faces
-            if t1 == SPHERE or (t2 == CLOUD and samp_cnt[s1] > samp_cnt[s2]):
+            # of two clouds, every sample of the smaller against the other's smooth
+            # surface, and the other's feature samples (edges, corners) against the
+            # smaller's flat faces
+            if t2 == CLOUD and samp_cnt[s1] > samp_cnt[s2]:
                 dir_a = False
                 dir_b = True
                 rev_a = t1 == CLOUD and t2 == CLOUD

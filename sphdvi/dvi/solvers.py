@@ -215,6 +215,20 @@ def _natural_residual(z, g, s, kind, mu, lo, hi, tmp):
 
 # ------------------------------------------------------- sliding correction
 @njit(cache=True)
+def max_abs_diff(n, a, b):
+    """max_k |a_k − b_k| over the first n entries (NaN if any difference is NaN, as numpy's
+    ``np.abs(a − b).max()``), without a temporary array."""
+    res = 0.0
+    for k in range(n):
+        d = abs(a[k] - b[k])
+        if d != d:
+            return d
+        if d > res:
+            res = d
+    return res
+
+
+@njit(cache=True)
 def sliding_speeds(nr, ra, rb, J, kind, mu, gdiag, v, s):
     """De Saxcé's sliding term of each friction triplet, ``s_k = μ_k ‖(J_u v, J_w v)‖`` on its
     normal row k (0 elsewhere and on rows that cannot act), at the velocities ``v``: Chrono::

@@ -21,8 +21,8 @@ from . import rows as rw
 from ._math import (body_rotations, frame_from_axis, integrate_bodies, np_mat_to_quat,
                     np_quat_to_mat)
 from ._kernels import apply_dof_masks, free_velocity, link_point_torques
-from .solvers import (SOLVER_ALIASES, SOLVER_NAMES, prepare_rows, row_residuals, scatter_impulses,
-                      sliding_speeds, solve_ccp, solve_direct)
+from .solvers import (SOLVER_ALIASES, SOLVER_NAMES, max_abs_diff, prepare_rows, row_residuals,
+                      scatter_impulses, sliding_speeds, solve_ccp, solve_direct)
 
 FLOATING = 0
 FIXED = 1
@@ -226,6 +226,13 @@ class System:
         self.edges = np.zeros((0, 2), np.int32)
         self.ed_off = np.zeros(0, np.int32)
         self.ed_cnt = np.zeros(0, np.int32)
+        # face polygons of box/hull planes (per plane of ``planes``): vertex indices (local to
+        # the shape) counter-clockwise about the outward normal, and the shape-local edge index
+        # of each polygon edge (fv[k] → fv[k+1]; -1: not in the edge list)
+        self.fv_off = np.zeros(0, np.int32)
+        self.fv_cnt = np.zeros(0, np.int32)
+        self.fv_idx = np.zeros(0, np.int32)
+        self.fv_edge = np.zeros(0, np.int32)
         # links
         self.links = []          # python records, index = link id
         self._mates = []
@@ -239,6 +246,7 @@ class System:
         self._prev_link_gamma = np.zeros(0)
         self._prev_h = None
         self._cap_rows = 0
+        self._w_vpred = np.zeros((0, 6))    # sliding correction: velocities the warm start predicts
         self._cap_contacts = 256
         self._cap_pairs = 1024
         self.contact_force = np.zeros((0, 3))
@@ -440,7 +448,36 @@ class System:
         self.ed_off = np.append(self.ed_off, np.int32(self.edges.shape[0])).astype(np.int32)
         self.ed_cnt = np.append(self.ed_cnt, np.int32(edges.shape[0])).astype(np.int32)
         self.edges = np.vstack([self.edges, np.asarray(edges, np.int32).reshape(-1, 2)])
+        for f_idx, f_edge in self._face_polygons(samples, planes, edges):
+            self.fv_off = np.append(self.fv_off, np.int32(self.fv_idx.shape[0])).astype(np.int32)
+            self.fv_cnt = np.append(self.fv_cnt, np.int32(len(f_idx))).astype(np.int32)
+            self.fv_idx = np.append(self.fv_idx, np.asarray(f_idx, np.int32)).astype(np.int32)
+            self.fv_edge = np.append(self.fv_edge, np.asarray(f_edge, np.int32)).astype(np.int32)
         return self.sh_type.shape[0] - 1
+
+    @staticmethod
+    def _face_polygons(verts, planes, edges):
+        """Per facet plane (n, d) of a box or hull: the vertices on it (|n·v + d| small),
+        ordered counter-clockwise about n (by angle about their centroid), and the index in
+        ``edges`` of each polygon edge (-1 where it is none: a vertex on an edge's line)."""
+        out = []
+        if planes.shape[0] == 0:
+            return out
+        ext = float(np.ptp(verts, axis=0).max()) if verts.shape[0] else 1.0
+        emap = {(int(min(a, b)), int(max(a, b))): k for k, (a, b) in enumerate(np.asarray(edges))}
+        for pl in planes:
+            n = pl[:3]
+            on = np.nonzero(np.abs(verts @ n + pl[3]) < 1e-7 * max(ext, 1e-300))[0]
+            c = verts[on].mean(axis=0)
+            u = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+            u /= np.linalg.norm(u)
+            w = np.cross(n, u)
+            d = verts[on] - c
+            f_idx = on[np.argsort(np.arctan2(d @ w, d @ u), kind="stable")]
+            f_edge = [emap.get((int(min(a, b)), int(max(a, b))), -1)
+                      for a, b in zip(f_idx, np.roll(f_idx, -1))]
+            out.append((f_idx, f_edge))
+        return out
 
     @staticmethod
     def _hull_edges(hull):
@@ -783,6 +820,10 @@ class System:
         self.r_C = np.zeros(cap)
         self.r_g = np.zeros(cap)
         self.r_gamma = np.zeros(cap)
+        # work arrays of the sliding correction (_solve_rows): bias without it, s, s_new
+        self.r_bias0 = np.zeros(cap)
+        self.r_slide = np.zeros(cap)
+        self.r_slide2 = np.zeros(cap)
 
     def _row_args(self):
         return (self.r_a, self.r_b, self.r_J, self.r_bias, self.r_E, self.r_kind, self.r_lo,
@@ -858,7 +899,8 @@ class System:
                                   self.samp_rad, self.pl_off, self.pl_cnt, self.planes,
                                   self.cg_meta, self.cg_start, self.edges, self.ed_off,
                                   self.ed_cnt, w_pos, w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
-                                  c["n"], c["gap"], c["key"], self.samp_nrm)
+                                  c["n"], c["gap"], c["key"], self.samp_nrm, self.fv_off,
+                                  self.fv_cnt, self.fv_idx, self.fv_edge)
             if nc <= cap:
                 break
             self._cap_contacts = int(nc * 1.5)
@@ -1056,21 +1098,26 @@ class System:
         if self.sliding_passes <= 0 or not friction:
             return self._solve_once(nr, nb, g, vfree, vout)
         args = (nr, self.r_a, self.r_b, self.r_J, self.r_kind, self.r_mu, self.r_g)
-        b0 = self.r_bias[:nr].copy()
-        s = np.empty(nr)
-        vpred = vfree.copy()
+        # work arrays kept on the System (rows: _ensure_rows; bodies: here), no allocation
+        if self._w_vpred.shape[0] != nb:
+            self._w_vpred = np.empty((nb, 6))
+        vpred = self._w_vpred
+        b0 = self.r_bias0[:nr]
+        b0[:] = self.r_bias[:nr]
+        s = self.r_slide[:nr]
+        s_new = self.r_slide2[:nr]
+        vpred[:] = vfree
         scatter_impulses(nr, self.r_a, self.r_b, self.r_MiJ, g, vpred)
         sliding_speeds(*args, vpred, s)
-        s_new = np.empty(nr)
         sliding_speeds(*args, vel6, s_new)
         np.minimum(s, s_new, out=s)
         its = 0
         for _ in range(self.sliding_passes):
-            self.r_bias[:nr] = b0 + s
+            np.add(b0, s, out=self.r_bias[:nr])
             it, res = self._solve_once(nr, nb, g, vfree, vout)
             its += it
             sliding_speeds(*args, vout, s_new)
-            if np.abs(s_new - s).max() <= max(self.sliding_tol, SLIDING_RES_FACTOR * res):
+            if max_abs_diff(nr, s_new, s) <= max(self.sliding_tol, SLIDING_RES_FACTOR * res):
                 break
             s, s_new = s_new, s
         return its, res

@@ -159,6 +159,52 @@ def test_cube_over_the_rim_of_a_floor(floor):
     assert s.pos[b, 2] < 0.0
 
 
+BALL_R = 0.05
+SLAB = np.array([[x, y, z] for x in np.arange(-15, 16) * DP for y in np.arange(-15, 16) * DP
+                 for z in (-2 * DP, -DP, 0.0)])                  # a three-layer block, top at z = 0
+
+
+def _ball_on_slab(xy, vel=(0.0, 0.0, 0.0), mu=0.5):
+    s = System(gravity=(0, 0, -G), solver="bb", max_iter=100, tol=1e-10, envelope=0.5 * DP)
+    m = s.add_material("m", friction=mu, restitution=0.0)
+    fl = s.add_body(1.0, kind="fixed")
+    s.add_cloud(fl, SLAB, DP / 2, material=m)
+    b = s.add_body(1.0, (0.4 * BALL_R ** 2,) * 3, pos=(xy[0], xy[1], BALL_R + DP / 2 + 0.001),
+                   vel=vel)
+    s.add_sphere(b, BALL_R, material=m)
+    return s, b
+
+
+@pytest.mark.parametrize("xy", [(0.0, 0.0), (DP / 2, 0.0), (DP / 2, DP / 2), (0.0037, 0.0061)],
+                         ids=["over_a_particle", "between_two", "between_four", "anywhere"])
+def test_sphere_rests_on_a_cloud_face_wherever_it_lands(xy):
+    """A true sphere on a cloud block's top face rests on the face's tangent plane, R + dp/2
+    above the top layer, with one contact holding m g at every step, wherever it lands on the
+    lattice (the sphere against each particle's sphere sat 0.8 / 1.7 mm low between two /
+    four particles and, off-centre, rocked with the force off by up to 260 %)."""
+    s, b = _ball_on_slab(xy)
+    fz = _run(s, b, 0.5, 0.3)
+    assert abs(s.pos[b, 2] - (BALL_R + DP / 2)) < 1e-6
+    np.testing.assert_allclose(s.pos[b, :2], xy, atol=1e-6)
+    assert np.abs(fz / G - 1.0).max() < 1e-2
+    assert s.n_contacts == 1
+
+
+def test_sphere_rolls_across_a_cloud_face_at_one_height():
+    """Thrown along the face (0.4, 0.1) m/s with Kfric 0.5, the sphere skids, then rolls at
+    5/7 of its speed over ~12 lattice cells, its centre at R + dp/2 within 1e-5 m throughout
+    (the particle spheres' bumps: 1.7 mm)."""
+    s, b = _ball_on_slab((-0.1, 0.013), vel=(0.4, 0.1, 0.0))
+    z = []
+    while s.time < 0.8 - 1e-9:
+        s.step(1e-3)
+        if s.time > 0.05:
+            z.append(s.pos[b, 2])
+    assert np.abs(np.array(z) - (BALL_R + DP / 2)).max() < 1e-5
+    assert s.pos[b, 0] > 0.1
+    np.testing.assert_allclose(s.vel[b, :2], (0.4 * 5 / 7, 0.1 * 5 / 7), rtol=1e-3)
+
+
 def test_2d_square_on_a_line():
     """2-D (plane_normal = y, as mechanism gives a 2-D case's clouds): a staggered square
     rests at one dp on a one-row floor and slides freely with Kfric 0."""
