@@ -243,6 +243,10 @@ class FloatingBodies:
         self.system, self.names = build_system(mech["bodies"], mech["links"], mech["materials"],
                                                **mech["system"])
         self.mkbounds = [int(m) for m in mech["mkbounds"]]
+        from .bodychecks import BodyWatch       # finite states, joints, embedded contacts (sphdvi.bodychecks)
+        self.watch = BodyWatch(self.system, self.names, self.mkbounds, mech["sizes"], mech["dp"])
+        for line in mech["warnings"]:
+            warnings.warn(line)
         self.is2d = bool(data["constants"]["is2d"])
         self.scale = np.asarray(mech.get("scaleforce", np.ones((len(self.mkbounds), 3))), float)
         if not self.is2d and np.any(self.scale != 1.0):
@@ -324,6 +328,7 @@ class FloatingBodies:
             self.hold(F, T)
             return
         self.system.step(dt, F, T)
+        self.watch.after_step(getattr(solver, "nstep", 0))     # a NaN body: stopped before the fluid sees it
         self.carry_particles(solver, sel, body)
         self.wrap_centres(solver)
         self.check_in_domain(solver, sel, body)
@@ -340,6 +345,7 @@ class FloatingBodies:
         F, T = self.loads(solver, sel, body)
         saved = self.system.get_state()
         self.system.step(dt_half, F, T)
+        self.watch.check_finite(getattr(solver, "nstep", 0) + 1)     # the step under way
         self.carry_particles(solver, sel, body)
         self.system.set_state(saved)
 

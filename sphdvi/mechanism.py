@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bodychecks import body_sizes, startup_warnings
 from .errors import CaseError
 
 TYPE_FLOATING, TYPE_MOVING, TYPE_FLUID = 2, 1, 3
@@ -125,8 +126,10 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
     """Build the inputs of :func:`sphdvi.dvi.run_bodies` from a case file read by
     :func:`sphdvi.io.casefile.read_case_h5`.
 
-    Returns ``{"bodies", "links", "materials", "system", "mkbounds"}`` where
-    ``mkbounds[i]`` is the mkbound of body i.
+    Returns ``{"bodies", "links", "materials", "system", "mkbounds", "scaleforce", "points", "sizes",
+    "dp", "warnings"}`` where ``mkbounds[i]`` is the mkbound of body i, ``points[i]`` its particles,
+    ``sizes[i]`` its size (:func:`sphdvi.bodychecks.body_sizes`) and ``warnings`` the start-up warnings
+    on the bodies (:func:`sphdvi.bodychecks.startup_warnings`) for the run to give.
     """
     js = data["json"]
     chrono = js.get("chrono") or {}
@@ -138,7 +141,7 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
     floating = {int(b["mkbound"]): b for b in js.get("bodies_extra", [])}
     collision = chrono.get("collision", {"activate": False, "distancedp": 0.5, "contactmethod": 0})
     entries = _body_entries(chrono.get("bodies") or [], floating)
-    materials, bodies, mkbounds = {}, [], []
+    materials, bodies, mkbounds, points = {}, [], [], []
     for entry in entries:
         mkb = int(entry["mkbound"])
         sel = bound & (label == mkb)
@@ -176,6 +179,7 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
         body["shapes"] = shapes
         bodies.append(body)
         mkbounds.append(mkb)
+        points.append(pts)
     links = [_link(ln, bodies) for ln in chrono.get("links", [])]
     g = consts["gravity"]
     system = {"gravity": tuple(g), "contactmethod": "smc" if collision.get("contactmethod") == 1 else "nsc",
@@ -183,8 +187,15 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
     solver = chrono.get("solver") or {}
     if solver.get("type"):
         system["solver"] = solver["type"].lower()
+    if solver.get("maxiter") is not None:       # <solver maxiter tolerance> (sphdvi's; the reader's)
+        system["max_iter"] = int(solver["maxiter"])
+    if solver.get("tolerance") is not None:
+        system["tol"] = float(solver["tolerance"])
+    sizes = body_sizes(points, dp)
     return {"bodies": bodies, "links": links, "materials": list(materials.values()), "system": system,
-            "mkbounds": mkbounds, "scaleforce": _scale_forces(chrono.get("scaleforce") or [], mkbounds)}
+            "mkbounds": mkbounds, "scaleforce": _scale_forces(chrono.get("scaleforce") or [], mkbounds),
+            "points": points, "sizes": sizes, "dp": dp,
+            "warnings": startup_warnings(bodies, sizes, mkbounds, system.get("solver", "bb"), is2d)}
 
 
 def _body_entries(listed: list, floating: dict) -> list:

@@ -591,10 +591,14 @@ def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quie
     if not system._packed:
         system._pack()
     run = BodiesOnlyRun(system, names, schedule, outdir, files, case_identity(data["particles"], data["constants"]))
+    run.watch = _body_watch(data, params, system, names, mech)
     if resume:
         run.resume()
     else:
         files.start()
+    for line in mech["warnings"]:           # inertia far below m L2, contact mass ratios (bodychecks)
+        files.log("WARNING: " + line)
+        warnings.warn(line)
     for section in ("savedt", "outputparts"):
         if js.get("special", {}).get(section):
             line = (f"<special><{section}>: a body-only run (no fluid) has no SPH time step or particle output "
@@ -616,16 +620,78 @@ def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quie
     return run.run(float(params["TimeMax"]), quiet, stop)
 
 
+def _body_watch(data, params, system, names, mech):
+    """The run-time checks of a body-only run (:class:`sphdvi.bodychecks.BodyWatch`): finite
+    states, joints, embedded contacts and the simulation domain (:func:`_bodies_domain`)."""
+    from .bodychecks import BodyWatch
+    domain = _bodies_domain(data, params)
+    return BodyWatch(system, names, mech["mkbounds"], mech["sizes"], mech["dp"], mech["points"], domain)
+
+
+def _bodies_domain(data, params):
+    """The simulation domain of a body-only run: along an axis that ``<simulationdomain>`` sets,
+    the case's domain, as an SPH run's; along one it leaves at ``default`` (DualSPHysics's default,
+    the particles' extent plus 0.05 h, which a swinging pendulum leaves at once: DualSPHysics runs
+    no case without fluid), the drawing box ``<definition>`` pointmin..pointmax, outside which the
+    case has nothing; a 2D case widened by h along y as the SPH run's; unbounded along a periodic axis
+    or where the limit cannot be read."""
+    import xml.etree.ElementTree as ET
+    c = data["constants"]
+    dom = data.get("domain") or {}
+    if dom.get("posmin") is None or dom.get("posmax") is None:
+        return None
+    lo, hi = np.array(dom["posmin"], float), np.array(dom["posmax"], float)
+    try:
+        root = ET.fromstring(data.get("source_xml") or "")
+    except (ET.ParseError, TypeError, ValueError):
+        root = None
+
+    def attr(path, a):
+        el = root.find(path) if root is not None else None
+        return None if el is None else el.get(a)
+    for i, a in enumerate("xyz"):
+        for bound, key, point in ((lo, "posmin", "pointmin"), (hi, "posmax", "pointmax")):
+            spec = attr(f"execution/parameters/simulationdomain/{key}", a)
+            if spec is not None and spec.replace(" ", "").lower() != "default":
+                continue                                # the case's own limit
+            try:
+                bound[i] = float(attr(f"casedef/geometry/definition/{point}", a))
+            except (TypeError, ValueError):
+                bound[i] = -np.inf if key == "posmin" else np.inf
+    if c["is2d"]:
+        lo[1] = min(lo[1], float(c["posy2d"])) - c["h"]
+        hi[1] = max(hi[1], float(c["posy2d"])) + c["h"]
+    for k in periodic_axes(data, params):
+        lo["xyz".index(k)], hi["xyz".index(k)] = -np.inf, np.inf
+    return lo, hi
+
+
 def _warm_up_bodies(system, dt: float) -> float:
     """Compile (or load from cache) the multibody kernels on a throw-away copy of the System, two
     steps of ``dt`` and the kernels of a first contact, so that runtime_s holds no JIT (37 s of a 38 s
-    pendulum run on an empty cache)."""
+    pendulum run on an empty cache). A copy that blows up (an absurd load: a NaN state, an error in a
+    kernel) is dropped and the steps are taken again without the imposed loads; whatever that copy
+    does, the run's own loop reports it (a divergence, exit 3)."""
     import copy
+    from .bodychecks import BodyWatch
     t0 = _time.perf_counter()
-    clone = copy.deepcopy(system)
-    clone.step(dt)
-    clone.step(dt)
-    clone.compile_contact_kernels()
+    for neutral in (False, True):
+        clone = copy.deepcopy(system)
+        if neutral:
+            clone._load_fn = []
+            clone.f_ext[:] = 0.0
+            clone.t_ext[:] = 0.0
+        try:
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                clone.step(dt)
+                clone.step(dt)
+                BodyWatch(clone, clone.names).after_step(2)     # its compiled checks too
+        except Exception:           # noqa: BLE001 -- only compiling here
+            continue
+        if np.isfinite(clone.pos).all() and np.isfinite(clone.quat).all():
+            break
+    copy.deepcopy(system).compile_contact_kernels()       # on zero contacts: the state does not matter
     return _time.perf_counter() - t0
 
 
@@ -653,6 +719,7 @@ class BodiesOnlyRun:
         self.resumed = False
         self._at_output = None   # (state, scalars) of the latest output not yet in restart.h5
         self._ckpt_wall = -math.inf      # the first output of a run is always written
+        self.watch = None        # the run-time checks (bodychecks.BodyWatch; None: finite states only)
 
     def resume(self) -> None:
         """Continue from the last output: the System's state from restart.h5 (into the System
@@ -691,7 +758,10 @@ class BodiesOnlyRun:
             self._at_output = None
 
     def run(self, tmax: float, quiet: bool, stop=None) -> RunResult:
+        from .bodychecks import BodyWatch, solver_hint
         s, sch, files = self.system, self.schedule, self.files
+        if self.watch is None:
+            self.watch = BodyWatch(s, self.names)
         s.defer_warnings = True
         self.body_log = BodyLog(self.outdir, s, self.names, float(s.time) if self.resumed else None)
         progress = Progress(tmax, quiet, counts="bodies")
@@ -704,14 +774,21 @@ class BodiesOnlyRun:
                     self._write_part(wall_prev, stepped=False)
                 stepped = False
                 while self.step < sch.nsteps:
-                    s.step(sch.dt)
+                    try:
+                        s.step(sch.dt)
+                    except Exception:
+                        self.watch.check_finite(self.step + 1)     # a kernel failing on a blown-up state
+                        raise
                     self.step += 1
                     stepped = True
-                    for line in s.take_warnings():          # an unconverged solve: run.log and stderr
-                        files.log("WARNING: " + line)
-                        if not quiet:
-                            warnings.warn(line)
-                    _check_bodies(s, self.names, self.step)
+                    try:
+                        self.watch.after_step(self.step)    # finite, joints, domain, embedded contacts
+                    finally:
+                        for line in s.take_warnings():      # an unconverged solve: run.log and stderr
+                            line = solver_hint(line)
+                            files.log("WARNING: " + line)
+                            if not quiet:
+                                warnings.warn(line)
                     if sch.is_output(self.step):
                         self.part += 1
                         self._write_part(wall_prev + (_time.perf_counter() - t_loop), stepped,
@@ -748,34 +825,6 @@ class BodiesOnlyRun:
 def _interrupted(signum, t: float, outdir: str, part: int) -> str:
     """The message of a run stopped by a signal."""
     return f"stopped by signal {signum} at t={t:.6g} s; resume with 'sphdvi run {outdir} --resume' from part {part}"
-
-
-def _check_bodies(s, names, step: int) -> None:
-    """Raise DivergenceError at the first non-finite body state (position, orientation,
-    velocity, angular velocity), naming the time, step, body and cause."""
-    if np.isfinite(s.pos).all() and np.isfinite(s.quat).all() and np.isfinite(s.vel).all() \
-            and np.isfinite(s.omega_b).all():
-        return
-    parts = (("position", s.pos), ("orientation", s.quat), ("velocity", s.vel), ("angular velocity", s.omega_b))
-    bad = {what: ~np.isfinite(a).all(axis=1) for what, a in parts}
-    i = int(np.flatnonzero(np.any(list(bad.values()), axis=0))[0])
-    nbad = int(np.count_nonzero(np.any(list(bad.values()), axis=0)))
-    what = ", ".join(w for w in bad if bad[w][i])
-    where = f" at {_fmt(s.pos[i])}" if np.isfinite(s.pos[i]).all() else ""
-    force, torque = s.total_force[i], s.total_torque[i]
-    loads = f"force {_fmt(force)} N, torque {_fmt(torque)} N m"
-    if not (np.isfinite(s.f_ext[i]).all() and np.isfinite(s.t_ext[i]).all()):
-        cause = f"its imposed load is not finite (force {_fmt(s.f_ext[i])} N, torque {_fmt(s.t_ext[i])} N m)"
-    elif not (np.isfinite(force).all() and np.isfinite(torque).all()):
-        cause = f"the forces on it are not finite ({loads}): the multibody solution blew up"
-    elif max(np.abs(force).max(), np.abs(torque).max()) > 1e100:
-        cause = f"the load on it is absurdly large ({loads})"
-    else:
-        cause = f"the multibody solution blew up ({loads})"
-    others = f" (and {nbad - 1} other bodies)" if nbad > 1 else ""
-    raise DivergenceError(
-        f"t={s.time:.6g} s, step {step}: body '{names[i]}'{where} has a non-finite {what} (NaN or inf)"
-        f"{others}; cause: {cause}; try a smaller DtFixed, or check the masses, loads and links")
 
 
 # ---------------------------------------------------------------------------------
@@ -1027,8 +1076,8 @@ class SPHRun:
                 + self._excluded_by_reason() + "; " + self._exclusion_cause(self._divergence_hint()))
         if not np.isfinite(sol.last_dt) or sol.last_dt <= 0:
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: time step {sol.last_dt} is not valid")
-        if self.bodies is not None and not (np.isfinite(self.bodies.pos).all() and np.isfinite(self.bodies.vel).all()):
-            raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: a floating body state is not finite")
+        if self.floating is not None:           # the body, its last finite state, the cause (bodychecks)
+            self.floating.watch.check_finite(sol.nstep)
 
     @staticmethod
     def _last_excluded(events: list) -> str:
@@ -1168,7 +1217,8 @@ class SPHRun:
         System's (an unconverged solve, :meth:`System.take_warnings`)."""
         lines, self.step_warnings = self.step_warnings, []
         if self.bodies is not None:
-            lines += self.bodies.take_warnings()
+            from .bodychecks import solver_hint
+            lines += [solver_hint(line) for line in self.bodies.take_warnings()]
         return lines
 
     # -- snapshots and checkpoints ------------------------------------------------------

@@ -1048,9 +1048,7 @@ def read_chrono(reader, el) -> dict:
     if el.find("ompthreads") is not None:
         out["ompthreads"] = int(reader.child_value(el, "ompthreads", lo=1))
     if el.find("solver") is not None:
-        s = reader.child(el, "solver")
-        out["solver"] = {k: s.get(k) for k in s.keys()}
-        reader.mark(s, *s.keys())
+        out["solver"] = _read_chrono_solver(reader, reader.child(el, "solver"))
     _read_chrono_timestepper(reader, reader.child(el, "timestepper"))
     grav = reader.child(el, "gravity")
     if grav is not None:      # in older DualSPHysics templates; v5.4's JChronoObjects::ReadXml does not read it
@@ -1067,6 +1065,49 @@ def read_chrono(reader, el) -> dict:
     scale = reader.child(el, "scaleforce")
     if scale is not None:
         out["scaleforce"] = _read_scaleforce(reader, scale, out["bodies"])
+    return out
+
+
+# <chrono><solver type>: Chrono's solver names (ChSolver::Type, DualSPHysics's JChronoData::TpSolverType
+# BB/MINRES) -> (sphdvi's solver, what it replaces or None where it is that method)
+_CHRONO_SOLVERS = {
+    "bb": ("bb", None), "barzilaiborwein": ("bb", None), "spg": ("bb", None),
+    "psor": ("psor", None), "pgs": ("psor", None), "sor": ("psor", None), "gs": ("psor", None),
+    "apgd": ("apgd", None), "apgdref": ("apgd", None), "direct": ("direct", None),
+    "minres": ("direct", "Chrono's MINRES (DualSPHysics's choice under SMC; bilateral rows only)"),
+    "pminres": ("direct", "Chrono's projected MINRES"),
+    "pjacobi": ("psor", "Chrono's projected Jacobi"), "pssor": ("psor", "Chrono's PSSOR (removed from Chrono)"),
+    "sparselu": ("direct", "Chrono's sparse LU"), "sparseqr": ("direct", "Chrono's sparse QR"),
+    "pardisomkl": ("direct", "Chrono's Pardiso"), "mumps": ("direct", "Chrono's MUMPS"),
+    "gmres": ("direct", "Chrono's GMRES"), "bicgstab": ("direct", "Chrono's BiCGSTAB"),
+    "admm": ("direct", "Chrono's ADMM"),
+}
+
+
+def _read_chrono_solver(reader, s) -> dict:
+    """``<solver type maxiter tolerance>``: the multibody solver, an sphdvi extension (DualSPHysics v5.4's
+    JChronoObjects::ReadXml has no <solver>: its line is commented out, and DSPHChronoLib picks Chrono's BB
+    under NSC and MINRES under SMC, FunDSPHChrono::GetSolverChIxAuto, with Chrono's iteration settings).
+    ``type`` a Chrono solver name (BB, the default; PSOR, APGD; MINRES and Chrono's linear solvers become
+    sphdvi's ``direct`` solver, with a warning), ``maxiter`` the iteration limit (default 100),
+    ``tolerance`` the residual (m/s) at which the iterations stop (default 1e-10). Other attributes get
+    the reader's unknown-attribute warning."""
+    out = {}
+    if reader.has(s, "type"):
+        raw = reader.text_attr(s, "type")
+        key = raw.lower().replace("_", "").replace("-", "").replace(" ", "")
+        if key not in _CHRONO_SOLVERS:
+            raise reader.error(s, f"<solver type={raw!r}> is not a known solver",
+                               "BB (DualSPHysics's), PSOR, APGD, MINRES or direct")
+        out["type"], replaced = _CHRONO_SOLVERS[key]
+        if replaced:
+            reader.warn(s, f"<solver type=\"{raw}\">: {replaced} is not in sphdvi; its 'direct' solver is used "
+                           "instead (joint rows by a dense Cholesky factorisation, contacts by a projected "
+                           "gradient)")
+    if reader.has(s, "maxiter"):
+        out["maxiter"] = reader.integer(s, "maxiter", lo=1)
+    if reader.has(s, "tolerance"):
+        out["tolerance"] = reader.num(s, "tolerance", nonnegative=True)
     return out
 
 

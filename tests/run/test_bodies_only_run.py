@@ -131,9 +131,12 @@ def test_run_bodies_arrays_match_the_run_files(tmp_path):
 def free_fall_case(tmp_path):
     """The pendulum's cube without its hinge under an absurd gravity, 1e306 m/s2: with
     DtFixed = 1 s the centre is at z = -1 - 1e306 k(k+1)/2 after step k, beyond the largest
-    double (1.8e308) at step 19."""
+    double (1.8e308) at step 19 (its <simulationdomain> reaches down to -1.79e308: the body leaves no
+    domain before it goes non-finite)."""
     text = PENDULUM.replace('z="-9.81"', 'z="-1e306"')
     text = re.sub(r"<link_hinge.*?</link_hinge>", "", text, flags=re.S)
+    text = text.replace("</parameters>", '<simulationdomain><posmin x="default" y="default" z="-1.79e308" />'
+                        '<posmax x="default" y="default" z="default" /></simulationdomain></parameters>')
     return case_file(tmp_path, text, "CaseFall_Def.xml")
 
 
@@ -147,7 +150,8 @@ def test_diverging_run_exits_3_and_keeps_rows(tmp_path):
     meta = json.loads((out / "run.json").read_text())
     assert meta["status"] == "diverged" and meta["steps"] == 19 and meta["physical_time"] == 19.0
     msg = meta["message"]
-    assert msg.startswith("t=19 s, step 19: body 'pend' has a non-finite position (NaN or inf)"), msg
+    assert msg.startswith("t=19 s, step 19: body 'pend' (mkbound 1) has a non-finite position"), msg
+    assert "its last finite state (t=18 s): position (" in msg
     assert "cause: the load on it is absurdly large (force (0, 0, -1e+307) N" in msg
     assert f"diverged: {msg}" in proc.stderr
     # the outputs before stay: t = 0, 5, 10, 15
