@@ -137,6 +137,7 @@ class ImposedMotions:
         self.fluidcount = fluidcount
         self.normals0 = normals0            # initial mDBC normals, indexed by idp
         self._slot = None                   # the moving particles' slot by idp (built at the first call)
+        self._batch = None                  # the compiled pass's plans (sphdvi.motion_batch, _build)
         self.first_outside = -1             # the first moving row placed outside the domain (apply), or -1
 
     def _build(self, s) -> None:
@@ -162,6 +163,21 @@ class ImposedMotions:
         self._active = np.ones(mkbs.size, np.bool_)
         self._last = [None] * mkbs.size             # the placement each mkbound was last put at
         self._rest = [False] * mkbs.size            # ... and left at rest there
+        # the same as bits of (R, d) for those the compiled pass may place (MotionBatch.eligible)
+        self._last_R = np.zeros((mkbs.size, 9), np.int64)
+        self._last_d = np.zeros((mkbs.size, 3), np.int64)
+        self._has_last = np.zeros(mkbs.size, np.bool_)
+        self._rest_fast = np.zeros(mkbs.size, np.bool_)
+        self._first = np.asarray([a for a, _ in self._bounds], np.int64)
+        self._end = np.asarray([b for _, b in self._bounds], np.int64)
+        # the translations evaluated in one compiled pass (sphdvi.motion_batch), the rest by their walk
+        from .motion_batch import MotionBatch
+        if self._batch is not None:
+            self._batch.sync()                      # grouped again: the walks go on from where it left them
+        self._batch = (MotionBatch(self.motions, self.mkbounds)
+                       if getattr(self.motions, "_walks", None) is not None else None)
+        if self._batch is not None and not any(self._batch.eligible):
+            self._batch = None                      # (wave paddles, rotations: one by one)
         if self.normals0 is not None:
             self._n0 = [self.normals0[idp[a:b]] for a, b in self._bounds]
             self._n0all = self.normals0[idp] + 0.0
@@ -191,21 +207,57 @@ class ImposedMotions:
             self._build(s)                          # the moving particles changed: group them again
             _, self.first_outside = self._place(s, t, dt, per, normals, flat, box)
 
+    def _still(self, g: int, rig, dt, still_test: bool) -> bool:
+        """The at-rest test of an mkbound the compiled pass may place (its last placement kept as
+        bits, :func:`sphdvi.motion_batch.place_translations`'s): False when it is left where it is."""
+        same = (self._has_last[g] and rig.R.tobytes() == self._last_R[g].tobytes()
+                and rig.d.tobytes() == self._last_d[g].tobytes())
+        if still_test and same:
+            if self._rest_fast[g]:
+                return False
+            self._rest_fast[g] = True
+        else:
+            self._rest_fast[g] = False
+        self._has_last[g] = bool(dt)
+        if dt:
+            self._last_R[g] = np.ascontiguousarray(rig.R).reshape(-1).view(np.int64)
+            self._last_d[g] = rig.d.view(np.int64)
+        return True
+
     def _place(self, s, t: float, dt, per, normals, flat: bool, box) -> tuple[int, int]:
         """Evaluate each mkbound's motion at t (skipping those at rest) and place its particles;
-        (rows found, the first row placed outside ``box`` or -1: a wall at rest did not move)."""
+        (rows found, the first row placed outside ``box`` or -1: a wall at rest did not move).
+        The translations a compiled pass covers (:class:`sphdvi.motion_batch.MotionBatch`) are
+        placed in one compiled pass too; the others one by one."""
+        from .motion_batch import _EYE_BITS, place_translations
         active = self._active
-        for g, mkb in enumerate(self.mkbounds):
-            rig = self.motions.transform(mkb, t)
-            key = (rig.R.tobytes(), rig.d.tobytes())
-            if dt and per is None and key == self._last[g]:
-                if self._rest[g]:                   # placed there at rest already
+        batch = self._batch
+        still_test = bool(dt) and per is None
+        if batch is not None:
+            others = batch.evaluate(t).tolist()
+            place_translations(batch.fast, bool(dt), still_test, batch.d, batch.V, batch.d_bits, _EYE_BITS,
+                               self._last_R, self._last_d, self._has_last, self._rest_fast, active,
+                               self._first, self._end, self._x0all, self._x, self._n0all if self.normals0
+                               is not None else self._x0all, self._n, self.normals0 is not None, self._vwc)
+        else:
+            others = range(len(self.mkbounds))
+        for g in others:
+            if batch is not None and batch.eligible[g]:
+                rig = batch.transform(g, t)
+                if not self._still(g, rig, dt, still_test):
                     active[g] = False
                     continue
-                self._rest[g] = True                # placed again where it was: at rest from now on
             else:
-                self._rest[g] = False
-            self._last[g] = key if dt else None
+                rig = self.motions.transform(self.mkbounds[g], t)
+                key = (rig.R.tobytes(), rig.d.tobytes())
+                if still_test and key == self._last[g]:
+                    if self._rest[g]:               # placed there at rest already
+                        active[g] = False
+                        continue
+                    self._rest[g] = True            # placed again where it was: at rest from now on
+                else:
+                    self._rest[g] = False
+                self._last[g] = key if dt else None
             active[g] = True
             a, b = self._bounds[g]
             if rig.rot:

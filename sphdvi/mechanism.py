@@ -46,9 +46,12 @@ def _vector_series(spec, what, allow_none=True):
     times = np.asarray(spec["times"], float)
     values = np.asarray([[np.nan if c is None else c for c in row] for row in spec["values"]], float)
     free = np.isnan(values).any(axis=0)        # 'none' in any row: that component is free
+    from .tables import TimeTable               # contiguous columns, a kept row: O(1) per step
+    table = TimeTable(times, values)
 
     def at(t):
-        return [None if free[k] else float(np.interp(t, times, values[:, k])) for k in range(3)]
+        row = table.at(t)
+        return [None if free[k] else float(row[k]) for k in range(3)]
     return at
 
 

@@ -140,11 +140,7 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
         state.update(carried)
         return Rigid()
     if kind in ("mvrect", "mvrectace"):
-        if kind == "mvrect":
-            v0, a = np.asarray(m["vel"], float), np.zeros(3)
-        else:
-            v0 = np.asarray(m["velini"], float) if "velini" in m else state.get("v", np.zeros(3))
-            a = np.asarray(m["ace"], float)
+        v0, a = _rect_params(m, state)
         d = v0 * tau + 0.5 * a * tau * tau
         v = v0 + a * tau
         state.update(carried, v=v)
@@ -161,9 +157,7 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
         state.update(carried, w=w)
         return _rotational(m, angle, w, circular=kind.startswith("mvcir"), state=state)
     if kind == "mvrectsinu":
-        f, A = np.asarray(m["freq"], float), np.asarray(m["ampl"], float)
-        ph = (np.asarray(m["phase"], float) * _angle_units(m) if "phase" in m
-              else np.asarray(state.get("phase3", np.zeros(3)), float))
+        f, A, ph = _rectsinu_params(m, state)
         arg = 2 * math.pi * f * tau + ph
         d = A * (np.sin(arg) - np.sin(ph))
         state.update(carried, phase3=np.where(A != 0.0, arg, ph))     # DualSPHysics advances moving axes only
@@ -181,6 +175,24 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
         state.update(carried)
         return _from_file(m, tau)
     raise ValueError(f"unsupported movement {kind}")
+
+
+def _rect_params(m: dict, state: dict) -> tuple:
+    """(v0, a) of an ``mvrect`` (a = 0) or ``mvrectace`` (v0 the previous movement's speed without
+    <velini>): d = v0 τ + a τ²/2."""
+    if m["type"] == "mvrect":
+        return np.asarray(m["vel"], float), np.zeros(3)
+    v0 = np.asarray(m["velini"], float) if "velini" in m else state.get("v", np.zeros(3))
+    return v0, np.asarray(m["ace"], float)
+
+
+def _rectsinu_params(m: dict, state: dict) -> tuple:
+    """(f, A, φ) of an ``mvrectsinu`` (φ the phase a previous sinusoidal movement reached without
+    <phase>): d = A [sin(2π f τ + φ) − sin φ]."""
+    f, A = np.asarray(m["freq"], float), np.asarray(m["ampl"], float)
+    ph = (np.asarray(m["phase"], float) * _angle_units(m) if "phase" in m
+          else np.asarray(state.get("phase3", np.zeros(3)), float))
+    return f, A, ph
 
 
 def _rotational(m, angle, w, circular, state=None) -> Rigid:
@@ -248,51 +260,58 @@ def file_columns(m) -> tuple[int, dict]:
 
 
 def _load_table(m):
-    """(times, {field: values}) of a file movement, read once per file (looked up once per movement)."""
+    """(table, {field: its column in the table}) of a file movement, read once per file (looked up
+    once per movement)."""
     return _of_movement(m, "table", _read_table)
 
 
 def _read_table(m):
-    """(times, {field: values}) of a file movement, from the file's cache."""
+    """(:class:`sphdvi.tables.TimeTable` of the file's used columns, {field: column}) of a file
+    movement, from the file's cache (the columns contiguous, read once: a look-up does not copy them)."""
     ncols, cols = file_columns(m)
     key = (m["file"], ncols, tuple(sorted(cols.items())))
     if key not in _FILE_CACHE:
         from .case.datafiles import read_motion_table
+        from .tables import TimeTable
         data = read_motion_table(m["file"], ncols, cols, f"<{m['type']}> file")
-        _FILE_CACHE[key] = (data[:, cols["fieldtime"]],
-                            {name: data[:, c] for name, c in cols.items() if name != "fieldtime"})
+        names = [name for name in cols if name != "fieldtime"]
+        table = TimeTable(data[:, cols["fieldtime"]], data[:, [cols[name] for name in names]])
+        _FILE_CACHE[key] = (table, {name: k for k, name in enumerate(names)})
     return _FILE_CACHE[key]
 
 
-def _file_value(t: np.ndarray, col: np.ndarray, tau: float) -> tuple[float, float]:
-    """A file column's displacement from its first row and its rate ``tau`` seconds into the
+def _file_values(table, tau: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each file column's displacement from its first row and its rate ``tau`` seconds into the
     movement, as DualSPHysics's JMotionMovActive::DfGetNewPos/DfGetNewAng with JMotionObj::ProcesTime:
     the file's first row plays at the movement's start (its time looked up is τ + t_0), the
     value is interpolated linearly between rows and held at the last row; the rate is the step's
     displacement over dt there: the slope of the row segment that holds τ, 0 before the first
-    row and from the last row on (strictly rising times: the reader checks them)."""
+    row and from the last row on (strictly rising times: the reader checks them).  One look-up
+    in the table (its kept row) gives both."""
+    t, cols = table.times, table.columns
     tf = tau + t[0]
-    value = float(np.interp(tf, t, col)) - col[0]
-    i = int(np.searchsorted(t, tf, side="right")) - 1
+    value = table.at(tf) - cols[:, 0]
+    i = table.last
     if i < 0 or i >= t.size - 1:
-        return value, 0.0
-    return value, float((col[i + 1] - col[i]) / (t[i + 1] - t[i]))
+        return value, np.zeros(cols.shape[0])
+    return value, (cols[:, i + 1] - cols[:, i]) / (t[i + 1] - t[i])
 
 
 def _from_file(m, tau) -> Rigid:
     """The transform of an ``mvrectfile`` (displacement per axis given in the file) or an
-    ``mvrotfile`` (angle about its axis) ``tau`` seconds after it started (:func:`_file_value`)."""
-    t, fields = _load_table(m)
+    ``mvrotfile`` (angle about its axis) ``tau`` seconds after it started (:func:`_file_values`)."""
+    table, fields = _load_table(m)
+    value, rate = _file_values(table, tau)
     if m["type"] == "mvrectfile":
         d = np.zeros(3)
         v = np.zeros(3)
         for k, name in enumerate(("fieldx", "fieldy", "fieldz")):
             if name in fields:
-                d[k], v[k] = _file_value(t, fields[name], tau)
+                d[k], v[k] = value[fields[name]], rate[fields[name]]
         return Rigid(d=d, V=v)
     units = _angle_units(m)
-    angle, w = _file_value(t, fields["fieldang"], tau)
-    return _rotational(m, angle * units, w * units, circular=False)
+    c = fields["fieldang"]
+    return _rotational(m, float(value[c]) * units, float(rate[c]) * units, circular=False)
 
 
 def chain_transform(chain: dict, t: float, walks: dict | None = None) -> Rigid:

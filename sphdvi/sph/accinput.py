@@ -57,14 +57,15 @@ class AccInput:
         self.globalgravity = bool(spec["globalgravity"])
         self.table = np.asarray(spec["table"], float)
         self.velocities = integrated_velocities(self.table)
+        self.times = np.ascontiguousarray(self.table[:, 0])     # searched every step: no copy per look-up
 
     def values(self, t: float):
         """(a_lin, α, v_lin, ω) at time t (linear interpolation, end values outside the
         table), or None outside the active interval."""
         if not (self.start <= t <= self.end):
             return None
-        acc = linear_value(self.table[:, 0], self.table[:, 1:7], t)
-        vel = linear_value(self.velocities[:, 0], self.velocities[:, 1:7], t)
+        acc = linear_value(self.times, self.table[:, 1:7], t)
+        vel = linear_value(self.times, self.velocities[:, 1:7], t)
         return acc[:3], acc[3:], vel[:3], vel[3:]
 
 

@@ -502,3 +502,23 @@ def mdbc_parallel(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell
             _mdbc2_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, oi, normals,
                          cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel,
                          tvel, wace)
+
+
+@njit(cache=True, error_model="numpy")
+def keep_moving_velocity(ptype, vel, v0):
+    """v0[i] = vel[i] for the moving boundary particles (type 1): their velocity before the motion
+    places them, for :func:`moving_wall_ace` (one pass, nothing allocated; audit e, finding 5)."""
+    for i in range(ptype.shape[0]):
+        if ptype[i] == 1:
+            for k in range(3):
+                v0[i, k] = vel[i, k]
+
+
+@njit(cache=True, error_model="numpy")
+def moving_wall_ace(ptype, vel, v0, dt, wall_ace):
+    """wall_ace[i] = (v^{n+1} − v^n)/dt of the moving boundary particles (type 1), the wall
+    acceleration of mDBC2's pressure cloning: DualSPHysics's CopyMotionVelAce (MotionAce)."""
+    for i in range(ptype.shape[0]):
+        if ptype[i] == 1:
+            for k in range(3):
+                wall_ace[i, k] = (vel[i, k] - v0[i, k]) / dt

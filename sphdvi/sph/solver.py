@@ -52,6 +52,7 @@ from .kernels import kernel_alpha, kernel_w
 from .specialise import specialised
 from .clock import time_reached
 from .state import FLUID, FluidState
+from ..tables import TimeTable
 
 DEFAULT_PARAMS = {
     "StepAlgorithm": 1, "VerletSteps": 40, "Kernel": 2, "ViscoTreatment": 1,
@@ -163,6 +164,9 @@ class SPHSolver:
         self.dt_table = None if dt_table is None else np.asarray(dt_table, float).reshape(-1, 2)
         self.dt_error = -np.inf
         self.visco_table = None if visco_table is None else np.asarray(visco_table, float).reshape(-1, 2)
+        # looked up every step: contiguous columns and a kept row (sphdvi.tables)
+        self._dt_lookup = None if self.dt_table is None else TimeTable.of_rows(self.dt_table)
+        self._visco_lookup = None if self.visco_table is None else TimeTable.of_rows(self.visco_table)
         self.state = state
         self.constants = dict(constants)
         self.params = resolve_params(params)
@@ -196,6 +200,7 @@ class SPHSolver:
         self._wall_ace_on = self.boundary == 2 and self.slip > 1 and bool(np.any(state.ptype == 1))
         if self._wall_ace_on:
             self.wall_ace = np.zeros((state.n, 3))
+            self._wall_v0 = np.zeros((state.n, 3))     # the moving walls' velocity before the hook
         self._no_wall_ace = np.zeros((1, 3))
         self._no_tvel = np.zeros((1, 3))
         self.ftmode = self._floating_mode(state)
@@ -432,10 +437,24 @@ class SPHSolver:
                 names += ["wall_ace"]
         return names
 
-    def _alloc(self):
-        """(Re)allocate the per-particle work arrays for the current N."""
+    def _alloc(self, reuse=False, keep=()):
+        """(Re)allocate the per-particle work arrays for the current N, zeroed.  ``reuse``: after an
+        exclusion (N shrinks), in the memory they already hold (views of their first rows, zeroed
+        as new ones; the reorder and extended-set buffers kept too), as DualSPHysics keeps its arrays
+        when particles go out; ``keep``: names of work arrays already compacted (not zeroed)."""
         s = self.state
         n = s.n
+
+        def z(name, shape, dtype=np.float64):
+            old = getattr(self, name, None) if reuse else None
+            if (old is None or not isinstance(old, np.ndarray) or old.dtype != dtype
+                    or old.shape[1:] != shape[1:] or old.shape[0] < shape[0] or not old.flags.c_contiguous):
+                return np.zeros(shape, dtype)
+            view = old[:shape[0]]
+            if name not in keep:
+                view.fill(0)
+            return view
+
         if not hasattr(self, "tau"):
             if self.step_algorithm == 1:
                 self.vel_m1 = s.vel.copy()
@@ -445,37 +464,39 @@ class SPHSolver:
                 self.vel_pre = s.vel.copy()
                 self.rhop_pre = s.rhop.copy()
             self.tau = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
-        self.nb = np.zeros((n, 8 if self.is2d else 10))
-        self.ace = np.zeros((n, 3))
-        self.ar = np.zeros(n)
-        self.viscdt = np.zeros(n)
-        self.out = np.zeros(n, np.int8)
-        self.cell_sorted = np.zeros(n, np.int64)
-        self.ptype_s = np.zeros(n, np.int8)
-        self.tau_s = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
-        self._identity = np.arange(n, dtype=np.int64)
+        self.nb = z("nb", (n, 8 if self.is2d else 10))
+        self.ace = z("ace", (n, 3))
+        self.ar = z("ar", (n,))
+        self.viscdt = z("viscdt", (n,))
+        self.out = z("out", (n,), np.int8)
+        self.cell_sorted = z("cell_sorted", (n,), np.int64)
+        self.ptype_s = z("ptype_s", (n,), np.int8)
+        self.tau_s = z("tau_s", (n, 6) if self.visco_kind == 2 else (1, 6))
+        old = getattr(self, "_identity", None) if reuse else None
+        self._identity = old[:n] if old is not None and old.shape[0] >= n else np.arange(n, dtype=np.int64)
         # the rows the last interaction read its particles from (cell order)
         self._rows = (s.ptype, self._identity, self.tau)
         if self.shift:
-            self.shiftpos = np.zeros((n, 3))
-            self.shiftdet = np.zeros(n)
+            self.shiftpos = z("shiftpos", (n, 3))
+            self.shiftdet = z("shiftdet", (n,))
         else:
-            self.shiftpos = np.zeros((1, 3))
-            self.shiftdet = np.zeros(1)
+            self.shiftpos = z("shiftpos", (1, 3))
+            self.shiftdet = z("shiftdet", (1,))
         if self.shift == 4:
             # per particle: 0 interior (shifted), 1 near the free surface, 2 on it, 3 isolated
-            self.fstype = np.zeros(n, np.int8)
-            self.fsnormal = np.zeros((n, 3))
+            self.fstype = z("fstype", (n,), np.int8)
+            self.fsnormal = z("fsnormal", (n, 3))
             self._fs_work = self._shift_adv_work(n)
         # ShiftAdvNCPress: 1 where the non-conservative pressure gradient may be used
-        self.nctype = np.zeros(n if self.adv else 1, np.int8)
-        self.gradvel = np.zeros((n, 6)) if self.visco_kind == 2 else np.zeros((1, 6))
+        self.nctype = z("nctype", (n if self.adv else 1,), np.int8)
+        self.gradvel = z("gradvel", (n, 6) if self.visco_kind == 2 else (1, 6))
         if self.nopen:
             from .nopen import NCOL
-            self.npshift = np.zeros((n, NCOL))
-        self.dtmax = np.zeros(((n + _ia.CHUNK - 1) // _ia.CHUNK, 3))
-        self._bufs = {}
-        self._ghost_bufs = {}      # Periodicity.ghosts's work arrays
+            self.npshift = z("npshift", (n, NCOL))
+        self.dtmax = z("dtmax", ((n + _ia.CHUNK - 1) // _ia.CHUNK, 3))
+        if not reuse:
+            self._bufs = {}
+            self._ghost_bufs = {}      # Periodicity.ghosts's work arrays
 
     # ------------------------------------------------------------------ kernels
     def _use_parallel(self, light=False):
@@ -599,9 +620,10 @@ class SPHSolver:
         dst = {}
         for name, a in src.items():
             buf = self._bufs.get(name)
-            if buf is None or buf.shape != a.shape:
+            if (buf is None or buf.shape[1:] != a.shape[1:] or buf.dtype != a.dtype
+                    or buf.shape[0] < a.shape[0]):
                 buf = np.empty_like(a)
-            dst[name] = buf
+            dst[name] = buf[:a.shape[0]]        # (longer after an exclusion: its first rows)
         fn = _ia.reorder_pack_parallel if self._use_parallel(light=True) else _ia.reorder_pack_serial
         fn(order, self.is2d, self.cst, self.nb, tuple(src[k] for k in f2), tuple(dst[k] for k in f2),
            tuple(src[k] for k in f1), tuple(dst[k] for k in f1), src["ptype"], dst["ptype"],
@@ -864,7 +886,7 @@ class SPHSolver:
         if self.dtfixed > 0.0:
             return self.dtfixed
         if self.dt_table is not None:
-            return float(np.interp(t, self.dt_table[:, 0], self.dt_table[:, 1]))
+            return self._dt_lookup.value(t)
         return 0.0
 
     def _set_visco(self, visco):
@@ -914,7 +936,7 @@ class SPHSolver:
         # function of the step number, so that a resumed run does the same)
         self._reorder_next = self.nstep % self.reorder_every == 0
         if self.visco_table is not None:
-            self._set_visco(float(np.interp(self.time, self.visco_table[:, 0], self.visco_table[:, 1])))
+            self._set_visco(self._visco_lookup.value(self.time))
         if self.step_algorithm == 1:
             dt = self._step_verlet()
         else:
@@ -927,11 +949,15 @@ class SPHSolver:
         if self.motion_hook is not None:
             if self._wall_ace_on:
                 # mDBC2 pressure cloning: wall acceleration (v^{n+1} - v^n)/dt of the moving
-                # particles, as DualSPHysics's CopyMotionVelAce
-                moving = self.state.ptype == 1
-                v0 = self.state.vel[moving]
+                # particles, as DualSPHysics's CopyMotionVelAce (two passes over the type 1 rows)
+                from .mdbc import keep_moving_velocity, moving_wall_ace
+                s = self.state
+                if self._wall_v0.shape[0] < s.n:
+                    self._wall_v0 = np.zeros((s.n, 3))
+                v0 = self._wall_v0[:s.n]
+                keep_moving_velocity(s.ptype, s.vel, v0)
                 self.motion_hook(self, self.time, dt)
-                self.wall_ace[moving] = (self.state.vel[moving] - v0) / dt
+                moving_wall_ace(self.state.ptype, self.state.vel, v0, dt, self.wall_ace)
             else:
                 self.motion_hook(self, self.time, dt)
         return dt
@@ -1022,9 +1048,12 @@ class SPHSolver:
         """Remove the flagged fluid particles from the state and work arrays, and keep an
         event of them (what they were when the step ending at ``t_end`` removed them).
         ``carry``: per-particle work arrays (attribute names) kept, less those rows, rather
-        than allocated anew."""
+        than zeroed.  The kept rows move down in place (:func:`_compact_rows`) and every array
+        becomes a view of its first rows: nothing is allocated (DualSPHysics moves the excluded
+        particles to the end of its arrays and shrinks Np, JCellDivCpu)."""
         s = self.state
         codes = self.out.copy()
+        n = codes.shape[0]
         bad = codes != 0
         for code, name in REASON_NAMES.items():
             self.n_excluded[name] += int(np.count_nonzero(codes == code))
@@ -1032,17 +1061,16 @@ class SPHSolver:
             "time": t_end, "idp": s.idp[bad].copy(), "pos": s.pos[bad].copy(),
             "vel": s.vel[bad].copy(), "rhop": s.rhop[bad].copy(),
             "reason": [REASON_NAMES[int(c)] for c in codes[bad]]})
-        keep = ~bad
-        s.select(keep)
+        for f in FluidState.FIELDS:
+            setattr(s, f, _compacted(getattr(s, f), codes))
         for name in self._aux_names():
             a = getattr(self, name)
-            if a.shape[0] == keep.shape[0]:
-                setattr(self, name, np.ascontiguousarray(a[keep]))
-        kept = {name: np.ascontiguousarray(getattr(self, name)[keep]) for name in carry
-                if getattr(self, name).shape[0] == keep.shape[0]}
-        self._alloc()
-        for name, a in kept.items():
-            setattr(self, name, a)
+            if a.shape[0] == n:
+                setattr(self, name, _compacted(a, codes))
+        kept = tuple(name for name in carry if getattr(self, name).shape[0] == n)
+        for name in kept:
+            setattr(self, name, _compacted(getattr(self, name), codes))
+        self._alloc(reuse=True, keep=kept)
 
     def take_excluded(self) -> list:
         """The exclusion events since the last call (oldest first); the list starts anew."""
@@ -1123,6 +1151,32 @@ class SPHSolver:
     def particle_forces(self):
         """m_a a_a for every particle (for floating bodies: fluid force, no gravity)."""
         return self.state.mass[:, None] * self.ace
+
+
+def _compacted(a: np.ndarray, codes: np.ndarray) -> np.ndarray:
+    """``a`` less the rows where ``codes`` is not 0, moved down in place: a view of its first rows
+    (a[codes == 0] in its own memory)."""
+    if not a.flags.c_contiguous:
+        return np.ascontiguousarray(a[codes == 0])
+    words = a.view(_WORDS[a.dtype.itemsize]) if a.dtype.itemsize in _WORDS else a.view(np.uint8)
+    m = _compact_rows(words.reshape(a.shape[0], -1), codes)
+    return a[:m]
+
+
+_WORDS = {8: np.uint64, 4: np.uint32, 1: np.uint8}     # rows copied as words of the item's size
+
+
+@numba.njit(cache=True)
+def _compact_rows(a, codes):
+    """The rows of ``a`` (rows of words) where ``codes`` is 0 moved down in order, in place; their count."""
+    m = 0
+    for i in range(a.shape[0]):
+        if codes[i] == 0:
+            if m != i:
+                for b in range(a.shape[1]):
+                    a[m, b] = a[i, b]
+            m += 1
+    return m
 
 
 @numba.njit(cache=True)
