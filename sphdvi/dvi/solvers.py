@@ -670,13 +670,353 @@ def solve_dense_bb(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
     return it, best_res
 
 
+# interior-point (log-barrier) solve of the dense contact CCP
+BIG_BOUND = 1e299            # |lo|, |hi| at or above this: no bound (rows use ±1e300)
+IPM_PROX = 1e-9             # proximal weight in the Newton matrix (Q has a unit diagonal)
+IPM_T0 = 0.01               # the starting t: this times the gradient-balancing value
+IPM_CENTRED = 1.0           # Newton decrement² below which t is raised ...
+IPM_T_FACTOR = 10.0         # ... by this factor
+IPM_MAX_ROWS = 300           # larger contact problems keep the projected gradient only (O(n³) a step)
+
+
+@njit(cache=True)
+def _dense_cholesky(H, n):
+    """In-place lower Cholesky factor of the leading n×n block of H; a pivot that rounding
+    leaves not positive (a near-singular H) is floored at 1e-15 of its row's diagonal."""
+    for j in range(n):
+        d = H[j, j]
+        floor = max(1e-15 * H[j, j], 1e-300)
+        for k in range(j):
+            d -= H[j, k] * H[j, k]
+        if d < floor:
+            d = floor
+        d = math.sqrt(d)
+        H[j, j] = d
+        for i in range(j + 1, n):
+            v = H[i, j]
+            for k in range(j):
+                v -= H[i, k] * H[j, k]
+            H[i, j] = v / d
+
+
+@njit(cache=True)
+def _cholesky_solve(L, n, x):
+    """Solve L Lᵀ x = x in place."""
+    for i in range(n):
+        v = x[i]
+        for k in range(i):
+            v -= L[i, k] * x[k]
+        x[i] = v / L[i, i]
+    for i in range(n - 1, -1, -1):
+        v = x[i]
+        for k in range(i + 1, n):
+            v -= L[k, i] * x[k]
+        x[i] = v / L[i, i]
+
+
+@njit(cache=True)
+def _barrier_feasible(z, typ, mu, lb, ub):
+    """z strictly inside K (cones, half-lines, boxes)?"""
+    n = z.shape[0]
+    for i in range(n):
+        t = typ[i]
+        if t == 1:
+            if not z[i] > lb[i]:
+                return False
+        elif t == 2:
+            if not z[i] < ub[i]:
+                return False
+        elif t == 3:
+            if not (z[i] > lb[i] and z[i] < ub[i]):
+                return False
+        elif t == 4:
+            m = mu[i]
+            if not (z[i] > 0.0 and m * m * z[i] * z[i] - z[i + 1] * z[i + 1] - z[i + 2] * z[i + 2] > 0.0):
+                return False
+    return True
+
+
+@njit(cache=True)
+def _barrier_terms(z, typ, mu, lb, ub, grad, H):
+    """Add the log barrier's gradient to ``grad`` and its (block-diagonal) Hessian to ``H``:
+    −log(z−l), −log(u−z) and, per friction cone, −log(μ²z_n² − ‖z_t‖²) (self-concordant,
+    parameter 2; Nesterov & Nemirovski 1994, Boyd & Vandenberghe 2004 §11.6)."""
+    n = z.shape[0]
+    for i in range(n):
+        t = typ[i]
+        if t == 1 or t == 3:
+            d = z[i] - lb[i]
+            grad[i] -= 1.0 / d
+            H[i, i] += 1.0 / (d * d)
+        if t == 2 or t == 3:
+            d = ub[i] - z[i]
+            grad[i] += 1.0 / d
+            H[i, i] += 1.0 / (d * d)
+        if t == 4:
+            m2 = mu[i] * mu[i]
+            a0 = 2.0 * m2 * z[i]
+            a1 = -2.0 * z[i + 1]
+            a2 = -2.0 * z[i + 2]
+            D = m2 * z[i] * z[i] - z[i + 1] * z[i + 1] - z[i + 2] * z[i + 2]
+            grad[i] -= a0 / D
+            grad[i + 1] -= a1 / D
+            grad[i + 2] -= a2 / D
+            a = (a0, a1, a2)
+            dd = (2.0 * m2, -2.0, -2.0)
+            for p in range(3):
+                for q in range(3):
+                    h = a[p] * a[q] / (D * D)
+                    if p == q:
+                        h -= dd[p] / D
+                    H[i + p, i + q] += h
+
+
+@njit(cache=True)
+def _barrier_value(z, typ, mu, lb, ub):
+    """The log barrier of K at a strictly feasible z."""
+    v = 0.0
+    n = z.shape[0]
+    for i in range(n):
+        t = typ[i]
+        if t == 1 or t == 3:
+            v -= math.log(z[i] - lb[i])
+        if t == 2 or t == 3:
+            v -= math.log(ub[i] - z[i])
+        if t == 4:
+            v -= math.log(mu[i] * mu[i] * z[i] * z[i] - z[i + 1] * z[i + 1] - z[i + 2] * z[i + 2])
+    return v
+
+
+@njit(cache=True)
+def _max_step(z, d, typ, mu, lb, ub):
+    """Largest α with z + α d still in K (closed; 1e300 when unbounded)."""
+    amax = 1e300
+    n = z.shape[0]
+    for i in range(n):
+        t = typ[i]
+        if (t == 1 or t == 3) and d[i] < 0.0:
+            amax = min(amax, (z[i] - lb[i]) / -d[i])
+        if (t == 2 or t == 3) and d[i] > 0.0:
+            amax = min(amax, (ub[i] - z[i]) / d[i])
+        if t == 4:
+            # D(α) = μ²(z_n + α d_n)² − ‖z_t + α d_t‖² = A α² + 2 B α + C, C > 0: first root > 0
+            m2 = mu[i] * mu[i]
+            A = m2 * d[i] * d[i] - d[i + 1] * d[i + 1] - d[i + 2] * d[i + 2]
+            B = m2 * z[i] * d[i] - z[i + 1] * d[i + 1] - z[i + 2] * d[i + 2]
+            C = m2 * z[i] * z[i] - z[i + 1] * z[i + 1] - z[i + 2] * z[i + 2]
+            root = 1e300
+            if A == 0.0:
+                if B < 0.0:
+                    root = -C / (2.0 * B)
+            else:
+                disc = B * B - A * C
+                if disc >= 0.0:
+                    sq = math.sqrt(disc)
+                    # roots (−B ± sq)/A, computed stably
+                    q = -(B + sq) if B >= 0.0 else -(B - sq)
+                    r1 = q / A
+                    r2 = C / q if q != 0.0 else 1e300
+                    for rt in (r1, r2):
+                        if rt > 0.0 and rt < root:
+                            root = rt
+            # the cone's other nappe (z_n < 0) also has D > 0: stop where z_n crosses 0
+            if d[i] < 0.0:
+                root = min(root, z[i] / -d[i])
+            amax = min(amax, root)
+    return amax
+
+
+@njit(cache=True)
+def solve_dense_ipm(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
+    """Log-barrier interior-point method (damped Newton on t·f + barrier, t raised 10× once
+    centred; Boyd & Vandenberghe 2004 §11.3, self-concordant step 1/(1+λ), §9.6) for the dense
+    CCP ``min_{γ∈K} ½γᵀNγ + rᵀγ`` on the Jacobi-scaled problem.  Newton steps invert N, so the
+    iteration count does not grow with its condition number (a light body under one 1e7 times
+    heavier); a first-order method's does.  Starts from ``gamma`` pushed into K's interior,
+    stops at the natural-map residual ``tol`` (as the other solvers), returns the best iterate."""
+    n = r.shape[0]
+    d0 = np.empty(n)
+    for k in range(n):
+        d0[k] = max(N[k, k], 1e-300)
+    average_friction_triplets(d0, kind, n)
+    s = np.sqrt(d0)
+    dmax = d0.max()
+    # variable types: 0 free, 1 lower bound, 2 upper bound, 3 both, 4 cone normal (owns the
+    # next two rows), 5 cone tangent, 6 fixed at 0 (a row that cannot act, μ = 0 tangents)
+    typ = np.zeros(n, np.int64)
+    lb = np.zeros(n)
+    ub = np.zeros(n)
+    fix = np.zeros(n)
+    act = np.ones(n, np.bool_)
+    i = 0
+    while i < n:
+        k = kind[i]
+        if k == FRIC_N:
+            dead = d0[i] <= 1e-300 or d0[i] < 1e-15 * dmax
+            if dead:
+                typ[i] = 6
+                typ[i + 1] = 6
+                typ[i + 2] = 6
+            elif mu[i] <= 0.0:
+                typ[i] = 1
+                typ[i + 1] = 6
+                typ[i + 2] = 6
+            else:
+                typ[i] = 4
+                typ[i + 1] = 5
+                typ[i + 2] = 5
+            i += 3
+            continue
+        if d0[i] <= 1e-300 or d0[i] < 1e-15 * dmax:
+            typ[i] = 6
+        elif k == UNILATERAL:
+            typ[i] = 1
+        elif k == BOXED:
+            hl = lo[i] > -BIG_BOUND
+            hh = hi[i] < BIG_BOUND
+            if hl and hh and hi[i] <= lo[i]:
+                typ[i] = 6
+                fix[i] = lo[i] * s[i]
+            elif hl and hh:
+                typ[i] = 3
+            elif hl:
+                typ[i] = 1
+            elif hh:
+                typ[i] = 2
+            lb[i] = lo[i] * s[i] if hl else 0.0
+            ub[i] = hi[i] * s[i] if hh else 0.0
+        i += 1
+    for k in range(n):
+        if typ[k] == 6:
+            act[k] = False
+    Q = np.empty((n, n))
+    for a in range(n):
+        for b in range(n):
+            Q[a, b] = N[a, b] / (s[a] * s[b])
+    c = r / s
+    # start: the warm start, projected, then strictly inside
+    z = gamma * s
+    project_all(z, kind, mu, lo, hi, s)
+    zmax = 0.0
+    for k in range(n):
+        if act[k]:
+            zmax = max(zmax, abs(z[k]), abs(r[k] / s[k]))
+    off = 1e-3 * zmax if zmax > 0.0 else 1.0
+    for k in range(n):
+        t = typ[k]
+        if t == 6:
+            z[k] = fix[k]
+        elif t == 1:
+            z[k] = max(z[k], lb[k]) + off
+        elif t == 2:
+            z[k] = min(z[k], ub[k]) - off
+        elif t == 3:
+            w = ub[k] - lb[k]
+            z[k] = min(max(z[k], lb[k] + 0.01 * w), ub[k] - 0.01 * w)
+        elif t == 4:
+            tn = math.sqrt(z[k + 1] * z[k + 1] + z[k + 2] * z[k + 2]) / mu[k]
+            z[k] = max(z[k], tn) + off + tn * 0.01
+    tmp = np.empty(n)
+    g = Q @ z + c
+    best = z.copy()
+    best_res = _natural_residual(z, g, s, kind, mu, lo, hi, tmp)
+    it = 0
+    if best_res <= tol:
+        gamma[:] = best / s
+        return 0, best_res
+    # t: balance the objective's and the barrier's gradients at the start
+    gb = np.zeros(n)
+    Hb = np.zeros((n, n))
+    _barrier_terms(z, typ, mu, lb, ub, gb, Hb)
+    num = 0.0
+    den = 0.0
+    for k in range(n):
+        if act[k]:
+            num -= g[k] * gb[k]
+            den += g[k] * g[k]
+    tt = num / den if den > 0.0 and num > 0.0 else 1.0
+    tt = min(max(tt * IPM_T0, 1e-12), 1e12)
+    H = np.empty((n, n))
+    grad = np.empty(n)
+    dz = np.empty(n)
+    dzf = np.empty(n)
+    idx = np.nonzero(act)[0]
+    na = idx.shape[0]
+    for it in range(1, max_iter + 1):
+        # Newton system on the active variables: (t Q + ∇²B) dz = −(t g + ∇B)
+        gb[:] = 0.0
+        Hb[:, :] = 0.0
+        _barrier_terms(z, typ, mu, lb, ub, gb, Hb)
+        for a in range(na):
+            ia = idx[a]
+            grad[a] = tt * g[ia] + gb[ia]
+            for b in range(na):
+                H[a, b] = tt * Q[ia, idx[b]] + Hb[ia, idx[b]]
+            # proximal (Levenberg–Marquardt) term ρ‖z − z_k‖²/2 about the current point: no
+            # change of the gradient, but bounded steps along directions where Q vanishes
+            # (self-equilibrated impulses of a wedged body: there the barrier has no minimum)
+            H[a, a] += tt * IPM_PROX
+        for a in range(na):
+            dz[a] = -grad[a]
+        _dense_cholesky(H, na)
+        _cholesky_solve(H, na, dz)
+        lam2 = 0.0
+        for a in range(na):
+            lam2 -= grad[a] * dz[a]
+        if not math.isfinite(lam2):
+            break
+        # largest step to K's boundary, then backtracking (Armijo) on t·f + B; the change of
+        # t·f is evaluated as t(α gᵀΔ + ½α² ΔᵀQΔ), free of cancellation at large t
+        for k in range(n):
+            dzf[k] = 0.0
+        for a in range(na):
+            dzf[idx[a]] = dz[a]
+        Qd = Q @ dzf
+        gd = 0.0
+        dQd = 0.0
+        for k in range(n):
+            gd += g[k] * dzf[k]
+            dQd += dzf[k] * Qd[k]
+        step = min(1.0, 0.99 * _max_step(z, dzf, typ, mu, lb, ub))
+        b0 = _barrier_value(z, typ, mu, lb, ub)
+        ok = False
+        for _bt in range(60):
+            for k in range(n):
+                tmp[k] = z[k] + step * dzf[k]
+            if _barrier_feasible(tmp, typ, mu, lb, ub):
+                phi = tt * (step * gd + 0.5 * step * step * dQd) + _barrier_value(tmp, typ, mu, lb, ub) - b0
+                if phi <= -0.25 * step * lam2 or step * math.sqrt(max(lam2, 0.0)) < 1e-12:
+                    ok = True
+                    break
+            step *= 0.5
+        if not ok:
+            break
+        z[:] = tmp
+        g = Q @ z + c
+        res = _natural_residual(z, g, s, kind, mu, lo, hi, tmp)
+        if res < best_res:
+            best_res = res
+            best[:] = z
+        if best_res <= tol:
+            break
+        if lam2 <= IPM_CENTRED:
+            tt *= IPM_T_FACTOR
+            if tt > 1e30:
+                break
+    gamma[:] = best / s
+    return it, best_res
+
+
 def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree, vout,
                  max_iter, tol):
     """Direct path for small mechanisms: the bilateral (and compliance) rows are
     eliminated exactly with a Cholesky factorisation of their Schur block and
     the remaining contact/boxed rows solve the reduced CCP
-    ``N' = N_cc − N_cb N_bb⁻¹ N_bc`` with a dense spectral projected gradient.
-    Robust to large mass ratios and stiff compliance (dense: nr ≲ 1000)."""
+    ``N' = N_cc − N_cb N_bb⁻¹ N_bc`` with a dense spectral projected gradient and, where that
+    has not reached ``tol`` in ``max_iter`` iterations (an ill-conditioned N': a light body
+    under a heavy one), with the interior-point method :func:`solve_dense_ipm` from its best
+    iterate (up to IPM_MAX_ROWS contact rows).  Robust to large mass ratios and stiff compliance
+    (dense: nr ≲ 1000)."""
     from scipy.linalg import cho_factor, cho_solve
     vout[:, :] = vfree
     if nr == 0:
@@ -707,8 +1047,16 @@ def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, v
             Ncc = Ncc - Nbc.T @ X
             rc = rc - X.T @ r[ib]
         gc = g[ic].copy()
-        it, res = solve_dense_bb(Ncc, rc, kind[ic].copy(), mu[ic].copy(), lo[ic].copy(),
-                                 hi[ic].copy(), gc, max_iter, tol)
+        kc, muc, loc, hic = kind[ic].copy(), mu[ic].copy(), lo[ic].copy(), hi[ic].copy()
+        it, res = solve_dense_bb(Ncc, rc, kc, muc, loc, hic, gc, max_iter, tol)
+        if res > tol and ic.size <= IPM_MAX_ROWS:
+            # not converged (an ill-conditioned N: a heavy body on a light one): Newton steps
+            gi = gc.copy()
+            it2, res2 = solve_dense_ipm(Ncc, rc, kc, muc, loc, hic, gi, max_iter, tol)
+            it += it2
+            if res2 < res:
+                res = res2
+                gc = gi
         g[ic] = gc
         if ib.size:
             g[ib] = -cho_solve(fac, r[ib] + Nbc @ gc)

@@ -174,10 +174,11 @@ def test_tiny_inertia_is_warned_about(tmp_path):
 def test_contact_mass_ratio_beyond_the_solver_is_warned_about():
     box = {"kind": "floating", "inertia": (1.0, 1.0, 1.0), "rotation_dof": (1, 1, 1), "shapes": [{"shape": "cloud"}]}
     bodies = [dict(box, name="light", mass=1.0), dict(box, name="heavy", mass=1e6, inertia=(1e6,) * 3)]
-    (line,) = startup_warnings(bodies, [0.1, 0.1], [1, 2], "direct", False)
+    (line,) = startup_warnings(bodies, [0.1, 0.1], [1, 2], "bb", False)
     assert line.startswith("colliding bodies 'heavy' (1e+06 kg) and 'light' (1 kg): mass ratio 1e+06, above the "
-                           "3e+04 that the 'direct' solver resolves")
-    assert startup_warnings(bodies, [0.1, 0.1], [1, 2], "bb", False) == []
+                           "1e+03 that the 'bb' solver resolves")
+    assert line.endswith('the direct solver (<solver type="direct"/>) holds 1e8')
+    assert startup_warnings(bodies, [0.1, 0.1], [1, 2], "direct", False) == []
 
 
 def test_not_converged_warning_names_the_case_settings():
