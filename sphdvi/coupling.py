@@ -321,6 +321,8 @@ class FloatingBodies:
             self.local_of_idp[idp] = local
         self._R0 = np.array(self.R0).reshape(-1, 3, 3)
         self._free_rows, self._tied_rows = _periodic_roles(self.system)
+        self._held = None           # the solver of a step held by FtPause whose loads are not computed yet
+        self._saved = None          # the multibody state the Symplectic predictor puts back (kept arrays)
         self._sel = np.empty(p["idp"].size, np.int64)     # rows and bodies of the floating particles,
         self._body = np.empty(p["idp"].size, np.int64)    # refilled each call (the solver reorders)
 
@@ -371,15 +373,18 @@ class FloatingBodies:
         """Advance the bodies by ``dt`` under this step's loads and carry their particles
         (``solver.ace`` holds this step's accelerations; a floating particle's has no gravity;
         ``solver.time`` is the step's end).  With Symplectic the step starts again from the
-        state :meth:`predict` left the bodies in, the one at the step's start."""
-        sel, body = self.rows(solver)
-        F, T = self.loads(solver, sel, body)
-        self.system.fluid_force, self.system.fluid_torque = F.copy(), T.copy()    # bodies.csv ffx.. ftz
+        state :meth:`predict` left the bodies in, the one at the step's start.  During FtPause
+        the bodies stay where they are and their loads wait for a bodies.csv row
+        (:meth:`held_loads`)."""
         if self.paused(solver.time - dt):
             self.system.time = solver.time     # frozen bodies (FtPause): the clock still runs
-            self.hold(F, T)
+            self._held = solver
             return
-        self.system.step(dt, F, T)
+        self._held = None
+        sel, body = self.rows(solver)
+        F, T = self.loads(solver, sel, body)
+        self.system.fluid_force, self.system.fluid_torque = F, T    # bodies.csv ffx.. ftz (fresh arrays)
+        self.system.advance(dt, F, T)
         self.watch.after_step(getattr(solver, "nstep", 0))     # a NaN body: stopped before the fluid sees it
         self.carry_particles(solver, sel, body)
         self.wrap_centres(solver)
@@ -395,11 +400,26 @@ class FloatingBodies:
             return
         sel, body = self.rows(solver)
         F, T = self.loads(solver, sel, body)
-        saved = self.system.get_state()
-        self.system.step(dt_half, F, T)
+        self._saved = saved = self.system.get_state(self._saved)    # into the last step's copy
+        self.system.advance(dt_half, F, T)
         self.watch.check_finite(getattr(solver, "nstep", 0) + 1)     # the step under way
         self.carry_particles(solver, sel, body)
         self.system.set_state(saved)
+
+    def held_loads(self) -> None:
+        """During FtPause, the loads of the last step on the held bodies (fluid_force,
+        fluid_torque, :meth:`hold`), computed only when a bodies.csv row is written (BodyLog's
+        ``prepare``, at outputs and TimeOutExtra), the only place they are read: the solver's
+        accelerations and the frozen particles are still those of the step's end then.  As
+        DualSPHysics's JSphCpuSingle::RunFloating, which sums them while paused only when a Part
+        or a TimeOutExtra row is due (``if(!ftpaused || saveftvalues)``)."""
+        solver, self._held = self._held, None
+        if solver is None:
+            return
+        sel, body = self.rows(solver)
+        F, T = self.loads(solver, sel, body)
+        self.system.fluid_force, self.system.fluid_torque = F, T
+        self.hold(F, T)
 
     def hold(self, F: np.ndarray, T: np.ndarray) -> None:
         """During FtPause, the loads on each held floating body for bodies.csv: its weight plus

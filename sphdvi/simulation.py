@@ -1672,7 +1672,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     if resume and "excl_part_pct" in extra:         # the levels already warned about (each warns once)
         excl_warn.part_pct, excl_warn.total_pct = int(extra["excl_part_pct"]), int(extra["excl_total_pct"])
     excluded_log = ExcludedLog(outdir, float(sol.time) if resume else None)
-    body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None)
+    body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None,
+                        prepare=sph.floating.held_loads)
                 if sph.bodies is not None else None)
     status, code, message = "completed", 0, ""
     with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:

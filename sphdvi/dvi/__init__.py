@@ -98,7 +98,10 @@ Stepping and state:
 
 * ``step(dt, forces=None, torques=None) -> (pos, quat, vel, omega_world)``;
   forces/torques: (nb, 3) world-frame loads for this step (torque about each
-  centre), added to gravity and the persistent loads — the fluid coupling.
+  centre), added to gravity and the persistent loads — the fluid coupling;
+  ``advance(dt, forces=None, torques=None)``: the same step without the return
+  value (the coupling's call).  The step's work arrays are kept on the System (sized
+  again when bodies, links or shapes are added): a step allocates almost nothing.
 * ``pos`` (nb,3), ``quat`` (nb,4, w x y z), ``vel`` (nb,3), ``omega_world``
   (nb,3), ``omega_b`` (body frame), ``time``.
 * Last step: ``total_force``/``total_torque`` (all loads incl. gravity,
@@ -109,11 +112,13 @@ Stepping and state:
   opposite sign of Chrono's ChLink::GetReaction2 (and of the ADAMS Rforce its joint
   tests compare with: the wrench on body 2) and in the world frame, not link frame 2:
   to compare with DSPH+Chrono's ChronoLink_forces.csv or ADAMS, negate it and rotate.
+  These arrays are written in place by the next step: copy them to keep them.
 * ``last_iterations`` (all passes), ``last_residual``, ``n_contacts``, ``n_rows``,
   ``take_warnings()``,
   ``constraint_violation()``, ``kinetic_energy()``, ``potential_energy()``,
   ``set_velocity(body, vel, omega)``, ``set_external_load(body, force, torque)``,
-  ``get_state()``/``set_state(st)`` (predictor–corrector couplings),
+  ``get_state(out=None)``/``set_state(st)`` (predictor–corrector couplings; ``out``: an
+  earlier state refilled in place),
   ``body_index(name)``, ``link_index(name)``.
 
 Body-only runs:

@@ -6,8 +6,8 @@ Shapes (local frame of the shape, attached to a body with an offset pose):
 type       dims                                       notes
 =========  =========================================  ===========================
 SPHERE     (r, -, -)                                   analytic
-BOX        half extents (hx, hy, hz)                   box–box: separating axes +
-                                                       face clipping (≤ 4 points)
+BOX        half extents (hx, hy, hz)                   a hull of 6 faces (box–box,
+                                                       box–hull as hull–hull)
 CAPSULE    (r, half length, -) along local z           segment + radius
 CYLINDER   (r, half length, -) along local z           exact SDF, rim samples
 PLANE      -                                           half-space z_local ≤ 0 is
@@ -24,21 +24,23 @@ vertices, cylinder rim points, cloud particles) and a signed distance function
 (exact inside; exact or a lower bound outside — the hull's max-of-planes).  A
 contact is created for each sample of one shape whose distance to the other
 shape, minus its radius, is below the envelope.  Exact special cases:
-sphere/capsule pairs (closest points between segments), box–box (separating
-axes + clipping of the incident face, ≤ 4 points), cylinder–plane (exact rim
-support point per cap), and box/hull pairs (separating-axis test over face
-normals and edge cross products: culls separated pairs and adds the edge–edge
-contact when an edge pair is the axis of least penetration; skipped above
-4096 edge pairs).  Particle clouds are searched through a body-frame cell grid
+sphere/capsule pairs (closest points between segments), cylinder–plane (exact rim
+support point per cap), and box/hull pairs, box–box included (separating-axis test over
+face normals and the cross products of the classes of parallel edges: culls separated
+pairs and adds the edge–edge contact when an edge pair is the axis of least penetration;
+skipped above 4096 edge pairs).  Particle clouds are searched through a body-frame cell grid
 (O(1) per query) and collided as a smooth surface, not a union of spheres (DualSPHysics's
 Chrono collides a triangle mesh): only surface particles are kept; a flat face's particle
 is its tangent plane r in front of it, an edge or corner particle its sphere
 (:func:`_cloud_query`); of two clouds, every sample of the smaller is tested against the
 other's surface and the other's edge and corner particles against the smaller's faces.
 A sphere against a cloud is its centre against the cloud's surface (one contact: the tangent
-plane of a face, the sphere of an edge or corner particle; :func:`_sphere_vs_cloud`).
-Polytope pairs (box/hull, not box–box) with a face axis of least penetration get a
-clipped face-face manifold of ≤ 4 points (:func:`_polytope_manifold`).  Limitations:
+plane of a face, the sphere of an edge or corner particle; :func:`_sphere_vs_cloud`); a
+capsule's axis points and a cylinder's rim points (and its exact deepest rim point per cap,
+:func:`_cylinder_cloud_support`) against the cloud's flat faces, the cloud's edge and corner
+particles against the capsule's or cylinder's exact surface.  Polytope pairs (box/hull,
+box–box included) with a face axis of least penetration get a clipped face-face manifold of
+≤ 4 points (:func:`_polytope_manifold`).  Limitations:
 cylinder–box/hull and cylinder–cylinder rely on 16 rim samples per cap (no
 exact rim–edge contact); a cloud's staircase (sloping or curved lattice
 surface) is collided as spheres; no rolling/spinning friction.
@@ -66,14 +68,22 @@ SHAPE_NAMES = {"sphere": SPHERE, "box": BOX, "capsule": CAPSULE, "cylinder": CYL
 # ------------------------------------------------------------------ transforms
 @njit(cache=True)
 def shape_world_poses(sh_body, sh_pos, sh_R, pos, Rb, w_pos, w_R):
+    """World pose of each shape: its body's pose composed with the shape's offset (element
+    loops: nothing allocated)."""
     for s in range(sh_body.shape[0]):
         b = sh_body[s]
         if b < 0:
-            w_pos[s] = sh_pos[s]
-            w_R[s] = sh_R[s]
-        else:
-            w_pos[s] = pos[b] + Rb[b] @ sh_pos[s]
-            w_R[s] = Rb[b] @ sh_R[s]
+            for i in range(3):
+                w_pos[s, i] = sh_pos[s, i]
+                for j in range(3):
+                    w_R[s, i, j] = sh_R[s, i, j]
+            continue
+        for i in range(3):
+            w_pos[s, i] = pos[b, i] + (Rb[b, i, 0] * sh_pos[s, 0] + Rb[b, i, 1] * sh_pos[s, 1]
+                                       + Rb[b, i, 2] * sh_pos[s, 2])
+            for j in range(3):
+                w_R[s, i, j] = (Rb[b, i, 0] * sh_R[s, 0, j] + Rb[b, i, 1] * sh_R[s, 1, j]
+                                + Rb[b, i, 2] * sh_R[s, 2, j])
 
 
 @njit(cache=True)
@@ -482,7 +492,7 @@ def _segment_of(t, dims, c, R):
     return c.copy(), c.copy()
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _emit_t(nc, cap, ba, bb, sa, sb, pt, n, gap, key, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
     """_emit for tuple vectors."""
     if nc < cap:
@@ -496,182 +506,6 @@ def _emit_t(nc, cap, ba, bb, sa, sb, pt, n, gap, key, c_a, c_b, c_sa, c_sb, c_pt
         c_gap[nc] = gap
         c_key[nc] = key
     return nc + 1
-
-
-@njit(cache=True)
-def _sat_sep(L, T, RA, hA, RB, hB):
-    """Separation of two boxes along the unit axis L (negative = overlap)."""
-    ra = 0.0
-    rb = 0.0
-    for k in range(3):
-        ra += hA[k] * abs(RA[0, k] * L[0] + RA[1, k] * L[1] + RA[2, k] * L[2])
-        rb += hB[k] * abs(RB[0, k] * L[0] + RB[1, k] * L[1] + RB[2, k] * L[2])
-    return abs(v_dot(T, L)) - ra - rb
-
-
-@njit(cache=True)
-def _box_box(sa, sb, ba, bb, cA, RA, hA, cB, RB, hB, env, keybase, nc, cap,
-             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep):
-    """Box–box: separating-axis test over 15 axes, then clipping of the incident
-    face against the reference face (≤ 4 points kept) or one edge–edge point."""
-    T = v_sub(cB, cA)
-    best_face = -1e300
-    face_ax = -1
-    for ax in range(6):
-        L = col(RA, ax) if ax < 3 else col(RB, ax - 3)
-        sep = _sat_sep(L, T, RA, hA, RB, hB)
-        if sep > env:
-            return nc
-        if sep > best_face:
-            best_face = sep
-            face_ax = ax
-    best_edge = -1e300
-    edge_i = -1
-    edge_j = -1
-    edge_L = (0.0, 0.0, 0.0)
-    for i in range(3):
-        for j in range(3):
-            L = v_cross(col(RA, i), col(RB, j))
-            ln = math.sqrt(v_dot(L, L))
-            if ln < 1e-6:
-                continue
-            L = v_scale(L, 1.0 / ln)
-            sep = _sat_sep(L, T, RA, hA, RB, hB)
-            if sep > env:
-                return nc
-            if sep > best_edge:
-                best_edge = sep
-                edge_i = i
-                edge_j = j
-                edge_L = L
-    scale = min(min(hA[0], hA[1]), min(hA[2], min(hB[0], min(hB[1], hB[2]))))
-    if edge_i >= 0 and best_edge > best_face + 0.05 * abs(best_face) + 1e-3 * scale:
-        L = edge_L
-        if v_dot(T, L) < 0.0:
-            L = v_scale(L, -1.0)
-        pa = cA
-        pb = cB
-        for k in range(3):
-            ak = col(RA, k)
-            bk = col(RB, k)
-            if k != edge_i:
-                pa = v_add(pa, v_scale(ak, hA[k] * math.copysign(1.0, v_dot(ak, L))))
-            if k != edge_j:
-                pb = v_sub(pb, v_scale(bk, hB[k] * math.copysign(1.0, v_dot(bk, L))))
-        ea = v_scale(col(RA, edge_i), hA[edge_i])
-        eb = v_scale(col(RB, edge_j), hB[edge_j])
-        x1, x2 = _closest_segments_t(v_sub(pa, ea), v_add(pa, ea), v_sub(pb, eb), v_add(pb, eb))
-        pt = v_scale(v_add(x1, x2), 0.5)
-        return _emit_t(nc, cap, ba, bb, sa, sb, pt, L, best_edge, keybase + 50,
-                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-    # face contact: reference box r, incident box i; nref points from r to i
-    if face_ax < 3:
-        fi = face_ax
-        cr = cA
-        Rr = RA
-        hr = hA
-        ci = cB
-        Ri = RB
-        hi_ = hB
-        nref = v_scale(col(RA, fi), math.copysign(1.0, v_dot(T, col(RA, fi))))
-        nab = nref
-    else:
-        fi = face_ax - 3
-        cr = cB
-        Rr = RB
-        hr = hB
-        ci = cA
-        Ri = RA
-        hi_ = hA
-        nref = v_scale(col(RB, fi), -math.copysign(1.0, v_dot(T, col(RB, fi))))
-        nab = v_scale(nref, -1.0)
-    jbest = 0
-    dbest = -1.0
-    for j in range(3):
-        dj = abs(v_dot(col(Ri, j), nref))
-        if dj > dbest:
-            dbest = dj
-            jbest = j
-    cj = col(Ri, jbest)
-    ninc = v_scale(cj, -math.copysign(1.0, v_dot(cj, nref)))
-    fc = v_add(ci, v_scale(ninc, hi_[jbest]))
-    u = (jbest + 1) % 3
-    v = (jbest + 2) % 3
-    U = v_scale(col(Ri, u), hi_[u])
-    V = v_scale(col(Ri, v), hi_[v])
-    for k in range(3):
-        poly[0, k] = fc[k] + U[k] + V[k]
-        poly[1, k] = fc[k] - U[k] + V[k]
-        poly[2, k] = fc[k] - U[k] - V[k]
-        poly[3, k] = fc[k] + U[k] - V[k]
-    npoly = 4
-    for side in range(4):
-        k = (fi + 1 + side // 2) % 3
-        sgn = 1.0 if side % 2 == 0 else -1.0
-        pn = v_scale(col(Rr, k), sgn)
-        off = v_dot(pn, cr) + hr[k]
-        nt = 0
-        for q in range(npoly):
-            q2 = (q + 1) % npoly
-            dp = poly[q, 0] * pn[0] + poly[q, 1] * pn[1] + poly[q, 2] * pn[2] - off
-            dq = poly[q2, 0] * pn[0] + poly[q2, 1] * pn[1] + poly[q2, 2] * pn[2] - off
-            if dp <= 0.0:
-                for c in range(3):
-                    tmp[nt, c] = poly[q, c]
-                nt += 1
-            if (dp <= 0.0) != (dq <= 0.0):
-                f = dp / (dp - dq)
-                for c in range(3):
-                    tmp[nt, c] = poly[q, c] + (poly[q2, c] - poly[q, c]) * f
-                nt += 1
-        npoly = nt
-        for q in range(nt):
-            for c in range(3):
-                poly[q, c] = tmp[q, c]
-        if npoly == 0:
-            return nc
-    # keep points below the envelope, at most 4 (deepest first, then spread)
-    cand = 0
-    first = -1
-    for q in range(npoly):
-        depth[q] = (nref[0] * (poly[q, 0] - cr[0]) + nref[1] * (poly[q, 1] - cr[1])
-                    + nref[2] * (poly[q, 2] - cr[2]) - hr[fi])
-        keep[q] = False
-        if depth[q] < env:
-            cand += 1
-            if first < 0 or depth[q] < depth[first]:
-                first = q
-    if cand == 0:
-        return nc
-    keep[first] = True
-    nk = 1
-    while nk < min(4, cand):
-        far = -1
-        fd = -1.0
-        for q in range(npoly):
-            if keep[q] or depth[q] >= env:
-                continue
-            dmin = 1e300
-            for p in range(npoly):
-                if keep[p]:
-                    dd = ((poly[q, 0] - poly[p, 0]) ** 2 + (poly[q, 1] - poly[p, 1]) ** 2
-                          + (poly[q, 2] - poly[p, 2]) ** 2)
-                    if dd < dmin:
-                        dmin = dd
-            if dmin > fd:
-                fd = dmin
-                far = q
-        if far < 0:
-            break
-        keep[far] = True
-        nk += 1
-    for q in range(npoly):
-        if keep[q]:
-            dq = 0.5 * depth[q]
-            pt = (poly[q, 0] - dq * nref[0], poly[q, 1] - dq * nref[1], poly[q, 2] - dq * nref[2])
-            nc = _emit_t(nc, cap, ba, bb, sa, sb, pt, nab, depth[q], keybase + q,
-                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-    return nc
 
 
 @njit(cache=True)
@@ -786,10 +620,94 @@ def _cylinder_plane_support(sc, sp, bc, bpl, nc, cap, env, keybase, sh_dims, w_p
 
 
 @njit(cache=True)
+def _cylinder_cloud_support(sc, scl, bc, bcl, swap, nc, cap, env, keybase, sh_dims, samp_off,
+                            samp_pts, samp_nrm, cg_meta, cg_start, w_pos, w_R,
+                            c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """Exact deepest rim point of each cap of a cylinder against a particle cloud's flat face
+    (as :func:`_cylinder_plane_support` against a plane): the face is the tangent plane of
+    the cloud's surface particle nearest the cap's centre (:func:`_cloud_query`, flat faces
+    only), the rim point deepest along its normal is queried again; a cap parallel to the face
+    is left to the rim samples.  ``swap``: the cylinder is the pair's second shape."""
+    RO = w_R[scl]
+    cO = row3(w_pos, scl)
+    dims = sh_dims[scl]
+    a = mat_t_vec(RO, col(w_R[sc], 2))                 # axis, cloud frame
+    c = mat_t_vec(RO, v_sub(row3(w_pos, sc), cO))      # centre, cloud frame
+    R = sh_dims[sc, 0]
+    H = sh_dims[sc, 1]
+    reach = R + H + dims[0] + max(env, 0.0) + 1e-12
+    for side in range(2):
+        cc = v_add(c, v_scale(a, H if side == 0 else -H))
+        phi0, g = _cloud_query(cc, scl, dims, samp_off, samp_pts, samp_nrm, cg_meta, cg_start,
+                               reach, 1.0, True)
+        if phi0 >= reach - dims[0]:
+            continue                                  # no flat face within reach
+        an = v_dot(a, g)
+        if abs(an) > 0.999:
+            continue
+        rdir = v_sub(v_scale(a, an), g)               # −g projected on the cap plane
+        rdir = v_scale(rdir, 1.0 / math.sqrt(v_dot(rdir, rdir)))
+        x = v_add(cc, v_scale(rdir, R))
+        phi, gx = _cloud_query(x, scl, dims, samp_off, samp_pts, samp_nrm, cg_meta, cg_start,
+                               dims[0] + max(env, 0.0) + 1e-12, 1.0, True)
+        if phi >= env:
+            continue
+        gw = mat_vec(RO, gx)
+        pt = v_sub(v_add(cO, mat_vec(RO, x)), v_scale(gw, 0.5 * phi))
+        key = keybase + 1000000 + 2 * side + (1 if swap else 0)
+        if swap:
+            nc = _emit_t(nc, cap, bcl, bc, scl, sc, pt, gw, phi, key,
+                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+        else:
+            nc = _emit_t(nc, cap, bc, bcl, sc, scl, pt, v_scale(gw, -1.0), phi, key,
+                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return nc
+
+
+@njit(cache=True, inline="always")
+def _inner_ball(s, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes):
+    """Centre (the vertex centroid, shape frame) and radius (its distance to the nearest
+    face plane, ≥ 0) of a ball inside the convex polytope s."""
+    m0 = 0.0
+    m1 = 0.0
+    m2 = 0.0
+    n = samp_cnt[s]
+    for i in range(samp_off[s], samp_off[s] + n):
+        m0 += samp_pts[i, 0]
+        m1 += samp_pts[i, 1]
+        m2 += samp_pts[i, 2]
+    f = 1.0 / max(n, 1)
+    m0 *= f
+    m1 *= f
+    m2 *= f
+    r = 1e300
+    for p in range(pl_off[s], pl_off[s] + pl_cnt[s]):
+        r = min(r, -(planes[p, 0] * m0 + planes[p, 1] * m1 + planes[p, 2] * m2 + planes[p, 3]))
+    return (m0, m1, m2), max(r, 0.0)
+
+
+@njit(cache=True)
+def _support_edge(rep, ne, off, ed_rep, edges, W, L, ext, tol):
+    """First edge of the parallel class ``rep`` whose two vertices (world, W) lie at the
+    extreme ``ext`` of the polytope along L (within tol); −1: none (L meets the class at a
+    vertex only)."""
+    for e in range(rep, ne):
+        if ed_rep[off + e] != rep:
+            continue
+        v0 = edges[off + e, 0]
+        v1 = edges[off + e, 1]
+        if (abs(L[0] * W[v0, 0] + L[1] * W[v0, 1] + L[2] * W[v0, 2] - ext) <= tol
+                and abs(L[0] * W[v1, 0] + L[1] * W[v1, 1] + L[2] * W[v1, 2] - ext) <= tol):
+            return e
+    return -1
+
+
+@njit(cache=True, inline="always")
 def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes, edges,
-                  ed_off, ed_cnt, w_pos, w_R, wa, wb):
+                  ed_off, ed_cnt, ed_rep, w_pos, w_R, wa, wb):
     """Separating-axis test of two convex polytopes (box/hull) over the face
-    normals of both and the cross products of their edges.  Returns
+    normals of both and the cross products of their edges (one per pair of classes of
+    parallel edges, ``ed_rep``: a box has 3 × 3).  Returns
     (separation, edge a, edge b, axis, face side, face plane): the edge pair is set (≥ 0)
     when an edge–edge axis is the axis of least penetration (its supporting edges); the
     face (side 0: of sa, 1: of sb; its index in ``planes``) is the face axis of least
@@ -813,6 +731,14 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
         wb[i, 0] = x[0]
         wb[i, 1] = x[1]
         wb[i, 2] = x[2]
+    # a ball inside each polytope (about its vertex centroid m, radius: the distance to the
+    # nearest face plane) bounds every axis's separation from above:
+    # sep(L) ≤ L·(m_b − m_a) − r_a − r_b; an axis bounded below the bar is skipped
+    ma, rin_a = _inner_ball(sa, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes)
+    mb, rin_b = _inner_ball(sb, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes)
+    ma = v_add(ca, mat_vec(Ra, ma))
+    mb = v_add(cb, mat_vec(Rb_, mb))
+    slack = 1e-9 * (1.0 + rin_a + rin_b)
     best_face = -1e300
     fside = 0
     fplane = -1
@@ -825,12 +751,29 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
         for p in range(pl_off[s], pl_off[s] + pl_cnt[s]):
             n = mat_vec(R, (planes[p, 0], planes[p, 1], planes[p, 2]))
             off = v_dot(n, c) - planes[p, 3]
+            # a face whose depth falls to the best so far (and below the envelope) can
+            # neither separate nor win: skipped on the balls' bound, else its vertex loop
+            # stops there (same result)
+            bar = best_face + (1e-9 * (1.0 + abs(best_face)) if side == 1 else 0.0)
+            stop = min(bar, env)
+            if side == 0:
+                ub = v_dot(n, mb) - off - rin_b
+            else:
+                ub = v_dot(n, ma) - off - rin_a
+            if ub <= stop - slack:
+                continue
             m = 1e300
+            low = False
             for i in range(nw):
                 d = n[0] * W[i, 0] + n[1] * W[i, 1] + n[2] * W[i, 2] - off
                 if d < m:
                     m = d
-            if m > best_face + (1e-9 * (1.0 + abs(best_face)) if side == 1 else 0.0):
+                    if m <= stop:
+                        low = True
+                        break
+            if low:
+                continue
+            if m > bar:
                 best_face = m
                 fside = side
                 fplane = p
@@ -845,19 +788,27 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
     if nea * neb > 4096:
         return best_face, -1, -1, bL, fside, fplane
     T = v_sub(cb, ca)
-    scale = 1e300
+    scale2 = 1e300
     for i in range(na):
         d = v_sub(row3(wa, i), ca)
-        scale = min(scale, math.sqrt(v_dot(d, d)))
+        scale2 = min(scale2, v_dot(d, d))
+    scale = math.sqrt(scale2)
     tol = 1e-9 * (1.0 + scale)
+    # an edge axis wins only above this (the return below); one that falls to it (and below
+    # the envelope) stops its vertex loop
+    win = best_face + 0.05 * abs(best_face) + 1e-6 * (1.0 + scale)
+    oa = ed_off[sa]
+    ob = ed_off[sb]
+    mdiff = v_sub(mb, ma)
+    rin_ab = rin_a + rin_b
     for i in range(nea):
-        a0 = edges[ed_off[sa] + i, 0]
-        a1 = edges[ed_off[sa] + i, 1]
-        da = v_sub(row3(wa, a1), row3(wa, a0))
+        if ed_rep[oa + i] != i:
+            continue                 # one axis per class of parallel edges
+        da = v_sub(row3(wa, edges[oa + i, 1]), row3(wa, edges[oa + i, 0]))
         for j in range(neb):
-            b0 = edges[ed_off[sb] + j, 0]
-            b1 = edges[ed_off[sb] + j, 1]
-            db = v_sub(row3(wb, b1), row3(wb, b0))
+            if ed_rep[ob + j] != j:
+                continue
+            db = v_sub(row3(wb, edges[ob + j, 1]), row3(wb, edges[ob + j, 0]))
             L = v_cross(da, db)
             ln = math.sqrt(v_dot(L, L))
             if ln < 1e-9 * math.sqrt(v_dot(da, da) * v_dot(db, db)) + 1e-300:
@@ -865,30 +816,44 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
             L = v_scale(L, 1.0 / ln)
             if v_dot(L, T) < 0.0:
                 L = v_scale(L, -1.0)
+            # the balls inside bound the separation: sep ≤ L·(mb − ma) − rin_a − rin_b; an
+            # axis that cannot reach the winning bar (nor the envelope) is skipped
+            if v_dot(L, mdiff) - rin_ab <= min(win, env) - slack:
+                continue
             maxa = -1e300
             for k in range(na):
                 d = L[0] * wa[k, 0] + L[1] * wa[k, 1] + L[2] * wa[k, 2]
                 if d > maxa:
                     maxa = d
+            stop = maxa + min(win, env)
             minb = 1e300
+            low = False
             for k in range(nbv):
                 d = L[0] * wb[k, 0] + L[1] * wb[k, 1] + L[2] * wb[k, 2]
                 if d < minb:
                     minb = d
+                    if minb <= stop:
+                        low = True
+                        break
+            if low:
+                continue
             sep = minb - maxa
             if sep > env:
                 return sep, -1, -1, L, fside, fplane
-            # only the edges that actually support the axis
-            if (abs(v_dot(L, row3(wa, a0)) - maxa) > tol or abs(v_dot(L, row3(wa, a1)) - maxa) > tol
-                    or abs(v_dot(L, row3(wb, b0)) - minb) > tol
-                    or abs(v_dot(L, row3(wb, b1)) - minb) > tol):
+            if sep <= best_edge or sep <= win:
                 continue
-            if sep > best_edge:
-                best_edge = sep
-                bea = i
-                beb = j
-                bL = L
-    if bea >= 0 and best_edge > best_face + 0.05 * abs(best_face) + 1e-6 * (1.0 + scale):
+            # only edges that actually support the axis: the first of each class
+            ia = _support_edge(i, nea, oa, ed_rep, edges, wa, L, maxa, tol)
+            if ia < 0:
+                continue
+            jb = _support_edge(j, neb, ob, ed_rep, edges, wb, L, minb, tol)
+            if jb < 0:
+                continue
+            best_edge = sep
+            bea = ia
+            beb = jb
+            bL = L
+    if bea >= 0 and best_edge > win:
         return best_edge, bea, beb, bL, fside, fplane
     return max(best_face, best_edge), -1, -1, bL, fside, fplane
 
@@ -908,10 +873,11 @@ def _vertex_key(s, v, s_lo):
 
 
 @njit(cache=True)
-def _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nref_v, fv_idx, fv_edge, ed_cnt):
+def _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nref_v, fv_idx, fv_edge, ned_r, ned_i):
     """Key of a clipped point: the crossing of the current polygon edge (label ``lab``: ≥ 0
     the incident face's edge lab, < 0 the reference face's edge −lab−1) with the reference
-    face's side plane j.  Two reference edges meet at a reference vertex."""
+    face's side plane j.  Two reference edges meet at a reference vertex.  ned_r, ned_i: the
+    edge counts of the reference and incident shapes."""
     if lab < 0:
         j1 = -lab - 1
         if (j1 + 1) % nref_v == j:
@@ -924,8 +890,8 @@ def _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nref_v, fv_idx, fv_edge,
     if er < 0 or ei < 0:
         return _EKEY0 + _EKEY_MOD + 9973 + ((lab * 61 + j) % 9973)
     if sr == s_lo:
-        return _EKEY0 + (np.int64(er) * ed_cnt[si] + ei) % _EKEY_MOD
-    return _EKEY0 + (np.int64(ei) * ed_cnt[sr] + er) % _EKEY_MOD
+        return _EKEY0 + (np.int64(er) * ned_i + ei) % _EKEY_MOD
+    return _EKEY0 + (np.int64(ei) * ned_r + er) % _EKEY_MOD
 
 
 @njit(cache=True)
@@ -948,66 +914,80 @@ def _hull_area4(a, b, c, p, n):
     return max(best, abs(t0 - t1))     # a p b c
 
 
+# columns of the face-face manifold's work arrays (a row per polygon point): fw (float) the
+# point (two buffers, the clipping alternates them), its gap, a score, and the output (point,
+# gap); iw (int) its key and label (two buffers each), the candidate list, the kept flag and
+# the output key
+_FP = 0
+_FGAP = 6
+_FSC = 7
+_FOUT = 8
+_NFW = 12
+_IKEY = 0
+_ILAB = 2
+_ICAND = 4
+_IUSED = 5
+_IOUT = 6
+_NIW = 7
+
+
 @njit(cache=True)
-def _pick(score, keys, cand, ncand, used, tol):
-    """Index (into the point arrays) of the unused candidate of largest score; those within
+def _pick(fw, iw, ncand, tol, pb):
+    """Index (a row of the work arrays) of the unused candidate of largest score; those within
     ``tol`` of the best are tied and the lowest key wins (a choice that does not flip with
-    round-off, for the warm start)."""
+    round-off, for the warm start).  pb: the column of the points' keys."""
     best = -1e300
     for m in range(ncand):
-        q = cand[m]
-        if not used[q] and score[q] > best:
-            best = score[q]
+        q = iw[m, _ICAND]
+        if iw[q, _IUSED] == 0 and fw[q, _FSC] > best:
+            best = fw[q, _FSC]
     pick = -1
     for m in range(ncand):
-        q = cand[m]
-        if used[q] or score[q] < best - tol:
+        q = iw[m, _ICAND]
+        if iw[q, _IUSED] != 0 or fw[q, _FSC] < best - tol:
             continue
-        if pick < 0 or keys[q] < keys[pick]:
+        if pick < 0 or iw[q, pb] < iw[pick, pb]:
             pick = q
     return pick
 
 
 @njit(cache=True)
-def _reduce4(poly, gapb, pkey, cand, ncand, used, score, nref, ext):
+def _reduce4(fw, iw, ncand, nref, ext, pc, pb):
     """Contact reduction to four points (as Bullet's persistent manifold): the deepest point,
     the one farthest from it, the one that maximises the triangle's area, then the one that
     maximises the area of the four points' convex hull (all in the reference plane).
-    Marks them in ``used``."""
+    Marks them used.  pc, pb: the columns of the points and of their keys."""
     for m in range(ncand):
-        used[cand[m]] = False
+        q = iw[m, _ICAND]
+        iw[q, _IUSED] = 0
+        fw[q, _FSC] = -fw[q, _FGAP]
+    i0 = _pick(fw, iw, ncand, 1e-5 * ext, pb)
+    iw[i0, _IUSED] = 1
+    p0 = (fw[i0, pc], fw[i0, pc + 1], fw[i0, pc + 2])
     for m in range(ncand):
-        score[cand[m]] = -gapb[cand[m]]
-    i0 = _pick(score, pkey, cand, ncand, used, 1e-5 * ext)
-    used[i0] = True
-    p0 = row3(poly, i0)
-    for m in range(ncand):
-        q = cand[m]
-        d = v_sub(row3(poly, q), p0)
+        q = iw[m, _ICAND]
+        d = v_sub((fw[q, pc], fw[q, pc + 1], fw[q, pc + 2]), p0)
         h = v_dot(d, nref)
-        score[q] = v_dot(d, d) - h * h
-    i1 = _pick(score, pkey, cand, ncand, used, 1e-6 * ext * ext)
-    used[i1] = True
-    p1 = row3(poly, i1)
+        fw[q, _FSC] = v_dot(d, d) - h * h
+    i1 = _pick(fw, iw, ncand, 1e-6 * ext * ext, pb)
+    iw[i1, _IUSED] = 1
+    p1 = (fw[i1, pc], fw[i1, pc + 1], fw[i1, pc + 2])
     for m in range(ncand):
-        q = cand[m]
-        score[q] = abs(_area_tri(p0, p1, row3(poly, q), nref))
-    i2 = _pick(score, pkey, cand, ncand, used, 1e-6 * ext * ext)
-    used[i2] = True
-    p2 = row3(poly, i2)
+        q = iw[m, _ICAND]
+        fw[q, _FSC] = abs(_area_tri(p0, p1, (fw[q, pc], fw[q, pc + 1], fw[q, pc + 2]), nref))
+    i2 = _pick(fw, iw, ncand, 1e-6 * ext * ext, pb)
+    iw[i2, _IUSED] = 1
+    p2 = (fw[i2, pc], fw[i2, pc + 1], fw[i2, pc + 2])
     for m in range(ncand):
-        q = cand[m]
-        score[q] = _hull_area4(p0, p1, p2, row3(poly, q), nref)
-    i3 = _pick(score, pkey, cand, ncand, used, 1e-6 * ext * ext)
-    used[i3] = True
+        q = iw[m, _ICAND]
+        fw[q, _FSC] = _hull_area4(p0, p1, p2, (fw[q, pc], fw[q, pc + 1], fw[q, pc + 2]), nref)
+    i3 = _pick(fw, iw, ncand, 1e-6 * ext * ext, pb)
+    iw[i3, _IUSED] = 1
 
 
-@njit(cache=True)
-def _polytope_manifold(s1, s2, b1, b2, fside, fplane, env, keybase, nc, cap,
-                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key,
-                       planes, pl_off, pl_cnt, fv_off, fv_cnt, fv_idx, fv_edge, ed_cnt,
-                       w_pos, w_R, wa, wb, poly, tmp, pkey, tkey, plab, tlab, gapb, cand,
-                       used, score):
+@njit(cache=True, inline="always")
+def _polytope_manifold(s1, s2, fside, fplane, env, planes, pl_off, pl_cnt, fv_off, fv_cnt,
+                       fv_idx, fv_edge, ed_cnt, w_pos, w_R, wa, wb, fw, iw):
     """Face-face contact manifold of two convex polytopes (box/hull), as Chrono's and
     Bullet's polyhedral clipping (Bullet: btPolyhedralContactClipping::clipHullAgainstHull):
     the reference face is the SAT face axis of least penetration (``fplane`` of side
@@ -1016,7 +996,9 @@ def _polytope_manifold(s1, s2, b1, b2, fside, fplane, env, keybase, nc, cap,
     Hodgman), the points below the reference face plus the envelope are kept and reduced to
     four (:func:`_reduce4`).  Each point is placed halfway between the faces and keyed by
     what it is (a vertex, or an edge of one crossing an edge of the other:
-    :func:`_crossing_key`), so that its key persists from step to step.  Returns nc."""
+    :func:`_crossing_key`), so that its key persists from step to step.  Returns (k, normal
+    from s1 to s2): the points are rows 0..k−1 of fw[:, _FOUT:_FOUT + 3] (gap: column
+    _FOUT + 3; key: iw[:, _IOUT]).  fw, iw: work arrays (≥ n_incident + n_reference rows)."""
     if fside == 0:
         sr = s1
         si = s2
@@ -1031,28 +1013,34 @@ def _polytope_manifold(s1, s2, b1, b2, fside, fplane, env, keybase, nc, cap,
     Rr = w_R[sr]
     nref = mat_vec(Rr, (planes[fplane, 0], planes[fplane, 1], planes[fplane, 2]))
     offr = v_dot(nref, row3(w_pos, sr)) - planes[fplane, 3]
-    Ri = w_R[si]
+    nab = nref if fside == 0 else v_scale(nref, -1.0)
+    # incident face: the most anti-parallel (nref in the incident shape's frame)
+    nl = mat_t_vec(w_R[si], nref)
     finc = -1
     dbest = 1e300
     for p in range(pl_off[si], pl_off[si] + pl_cnt[si]):
-        d = v_dot(mat_vec(Ri, (planes[p, 0], planes[p, 1], planes[p, 2])), nref)
+        d = planes[p, 0] * nl[0] + planes[p, 1] * nl[1] + planes[p, 2] * nl[2]
         if d < dbest:
             dbest = d
             finc = p
     if finc < 0:
-        return nc
+        return 0, nab
     fr_off = fv_off[fplane]
     nrv = fv_cnt[fplane]
     fi_off = fv_off[finc]
     niv = fv_cnt[finc]
+    ned_r = ed_cnt[sr]
+    ned_i = ed_cnt[si]
     for k in range(niv):
         v = fv_idx[fi_off + k]
         for c in range(3):
-            poly[k, c] = Wi[v, c]
-        pkey[k] = _vertex_key(si, v, s_lo)
-        plab[k] = k
+            fw[k, _FP + c] = Wi[v, c]
+        iw[k, _IKEY] = _vertex_key(si, v, s_lo)
+        iw[k, _ILAB] = k
     npoly = niv
     ext = 0.0
+    pc = 0                           # the current polygon's buffer (0 or 1: fw columns 0 / 3)
+    mcl = fw.shape[0]
     for j in range(nrv):
         a = row3(Wr, fv_idx[fr_off + j])
         e = v_sub(row3(Wr, fv_idx[fr_off + (j + 1) % nrv]), a)
@@ -1065,69 +1053,82 @@ def _polytope_manifold(s1, s2, b1, b2, fside, fplane, env, keybase, nc, cap,
         pn = v_scale(pn, 1.0 / ln)
         off = v_dot(pn, a)
         eps = 1e-9 * ln_e          # a vertex on a side plane within round-off counts as inside
+        c0 = 3 * pc
+        c1 = 3 - c0
+        dmax = -1e300
+        for q in range(npoly):
+            dq = fw[q, c0] * pn[0] + fw[q, c0 + 1] * pn[1] + fw[q, c0 + 2] * pn[2] - off
+            fw[q, _FSC] = dq
+            dmax = max(dmax, dq)
+        if dmax <= eps:
+            continue               # all inside this side plane: the polygon stays
         nt = 0
         for q in range(npoly):
-            if nt + 2 > poly.shape[0]:
+            if nt + 2 > mcl:
                 break              # (only a degenerate polygon could outgrow n_inc + n_ref)
-            q2 = (q + 1) % npoly
-            dp = poly[q, 0] * pn[0] + poly[q, 1] * pn[1] + poly[q, 2] * pn[2] - off
-            dq = poly[q2, 0] * pn[0] + poly[q2, 1] * pn[1] + poly[q2, 2] * pn[2] - off
+            q2 = q + 1 if q + 1 < npoly else 0
+            dp = fw[q, _FSC]
+            dq = fw[q2, _FSC]
             inp = dp <= eps
             inq = dq <= eps
             if inp:
                 for c in range(3):
-                    tmp[nt, c] = poly[q, c]
-                tkey[nt] = pkey[q]
-                tlab[nt] = plab[q]
+                    fw[nt, c1 + c] = fw[q, c0 + c]
+                iw[nt, _IKEY + 1 - pc] = iw[q, _IKEY + pc]
+                iw[nt, _ILAB + 1 - pc] = iw[q, _ILAB + pc]
                 nt += 1
             if inp != inq:
                 f = min(max(dp / (dp - dq), 0.0), 1.0)
                 for c in range(3):
-                    tmp[nt, c] = poly[q, c] + (poly[q2, c] - poly[q, c]) * f
-                tkey[nt] = _crossing_key(plab[q], j, sr, si, s_lo, fr_off, fi_off, nrv, fv_idx,
-                                         fv_edge, ed_cnt)
-                tlab[nt] = -(j + 1) if inp else plab[q]
+                    fw[nt, c1 + c] = fw[q, c0 + c] + (fw[q2, c0 + c] - fw[q, c0 + c]) * f
+                lab = iw[q, _ILAB + pc]
+                iw[nt, _IKEY + 1 - pc] = _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nrv,
+                                                       fv_idx, fv_edge, ned_r, ned_i)
+                iw[nt, _ILAB + 1 - pc] = -(j + 1) if inp else lab
                 nt += 1
         npoly = nt
-        for q in range(nt):
-            for c in range(3):
-                poly[q, c] = tmp[q, c]
-            pkey[q] = tkey[q]
-            plab[q] = tlab[q]
+        pc = 1 - pc
         if npoly == 0:
-            return nc
+            return 0, nab
     # points below the reference face + envelope (coincident ones once)
+    c0 = 3 * pc
     ncand = 0
     tol2 = (1e-9 * ext) ** 2
     for q in range(npoly):
-        gapb[q] = v_dot(nref, row3(poly, q)) - offr
-        if gapb[q] >= env:
+        g = nref[0] * fw[q, c0] + nref[1] * fw[q, c0 + 1] + nref[2] * fw[q, c0 + 2] - offr
+        fw[q, _FGAP] = g
+        if g >= env:
             continue
         dup = False
         for m in range(ncand):
-            d = v_sub(row3(poly, q), row3(poly, cand[m]))
-            if v_dot(d, d) <= tol2:
+            r = iw[m, _ICAND]
+            d0 = fw[q, c0] - fw[r, c0]
+            d1 = fw[q, c0 + 1] - fw[r, c0 + 1]
+            d2 = fw[q, c0 + 2] - fw[r, c0 + 2]
+            if d0 * d0 + d1 * d1 + d2 * d2 <= tol2:
                 dup = True
                 break
         if not dup:
-            cand[ncand] = q
+            iw[ncand, _ICAND] = q
             ncand += 1
     if ncand > 4:
-        _reduce4(poly, gapb, pkey, cand, ncand, used, score, nref, ext)
+        _reduce4(fw, iw, ncand, nref, ext, c0, _IKEY + pc)
     else:
         for m in range(ncand):
-            used[cand[m]] = True
-    nab = nref if fside == 0 else v_scale(nref, -1.0)
+            iw[iw[m, _ICAND], _IUSED] = 1
+    # the kept points, halfway between the faces, into rows 0..k-1 of the output columns
+    k = 0
     for m in range(ncand):
-        q = cand[m]
-        if not used[q]:
+        q = iw[m, _ICAND]
+        if iw[q, _IUSED] == 0:
             continue
-        g = gapb[q]
-        pt = (poly[q, 0] - 0.5 * g * nref[0], poly[q, 1] - 0.5 * g * nref[1],
-              poly[q, 2] - 0.5 * g * nref[2])
-        nc = _emit_t(nc, cap, b1, b2, s1, s2, pt, nab, g, keybase + pkey[q],
-                     c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-    return nc
+        g = fw[q, _FGAP]
+        for c in range(3):
+            fw[k, _FOUT + c] = fw[q, c0 + c] - 0.5 * g * nref[c]
+        fw[k, _FOUT + 3] = g
+        iw[k, _IOUT] = iw[q, _IKEY + pc]
+        k += 1
+    return k, nab
 
 
 @njit(cache=True)
@@ -1139,19 +1140,16 @@ def _point_like(t):
 def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cnt,
                  samp_pts, samp_rad, pl_off, pl_cnt, planes, cg_meta, cg_start, edges, ed_off,
                  ed_cnt, w_pos, w_R, lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key,
-                 samp_nrm, fv_off, fv_cnt, fv_idx, fv_edge):
+                 samp_nrm, fv_off, fv_cnt, fv_idx, fv_edge, ed_rep):
     """All contacts of the candidate pairs with gap < env.  Returns the count
     (which may exceed the capacity: the caller then grows and calls again).
     ``samp_nrm``: per sample, a cloud particle's outward normal and flag
     (:func:`cloud_surface`; zero for other shapes' samples); ``fv_*``: the face polygons
-    of the box/hull planes (System._face_polygons)."""
+    of the box/hull planes (System._face_polygons); ``ed_rep``: per box/hull edge, the
+    shape-local index of the first edge parallel to it (System._edge_classes)."""
     cap = c_a.shape[0]
     nc = 0
     ns = sh_type.shape[0]
-    poly = np.empty((16, 3))
-    tmp = np.empty((16, 3))
-    depth = np.empty(16)
-    keep = np.zeros(16, np.bool_)
     maxv = 8
     for s in range(ns):
         if sh_type[s] == HULL and samp_cnt[s] > maxv:
@@ -1162,17 +1160,31 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
     for p in range(fv_cnt.shape[0]):
         maxf = max(maxf, fv_cnt[p])
     mcl = 2 * maxf + 4               # a clipped polygon: ≤ incident + reference vertices
-    cpoly = np.empty((mcl, 3))
-    ctmp = np.empty((mcl, 3))
-    ckey = np.empty(mcl, np.int64)
-    ckey2 = np.empty(mcl, np.int64)
-    clab = np.empty(mcl, np.int64)
-    clab2 = np.empty(mcl, np.int64)
-    cgap = np.empty(mcl)
-    ccand = np.empty(mcl, np.int64)
-    cused = np.zeros(mcl, np.bool_)
-    cscore = np.empty(mcl)
+    # the polytope pairs read each shape's offsets and counts from one row (one cache line,
+    # not six: the shapes of successive pairs are far apart in memory)
+    meta = np.empty((ns, 6), np.int32)
+    for s in range(ns):
+        meta[s, 0] = samp_off[s]
+        meta[s, 1] = samp_cnt[s]
+        meta[s, 2] = pl_off[s]
+        meta[s, 3] = pl_cnt[s]
+        meta[s, 4] = ed_off[s]
+        meta[s, 5] = ed_cnt[s]
+    m_soff = meta[:, 0]
+    m_scnt = meta[:, 1]
+    m_poff = meta[:, 2]
+    m_pcnt = meta[:, 3]
+    m_eoff = meta[:, 4]
+    m_ecnt = meta[:, 5]
+    fw = np.empty((mcl, _NFW))
+    iw = np.zeros((mcl, _NIW), np.int64)
+    # pairs in the order of their shapes (the sweep's order visits shapes far apart in memory)
+    pkey = np.empty(npair, np.int64)
     for q in range(npair):
+        pkey[q] = np.int64(min(pairs[q, 0], pairs[q, 1])) * ns + max(pairs[q, 0], pairs[q, 1])
+    order = np.argsort(pkey)
+    for qq in range(npair):
+        q = order[qq]
         s1 = pairs[q, 0]
         s2 = pairs[q, 1]
         # canonical order: lower type first (plane last for the sample loop)
@@ -1200,26 +1212,23 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                 nc = _emit(nc, cap, b1, b2, s1, s2, pt, n, gap, keybase,
                            c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
             continue
-        if t1 == BOX and t2 == BOX:
-            nc = _box_box(s1, s2, b1, b2, row3(w_pos, s1), w_R[s1], sh_dims[s1], row3(w_pos, s2),
-                          w_R[s2], sh_dims[s2], env, keybase, nc, cap,
-                          c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, poly, tmp, depth, keep)
-            continue
         if (t1 == BOX or t1 == HULL) and (t2 == BOX or t2 == HULL):
-            sep, ea, eb, L, fside, fplane = _polytope_sat(s1, s2, env, samp_off, samp_cnt,
-                                                          samp_pts, pl_off, pl_cnt, planes,
-                                                          edges, ed_off, ed_cnt, w_pos, w_R,
-                                                          wa, wb)
+            sep, ea, eb, L, fside, fplane = _polytope_sat(s1, s2, env, m_soff, m_scnt,
+                                                          samp_pts, m_poff, m_pcnt, planes,
+                                                          edges, m_eoff, m_ecnt, ed_rep, w_pos,
+                                                          w_R, wa, wb)
             if sep > env:
                 continue  # a separating axis: no contact (also removes SDF lower-bound ghosts)
             if ea < 0 and fplane >= 0:
-                nc0 = nc
-                nc = _polytope_manifold(s1, s2, b1, b2, fside, fplane, env, keybase, nc, cap,
-                                        c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key,
-                                        planes, pl_off, pl_cnt, fv_off, fv_cnt, fv_idx, fv_edge,
-                                        ed_cnt, w_pos, w_R, wa, wb, cpoly, ctmp, ckey, ckey2,
-                                        clab, clab2, cgap, ccand, cused, cscore)
-                if nc > nc0:
+                k, nab = _polytope_manifold(s1, s2, fside, fplane, env, planes, m_poff, m_pcnt,
+                                            fv_off, fv_cnt, fv_idx, fv_edge, m_ecnt, w_pos, w_R,
+                                            wa, wb, fw, iw)
+                for m in range(k):
+                    nc = _emit_t(nc, cap, b1, b2, s1, s2,
+                                 (fw[m, _FOUT], fw[m, _FOUT + 1], fw[m, _FOUT + 2]), nab,
+                                 fw[m, _FOUT + 3], keybase + iw[m, _IOUT],
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+                if k > 0:
                     continue   # the face-face manifold (else: the vertex-face samples below)
             if ea >= 0:
                 pa0 = row3(wa, edges[ed_off[s1] + ea, 0])
@@ -1240,6 +1249,30 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                                   samp_off, samp_cnt, samp_pts, samp_nrm, cg_meta, cg_start,
                                   w_pos, w_R, lo, hi, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap,
                                   c_key)
+            continue
+        if (((t1 == CAPSULE or t1 == CYLINDER) and t2 == CLOUD)
+                or (t1 == CLOUD and (t2 == CAPSULE or t2 == CYLINDER))):
+            # the shape's samples (a capsule's axis points, a cylinder's rim points) against
+            # the cloud's flat faces (tangent planes), the cloud's edge and corner particles
+            # against the shape's exact surface (_samples_vs_sdf, features_only)
+            sw = t1 == CLOUD
+            sx = s2 if sw else s1
+            scl = s1 if sw else s2
+            bx = b2 if sw else b1
+            bcl = b1 if sw else b2
+            nc = _samples_vs_sdf(sx, scl, bx, bcl, sw, nc, cap, env, keybase, sh_type, sh_dims,
+                                 samp_off, samp_cnt, samp_pts, samp_rad, pl_off, pl_cnt, planes,
+                                 cg_meta, cg_start, w_pos, w_R, lo, hi, sh_body,
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, samp_nrm, True)
+            nc = _samples_vs_sdf(scl, sx, bcl, bx, not sw, nc, cap, env, keybase, sh_type,
+                                 sh_dims, samp_off, samp_cnt, samp_pts, samp_rad, pl_off, pl_cnt,
+                                 planes, cg_meta, cg_start, w_pos, w_R, lo, hi, sh_body,
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key, samp_nrm, True)
+            if sh_type[sx] == CYLINDER:
+                nc = _cylinder_cloud_support(sx, scl, bx, bcl, sw, nc, cap, env, keybase,
+                                             sh_dims, samp_off, samp_pts, samp_nrm, cg_meta,
+                                             cg_start, w_pos, w_R,
+                                             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
             continue
         pl1 = _point_like(t1)
         pl2 = _point_like(t2)

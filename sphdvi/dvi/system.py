@@ -20,7 +20,8 @@ from . import collision as col
 from . import rows as rw
 from ._math import (body_rotations, frame_from_axis, integrate_bodies, np_mat_to_quat,
                     np_quat_to_mat)
-from ._kernels import apply_dof_masks, free_velocity, link_point_torques
+from ._kernels import (apply_dof_masks, copy_state, gather_warm, prepare_live_rows, scatter_warm,
+                       step_end, step_free, step_start)
 from .solvers import (SOLVER_ALIASES, SOLVER_NAMES, max_abs_diff, prepare_rows, row_residuals,
                       scatter_impulses, sliding_speeds, solve_ccp, solve_direct)
 
@@ -226,6 +227,7 @@ class System:
         self.edges = np.zeros((0, 2), np.int32)
         self.ed_off = np.zeros(0, np.int32)
         self.ed_cnt = np.zeros(0, np.int32)
+        self.ed_rep = np.zeros(0, np.int32)     # per edge: first parallel edge (_edge_classes)
         # face polygons of box/hull planes (per plane of ``planes``): vertex indices (local to
         # the shape) counter-clockwise about the outward normal, and the shape-local edge index
         # of each polygon edge (fv[k] → fv[k+1]; -1: not in the edge list)
@@ -249,6 +251,7 @@ class System:
         self._w_vpred = np.zeros((0, 6))    # sliding correction: velocities the warm start predicts
         self._cap_contacts = 256
         self._cap_pairs = 1024
+        self._work_shape = None         # (bodies, links, shapes) the step's work arrays are sized for
         self.contact_force = np.zeros((0, 3))
         self.contact_torque = np.zeros((0, 3))
         self.fluid_force = np.zeros((0, 3))     # the fluid's load of the last step (set by the coupling)
@@ -448,12 +451,29 @@ class System:
         self.ed_off = np.append(self.ed_off, np.int32(self.edges.shape[0])).astype(np.int32)
         self.ed_cnt = np.append(self.ed_cnt, np.int32(edges.shape[0])).astype(np.int32)
         self.edges = np.vstack([self.edges, np.asarray(edges, np.int32).reshape(-1, 2)])
+        self.ed_rep = np.append(self.ed_rep, self._edge_classes(samples, edges)).astype(np.int32)
         for f_idx, f_edge in self._face_polygons(samples, planes, edges):
             self.fv_off = np.append(self.fv_off, np.int32(self.fv_idx.shape[0])).astype(np.int32)
             self.fv_cnt = np.append(self.fv_cnt, np.int32(len(f_idx))).astype(np.int32)
             self.fv_idx = np.append(self.fv_idx, np.asarray(f_idx, np.int32)).astype(np.int32)
             self.fv_edge = np.append(self.fv_edge, np.asarray(f_edge, np.int32)).astype(np.int32)
         return self.sh_type.shape[0] - 1
+
+    @staticmethod
+    def _edge_classes(verts, edges):
+        """Per edge of a box or hull: the index of the first edge parallel to it (its own
+        index if none), so that the separating-axis test tries each pair of edge directions
+        once (collision._polytope_sat)."""
+        edges = np.asarray(edges, np.int64).reshape(-1, 2)
+        d = verts[edges[:, 1]] - verts[edges[:, 0]] if edges.shape[0] else np.zeros((0, 3))
+        rep = np.arange(edges.shape[0], dtype=np.int32)
+        ln = np.linalg.norm(d, axis=1)
+        for k in range(1, edges.shape[0]):
+            par = np.linalg.norm(np.cross(d[:k], d[k]), axis=1) <= 1e-12 * ln[:k] * ln[k]
+            par &= rep[:k] == np.arange(k)
+            if par.any():
+                rep[k] = int(np.argmax(par))
+        return rep
 
     @staticmethod
     def _face_polygons(verts, planes, edges):
@@ -772,6 +792,18 @@ class System:
         self._link_b1 = np.array([l["b1"] for l in self.links], np.int64)
         self._imposed_fn_idx = [i for i, f in enumerate(self._imposed_fn) if f is not None]
         self._motion_idx = [i for i, f in enumerate(self._motion) if f is not None]
+        # what the step has to do (only what the scene has runs)
+        self._spring_fn = [j for j, s in enumerate(S) if callable(s["k"]) or callable(s["c"])]
+        self._time_dependent = bool(self._load_fn or self._mate_timedep or self._motors or self._spring_fn)
+        self._static_imposed = not np.isnan(self.imposed).all()
+        self._preload_springs = [s for s in S if s["f0"] != 0]
+        self._link_rows_max = 6 * nm + ns + nd + npu + 6 * self.nb
+        self._p1w_parts = [(a, l) for a, l in ((self.m_P1w, self.m_lid), (self.s_P1w, self.s_lid),
+                                                (self.d_P1w, self.d_lid), (self.p_P1w, self.p_lid))
+                           if l.shape[0]]
+        if len(self._p1w_parts) == 1 and np.array_equal(self._p1w_parts[0][1], np.arange(len(self.links))):
+            self._link_P1w = self._p1w_parts[0][0]      # one link type, in link order: its own array
+            self._p1w_parts = []
         self._packed = True
 
     def _update_time_dependent(self, t_next):
@@ -794,7 +826,8 @@ class System:
                 self.m_mdval[i, k] = (_eval(target, t_next) - now) / h if h > 0 else 0.0
             else:
                 self.m_mval[i, k] = _eval(target, t_next)
-        for j, s in enumerate(self._springs):
+        for j in self._spring_fn:
+            s = self._springs[j]
             if callable(s["k"]):
                 self.s_k[j] = s["k"](t_next)
             if callable(s["c"]):
@@ -859,7 +892,7 @@ class System:
         if self.p_b1.shape[0]:
             nr = rw.build_pulley_rows(nr, self.pos, R, self.p_b1, self.p_b2, self.p_a1, self.p_a2,
                                       self.p_r1, self.p_r2, self.p_lid, self.p_P1w, *self._row_args())
-        if self._imposed_fn_idx or not np.isnan(self._imposed_now).all():
+        if self._imposed_fn_idx or (self._static_imposed and not np.isnan(self._imposed_now).all()):
             nr = rw.build_imposed_rows(nr, R, self._imposed_now, *self._row_args())
         return nr
 
@@ -873,16 +906,16 @@ class System:
         self.n_contacts = 0
         if ns < 2:
             return 0
-        w_pos = np.empty((ns, 3))
-        w_R = np.empty((ns, 3, 3))
+        self._work()
+        w_pos, w_R, lo, hi = self._w_shapes          # work arrays kept on the System
         col.shape_world_poses(self.sh_body, self.sh_pos, self.sh_R, self.pos, R, w_pos, w_R)
-        lo = np.empty((ns, 3))
-        hi = np.empty((ns, 3))
         col.shape_aabbs(self.sh_type, self.sh_dims, self.samp_off, self.samp_cnt, self.samp_pts,
                         self.samp_rad, w_pos, w_R, self.envelope, lo, hi)
-        active = self.kind == FLOATING
+        active = self._w_active
         while True:
-            pairs = np.empty((self._cap_pairs, 2), np.int64)
+            if self._w_pairs.shape[0] != self._cap_pairs:
+                self._w_pairs = np.empty((self._cap_pairs, 2), np.int64)
+            pairs = self._w_pairs
             npair = col.broad_phase(lo, hi, self.sh_body, self.sh_type, active, pairs, w_pos, w_R,
                                     self.envelope)
             if npair <= self._cap_pairs:
@@ -890,17 +923,22 @@ class System:
             self._cap_pairs = int(npair * 1.5)
         while True:
             cap = self._cap_contacts
-            c = dict(a=np.empty(cap, np.int32), b=np.empty(cap, np.int32),
-                     sa=np.empty(cap, np.int32), sb=np.empty(cap, np.int32),
-                     pt=np.empty((cap, 3)), n=np.empty((cap, 3)), gap=np.empty(cap),
-                     key=np.empty(cap, np.int64))
+            if self._w_c is None or self._w_c["a"].shape[0] != cap:
+                self._w_c = dict(a=np.empty(cap, np.int32), b=np.empty(cap, np.int32),
+                                 sa=np.empty(cap, np.int32), sb=np.empty(cap, np.int32),
+                                 pt=np.empty((cap, 3)), n=np.empty((cap, 3)), gap=np.empty(cap),
+                                 key=np.empty(cap, np.int64))
+                # per contact: friction, restitution, first row, warm start (System.advance)
+                self._w_cmu, self._w_ce = np.empty(cap), np.empty(cap)
+                self._w_crow, self._w_g3 = np.empty(cap, np.int64), np.zeros((cap, 3))
+            c = self._w_c
             nc = col.narrow_phase(npair, pairs, self.envelope, self.sh_body, self.sh_type,
                                   self.sh_dims, self.samp_off, self.samp_cnt, self.samp_pts,
                                   self.samp_rad, self.pl_off, self.pl_cnt, self.planes,
                                   self.cg_meta, self.cg_start, self.edges, self.ed_off,
                                   self.ed_cnt, w_pos, w_R, lo, hi, c["a"], c["b"], c["sa"], c["sb"], c["pt"],
                                   c["n"], c["gap"], c["key"], self.samp_nrm, self.fv_off,
-                                  self.fv_cnt, self.fv_idx, self.fv_edge)
+                                  self.fv_cnt, self.fv_idx, self.fv_edge, self.ed_rep)
             if nc <= cap:
                 break
             self._cap_contacts = int(nc * 1.5)
@@ -937,6 +975,11 @@ class System:
                               c_mu, c_e, c_row, *self._row_args())
         col.match_warm_start(nc, c["key"], np.zeros(0, np.int64), np.zeros((0, 3)),
                              np.zeros((nc, 3)))
+        invm3, invI = apply_dof_masks(self.inv_mass, self.inv_I_b, self.dof_mask, R)
+        prepare_live_rows(0, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
+                          self.r_MiJ, self.r_g, self.r_bias, self.r_gamma)
+        scatter_warm(self.r_gamma, c_row, c_mu, np.zeros((0, 3)))
+        gather_warm(self.r_gamma, c_row, c_mu, np.zeros((0, 3)))
 
     # ---------------------------------------------------------------- step
     def step(self, dt, forces=None, torques=None):
@@ -945,39 +988,82 @@ class System:
         forces, torques: optional (nb, 3) world-frame external loads for this
         step only (torque about each body's centre), added to gravity and the
         persistent loads — this is how a fluid solver drives the bodies.
-        Returns (pos, quat, vel, omega_world) views/arrays after the step."""
+        Returns (pos, quat, vel, omega_world) views/arrays after the step
+        (:meth:`advance` is the step without them)."""
+        self.advance(dt, forces, torques)
+        return self.pos, self.quat, self.vel, self.omega_world
+
+    def _work(self):
+        """The step's work arrays, kept on the System and sized again only when the bodies,
+        links or shapes change (as the row arrays, :meth:`_ensure_rows`): the step allocates
+        (almost) nothing.  ``contact_force`` ... ``link_torque`` are written in place from step to
+        step (read them, or copy them to keep them)."""
+        nb, nl, ns = self.nb, len(self.links), self.sh_type.shape[0]
+        if self._work_shape == (nb, nl, ns):
+            return
+        self._work_shape = (nb, nl, ns)
+        z = np.zeros
+        self._w_R = z((nb, 3, 3))
+        self._applied_F, self._applied_T = z((nb, 3)), z((nb, 3))
+        self._smc_f, self._smc_t = z((nb, 3)), z((nb, 3))
+        self._w_invm3, self._w_invI = z((nb, 3)), z((nb, 3, 3))
+        self._w_vel6, self._w_vfree, self._w_vout = z((nb, 6)), z((nb, 6)), z((nb, 6))
+        self._w_imp = z((nb, 6))
+        # (bf, bt: zero at each step's start, step_end zeroes them after use)
+        self._w_cf, self._w_ct, self._w_bf, self._w_bt = z((nb, 3)), z((nb, 3)), z((nb, 3)), z((nb, 3))
+        self._w_lf, self._w_ltc = z((nl, 3)), z((nl, 3))
+        self._w_out = [z((nb, 3)) for _ in range(4)] + [z((nl, 3)) for _ in range(2)]
+        self._w_none = z((0, 3))
+        self._w_shapes = (z((ns, 3)), z((ns, 3, 3)), z((ns, 3)), z((ns, 3)))
+        self._w_active = self.kind == FLOATING
+        self._w_pairs = np.empty((0, 2), np.int64)
+        self._w_c = None
+
+    def advance(self, dt, forces=None, torques=None):
+        """:meth:`step` without its return value (a coupling's call: nothing allocated for it).
+
+        Only what the scene has runs: no collision pass without two shapes, no row building
+        without links, contacts or imposed velocities (a free body: v = v_free), no Python
+        loop over time-dependent values, moving bodies or spring preloads it lacks."""
         h = float(dt)
         nb = self.nb
         if not self._packed:
             self._pack()
+        self._work()
         t_next = self.time + h
-        self._update_time_dependent(t_next)
-        R = body_rotations(self.quat)
+        if self._time_dependent:
+            self._update_time_dependent(t_next)
+        R = self._w_R
+        F = self._applied_F
+        T = self._applied_T
+        step_start(self.quat, self.f_ext, self.t_ext,
+                   self._w_none if forces is None else np.ascontiguousarray(forces, np.float64).reshape(nb, 3),
+                   self._w_none if torques is None else np.ascontiguousarray(torques, np.float64).reshape(nb, 3),
+                   self.mass, self.gravity, self.kind, R, F, T)
         # imposed velocities (rows) and moving bodies (kinematic)
-        imp = self.imposed.copy()
-        for i in self._imposed_fn_idx:
-            imp[i] = [np.nan if c is None else c for c in self._imposed_fn[i](t_next)]
-        self._imposed_now = imp
+        if self._imposed_fn_idx:
+            imp = self._w_imp
+            imp[:] = self.imposed
+            for i in self._imposed_fn_idx:
+                imp[i] = [np.nan if c is None else c for c in self._imposed_fn[i](t_next)]
+            self._imposed_now = imp
+        else:
+            self._imposed_now = self.imposed
         for i in self._motion_idx:
             if self.kind[i] == MOVING:
                 v, w = self._motion[i](t_next)
                 self.vel[i] = v
                 self.omega_b[i] = R[i].T @ np.asarray(w, float)
-        # applied loads
-        F = self.f_ext.copy()
-        T = self.t_ext.copy()
-        if forces is not None:
-            F += np.asarray(forces, float).reshape(nb, 3)
-        if torques is not None:
-            T += np.asarray(torques, float).reshape(nb, 3)
-        F += self.mass[:, None] * self.gravity[None, :] * (self.kind == FLOATING)[:, None]
         # explicit preloads of springs without stiffness/damping
-        self._spring_preloads(R, F, T)
+        if self._preload_springs:
+            self._spring_preloads(R, F, T)
+        elif self._preload_links:
+            self._preload_links = []
         nc = self._collide(R)
         smc = self.contactmethod.lower() == "smc"
-        self._smc_f = np.zeros((nb, 3))
-        self._smc_t = np.zeros((nb, 3))
         if smc and nc > 0:
+            self._smc_f[:] = 0.0
+            self._smc_t[:] = 0.0
             c = self._c
             col.smc_forces(nc, c["a"], c["b"], c["sa"], c["sb"], c["pt"], c["n"], c["gap"],
                            self.sh_mat, self.sh_rad, self.mat_mu, self.mat_e, self.mat_E,
@@ -985,49 +1071,48 @@ class System:
                            self._smc_f, self._smc_t, self.smc_model.lower() != "hooke")
             F += self._smc_f
             T += self._smc_t
-        self._applied_F = F
-        self._applied_T = T
-        invm3, invI = apply_dof_masks(self.inv_mass, self.inv_I_b, self.dof_mask, R)
-        vel6 = np.empty((nb, 6))
-        vel6[:, :3] = self.vel
-        vel6[:, 3:] = self.omega_b
-        vfree = free_velocity(h, self.kind, invm3, invI, self.I_b, R, vel6, F, T)
+            self._smc_on = True
+        elif getattr(self, "_smc_on", False):
+            self._smc_f[:] = 0.0
+            self._smc_t[:] = 0.0
+            self._smc_on = False
+        invm3, invI = self._w_invm3, self._w_invI
+        vel6, vfree, vout = self._w_vel6, self._w_vfree, self._w_vout
+        step_free(h, self.kind, self.inv_mass, self.inv_I_b, self.dof_mask, R, self.I_b, self.vel,
+                  self.omega_b, F, T, invm3, invI, vel6, vfree)
         # rows
         ncr = 0 if smc else nc
-        self._ensure_rows(self._max_link_rows() + 3 * ncr)
-        nl_rows = self._build_link_rows(h, R, vel6, invm3, invI)
+        self._ensure_rows(self._link_rows_max + 3 * ncr)
+        nl_rows = self._build_link_rows(h, R, vel6, invm3, invI) \
+            if self.links or self._imposed_fn_idx or self._static_imposed else 0
         g = self.r_gamma
         g[:] = 0.0
         # warm start: impulses of the last step, rescaled to this step (γ = h·force)
         ws = 1.0 if self._prev_h is None else h / self._prev_h
         if self._prev_link_gamma.shape[0] == nl_rows:
-            g[:nl_rows] = self._prev_link_gamma * ws
+            np.multiply(self._prev_link_gamma, ws, out=g[:nl_rows])
         nr = nl_rows
         if ncr > 0:
             c = self._c
-            c_mu = np.empty(nc)
-            c_e = np.empty(nc)
+            c_mu = self._w_cmu[:nc]
+            c_e = self._w_ce[:nc]
             col.contact_materials(nc, c["sa"], c["sb"], self.sh_mat, self.mat_mu, self.mat_e,
                                   c_mu, c_e)
-            c_row = np.empty(nc, np.int64)
+            c_row = self._w_crow[:nc]
             nr = rw.build_contact_rows(nr, h, self.recovery_speed, self.min_bounce_speed,
                                        self.pos, R, vel6, nc, c["a"], c["b"], c["pt"], c["n"],
                                        c["gap"], c_mu, c_e, c_row, *self._row_args())
-            g3 = np.zeros((nc, 3))
+            g3 = self._w_g3[:nc]
+            g3[:] = 0.0
             col.match_warm_start(nc, c["key"], self._prev_keys, self._prev_g3, g3)
             if ws != 1.0:
                 g3 *= ws
-            _scatter_warm(g, c_row, c_mu, g3)
+            scatter_warm(g, c_row, c_mu, g3)
             self._c_row = c_row
             self._c_mu = c_mu
-        vout = np.empty((nb, 6))
-        if nr:
-            prepare_rows(nr, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
-                         self.r_MiJ, self.r_g)
-            dead = self.r_g[:nr] >= 1e300  # rows that cannot act (no dynamic body)
-            if dead.any():
-                self.r_bias[:nr][dead] = 0.0
-                g[:nr][dead] = 0.0
+        if nr:                          # (rows that cannot act, no dynamic body: no bias, no warm start)
+            prepare_live_rows(nr, self.r_a, self.r_b, self.r_J, self.r_E, self.r_kind, invm3, invI,
+                              self.r_MiJ, self.r_g, self.r_bias, g)
         if not nr:                      # no link, no contact: v = v_free (what the solvers return)
             vout[:] = vfree
             it, res = 0, 0.0
@@ -1038,27 +1123,26 @@ class System:
         self.n_rows = nr
         self._check_residual(nr, g, vout, h)
         # warm-start caches
-        self._prev_link_gamma = g[:nl_rows].copy()
+        if self._prev_link_gamma.shape[0] == nl_rows:
+            self._prev_link_gamma[:] = g[:nl_rows]
+        else:
+            self._prev_link_gamma = g[:nl_rows].copy()
         self._prev_h = h
         if ncr > 0:
             keys = self._c["key"][:nc]
             order = np.argsort(keys)
-            g3 = _gather_warm(g, self._c_row, self._c_mu)
-            self._prev_keys = keys[order].copy()
+            g3 = self._w_g3[:nc]
+            gather_warm(g, self._c_row, self._c_mu, g3)
+            self._prev_keys = keys[order]       # (new arrays: the cache that get_state copies)
             self._prev_g3 = g3[order]
-        else:
+        elif self._prev_keys.shape[0]:
             self._prev_keys = np.zeros(0, np.int64)
             self._prev_g3 = np.zeros((0, 3))
-        # reactions
+        # reactions, then the state update
         self._accumulate(nr, h, R)
-        # state update
-        self.vel[:] = vout[:, :3]
-        self.omega_b[:] = vout[:, 3:]
-        integrate_bodies(self.pos, self.quat, self.vel, self.omega_b, self.kind, h)
         self.time = t_next
         if self.position_projection and self._mates:
             self._project_positions(invm3, invI)
-        return self.pos, self.quat, self.vel, self.omega_world
 
     def _solve_once(self, nr, nb, g, vfree, vout):
         """One CCP solve of the rows (warm start and result in ``g``, v⁺ in ``vout``)."""
@@ -1225,55 +1309,84 @@ class System:
                 T[s["b2"]] -= np.cross(P2 - x2, f)
 
     def _accumulate(self, nr, h, R):
-        nb = self.nb
-        nl = len(self.links)
-        cf = np.zeros((nb, 3))
-        ct = np.zeros((nb, 3))
-        bf = np.zeros((nb, 3))
-        bt = np.zeros((nb, 3))
-        lf = np.zeros((nl, 3))
-        ltc = np.zeros((nl, 3))
+        """The step's reactions into the kept arrays (contact, total and link loads,
+        :func:`rows.accumulate_row_forces`), then v⁺ and the move (:func:`_kernels.step_end`)."""
+        cf, ct, bf, bt, lf, ltc = (self._w_cf, self._w_ct, self._w_bf, self._w_bt, self._w_lf,
+                                   self._w_ltc)
         rw.accumulate_row_forces(nr, self.r_a, self.r_b, self.r_J, self.r_gamma, 1.0 / h, R,
-                                 self.r_link, nl, cf, ct, lf, ltc, nb, bf, bt)
+                                 self.r_link, lf.shape[0], cf, ct, lf, ltc, self.nb, bf, bt)
         for lid, f, tc in self._preload_links:
             lf[lid] += f
             ltc[lid] += tc
-        self.contact_force = cf + self._smc_f
-        self.contact_torque = ct + self._smc_t
-        self.total_force = self._applied_F + bf
-        self.total_torque = self._applied_T + bt
         # link torque about the link point on body 1
         P1w = self._link_P1w
-        for arr, lids in ((self.m_P1w, self.m_lid), (self.s_P1w, self.s_lid),
-                          (self.d_P1w, self.d_lid), (self.p_P1w, self.p_lid)):
-            if lids.shape[0]:
-                P1w[lids] = arr
-        self.link_force = lf
-        b1 = self._link_b1
-        self.link_torque = link_point_torques(lf, ltc, P1w, b1, self.pos)
+        for arr, lids in self._p1w_parts:
+            P1w[lids] = arr
+        out = self._w_out
+        self.contact_force, self.contact_torque, self.total_force, self.total_torque = out[:4]
+        self.link_force, self.link_torque = out[4], out[5]
+        out[4][:] = lf
+        step_end(h, cf, ct, self._smc_f, self._smc_t, self._applied_F, self._applied_T, bf, bt,
+                 out[0], out[1], out[2], out[3], lf, ltc, P1w, self._link_b1, out[5], self._w_vout,
+                 self.pos, self.quat, self.vel, self.omega_b, self.kind)
 
     # ------------------------------------------------------------ state
-    def get_state(self):
+    def _bodies_like(self, st):
+        """Whether the state ``st``'s poses and velocities are float64 arrays of this System's
+        shapes (copy_state's arrays: a compiled copy checks no bounds)."""
+        for key in ("pos", "quat", "vel", "omega_b"):
+            a, b = st.get(key), getattr(self, key)
+            if not isinstance(a, np.ndarray) or a.shape != b.shape or a.dtype != np.float64:
+                return False
+        return True
+
+    def get_state(self, out=None):
         """A copy of the dynamic state (poses, velocities, time, joint angle
-        counters, warm-start caches): for predictor–corrector couplings."""
-        st = dict(pos=self.pos.copy(), quat=self.quat.copy(), vel=self.vel.copy(),
-                  omega_b=self.omega_b.copy(), time=self.time,
-                  prev_keys=self._prev_keys.copy(), prev_g3=self._prev_g3.copy(),
-                  prev_link_gamma=self._prev_link_gamma.copy(), prev_h=self._prev_h)
-        if hasattr(self, "m_angle"):
-            st["m_angle"] = self.m_angle.copy()
-        return st
+        counters, warm-start caches): for predictor–corrector couplings.  ``out``: a state an
+        earlier call returned, refilled in place where its arrays have the sizes (a coupling's
+        kept copy: nothing allocated) and returned."""
+        angle = getattr(self, "m_angle", None)
+        if out is None or not self._bodies_like(out) or ("m_angle" in out) != (angle is not None):
+            st = dict(pos=self.pos.copy(), quat=self.quat.copy(), vel=self.vel.copy(),
+                      omega_b=self.omega_b.copy(), time=self.time,
+                      prev_keys=self._prev_keys.copy(), prev_g3=self._prev_g3.copy(),
+                      prev_link_gamma=self._prev_link_gamma.copy(), prev_h=self._prev_h)
+            if angle is not None:
+                st["m_angle"] = angle.copy()
+            return st
+        copy_state(self.pos, self.quat, self.vel, self.omega_b, out["pos"], out["quat"], out["vel"],
+                   out["omega_b"])
+        for key, a in (("prev_keys", self._prev_keys), ("prev_g3", self._prev_g3),
+                       ("prev_link_gamma", self._prev_link_gamma), ("m_angle", angle)):
+            if a is None:
+                continue
+            if out[key].shape == a.shape:
+                if a.size:
+                    out[key][...] = a
+            else:
+                out[key] = a.copy()
+        out["time"] = self.time
+        out["prev_h"] = self._prev_h
+        return out
 
     def set_state(self, st):
-        """Restore a state returned by :meth:`get_state`."""
-        self.pos[:] = st["pos"]
-        self.quat[:] = st["quat"]
-        self.vel[:] = st["vel"]
-        self.omega_b[:] = st["omega_b"]
+        """Restore a state returned by :meth:`get_state` (copied: ``st`` stays the caller's)."""
+        if self._bodies_like(st):
+            copy_state(st["pos"], st["quat"], st["vel"], st["omega_b"], self.pos, self.quat, self.vel,
+                       self.omega_b)
+        else:                           # another layout (a checkpoint of other bodies): numpy's error
+            self.pos[:] = st["pos"]
+            self.quat[:] = st["quat"]
+            self.vel[:] = st["vel"]
+            self.omega_b[:] = st["omega_b"]
         self.time = st["time"]
-        self._prev_keys = st["prev_keys"].copy()
-        self._prev_g3 = st["prev_g3"].copy()
-        self._prev_link_gamma = st["prev_link_gamma"].copy()
+        for key in ("prev_keys", "prev_g3", "prev_link_gamma"):
+            a, b = getattr(self, "_" + key), st[key]
+            if a.shape == b.shape and a is not b:
+                if a.size:
+                    a[...] = b
+            else:
+                setattr(self, "_" + key, b.copy())
         self._prev_h = st["prev_h"]
         if "m_angle" in st and hasattr(self, "m_angle"):
             self.m_angle[:] = st["m_angle"]
@@ -1335,19 +1448,3 @@ class System:
         C = C[np.isfinite(C)]
         return float(np.abs(C).max()) if C.size else 0.0
 
-
-def _scatter_warm(g, c_row, c_mu, g3):
-    rows = c_row
-    g[rows] = g3[:, 0]
-    fr = c_mu > 0
-    g[rows[fr] + 1] = g3[fr, 1]
-    g[rows[fr] + 2] = g3[fr, 2]
-
-
-def _gather_warm(g, c_row, c_mu):
-    g3 = np.zeros((c_row.shape[0], 3))
-    g3[:, 0] = g[c_row]
-    fr = c_mu > 0
-    g3[fr, 1] = g[c_row[fr] + 1]
-    g3[fr, 2] = g[c_row[fr] + 2]
-    return g3

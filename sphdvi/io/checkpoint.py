@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import InputError, h5_reason
 from .atomic import atomic_path
-from .bodystate import body_state, read_body_state, write_body_state
+from .bodystate import body_state, read_body_state, write_array, write_body_state
 
 RESTART_FILE = "restart.h5"            # in a run's output folder
 BODIES_RESTART_FORMAT = "sphdvi-bodies-restart"
@@ -39,7 +39,7 @@ def save_sph_checkpoint(path: str, solver_state: dict, extra: dict, body_state: 
             for group in ("state", "aux"):
                 g = f.create_group(group)
                 for name, a in solver_state[group].items():
-                    g.create_dataset(name, data=a)
+                    write_array(g, name, a)
             sc = f.create_group("scalars")
             for name, value in solver_state["scalars"].items():
                 sc.attrs[name] = value

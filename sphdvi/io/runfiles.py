@@ -217,11 +217,14 @@ def _pad_rows(rows: list[str], ncols: int) -> list[str]:
 class BodyLog:
     """``bodies.csv`` and ``links.csv`` of a run with bodies (one row per body
     and per link at every output time, and at TimeOutExtra between outputs): the rows are
-    appended at each output; a resume cuts the files back to the restart time, atomically."""
+    appended at each output; a resume cuts the files back to the restart time, atomically.
+    ``prepare``: called before each row (the loads on bodies held by FtPause, computed only
+    for the rows: FloatingBodies.held_loads)."""
 
-    def __init__(self, outdir: str, system, names, resume_time: float | None = None):
+    def __init__(self, outdir: str, system, names, resume_time: float | None = None, prepare=None):
         from ..dvi.runner import BODIES_HEADER, LINKS_HEADER
         self.system, self.names = system, names
+        self.prepare = prepare
         self.paths = (os.path.join(outdir, "bodies.csv"), os.path.join(outdir, "links.csv"))
         self.headers = (BODIES_HEADER, LINKS_HEADER)
         self.rows: tuple[list, list] = ([], [])        # rows not yet written
@@ -233,6 +236,8 @@ class BodyLog:
         """Add a row per body and link at the current time; append the pending rows to the
         files when ``flush`` (at every TimeOut output; TimeOutExtra rows wait in memory)."""
         from ..dvi.runner import csv_rows
+        if self.prepare is not None:
+            self.prepare()
         bodies, links = csv_rows(self.system, self.names)
         self.rows[0].extend(bodies)
         self.rows[1].extend(links)

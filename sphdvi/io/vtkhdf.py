@@ -129,6 +129,23 @@ class VTKHDFParticleWriter:
                 self.f.close()
                 raise InputError(f"--resume: {exc}") from None
         self.root = self.f["VTKHDF"]
+        self._bind()
+
+    def _bind(self):
+        """Keep the datasets an append writes (an h5py group look-up per dataset and output cost
+        more than the writes: ~6 ms an output)."""
+        root = self.root
+        steps = root["Steps"]
+        self._steps = steps
+        self._points = root["Points"]
+        self._nop = root["NumberOfPoints"]
+        self._vconn = root["Vertices"]["Connectivity"]
+        self._pdata = [(name, dtype, root["PointData"][name]) for name, (dtype, _) in self.arrays.items()]
+        self._counts = [(topo == "Vertices", root[topo]["NumberOfCells"], root[topo]["NumberOfConnectivityIds"])
+                        for topo in TOPOLOGIES]
+        self._meta = {name: steps[name] for name in ("Values", "PartOffsets", "NumberOfParts", "PointOffsets",
+                                                     "CellOffsets", "ConnectivityIdOffsets")}
+        self._pdo = [steps["PointDataOffsets"][name] for name in self.arrays]
 
     # -- layout -----------------------------------------------------------------------
     def _create(self):
@@ -205,46 +222,56 @@ class VTKHDFParticleWriter:
 
     # -- append -----------------------------------------------------------------------
     def append(self, time: float, points: np.ndarray, point_data: dict[str, np.ndarray]) -> None:
-        """Write one step: ``points`` (N,3) of live particles and their arrays."""
+        """Write one step: ``points`` (N,3) of live particles and their arrays, then the step's
+        rows of the Steps metadata, then NSteps (what makes the step visible), then a flush."""
         root = self.root
-        steps = root["Steps"]
+        steps = self._steps
         s = int(steps.attrs["NSteps"])
-        if root["NumberOfPoints"].shape[0] != s:   # leftovers of an interrupted append
+        if self._nop.id.shape[0] != s:             # leftovers of an interrupted append
             self.truncate_to(s)
         n = int(points.shape[0])
-        start = int(root["Points"].shape[0])
-        self._extend(root["Points"], np.asarray(points, dtype=np.float64))
-        for name, (dtype, ncomp) in self.arrays.items():
-            self._extend(root["PointData"][name], np.asarray(point_data[name], dtype=dtype))
-        vert = root["Vertices"]
-        if vert["Connectivity"].shape[0] < n:           # topology 0..n-1 stored once, grown on demand
+        start = int(self._points.id.shape[0])
+        self._extend(self._points, np.asarray(points, dtype=np.float64))
+        for name, dtype, ds in self._pdata:
+            self._extend(ds, np.asarray(point_data[name], dtype=dtype))
+        if self._vconn.id.shape[0] < n:                # topology 0..n-1 stored once, grown on demand
+            vert = root["Vertices"]
             old = vert["Connectivity"].shape[0]
             vert["Connectivity"].resize(n, axis=0)
             vert["Connectivity"][old:] = np.arange(old, n, dtype=np.int64)
             vert["Offsets"].resize(n + 1, axis=0)
             vert["Offsets"][old + 1:] = np.arange(old + 1, n + 1, dtype=np.int64)
-        for topo in TOPOLOGIES:
-            g = root[topo]
-            count = n if topo == "Vertices" else 0
-            self._extend(g["NumberOfCells"], np.array([count], np.int64))
-            self._extend(g["NumberOfConnectivityIds"], np.array([count], np.int64))
-        self._extend(root["NumberOfPoints"], np.array([n], np.int64))
-        self._extend(steps["Values"], np.array([time], np.float64))
-        self._extend(steps["PartOffsets"], np.array([s], np.int64))
-        self._extend(steps["NumberOfParts"], np.array([1], np.int64))
-        self._extend(steps["PointOffsets"], np.array([start], np.int64))
-        self._extend(steps["CellOffsets"], np.zeros((1, 4), np.int64))
-        self._extend(steps["ConnectivityIdOffsets"], np.zeros((1, 4), np.int64))
-        for name in self.arrays:
-            self._extend(steps["PointDataOffsets"][name], np.array([start], np.int64))
+        none, count = np.zeros(1, np.int64), np.array([n], np.int64)
+        for is_vert, cells, ids in self._counts:
+            self._extend(cells, count if is_vert else none)
+            self._extend(ids, count if is_vert else none)
+        self._extend(self._nop, count)
+        meta = self._meta
+        self._extend(meta["Values"], np.array([time], np.float64))
+        self._extend(meta["PartOffsets"], np.array([s], np.int64))
+        self._extend(meta["NumberOfParts"], np.ones(1, np.int64))
+        first = np.array([start], np.int64)
+        self._extend(meta["PointOffsets"], first)
+        self._extend(meta["CellOffsets"], np.zeros((1, 4), np.int64))
+        self._extend(meta["ConnectivityIdOffsets"], np.zeros((1, 4), np.int64))
+        for ds in self._pdo:
+            self._extend(ds, first)
         steps.attrs["NSteps"] = np.int64(s + 1)
         self.f.flush()
 
     @staticmethod
     def _extend(ds, data):
-        old = ds.shape[0]
-        ds.resize(old + data.shape[0], axis=0)
-        ds[old:] = data
+        """Append ``data``'s rows to the chunked dataset ``ds`` (h5py's low-level calls: the
+        high-level resize and slice assignment cost ~0.2 ms each in Python)."""
+        from h5py import h5s
+        data = np.ascontiguousarray(data)
+        old = ds.id.shape[0]
+        ds.id.set_extent((old + data.shape[0],) + data.shape[1:])
+        if data.shape[0] == 0:
+            return
+        fspace = ds.id.get_space()
+        fspace.select_hyperslab((old,) + (0,) * (data.ndim - 1), data.shape)
+        ds.id.write(h5s.create_simple(data.shape), fspace, data)
 
     def close(self):
         if self.f:

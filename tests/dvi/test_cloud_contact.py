@@ -256,3 +256,62 @@ def test_cli_cube_drop_rests_on_its_face(tmp_path):
     late = d["time"] > 0.35
     np.testing.assert_allclose(d["z"][late], 0.0 + DP + 0.05, atol=1e-5)
     assert np.abs(d["cfz"][late] / G - 1.0).max() < 1e-2
+
+
+# a capsule or a cylinder lying on the cloud block's top face (axis along x, turned by yaw
+# about z): its axis samples (capsule) or rim support points (cylinder) against the face's
+# tangent plane, the block's edge and corner particles against its exact surface
+ROD_R = 0.03
+ROD_H = 0.08                                    # half length
+
+
+def _rod_on_slab(shape, xy, yaw=0.0, vel=(0.0, 0.0, 0.0), mu=0.5):
+    s = System(gravity=(0, 0, -G), solver="bb", max_iter=100, tol=1e-10, envelope=0.5 * DP)
+    m = s.add_material("m", friction=mu, restitution=0.0)
+    fl = s.add_body(1.0, kind="fixed")
+    s.add_cloud(fl, SLAB, DP / 2, material=m)
+    q = _qmul(_rot(2, yaw), _rot(1, 90.0))        # local z (the axis) along x, then yaw
+    Ia = 0.5 * ROD_R ** 2
+    It = (3 * ROD_R ** 2 + (2 * ROD_H) ** 2) / 12
+    b = s.add_body(1.0, (It, It, Ia), pos=(xy[0], xy[1], ROD_R + DP / 2 + 0.001), quat=q,
+                   vel=vel)
+    if shape == "capsule":
+        s.add_capsule(b, ROD_R, ROD_H, material=m)
+    else:
+        s.add_cylinder(b, ROD_R, ROD_H, material=m)
+    return s, b
+
+
+@pytest.mark.parametrize("shape", ["capsule", "cylinder"])
+@pytest.mark.parametrize("xy, yaw", [((0.0, 0.0), 0.0), ((DP / 2, DP / 2), 0.0),
+                                     ((0.0037, 0.0061), 0.0), ((0.0037, 0.0061), 27.0)],
+                         ids=["over_a_row", "between_rows", "anywhere", "anywhere_turned"])
+def test_rod_rests_on_a_cloud_face_wherever_it_lands(shape, xy, yaw):
+    """A capsule or a cylinder lying on a cloud block's top face rests on the face's tangent
+    plane, its axis R + dp/2 above the top layer (to 1e-9 m), level, with the contact force
+    m g to 1 % at every step of the last 0.2 s, wherever it lands and however it is turned
+    (against each particle's sphere it sank between the particles and rocked)."""
+    s, b = _rod_on_slab(shape, xy, yaw)
+    fz = _run(s, b, 0.5, 0.3)
+    assert abs(s.pos[b, 2] - (ROD_R + DP / 2)) < 1e-9
+    np.testing.assert_allclose(s.pos[b, :2], xy, atol=1e-6)
+    axis = np_quat_to_mat(s.quat[b])[:, 2]
+    assert abs(axis[2]) < 1e-8
+    assert np.abs(fz / G - 1.0).max() < 1e-2
+
+
+@pytest.mark.parametrize("shape", ["capsule", "cylinder"])
+def test_rod_rolls_across_a_cloud_face_at_one_height(shape):
+    """Thrown across its axis at 0.3 m/s with Kfric 0.5, the rod skids, then rolls over ~8
+    lattice cells, its axis at R + dp/2 within 1e-6 m throughout."""
+    s, b = _rod_on_slab(shape, (-0.1, 0.0037), yaw=90.0, vel=(0.3, 0.0, 0.0))
+    z = []
+    while s.time < 0.6 - 1e-9:
+        s.step(1e-3)
+        if s.time > 0.05:
+            z.append(s.pos[b, 2])
+    assert np.abs(np.array(z) - (ROD_R + DP / 2)).max() < 1e-6
+    assert s.pos[b, 0] > 0.0
+    omega = s.omega_world[b]
+    # rolling without slip: v = ω × (R + dp/2) about the axis (world y)
+    assert abs(s.vel[b, 0] - omega[1] * ROD_R) < 1e-3 * abs(s.vel[b, 0]) + 1e-6

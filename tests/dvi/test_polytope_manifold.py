@@ -1,4 +1,4 @@
-"""Face-face contact manifold of two polytopes (box/hull pairs other than box-box).
+"""Face-face contact manifold of two polytopes (box/hull pairs; box-box: test_box_manifold.py).
 
 collision._polytope_manifold: the SAT face axis of least penetration is the reference face,
 the other polytope's most anti-parallel face the incident one; the incident polygon is clipped

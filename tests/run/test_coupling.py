@@ -101,7 +101,8 @@ def test_frozen_bodies_during_ftpause(case_data):
     """FtPause: the body does not move and its particles stay, but the clock goes on; the
     pause holds while the step's start time is below FtPause (DualSPHysics's RunFloating:
     TimeStep < FtPause), and bodies.csv's loads are then what acts on the held body, its weight
-    plus the fluid's force and moment (DualSPHysics keeps computing them for its output)."""
+    plus the fluid's force and moment (DualSPHysics keeps computing them for its output; sphdvi
+    only when a row is written: FloatingBodies.held_loads, BodyLog's prepare)."""
     fluidcount = int(case_data["json"]["mkconfig"]["fluidcount"])
     fb = FloatingBodies(case_data, MotionSet([], []), fluidcount, ftpause=0.1)
     sol = _solver(case_data)
@@ -110,8 +111,18 @@ def test_frozen_bodies_during_ftpause(case_data):
     sol.ace[sel, 0] = sol.state.pos[sel, 2] - sol.state.pos[sel, 2].mean()     # a moment about y
     before = sol.state.pos.copy()
     sol.time = 0.05
+    calls = []
+    loads = fb.loads
+    fb.loads = lambda *a: calls.append(1) or loads(*a)
     fb.step(sol, 1e-3)
     assert np.array_equal(sol.state.pos, before) and fb.system.time == 0.05
+    # the held loads wait for a bodies.csv row (audit e, finding 6: they were summed every step)
+    assert not calls
+    fb.held_loads()
+    assert len(calls) == 1
+    fb.held_loads()                     # once per held step
+    assert len(calls) == 1
+    fb.loads = loads
     F, T = fb.loads(sol, np.flatnonzero(sel), np.zeros(int(sel.sum()), np.int64))
     m = fb.system.mass[0]
     assert np.allclose(fb.system.total_force[0], F[0] + m * fb.system.gravity, rtol=1e-12)

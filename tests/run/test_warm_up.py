@@ -47,7 +47,7 @@ before = [a.copy() for a in (sol.state.pos, sol.state.vel, sol.state.rhop, sph.b
                              sph.bodies.vel)]
 out = {"dvi_before": loaded(DK) + loaded(DM), "acc_before": len(A._add_serial.signatures)}
 S._warm_up(sph)
-out["dvi_after"] = len(DM.integrate_bodies.signatures) + len(DK.free_velocity.signatures)
+out["dvi_after"] = len(DK.step_free.signatures) + len(DK.step_end.signatures)
 out["acc_after"] = len(A._add_serial.signatures) + len(A.fluid_ace_max2.signatures)
 after = (sol.state.pos, sol.state.vel, sol.state.rhop, sph.bodies.pos, sph.bodies.quat, sph.bodies.vel)
 out["unchanged"] = all(np.array_equal(a, b) for a, b in zip(before, after))
@@ -77,7 +77,7 @@ def test_warm_up_compiles_what_switches_on_later(case_h5, tmp_path):
     out = json.loads(res.stdout.split("RESULT ", 1)[1])
     # nothing of the multibody step, the late accinput or the late gauge before
     assert out["acc_before"] == 0 and out["gauges_before"] == 0
-    # FtPause 0.05: the bodies' step (integrate_bodies, free_velocity) is ready before the loop
+    # FtPause 0.05: the bodies' step (step_free, step_end) is ready before the loop
     assert out["dvi_after"] >= 2, out
     # the <accinput> starting at t=0.02: its kernel and the dt term's
     assert out["acc_after"] >= 2, out
