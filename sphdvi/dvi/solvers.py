@@ -605,14 +605,22 @@ def assemble_dense(nr, ra, rb, J, MiJ, E):
 
 
 @njit(cache=True)
-def solve_dense_bb(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
-    """Spectral projected gradient on an explicit (small) N, Jacobi-scaled."""
-    n = r.shape[0]
+def dense_jacobi_scaling(N, kind):
+    """Diagonal of a dense N (floored at 1e-300), averaged over each friction triplet, and its
+    square root: the Jacobi scaling γ = s·γ̃ of the dense solvers (as the matrix-free ones)."""
+    n = N.shape[0]
     d0 = np.empty(n)
     for k in range(n):
         d0[k] = max(N[k, k], 1e-300)
     average_friction_triplets(d0, kind, n)
-    s = np.sqrt(d0)
+    return d0, np.sqrt(d0)
+
+
+@njit(cache=True)
+def solve_dense_bb(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
+    """Spectral projected gradient on an explicit (small) N, Jacobi-scaled."""
+    n = r.shape[0]
+    d0, s = dense_jacobi_scaling(N, kind)
     Ns = N / np.outer(s, s)
     rs = r / s
     z = gamma * s
@@ -835,11 +843,7 @@ def solve_dense_ipm(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
     heavier); a first-order method's does.  Starts from ``gamma`` pushed into K's interior,
     stops at the natural-map residual ``tol`` (as the other solvers), returns the best iterate."""
     n = r.shape[0]
-    d0 = np.empty(n)
-    for k in range(n):
-        d0[k] = max(N[k, k], 1e-300)
-    average_friction_triplets(d0, kind, n)
-    s = np.sqrt(d0)
+    d0, s = dense_jacobi_scaling(N, kind)
     dmax = d0.max()
     # variable types: 0 free, 1 lower bound, 2 upper bound, 3 both, 4 cone normal (owns the
     # next two rows), 5 cone tangent, 6 fixed at 0 (a row that cannot act, μ = 0 tangents)
