@@ -196,8 +196,10 @@ def test_interrupted_commands_exit_1_with_a_message(tmp_path):
         slow()
     """)
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        # the child starts with SIGHUP at its default, whatever this process inherited (under nohup
+        # SIGHUP is ignored, and report_errors rightly leaves an ignored SIGHUP ignored)
         proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                text=True)
+                                text=True, preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_DFL))
         assert proc.stdout.readline().strip() == "ready"
         proc.send_signal(sig)
         _, err = proc.communicate(timeout=30)
