@@ -1076,8 +1076,8 @@ class SPHRun:
                 + self._excluded_by_reason() + "; " + self._exclusion_cause(self._divergence_hint()))
         if not np.isfinite(sol.last_dt) or sol.last_dt <= 0:
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: time step {sol.last_dt} is not valid")
-        if self.floating is not None:           # the body, its last finite state, the cause (bodychecks)
-            self.floating.watch.check_finite(sol.nstep)
+        # the floating bodies' states were checked where they changed (FloatingBodies.step / predict:
+        # bodychecks.BodyWatch), before their particles reached the fluid
 
     @staticmethod
     def _last_excluded(events: list) -> str:
