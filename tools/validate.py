@@ -16,6 +16,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
                                              # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
                                              # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
+    python tools/validate.py W3 --fine       # also the resolutions run only on request (W3 depth/dp 40, dp 0.01: ~15 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
     python tools/validate.py S16M --dp 0.02 --dp 0.01 --threads 2     # some of a case's resolutions
     python tools/validate.py S3 S7 --constant coefh=1.2                # the case files with another constant
@@ -56,6 +57,7 @@ class Resolution:
     dp: float
     args: list = field(default_factory=list)     # extra `sphdvi run` options (--tmax, --set ...)
     scored: bool = True                          # False: coarser than the resolution TOLERANCES sets the target at
+    on_request: bool = False                     # True: an hour or more; runs only when --dp names it or with --fine
 
 
 @dataclass
@@ -379,7 +381,8 @@ def cases() -> list:
              "within 15 % (judgement, as W3)", slow=True),
         Case("W3", "waves from a measured flap motion (Hadzic et al. 2005 flume): wave probes",
              case_path("flapwaves2d", "CaseFlapWavesHadzic2D_Def.xml"),
-             [Resolution("depth/dp 10", 0.04), Resolution("depth/dp 20", 0.02)],
+             [Resolution("depth/dp 10", 0.04), Resolution("depth/dp 20", 0.02),
+              Resolution("depth/dp 40", 0.01, on_request=True)],
              score_flap_waves, [("corr WP1", "WP1_corr", "{:.3f}"), ("corr WP2", "WP2_corr", "{:.3f}"),
                                 ("rms WP1 %", "WP1_rms", PCT), ("rms WP2 %", "WP2_rms", PCT),
                                 ("lag WP1 s", "WP1_lag", "{:+.3f}"), ("lag WP2 s", "WP2_lag", "{:+.3f}")],
@@ -518,6 +521,17 @@ def slow_names(every) -> list[str]:
     return [c.name for c in every if c.slow]
 
 
+def _all_resolutions(case) -> list:
+    """Every resolution of ``case``, those run only on request included."""
+    return case.resolutions() if callable(case.resolutions) else list(case.resolutions)
+
+
+def _unmatched_dps(chosen, dps) -> list:
+    """The --dp values that no chosen case has a resolution at (a typo: nothing would run for them)."""
+    return [d for d in dps or () if not any(math.isclose(r.dp, d, rel_tol=1e-9)
+                                            for c in chosen for r in _all_resolutions(c))]
+
+
 def main(argv=None) -> int:
     every = cases()
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -527,7 +541,10 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--coarse", action="store_true", help="only the coarsest resolution of each case")
     ap.add_argument("--dp", type=float, action="append", metavar="DP",
-                    help="only the resolutions of this dp (repeatable)")
+                    help="only the resolutions of this dp (repeatable); a resolution run only on request "
+                         "(W3 depth/dp 40) runs when --dp names it")
+    ap.add_argument("--fine", action="store_true",
+                    help="also the resolutions run only on request (W3 depth/dp 40: ~15 min on 2 threads)")
     ap.add_argument("--keep", metavar="DIR", help="keep the run folders under DIR (default: a temporary folder)")
     ap.add_argument("--csv", metavar="FILE", help="also write every row to FILE")
     ap.add_argument("--constant", action="append", metavar="NAME=VALUE",
@@ -546,6 +563,10 @@ def main(argv=None) -> int:
     chosen = [c for c in every if c.name in picked] if args.names else [c for c in every if args.all or not c.slow]
     base = args.keep or tempfile.mkdtemp(prefix="sphdvi-validate-")
     table, failed = [], 0
+    unmatched = _unmatched_dps(chosen, args.dp)
+    if unmatched:
+        ap.error(f"no chosen case has a resolution at --dp {', '.join(f'{d:g}' for d in unmatched)}; their dps: "
+                 + "; ".join(f"{c.name} " + ", ".join(f"{r.dp:g}" for r in _all_resolutions(c)) for c in chosen))
     for case in chosen:
         print(f"\n{case.name} {case.title}\n  target: {case.target_text}")
         if constants:
@@ -553,11 +574,16 @@ def main(argv=None) -> int:
         head = f"  {'resolution':<11}{'dp':>9}{'particles':>10}{'steps':>8}{'runtime_s':>10}{'µs/p-step':>10}{'thr':>4}"
         print(head + "".join(f"{h:>{max(len(h) + 2, 12)}}" for h, _, _ in case.columns) + "  target")
         rows = []
-        resolutions = case.resolutions() if callable(case.resolutions) else case.resolutions
-        if args.coarse:
-            resolutions = resolutions[:1]
+        resolutions = _all_resolutions(case)
         if args.dp:
             resolutions = [r for r in resolutions if any(math.isclose(r.dp, d, rel_tol=1e-9) for d in args.dp)]
+        elif not args.fine:
+            resolutions = [r for r in resolutions if not r.on_request]
+        if args.coarse:
+            resolutions = resolutions[:1]
+        if not resolutions and args.dp:
+            print(f"  (no resolution of {case.name} at --dp {', '.join(f'{d:g}' for d in args.dp)}; its dps: "
+                  + ", ".join(f"{r.dp:g}" for r in _all_resolutions(case)) + ")")
         for res in resolutions:
             outdir = os.path.join(base, f"{case.name}_{res.dp:g}")
             copy = case_with_constants(case.case, constants) if constants else None

@@ -89,3 +89,30 @@ def test_help_lists_every_case_and_the_slow_ones_all_adds():
     assert set(slow) == {"S4", "S8", "S16", "S16M", "S16O", "S18", "W4"}
     assert "also the slow cases " + ", ".join(slow) in text
     assert "default: all but the slow " + ", ".join(slow) in text
+
+
+def test_dp_naming_no_resolution_is_exit_2_and_lists_the_cases_dps():
+    """--dp that no chosen case has (a typo) ran nothing and exited 0; now exit 2 naming the dps."""
+    r = subprocess.run([sys.executable, str(REPO / "tools" / "validate.py"), "W3", "--dp", "0.03"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert "--dp 0.03" in r.stderr and "W3 0.04, 0.02, 0.01" in r.stderr
+
+
+def test_resolutions_on_request_run_only_when_named_or_with_fine(monkeypatch):
+    """W3's depth/dp 40 (an hour on 1 thread) is left out of a plain run, runs with --fine or
+    when --dp names it; --coarse still takes the coarsest of what is left."""
+    validate = _validate_module()
+    ran = []
+
+    def fake_run(case, res, outdir, threads):
+        ran.append((case.name, res.dp))
+        return {"rc": 1, "status": "failed", "message": "not run", "particles": 0, "steps": 0, "runtime_s": 0.0,
+                "us": 0.0, "threads_used": 1}
+
+    monkeypatch.setattr(validate, "run_case", fake_run)
+    for argv, expected in ((["W3"], [0.04, 0.02]), (["W3", "--fine"], [0.04, 0.02, 0.01]),
+                           (["W3", "--dp", "0.01"], [0.01]), (["W3", "--coarse", "--fine"], [0.04])):
+        ran.clear()
+        assert validate.main(argv) == 1
+        assert ran == [("W3", d) for d in expected], argv
