@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
-from .mkrange import parse_mk_range
+from .mkrange import format_mk_range, parse_mk_range, parse_range_filter
 from .normals_xml import read_initialize, read_normals, read_onlypos, read_velocity_profile
 from .outputs_xml import read_outputparts, read_savedt
 from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
@@ -1162,6 +1162,12 @@ def _read_chrono_bodies(reader, el, out: dict) -> tuple[dict, dict]:
             empty[bid] = b.sourceline
             continue
         mks = _range_filter_mks(reader, b, "mkbound")
+        if not mks:                     # e.g. mkbound="3-1" or "-3": JRangeFilter gives no value either
+            reader.mark(b, *b.keys())
+            reader.warn(b, f"body '{bid}' has no mkbound (mkbound=\"{b.get('mkbound')}\" gives none): it defines no "
+                           "body and is skipped, as DualSPHysics skips it; a link naming it is an error")
+            empty[bid] = b.sourceline
+            continue
         names = [bid] if len(mks) == 1 else [f"{bid}{mk}" for mk in mks]
         for name, mk in zip(names, mks):
             if name in ids:
@@ -1190,16 +1196,27 @@ def _read_chrono_bodies(reader, el, out: dict) -> tuple[dict, dict]:
 
 
 def _range_filter_mks(reader, el, attr: str) -> list:
-    """A ``<chrono>`` mkbound list, read by DualSPHysics with JRangeFilter: a list of blanks only
-    (``mkbound=" "``) is one item that atoi reads as 0, so it means mkbound 0; the same here, with a
-    warning (almost surely a typo). Anything else as :func:`_mk_list`."""
-    raw = el.get(attr)
-    if raw is not None and raw and not raw.strip():
-        reader.mark(el, attr)
+    """A ``<chrono>`` mkbound list, read as DualSPHysics reads it with JRangeFilter
+    (:func:`~sphdvi.case.mkrange.parse_range_filter`): a list of blanks only (``mkbound=" "``) is one
+    item that atoi reads as 0, so it means mkbound 0; an empty item (``"1,,3"``) is skipped, a blank
+    one (``"1, ,3"``) is 0, ``"1-"`` is 1, ``"-3"`` and ``"3-1"`` give nothing: the same here, with a
+    warning for each of these (almost surely typos). Letters, decimals, signs are an error (atoi
+    would read some other number). The list may come out empty (the caller says what that means)."""
+    raw = reader.raw(el, attr, expected='mk values and ranges like "0-3,7"')     # as written: blanks count
+    if raw.strip().startswith("#"):
+        raw = reader.text_attr(el, attr)                                     # an expression's value
+    if raw and not raw.strip():
         reader.warn(el, f"{attr}=\"{raw}\" (blanks only) is read as mkbound 0, as DualSPHysics reads it (its mk "
                         "list parser turns the blank item into 0); write the mkbound you mean")
         return [0]
-    return _mk_list(reader, el, attr)
+    try:
+        mks, notes = parse_range_filter(raw)
+    except ValueError as exc:
+        raise reader.error(el, f"{attr}: {exc}", 'mk values and ranges like "0-3,7"') from None
+    if notes:
+        reader.warn(el, f"{attr}=\"{raw}\": " + "; ".join(notes) + ", as DualSPHysics's mk list parser (JRangeFilter) "
+                        f"reads it, so the list is {format_mk_range(mks) or 'empty'}; write the mkbounds you mean")
+    return mks
 
 
 def _name_chrono_links(reader, el, links: list) -> None:
@@ -1234,6 +1251,11 @@ def _read_scaleforce(reader, scale, bodies: list) -> list:
     out = []
     for b in reader.children(scale, "body"):
         mks = _range_filter_mks(reader, b, "mkbound")
+        if not mks:                     # JChronoObjects::ReadScaleForces loops over no mkbound
+            reader.mark(b, *b.keys())
+            reader.warn(b, f"mkbound=\"{b.get('mkbound')}\" gives no mkbound: this <body> scales nothing, as in "
+                           "DualSPHysics")
+            continue
         bad = [mk for mk in mks if known and mk not in known]
         if bad:
             raise reader.error(b, f"mkbound {bad[0]} is not a <chrono> body", "the mkbound of a <chrono> body "

@@ -237,6 +237,8 @@ def _points_from_lines(lines, ncoord, source, is2d=None):
             continue
         where = f"{source}:{no}: " if source else ""
         word = line.split()[0].upper()
+        if word in _TRANSFORMS:
+            raise ValueError(_transform_refusal(where, raw.strip(), word))
         if word in ("POINTS", "POINTSLIST", "POINTSENDLIST"):
             _check_block_complete(mode, block)
             mode, block = word, []
@@ -266,6 +268,23 @@ def _points_from_lines(lines, ncoord, source, is2d=None):
     if not np.isfinite(arr).all():
         raise ValueError("point coordinates must be finite")
     return arr
+
+
+# MeasureTool's transformation lines (doc/help/FilePointsTemplate.txt): not read, see below
+_TRANSFORMS = ("MOVE", "ROTATEAXIS", "SCALE")
+
+
+def _transform_refusal(where, text, word):
+    """The error for a MOVE / ROTATEAXIS / SCALE line. DualSPHysics's FilePointsTemplate.txt gives
+    their syntax and one line, "Use_transformation_options_between_POINTS_and_after_POINTSLIST_or_
+    POINTSENDLIST", but not which points they move (those after the line or before it), whether
+    they add up or a block resets them, their order of composition nor the rotation's sense, and
+    MeasureTool's source is not public: rather than guess, they are refused."""
+    return (f"{where}'{text}': MeasureTool's transformation lines (MOVE, ROTATEAXIS, SCALE) are not read by "
+            f"sphdvi ({word} here): DualSPHysics documents their syntax but not which points they move (those "
+            "after the line or before it), whether they add up or what resets them, nor their order; write the "
+            "points out already transformed, as x y z rows or POINTSLIST / POINTSENDLIST blocks (or transform "
+            "them outside sphdvi), and remove the line")
 
 
 def _plain_point(vals, ncoord, where, text, source, is2d):
@@ -359,7 +378,14 @@ def _component_names(var: str, is2d: bool):
 def tracked_motion(run: RunOutput, mks, mkbound=False):
     """A function snapshot -> (R, t), the rigid motion since the case's start of the boundary
     or floating particles with mk (or mkbound) in ``mks`` (Kabsch fit of their positions to
-    their initial ones, by Idp): MeasureTool's ``-trackmk``, points that move with a tank."""
+    their initial ones, by Idp): MeasureTool's ``-trackmk``, points that move with a tank.
+    With periodic boundaries the run wraps a set that crosses a periodic end particle by particle,
+    so each particle is first taken at its periodic image nearest where the motion so far puts it
+    (:func:`unwrap_near`): at the first snapshot measured, the set's start moved as its particle
+    nearest the initial centroid moved (any travel, any size of set, while the rotation moves no
+    particle half a period away from that translation), then the previous fit (any motion of less
+    than half a period between two outputs); :func:`tracked_points` brings the points back into the
+    periodic box. Snapshots are to be given in time order."""
     p = run.data["particles"]
     first = Snapshot(part=0, time=0.0, pos=np.asarray(p["pos"], float), vel=None, rhop=None, press=None,
                      ptype=np.asarray(p["type"]), idp=np.asarray(p["idp"], np.int64), mk=np.asarray(p["mk"]),
@@ -373,11 +399,40 @@ def tracked_motion(run: RunOutput, mks, mkbound=False):
     ref_pos = np.zeros((int(first.idp.max()) + 1, 3))
     ref_pos[first.idp[sel]] = first.pos[sel]
     is2d = run.spec.is2d
+    per = run.periodicity
+    anchor = int(first.idp[sel][np.argmin(np.linalg.norm(first.pos[sel] - first.pos[sel].mean(axis=0), axis=1))])
+    last = []                   # the previous fit (R, t), with periodic boundaries
 
     def motion(snap: Snapshot):
         cur = target_mask(snap, mks, run.fluidcount, mkbound)
-        return rigid_fit(ref_pos[snap.idp[cur]], np.asarray(snap.pos[cur], float), is2d)
+        ref, pos = ref_pos[snap.idp[cur]], np.asarray(snap.pos[cur], float)
+        if per is None:
+            return rigid_fit(ref, pos, is2d)
+        if last:
+            guess = ref @ last[0][0].T + last[0][1]
+        else:
+            k = np.flatnonzero(snap.idp[cur] == anchor)
+            a = int(k[0]) if k.size else 0
+            guess = ref + (pos[a] - ref[a])
+        fit = rigid_fit(ref, unwrap_near(pos, guess, per), is2d)
+        last[:] = [fit]
+        return fit
     return motion
+
+
+def tracked_points(start, R, t, per=None):
+    """The points ``start`` (at the case's start) carried by the rigid motion (R, t) of
+    :func:`tracked_motion`; with periodic boundaries (``per``) brought into the periodic box, where
+    the run keeps the fluid: along each periodic axis k in turn, minus the whole periods S_k they
+    are past its low end (JSphCpu::UpdatePos's wrap, increments included, repeated for a motion of
+    more than one period)."""
+    points = start @ R.T + t
+    if per is not None:
+        for k in per.axes:
+            n = np.floor((points[:, k] - per.lo[k]) / per.length[k])
+            if n.any():
+                points -= n[:, None] * per.shift[k]
+    return points
 
 
 def measure_points(run: RunOutput, points, variables=VARS, kclimit=core.DEFAULT_KCLIMIT, order=0,
@@ -412,7 +467,7 @@ def measure_points(run: RunOutput, points, variables=VARS, kclimit=core.DEFAULT_
         grid = run.fluid_grid(snap)
         if motion is not None:
             R, t = motion(snap)
-            points = start @ R.T + t
+            points = tracked_points(start, R, t, run.periodicity)
         fields = [v for v in variables if v != "kcorr"]
         vals, ksum = core.interpolate(grid, points, fields, order=order, kclimit=kclimit)
         # column order: variable, point, component
@@ -656,6 +711,17 @@ def unwrap_rigid(pos, anchor: int, per):
     d = pos - pos[anchor]
     per.min_image(d)
     return pos[anchor] + d
+
+
+def unwrap_near(pos, guess, per):
+    """Each position of ``pos`` moved by whole periods (``per``: the run's periodicity, increments
+    included) to its image nearest ``guess`` (the same particle's expected position): a rigid set
+    the run wrapped particle by particle made whole again, as :func:`unwrap_rigid` but about a
+    guess of each particle's place rather than one particle (so also for a set longer than half a
+    period, e.g. the floor of a periodic channel). A position already nearest is returned as it is."""
+    d0 = np.asarray(pos, float) - guess
+    d = per.min_image(d0.copy())
+    return np.asarray(pos, float) + (d - d0)
 
 
 def rigid_velocity(pos, vel, centre, is2d=False):
