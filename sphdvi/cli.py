@@ -96,7 +96,7 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
 
 
 @main.command(context_settings=CONTEXT)
-@click.argument("source", type=click.Path())
+@click.argument("source", type=click.Path(), required=False)
 @click.option("-o", "--out", "outdir", type=click.Path(file_okay=False), default=None,
               help="Output folder (default: SOURCE when it is a gencase output, else ./<casename>_out).")
 @click.option("--tmax", type=FiniteFloat(min=0), default=None,
@@ -124,8 +124,14 @@ def gencase(case_xml, outdir, max_nodes, dp, overwrite, quiet):
                    "accepted.")
 @click.option("-q", "--quiet", is_flag=True,
               help="No progress bar or lines, no summary; warnings and errors still print.")
+@click.option("--manifest", type=click.Path(dir_okay=False), default=None,
+              help="Run one entry of a sweep ('sphdvi sweep new'): SWEEPDIR/sweep.csv, with --index; instead of "
+                   "SOURCE, -o, --set, --dp, --tmax, --tout. A completed entry is not run again, an interrupted "
+                   "one resumes.")
+@click.option("--index", type=click.IntRange(min=0), default=None, help="The entry of --manifest (0, 1, ...).")
+@click.option("--retry", is_flag=True, help="With --manifest: run a failed or diverged entry again from the start.")
 @report_errors
-def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet):
+def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, manifest, index, retry):
     """Run a case: SOURCE is a case XML (gencase runs first) or a gencase output folder.
 
     \b
@@ -146,6 +152,14 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet)
     """
     from .errors import InputError
     from .simulation import _Stop
+    if manifest is not None or index is not None or retry:     # a sweep's entry (sphdvi/sweep_cli.py)
+        from .sweep_cli import run_manifest_entry
+        return run_manifest_entry(manifest, index, retry, threads, quiet, {
+            "SOURCE": source, "-o": outdir, "--set": sets, "--dp": dp is not None, "--tmax": tmax is not None,
+            "--tout": tout is not None, "--resume": resume, "--overwrite": overwrite})
+    if source is None:
+        raise click.UsageError("Missing argument 'SOURCE' (a case XML or a gencase output folder; or --manifest "
+                               "with --index).")
     if resume and overwrite:
         raise InputError("--resume and --overwrite: give one (--resume continues the run in OUT, --overwrite "
                          "deletes its results and starts again)")
@@ -267,6 +281,8 @@ def export(outdir, fmt, subdir, isosurface, iso_spacing, iso_threshold):
 
 from .measure.cli import measure as _measure  # noqa: E402
 main.add_command(_measure)
+from .sweep_cli import sweep as _sweep  # noqa: E402
+main.add_command(_sweep)
 
 if __name__ == "__main__":  # pragma: no cover
     main()
