@@ -593,7 +593,7 @@ def format_table(rows) -> str:
 # ---------------------------------------------------------------------------------
 # sweep collect: one tidy CSV
 # ---------------------------------------------------------------------------------
-def _csv_value(v) -> str:
+def csv_value(v) -> str:
     if v is None:
         return ""
     return repr(v) if isinstance(v, float) else str(v)
@@ -605,14 +605,17 @@ def summary_table(sweep: Sweep) -> list[list[str]]:
     for i, values in enumerate(sweep.runs):
         meta = run_info(sweep.run_dir(i)) or {}
         rows.append([str(i), *values, os.path.basename(sweep.run_dir(i)), str(meta.get("status") or "pending"),
-                     *(_csv_value(meta.get(f)) for f in COLLECT_FIELDS)])
+                     *(csv_value(meta.get(f)) for f in COLLECT_FIELDS)])
     return rows
 
 
-def _read_run_csv(path: str) -> tuple[list[str], list[list[str]]]:
+def read_run_csv(path: str) -> tuple[list[str], list[list[str]]]:
     """A run folder's CSV (``,`` or ``;`` separated, as sphdvi's gauge and DtInfo files): header, rows."""
-    with open(path, newline="", encoding="utf-8") as fh:
-        text = fh.read()
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            text = fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot be read as a CSV text file ({getattr(exc, 'strerror', None) or exc})") from None
     first = text.split("\n", 1)[0]
     sep = ";" if first.count(";") > first.count(",") else ("\t" if first.count("\t") > first.count(",") else ",")
     rows = [r for r in csv.reader(io.StringIO(text), delimiter=sep) if r]
@@ -638,7 +641,7 @@ def file_table(sweep: Sweep, names) -> tuple[list[list[str]], list[str]]:
             if not os.path.isfile(path):
                 missing.append(os.path.join(os.path.basename(sweep.run_dir(i)), name))
                 continue
-            header, rows = _read_run_csv(path)
+            header, rows = read_run_csv(path)
             stem = os.path.splitext(os.path.basename(name))[0]
             header = [f"{stem}.{h}" if h in lead else h for h in header]
             for h in header:

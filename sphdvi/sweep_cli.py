@@ -1,4 +1,4 @@
-"""``sphdvi sweep``: parameter sweeps and convergence studies (new, run, status, collect), and
+"""``sphdvi sweep``: parameter sweeps and convergence studies (new, run, status, collect, converge), and
 ``sphdvi run --manifest SWEEPDIR/sweep.csv --index I`` (one entry, as a SLURM array task runs it).
 
 Only click is imported at module level (``sphdvi --help`` stays fast); the logic is in
@@ -26,6 +26,7 @@ def sweep():
       sphdvi sweep run SWEEP             # or here, J runs at a time
       sphdvi sweep status SWEEP
       sphdvi sweep collect SWEEP -o tidy.csv [--file GaugesSWL_Swl_x02.csv]
+      sphdvi sweep converge SWEEP --file GaugesSWL_WP1.csv --column swlz [--reference ref.csv]
     """
 
 
@@ -273,3 +274,87 @@ def collect(sweepdir, out, names):
         table = sw.summary_table(s)
     write_text_atomic(out, sw.table_text(table))
     click.echo(f"{len(table) - 1} rows -> {out}")
+
+
+@sweep.command("converge", context_settings=CONTEXT)
+@click.argument("sweepdir", type=click.Path(file_okay=False))
+@click.option("--file", "name", required=True, metavar="NAME",
+              help="The CSV in each run folder that holds the signal (a gauge file, bodies.csv, a 'measure --csv' "
+                   "output).")
+@click.option("--column", required=True, metavar="COL", help="Its column to study (the unit may be left out: swlz).")
+@click.option("--time-column", default=None, metavar="COL", help="Its time column (default: the one named time).")
+@click.option("--where", "where", multiple=True, metavar="COL=VALUE",
+              help="Only the rows with this value (repeatable), e.g. --where body=floating50 in bodies.csv.")
+@click.option("--reference", type=click.Path(dir_okay=False, exists=True), default=None,
+              help="A CSV of the reference signal (analytic or measured; ',' ';' or tab separated): each run's "
+                   "error against it. Without it, each run's difference to the next finer run.")
+@click.option("--ref-column", default=None, metavar="COL", help="The reference's column (default: --column).")
+@click.option("--ref-time-column", default=None, metavar="COL",
+              help="The reference's time column (default: the one named time).")
+@click.option("--norm", type=click.Choice(["rms", "max", "end"]), default="rms", show_default=True,
+              help="rms or max over the shared times, or the difference at the last shared time.")
+@click.option("--tmin", type=FiniteFloat(), default=None, help="Score from this time [s].")
+@click.option("--tmax", type=FiniteFloat(), default=None, help="Score up to this time [s].")
+@click.option("--relative", is_flag=True, help="Divide by the same norm of the reference (or of the finer run).")
+@click.option("-o", "--out", "out", type=click.Path(dir_okay=False), default=None,
+              help="Also write the table as CSV (atomically).")
+@report_errors
+def converge(sweepdir, name, column, time_column, where, reference, ref_column, ref_time_column, norm, tmin, tmax,
+             relative, out):
+    """Error against resolution and run time of a sweep over dp: for each group of runs that differ
+    only in dp, each completed run's error (against --reference) or difference to the next finer
+    run, its wall time (run.json runtime_s) and the observed order (sphdvi/convergence.py)."""
+    from . import convergence as cv
+    from . import sweep as sw
+    from .errors import InputError
+    from .io.atomic import write_text_atomic
+    s = sw.open_sweep(sweepdir)
+    pairs = []
+    for item in where:
+        k, eq, v = item.partition("=")
+        if not eq or not k.strip():
+            raise InputError(f"--where {item}: expected COL=VALUE")
+        pairs.append((k.strip(), v.strip()))
+    ref = None
+    if reference is not None:
+        header, rows = sw.read_run_csv(reference)
+        ref = cv.series(header, rows, ref_column or column, reference, time_name=ref_time_column)
+    groups = cv.group_levels(s.keys, s.runs)
+    others = [k for k in s.keys if k != "dp"]
+    table = [[*others, "index", "dp", "status", "particles", "runtime_s",
+              ("error" if ref is not None else "diff_to_finer") + ("_relative" if relative else ""), "order"]]
+    skipped = []
+    for values, idx in groups:
+        dps, signals, metas = [], [], []
+        for i in idx:
+            meta = sw.run_info(s.run_dir(i)) or {}
+            path = os.path.join(s.run_dir(i), name)
+            sig = None
+            if meta.get("status") != "completed":
+                skipped.append(f"{os.path.basename(s.run_dir(i))} ({meta.get('status') or 'pending'})")
+            elif not os.path.isfile(path):
+                skipped.append(f"{os.path.basename(s.run_dir(i))} (no {name})")
+            else:
+                header, rows = sw.read_run_csv(path)
+                sig = cv.series(header, rows, column, path, time_name=time_column, where=pairs)
+            dps.append(float(s.runs[i][s.keys.index("dp")]))
+            signals.append(sig)
+            metas.append(meta)
+        err, orders = cv.level_errors(dps, signals, norm, ref, tmin, tmax, relative)
+        for k, i in enumerate(idx):
+            meta = metas[k]
+            table.append([*(values[o] for o in others), str(i), s.runs[i][s.keys.index("dp")],
+                          str(meta.get("status") or "pending"), sw.csv_value(meta.get("particles")),
+                          sw.csv_value(meta.get("runtime_s")), _fmt(err[k]), _fmt(orders[k])])
+    if skipped:
+        click.echo(f"left out ({len(skipped)}): {', '.join(skipped)}", err=True)
+    click.echo(sw.format_table(table))
+    if out is not None:
+        folder = os.path.dirname(os.path.abspath(out))
+        if not os.path.isdir(folder):
+            raise InputError(f"-o {out}: the folder {folder} does not exist; expected a file in an existing folder")
+        write_text_atomic(out, sw.table_text(table))
+
+
+def _fmt(v: float) -> str:
+    return "" if v != v else f"{v:.6g}"
