@@ -8,7 +8,7 @@ are DualSPHysics's (``maxdisth`` 2, ``limitdist`` 0.5 dp, ``clear`` true, ``dist
 """
 from __future__ import annotations
 
-from .mkrange import parse_mk_range
+from .mkrange import format_mk_range, parse_mk_range, range_filter_attr
 
 GENCASE_TAGS = {"norset": "set", "norplane": "plane", "norsphere": "sphere", "norcylinder": "cylinder",
                 "norparts": "parts", "norgeometry": "geometry"}
@@ -70,18 +70,45 @@ def _mkbound(reader, el, required: bool) -> str:
     return text.strip()
 
 
+def _initialize_mks(reader, el, attr: str, required: bool):
+    """The mk list of a ``<special><initialize>`` operation as JDsInitializeOp_*::ReadXml reads it: an
+    optional attribute (GetAttributeStr), none or empty meaning every boundary (fluid for
+    ``mkfluid``), anything else a JRangeFilter list (:func:`~sphdvi.case.mkrange.range_filter_attr`).
+    ``required`` (boundnormal_plane, whose Run loops over the list's values only): no list is no
+    particle. Returns the list as ``"0-3,7"``, ``""`` for all, None for an operation that acts on no
+    particle (warned: DualSPHysics runs it on nothing, sphdvi drops it)."""
+    text = el.get(attr)
+    reader.mark(el, attr)
+    if not text:
+        if not required:
+            return ""
+        reader.warn(el, f"no {attr} (or {attr}=\"\"): DualSPHysics's <{el.tag}> computes the normals of its listed "
+                        f"{attr}s only, so it does nothing, nor does sphdvi; give the {attr}s, e.g. {attr}=\"0\"")
+        return None
+    mks = range_filter_attr(reader, el, attr)
+    if not mks:
+        reader.warn(el, f"{attr}=\"{text}\" gives no {attr}: this <{el.tag}> acts on no particle and is skipped, as "
+                        "it does nothing in DualSPHysics")
+        return None
+    return format_mk_range(mks)
+
+
 def _nonzero(reader, el, tag, vec):
     if not any(vec):
         raise reader.error(reader.child(el, tag), f"<{tag}> is the zero vector", "a non-zero direction")
     return vec
 
 
-def read_normal_op(reader, el, kind: str) -> dict:
+def read_normal_op(reader, el, kind: str, solver: bool = False) -> dict | None:
     """One normals operation (see the module docstring) as a dict: ``kind``, ``tag``,
-    ``line``, ``mkbound`` (``""``: every boundary), ``onlypos`` and the kind's fields."""
+    ``line``, ``mkbound`` (``""``: every boundary), ``onlypos`` and the kind's fields. ``solver``:
+    an ``<initialize>`` one, whose mkbound list DualSPHysics reads with JRangeFilter (None: one that
+    acts on no particle); GenCase's ``<normals>`` lists keep the strict form (GenCase's reader is
+    not public)."""
     reader.check_children(el, CHILDREN[kind] | {"rem"})
-    op = {"kind": kind, "tag": el.tag, "line": el.sourceline,
-          "mkbound": _mkbound(reader, el, kind == "plane")}
+    required = kind == "plane"
+    mkbound = _initialize_mks(reader, el, "mkbound", required) if solver else _mkbound(reader, el, required)
+    op = {"kind": kind, "tag": el.tag, "line": el.sourceline, "mkbound": mkbound}
     op["onlypos"] = read_onlypos(reader, el) if kind != "geometry" else None
     if kind in ("plane", "sphere", "cylinder", "parts"):
         op["maxdisth"] = _scalar_el(reader, el, "maxdisth", 2.0)
@@ -119,7 +146,7 @@ def read_normal_op(reader, el, kind: str) -> dict:
         op["distanceh"] = _scalar_el(reader, el, "distanceh", 2.0, positive=True)
         if reader.child(el, "svshapes") is not None:
             _scalar_el(reader, el, "svshapes", False, "bool")
-    return op
+    return None if mkbound is None else op          # read whole (its errors count), then dropped
 
 
 def read_normals(reader, casedef) -> list:
@@ -148,33 +175,31 @@ def read_initialize(reader, el) -> dict:
     out = {"normals": [], "velocity": []}
     for c in reader.children(el):
         if c.tag in INITIALIZE_TAGS:
-            out["normals"].append(read_normal_op(reader, c, INITIALIZE_TAGS[c.tag]))
+            op = read_normal_op(reader, c, INITIALIZE_TAGS[c.tag], solver=True)
+            if op is not None:
+                out["normals"].append(op)
         elif c.tag == "fluidvelocity":
-            out["velocity"].append(read_fluid_velocity(reader, c))
+            item = read_fluid_velocity(reader, c)
+            if item is not None:
+                out["velocity"].append(item)
     return out
 
 
-def read_fluid_velocity(reader, el) -> dict:
+def read_fluid_velocity(reader, el) -> dict | None:
     """``<fluidvelocity mkfluid>``: a velocity along ``<direction>``, uniform (``<velocity v>``),
     linear in z (``<velocity2 v v2 z z2>``) or parabolic (``<velocity3 ...>``); the item form
-    of ``<initials><velocity>``."""
+    of ``<initials><velocity>``. The mkfluid list as JDsInitializeOp_FluidVel reads it (none or
+    empty: every fluid particle; see :func:`_initialize_mks`); None for one that gives no mkfluid."""
     reader.check_children(el, {"onlypos", "direction", "velocity", "velocity2", "velocity3", "rem"})
     item = {"type": "velocity", "element": el.tag, "line": el.sourceline}
-    text = el.get("mkfluid")
-    reader.mark(el, "mkfluid")
-    if text is not None and text.strip():
-        try:
-            item["mkfluid"] = parse_mk_range(text)
-        except ValueError as exc:
-            raise reader.error(el, f"mkfluid={text!r}: {exc}", 'mkfluid values and ranges such as mkfluid="0-2"') from None
-    else:
-        item["mkfluid"] = None                  # every fluid particle
+    listed = _initialize_mks(reader, el, "mkfluid", False)
+    item["mkfluid"] = parse_mk_range(listed) if listed else None    # None: every fluid particle
     box = read_onlypos(reader, el)
     if box is not None:
         item["onlypos"] = box
     item["direction"] = _nonzero(reader, el, "direction", _vector(reader, el, "direction"))
     item["profile"], item["params"] = read_velocity_profile(reader, el)
-    return item
+    return None if listed is None else item
 
 
 VELOCITY_PROFILES = {"velocity": ("v",), "velocity2": ("v", "v2", "z", "z2"),

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import CaseError
+from .mkrange import parse_filtermk
 
 OPERATIONS = ("add", "del", "confirm")
 PARTICLE_TYPES = ("fixed", "moving", "floating", "fluid", "bound")
@@ -182,14 +183,17 @@ def _read_mk(reader, el) -> dict:
         raise reader.error(el, "<filtermk> needs one of <mk>, <mkbound> and <mkfluid>" +
                            (f" (it has {', '.join(given)})" if given else ""), '<mkbound v="20-25"/> for example')
     c = reader.child(el, given[0])
-    raw = reader.text_attr(c, "v")
-    parts = raw.split("-")
+    raw = reader.text_attr(c, "v", "")
     try:
-        lo, hi = (int(parts[0]), int(parts[-1])) if len(parts) in (1, 2) else (None, None)
-    except ValueError:
-        lo = hi = None
-    if lo is None or lo < 0 or hi < lo:
-        raise reader.error(c, f"v={raw!r} is not an mk value or range", 'a value "10" or a range "10-15"')
+        lo, hi, notes = parse_filtermk(raw)
+    except ValueError as exc:
+        raise reader.error(c, f"v={raw!r} is not an mk value or range ({exc})",
+                           'a value "10" or a range "10-15"') from None
+    if notes:
+        head = f"v=\"{raw}\": " + "; ".join(notes) if c.get("v") is not None else "no v: read as 0"
+        chosen = "nothing" if hi < lo else f"{given[0]} {lo}" + ("" if lo == hi else f"-{hi}")
+        reader.warn(c, head + f", as DualSPHysics reads it (JDsOutputPartsOp_Mk), so the filter selects {chosen}; "
+                              f"write the {given[0]} you mean")
     return {"field": given[0], "lo": lo, "hi": hi}
 
 

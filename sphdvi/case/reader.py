@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
 from .model import Case, ConstantsDef, FloatingDef, Material
-from .mkrange import format_mk_range, parse_mk_range, parse_range_filter
+from .mkrange import accinput_mk_attr, parse_mk_range, prop_link_attr, range_filter_attr
 from .normals_xml import read_initialize, read_normals, read_onlypos, read_velocity_profile
 from .outputs_xml import read_outputparts, read_savedt
 from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
@@ -743,7 +743,9 @@ def read_properties(reader, casedef, fluidcount: int = 9):
             for link in reader.children(c):
                 if link.tag != "link":
                     raise reader.error(link, f"unknown element <{link.tag}>", "<link>")
-                links.append(_read_link_mks(reader, link, fluidcount))
+                d = _read_link_mks(reader, link, fluidcount)
+                if d is not None:                       # None: a link DualSPHysics drops (empty list)
+                    links.append(d)
         else:
             raise reader.error(c, f"unknown element <{c.tag}> in <properties>", "property, propertyfile, links")
     for d in links:
@@ -761,10 +763,12 @@ def _read_property_into(reader, el, materials: dict) -> None:
     materials.setdefault(m.name, m)
 
 
-def _read_link_mks(reader, link, fluidcount: int) -> dict:
+def _read_link_mks(reader, link, fluidcount: int) -> dict | None:
     """A ``<link>``'s particles, as JCasePropLinks::ReadXml: ``mkbound``, else ``mkfluid``, else
     ``mk`` (the global mk: GetProps matches it to the particle's mk, which is mkfluid + 1 for
-    fluid and mkbound + fluidcount + 1 for boundaries, sphdvi's and GenCase's numbering)."""
+    fluid and mkbound + fluidcount + 1 for boundaries, sphdvi's and GenCase's numbering). The list is
+    read as JCasePropLinks reads it (:func:`~sphdvi.case.mkrange.prop_link_attr`): None for a link it
+    drops (an empty list)."""
     d = {"property": reader.text_attr(link, "property"), "line": link.sourceline}
     given = [a for a in ("mkbound", "mkfluid", "mk") if link.get(a) is not None]
     if not given:
@@ -773,11 +777,13 @@ def _read_link_mks(reader, link, fluidcount: int) -> dict:
         reader.mark(link, *given[1:])
         reader.warn(link, f"{given[0]} and {' and '.join(given[1:])} given: DualSPHysics reads {given[0]} "
                           f"only, and so does sphdvi")
+    mks = prop_link_attr(reader, link, given[0])
+    if mks is None:
+        return None
     if given[0] != "mk":
-        d[given[0]] = _mk_list(reader, link, given[0])
+        d[given[0]] = mks
         return d
     first_bound = fluidcount + 1
-    mks = _mk_list(reader, link, "mk")
     bound = [mk - first_bound for mk in mks if mk >= first_bound]
     fluid = [mk - 1 for mk in mks if 1 <= mk < first_bound]
     if bound:
@@ -1197,26 +1203,10 @@ def _read_chrono_bodies(reader, el, out: dict) -> tuple[dict, dict]:
 
 def _range_filter_mks(reader, el, attr: str) -> list:
     """A ``<chrono>`` mkbound list, read as DualSPHysics reads it with JRangeFilter
-    (:func:`~sphdvi.case.mkrange.parse_range_filter`): a list of blanks only (``mkbound=" "``) is one
-    item that atoi reads as 0, so it means mkbound 0; an empty item (``"1,,3"``) is skipped, a blank
-    one (``"1, ,3"``) is 0, ``"1-"`` is 1, ``"-3"`` and ``"3-1"`` give nothing: the same here, with a
-    warning for each of these (almost surely typos). Letters, decimals, signs are an error (atoi
-    would read some other number). The list may come out empty (the caller says what that means)."""
-    raw = reader.raw(el, attr, expected='mk values and ranges like "0-3,7"')     # as written: blanks count
-    if raw.strip().startswith("#"):
-        raw = reader.text_attr(el, attr)                                     # an expression's value
-    if raw and not raw.strip():
-        reader.warn(el, f"{attr}=\"{raw}\" (blanks only) is read as mkbound 0, as DualSPHysics reads it (its mk "
-                        "list parser turns the blank item into 0); write the mkbound you mean")
-        return [0]
-    try:
-        mks, notes = parse_range_filter(raw)
-    except ValueError as exc:
-        raise reader.error(el, f"{attr}: {exc}", 'mk values and ranges like "0-3,7"') from None
-    if notes:
-        reader.warn(el, f"{attr}=\"{raw}\": " + "; ".join(notes) + ", as DualSPHysics's mk list parser (JRangeFilter) "
-                        f"reads it, so the list is {format_mk_range(mks) or 'empty'}; write the mkbounds you mean")
-    return mks
+    (:func:`~sphdvi.case.mkrange.range_filter_attr`): ``" "`` is mkbound 0, ``"1,,3"`` 1 and 3, ``"1, ,3"``
+    0, 1 and 3, ``"1-"`` 1, ``"-3"`` and ``"3-1"`` nothing, each warned; letters, decimals, signs an
+    error. The list may come out empty (the caller says what that means)."""
+    return range_filter_attr(reader, el, attr)
 
 
 def _name_chrono_links(reader, el, links: list) -> None:
@@ -1970,7 +1960,7 @@ def read_accinputs(reader, el) -> list:
         if c.get("mkbound") is not None:
             raise reader.error(c, "an <accinput> on floating bodies (mkbound) is not supported by sphdvi",
                                'mkfluid="..." (imposed accelerations of fluid particles)')
-        mks = _mk_list(reader, c, "mkfluid")
+        mks = accinput_mk_attr(reader, c, "mkfluid")
         for mk in mks:
             if mk in seen:
                 raise reader.error(c, f"mkfluid {mk} already has an <accinput> (line {seen[mk]})",

@@ -4,8 +4,8 @@ JChronoObjects::ReadXml and ReadScaleForces pass the attribute to JRangeFilter::
 at each comma (fun::StrSplit, so a trailing comma ends the list), an empty item is skipped, each number is
 read with C's atoi (a blank one is 0), ``a-`` is a alone, ``-b`` and a reversed range give nothing,
 ``a-b:step`` steps. sphdvi reads the same values and warns where the list was almost surely mistyped;
-before, any empty item was an error ("empty item in mk list"). The other mk lists (floatings,
-initialize, ...) keep their errors."""
+before, any empty item was an error ("empty item in mk list"). The other lists DualSPHysics reads
+(initialize, accinput, links, filtermk) are in test_mk_lists_other.py; GenCase's keep their errors."""
 import re
 
 import pytest
@@ -137,7 +137,7 @@ def test_scaleforce_lists(tmp_path):
 
 
 def test_other_mk_lists_keep_their_errors(tmp_path):
-    """Lists DualSPHysics does not read with JRangeFilter (here <floating mkbound>, parse_mk_range) still
-    refuse an empty item."""
+    """GenCase's lists (here <floating mkbound>, parse_mk_range; its reader is not public) still refuse
+    an empty item."""
     with pytest.raises(ValueError, match="empty item in mk list '1,,2'"):
         parse_mk_range("1,,2")
