@@ -89,18 +89,25 @@ def _table(v):
     return [[t, x] for t, x in zip(v["times"], v["values"])]
 
 
+def links_property(mkbound, links):
+    """The property of an mkbound from every ``<link>`` that names it, as JCasePropLinks::GetProps:
+    the links' properties joined in one combination (two links "a" and "b" are one link "a+b"),
+    which :func:`_material_for` sorts and rids of repeats (GetPropsSort); None if no link names it."""
+    combos = [ln["property"] for ln in links if mkbound in ln.get("mkbound", [])]
+    return "+".join(combos) if combos else None
+
+
 def _material_for(mkbound, case_json, body_property=None):
-    """(name, contact spec) of an mkbound's property: the floating's own ``property`` or
-    the ``<link>`` naming the mkbound.  A combination ``"steel + userdef01"`` is read as
-    DualSPHysics reads it (JCaseProperties::GetPropsSort, JSph::LoadDemData): the names sorted
-    (as written, repeats dropped), each value taken from the first of them that has it, except
-    that a ``*_User`` value of any of them wins over the plain ones."""
+    """(name, contact spec) of an mkbound's property: the floating's own ``property``, else
+    the properties of all the ``<link>`` elements naming the mkbound (:func:`links_property`).
+    A combination ``"steel + userdef01"`` is read as DualSPHysics reads it
+    (JCaseProperties::GetPropsSort, JSph::LoadDemData): the names sorted (as written, repeats
+    dropped), each value taken from the first of them that has it, except that a ``*_User``
+    value of any of them wins over the plain ones."""
     mats = case_json.get("materials", {})
     combo = body_property
     if combo is None:
-        for link in case_json.get("material_links", []):
-            if mkbound in link.get("mkbound", []):
-                combo = link["property"]
+        combo = links_property(mkbound, case_json.get("material_links", []))
     if combo is None:
         return None, None
     names = sorted({n.strip() for n in combo.split("+") if n.strip()})

@@ -218,6 +218,7 @@ def check_outputparts(spec: dict, label: np.ndarray, ptype: np.ndarray, mk: np.n
                 if v not in drawn:
                     raise CaseError(f"<filtermk> selects {f['field']} {v}, which has no particles", file=file,
                                     line=f["line"], element="filtermk", expected=f"a {f['field']} the geometry draws")
+            _check_mk_range_type(f, label, ptype, mk, file)
         follow = f.get("ftfollow")
         if follow:
             mkb = follow.get("mkbound", follow.get("mk", 0) - fluidcount - 1)
@@ -229,6 +230,28 @@ def check_outputparts(spec: dict, label: np.ndarray, ptype: np.ndarray, mk: np.n
             follow["centre0"] = list(floating_mkbounds[mkb])      # the filter moves as the centre does
             if f["kind"] == "sphere" and f["centre"] is None:
                 f["centre"] = follow["centre0"]
+
+
+def _check_mk_range_type(f: dict, label: np.ndarray, ptype: np.ndarray, mk: np.ndarray, file: str) -> None:
+    """The two ends of a ``<filtermk>`` range are particles of one type (fixed, moving, floating or
+    fluid), as JDsOutputPartsOp_Mk::ReadXmlExtra requires of the mk blocks of its ends ("The values
+    of the mk range include different types of particles."): a range from fluid to boundary, or from
+    a fixed to a floating mkbound, is refused at gencase."""
+    from .gencase import TYPE_FIXED, TYPE_FLOATING, TYPE_FLUID, TYPE_MOVING
+    if f["field"] == "mkfluid":
+        return
+    names = {TYPE_FIXED: "fixed", TYPE_MOVING: "moving", TYPE_FLOATING: "floating", TYPE_FLUID: "fluid"}
+    ends = {}
+    for v in (f["lo"], f["hi"]):
+        sel = (mk == v) if f["field"] == "mk" else ((ptype != TYPE_FLUID) & (label == v))
+        ends[v] = names[int(ptype[sel][0])]
+    if len(set(ends.values())) > 1:
+        what = " and ".join(f"{f['field']} {v} is {t}" for v, t in ends.items())
+        raise CaseError(f"<filtermk> range {f['field']} {f['lo']}-{f['hi']} includes different types of particles "
+                        f"({what}): DualSPHysics stops (\"The values of the mk range include different types of "
+                        f"particles.\")", file=file, line=f["line"], element="filtermk",
+                        expected="a range whose two ends are of one type (fixed, moving, floating or fluid); "
+                                 "one <filtermk> per type for the others")
 
 
 def _walk(filters):

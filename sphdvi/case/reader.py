@@ -768,7 +768,8 @@ def _read_link_mks(reader, link, fluidcount: int) -> dict | None:
     ``mk`` (the global mk: GetProps matches it to the particle's mk, which is mkfluid + 1 for
     fluid and mkbound + fluidcount + 1 for boundaries, sphdvi's and GenCase's numbering). The list is
     read as JCasePropLinks reads it (:func:`~sphdvi.case.mkrange.prop_link_attr`): None for a link it
-    drops (an empty list)."""
+    drops (an empty list, or no property name: JCasePropLinks::AddLink keeps a link only when
+    both are non-empty, blanks dropped; warned here, a likely mistake)."""
     d = {"property": reader.text_attr(link, "property"), "line": link.sourceline}
     given = [a for a in ("mkbound", "mkfluid", "mk") if link.get(a) is not None]
     if not given:
@@ -777,6 +778,12 @@ def _read_link_mks(reader, link, fluidcount: int) -> dict | None:
         reader.mark(link, *given[1:])
         reader.warn(link, f"{given[0]} and {' and '.join(given[1:])} given: DualSPHysics reads {given[0]} "
                           f"only, and so does sphdvi")
+    if not d["property"].replace(" ", "").replace("+", ""):
+        reader.mark(link, given[0])
+        reader.warn(link, f"property={link.get('property')!r} names no property: the link is dropped, as "
+                          f"DualSPHysics drops it (JCasePropLinks::AddLink), and gives {given[0]} "
+                          f"{link.get(given[0])!r} nothing")
+        return None
     mks = prop_link_attr(reader, link, given[0])
     if mks is None:
         return None
@@ -802,7 +809,8 @@ def _check_property_names(reader, combo: str, materials: dict, line: int, elemen
     whatever the case of its letters (JCaseProperties::GetIndexProperty), so "Steel" is "steel"."""
     by_lower = {k.lower(): k for k in materials}
     names = []
-    for name in combo.split("+"):
+    pieces = [n for n in combo.split("+") if n.replace(" ", "")] or [combo]   # "a+" is "a" (GetPropsSort)
+    for name in pieces:
         key = by_lower.get(name.replace(" ", "").lower())
         if key is None:
             raise CaseError(f"property '{name.strip()}' is not defined", file=reader.file, line=line,
@@ -1282,7 +1290,8 @@ def check_chrono_case(reader, case) -> None:
         mk = body["mkbound"]
         combo = next((fd.property for fd in case.floatings if mk in fd.mkbound and fd.property), None)
         if combo is None:
-            combo = next((ln["property"] for ln in case.material_links if mk in ln.get("mkbound", [])), None)
+            from ..mechanism import links_property      # every link naming the mkbound (GetProps)
+            combo = links_property(mk, case.material_links)
         merged = {}
         for name in (combo or "").split("+"):
             mat = case.materials.get(name.strip())
