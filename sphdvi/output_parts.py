@@ -110,6 +110,10 @@ def _mk(f, pos, ptype, mk, fluidcount, shift):
         value, kind = mk - 1, ptype == 3
     else:
         value, kind = mk - fluidcount - 1, ptype != 3
+    if f.get("ptype") is not None:
+        # JDsOutputPartsOp_Mk: the codes between the ends' mk blocks, which are of the ends' type (a
+        # floating mkbound 1 inside a range of fixed mkbounds 0-2 is not selected)
+        kind = kind & (ptype == f["ptype"])
     return kind & (value >= f["lo"]) & (value <= f["hi"])
 
 

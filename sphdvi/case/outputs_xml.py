@@ -236,15 +236,19 @@ def _check_mk_range_type(f: dict, label: np.ndarray, ptype: np.ndarray, mk: np.n
     """The two ends of a ``<filtermk>`` range are particles of one type (fixed, moving, floating or
     fluid), as JDsOutputPartsOp_Mk::ReadXmlExtra requires of the mk blocks of its ends ("The values
     of the mk range include different types of particles."): a range from fluid to boundary, or from
-    a fixed to a floating mkbound, is refused at gencase."""
+    a fixed to a floating mkbound, is refused at gencase. Their type is kept in ``f["ptype"]``: DualSPHysics
+    selects the particle codes between the two ends' blocks, all of that type, so a block of another type
+    whose mk lies inside the range is not selected."""
     from .gencase import TYPE_FIXED, TYPE_FLOATING, TYPE_FLUID, TYPE_MOVING
     if f["field"] == "mkfluid":
+        f["ptype"] = TYPE_FLUID
         return
     names = {TYPE_FIXED: "fixed", TYPE_MOVING: "moving", TYPE_FLOATING: "floating", TYPE_FLUID: "fluid"}
     ends = {}
     for v in (f["lo"], f["hi"]):
         sel = (mk == v) if f["field"] == "mk" else ((ptype != TYPE_FLUID) & (label == v))
         ends[v] = names[int(ptype[sel][0])]
+        f["ptype"] = int(ptype[sel][0])     # the selection keeps to it (output_parts._mk)
     if len(set(ends.values())) > 1:
         what = " and ".join(f"{f['field']} {v} is {t}" for v, t in ends.items())
         raise CaseError(f"<filtermk> range {f['field']} {f['lo']}-{f['hi']} includes different types of particles "

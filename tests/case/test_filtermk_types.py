@@ -67,3 +67,17 @@ def test_gencase_exits_2(tmp_path):
     case = write_case(tmp_path, case_text("mk", "1-12"))
     res = CliRunner().invoke(main, ["gencase", case, "-o", str(tmp_path / "out")])
     assert res.exit_code == 2 and "includes different types of particles" in res.output
+
+
+@pytest.mark.parametrize("field, v, mks", [("mkbound", "0-2", {10, 12}), ("mk", "10-12", {10, 12}),
+                                           ("mkbound", "1", {11}), ("mk", "1-2", {1, 2})])
+def test_a_block_of_another_type_inside_the_range_is_not_selected(tmp_path, field, v, mks):
+    """DualSPHysics selects the particle codes between the two ends' mk blocks, all of the ends' type:
+    the floating mkbound 1 (mk 11) inside the fixed range mkbound 0-2 is left out (sphdvi took every
+    mk of the range)."""
+    from sphdvi.output_parts import OutputParts
+    r = build(tmp_path, field, v)
+    p = r.particles
+    sel = OutputParts(r.case.special["outputparts"], r.case.fluidcount).select(p["pos"], p["type"], p["mk"])
+    assert set(p["mk"][sel].tolist()) == mks
+    assert sel.sum() == sum((p["mk"] == m).sum() for m in mks)
