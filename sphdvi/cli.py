@@ -168,9 +168,10 @@ def run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet,
         _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop)
 
 
-def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
+def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop, hint=None):
     """OUT from SOURCE and -o, locked for the command's life (:func:`~sphdvi.io.runfolder.run_lock`:
-    a second run into it is refused), then :func:`_run_locked`."""
+    a second run into it is refused), then :func:`_run_locked`.  ``hint``: rewrites the message of
+    a run that did not complete (a sweep's entry: its advice names the sweep's command)."""
     from .errors import InputError
     from .io.runfolder import run_command, run_lock
     is_xml = os.path.isfile(source) and source.lower().endswith(".xml")
@@ -185,10 +186,10 @@ def _run(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet
         raise InputError(f"--resume: {outdir} does not exist: there is no run to continue; start one without "
                          f"--resume: {run_command(source, outdir, tmax=tmax, tout=tout, sets=sets)}")
     with run_lock(outdir):
-        _run_locked(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop)
+        _run_locked(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop, hint)
 
 
-def _run_locked(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop):
+def _run_locked(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp, quiet, stop, hint=None):
     from .errors import InputError
     from .io.runfolder import (SetAside, case_outputs, check_new_run_folder, check_other_case, earlier_exports,
                                earlier_results, restored_on_bad_input)
@@ -221,7 +222,7 @@ def _run_locked(source, outdir, tmax, tout, threads, sets, resume, overwrite, dp
     result = run_case(case_h5, outdir, tmax=tmax, tout=tout, threads=threads, sets=sets, resume=resume,
                       quiet=quiet, expect_dp=drawn_dp, overwrite=overwrite, stop=stop, set_aside=set_aside)
     if result.status != "completed":
-        click.echo(f"{result.status}: {result.message}", err=True)
+        click.echo(f"{result.status}: {hint(result.message) if hint else result.message}", err=True)
     elif not quiet:
         click.echo(f"completed: t = {result.physical_time:.6g} s, {result.steps} steps, "
                    f"{result.runtime_s:.2f} s of time stepping -> {outdir}", err=True)

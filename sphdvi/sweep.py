@@ -55,6 +55,35 @@ def run_dir_name(index: int, count: int) -> str:
 # ---------------------------------------------------------------------------------
 # the parameter space: --vary, --table
 # ---------------------------------------------------------------------------------
+def canonical_key(key: str) -> str:
+    """A varied or fixed key as ``sphdvi run --set`` identifies it: the <constantsdef> constants it
+    takes in any letter case (CFLnumber, :data:`sphdvi.simulation.RUN_CONSTANTS`) under their one
+    name; the <parameters> keys as written (case-sensitive, as in the XML)."""
+    from .simulation import RUN_CONSTANTS
+    key = key.strip()
+    return RUN_CONSTANTS.get(key.lower(), key)
+
+
+def _same_value_key(value: str):
+    """What makes two values of a key the same run: the number (``0.01``, ``0.010``, ``1e-2``),
+    else the text."""
+    try:
+        return float(value)
+    except ValueError:
+        return value
+
+
+def _check_repeats(key: str, values, where: str) -> None:
+    """Values of one key that are the same number (``0.01,0.010``): the same runs twice."""
+    seen = {}
+    for v in values:
+        k = _same_value_key(v)
+        if k in seen:
+            raise InputError(f"{where} {key}: {seen[k]} and {v} are the same value (the same runs twice); "
+                             "expected each value once")
+        seen[k] = v
+
+
 def parse_vary(items) -> tuple[list[str], list[list[str]]]:
     """``--vary KEY=V1,V2,...`` (repeatable) -> the keys and their value lists, in the order given."""
     keys, values = [], []
@@ -64,8 +93,10 @@ def parse_vary(items) -> tuple[list[str], list[list[str]]]:
         if not sep or not key or not text or any(not v for v in vals):
             raise InputError(f"--vary {item!r}: expected KEY=V1,V2,... (a key, then values separated by commas, "
                              "none empty)")
+        key = canonical_key(key)
         if key in keys:
             raise InputError(f"--vary {key}: given twice; expected each key once, with all its values")
+        _check_repeats(key, vals, "--vary")
         keys.append(key)
         values.append(vals)
     return keys, values
@@ -77,29 +108,40 @@ def product_rows(values: list[list[str]]) -> list[list[str]]:
 
 
 def read_table(path: str) -> tuple[list[str], list[list[str]]]:
-    """``--table FILE.csv``: the header names the keys, each further row is one run (blank lines skipped)."""
+    """``--table FILE.csv``: the header names the keys, each further row is one run (blank lines
+    skipped; blanks after a comma allowed, as in hand-written CSV files)."""
     try:
         with open(path, newline="", encoding="utf-8-sig") as fh:
             text = fh.read()
-    except OSError as exc:
-        raise InputError(f"--table {path}: cannot be read ({exc.strerror or exc}); expected a CSV file whose "
-                         "header names the keys and whose rows give one run each") from None
-    lines = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(text)), start=1) if any(c.strip() for c in row)]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"--table {path}: cannot be read ({getattr(exc, 'strerror', None) or exc}); expected a "
+                         "CSV text file whose header names the keys and whose rows give one run each") from None
+    lines = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(text), skipinitialspace=True), start=1)
+             if any(c.strip() for c in row)]
     if not lines:
         raise InputError(f"--table {path}: empty; expected a header naming the keys, then one row per run")
-    keys = [k.strip() for k in lines[0][1]]
+    keys = [canonical_key(k) for k in lines[0][1]]
+    if len(keys) == 1 and (";" in keys[0] or "\t" in keys[0]):
+        raise InputError(f"{path}:{lines[0][0]}: the header has one column {keys[0]!r}; expected the keys "
+                         "separated by ',' (a ';' or tab separated table: save it with commas)")
     if any(not k for k in keys):
         raise InputError(f"{path}:{lines[0][0]}: an empty column name in the header; expected the keys (dp or "
                          "--set keys)")
     dup = sorted({k for k in keys if keys.count(k) > 1})
     if dup:
-        raise InputError(f"{path}:{lines[0][0]}: column {', '.join(dup)} given twice; expected each key once")
-    rows = []
+        raise InputError(f"{path}:{lines[0][0]}: column {', '.join(dup)} given twice; expected each key once "
+                         "(CFLnumber in any letter case is one key)")
+    rows, seen = [], {}
     for n, row in lines[1:]:
         cells = [c.strip() for c in row]
         if len(cells) != len(keys) or any(not c for c in cells):
             raise InputError(f"{path}:{n}: {len(cells)} values {cells}; expected {len(keys)} values, none empty "
                              f"({', '.join(keys)})")
+        same = tuple(_same_value_key(c) for c in cells)
+        if same in seen:
+            raise InputError(f"{path}:{n}: the same run as line {seen[same]} ({describe(keys, cells)}); expected "
+                             "each run once")
+        seen[same] = n
         rows.append(cells)
     if not rows:
         raise InputError(f"{path}: a header and no rows; expected one row per run")
@@ -107,13 +149,14 @@ def read_table(path: str) -> tuple[list[str], list[list[str]]]:
 
 
 def _check_key_names(keys, sets) -> None:
-    """The varied keys: not the manifest's own columns, not also fixed with --set."""
-    fixed = {str(s).partition("=")[0].strip() for s in sets or ()}
+    """The varied keys: not the manifest's own columns, not also fixed with --set (CFLnumber in any
+    letter case is one key, as for ``--set``)."""
+    fixed = {canonical_key(str(s).partition("=")[0]) for s in sets or ()}
     for key in keys:
         if key.lower() in RESERVED:
             raise InputError(f"{key}: a column of the manifest itself ({', '.join(RESERVED)}); expected dp or a "
                              "--set key")
-        if key in fixed:
+        if canonical_key(key) in fixed:
             raise InputError(f"{key}: both varied and fixed with --set {key}=...; expected one of them")
 
 
@@ -160,9 +203,11 @@ def _check_dp(value: str, where: str) -> None:
 
 def check_entries(case_xml: str, keys, rows, sets, tmax, tout, source: str = "--vary") -> list[str]:
     """Check every key and value of the sweep as ``sphdvi run --set``/``--dp`` would (InputError
-    naming the key, exit 2, before anything is written): each value alone, then each entry whole
-    (the checks across parameters, e.g. RhopOutMin < RhopOutMax).  Returns the warnings those
-    checks give (each once), for the command to print."""
+    naming the key, exit 2, before anything is written): each entry whole (the checks across
+    parameters, e.g. RhopOutMin < RhopOutMax), an entry's error named by the value that fails
+    alone where one does (per-key messages; a value valid only with the other values of its
+    entry is accepted).  Returns the warnings those checks give (each once), for the command to
+    print."""
     from .simulation import apply_overrides, conflicting_options
     _check_key_names(keys, sets)
     base = case_parameters(case_xml)
@@ -171,6 +216,7 @@ def check_entries(case_xml: str, keys, rows, sets, tmax, tout, source: str = "--
         warnings.simplefilter("always")
         conflicting_options(sets, tmax, tout)
         apply_overrides(base, sets, tmax, tout)
+        alone = {}          # (key, value) -> its message when it fails against the case's other values
         for col, key in enumerate(keys):
             for value in dict.fromkeys(row[col] for row in rows):
                 where = f"{source} {key}={value}"
@@ -181,7 +227,8 @@ def check_entries(case_xml: str, keys, rows, sets, tmax, tout, source: str = "--
                     conflicting_options([f"{key}={value}"], tmax, tout)
                     apply_overrides(base, list(sets or ()) + [f"{key}={value}"], tmax, tout)
                 except InputError as exc:
-                    raise InputError(f"{where}: {exc}") from None
+                    alone[(key, value)] = f"{where}: {exc}"
+                    continue
                 _check_data_file(key, value, where)
         for item in sets or ():
             key, _, value = (x.strip() for x in str(item).partition("="))
@@ -189,9 +236,11 @@ def check_entries(case_xml: str, keys, rows, sets, tmax, tout, source: str = "--
         for i, row in enumerate(rows):
             entry_sets, _ = _entry_sets(keys, row, sets)
             try:
+                conflicting_options(entry_sets, tmax, tout)
                 apply_overrides(base, entry_sets, tmax, tout)
             except InputError as exc:
-                raise InputError(f"run {i} ({describe(keys, row)}): {exc}") from None
+                failed = [alone[(k, v)] for k, v in zip(keys, row) if (k, v) in alone]
+                raise InputError(failed[0] if failed else f"run {i} ({describe(keys, row)}): {exc}") from None
     for w in caught:
         text = str(w.message)
         if text not in seen:
@@ -248,24 +297,66 @@ def file_sha256(path: str) -> str:
     return h.hexdigest()
 
 
-def make_spec(case_xml: str, keys, rows, sets, tmax, tout, threads: int, time_limit: str, throttle: int) -> dict:
-    """sweep.json: everything needed to run entry i (its values: ``runs[i]``, in ``keys`` order)."""
+def case_data_files(case_xml: str) -> dict:
+    """The files a case names ({path relative to its folder: sha256}): every attribute value or
+    element text of the XML that names a file in the case's folder or below (``[CaseName]``
+    replaced), as GenCase and DualSPHysics resolve them (against DirCase, the case's folder):
+    motion tables (<mvrotfile>, <file>), STL/PLY/VTK drawings, ViscoTime/DtFixedFile, property
+    and model files.  Each new run's gencase reads them again, so they are part of the case."""
+    import xml.etree.ElementTree as ET
+    from .case.reader import case_name_from_path
+    base = os.path.dirname(os.path.abspath(case_xml))
+    name = case_name_from_path(case_xml)
+    try:
+        root = ET.parse(case_xml).getroot()
+    except (OSError, ET.ParseError):
+        return {}
+    found = {}
+    for el in root.iter():
+        for value in [*el.attrib.values(), el.text or ""]:
+            value = value.strip()
+            if not value or value.startswith("#") or "\n" in value or "\x00" in value or len(value) > 4096:
+                continue
+            value = re.sub(r"\[casename\]", lambda _: name, value.replace("\\", "/"), flags=re.IGNORECASE)
+            path = os.path.normpath(os.path.join(base, value))
+            if os.path.commonpath([path, base]) != base or path == os.path.abspath(case_xml) or \
+                    not os.path.isfile(path):
+                continue
+            rel = os.path.relpath(path, base)
+            if rel not in found:
+                found[rel] = file_sha256(path)
+    return dict(sorted(found.items()))
+
+
+def make_spec(case_xml: str, keys, rows, sets, tmax, tout, threads: int, time_limit: str, throttle: int,
+              command: str | None = None) -> dict:
+    """sweep.json: everything needed to run entry i (its values: ``runs[i]``, in ``keys`` order);
+    the case's checksum and those of the files it names (:func:`case_data_files`)."""
     from .simulation import absolute_file_sets
     return {"format": FORMAT, "version": __version__,
             "case": os.path.abspath(case_xml), "case_sha256": file_sha256(case_xml),
+            "case_files": case_data_files(case_xml),
             "set": list(absolute_file_sets(sets)), "tmax": tmax, "tout": tout, "threads": int(threads),
             "keys": list(keys), "runs": absolute_values(keys, rows),
-            "slurm": {"time": time_limit, "throttle": int(throttle)}}
+            "slurm": {"time": time_limit, "throttle": int(throttle), "command": command}}
 
 
 def spec_differences(old: dict, new: dict) -> list[str]:
     """What differs between two sweep specs (the sphdvi version aside), in words."""
     out = []
-    for name in ("case", "case_sha256", "set", "tmax", "tout", "threads", "keys"):
+    for name in ("case", "case_sha256", "case_files", "set", "tmax", "tout", "threads", "keys"):
+        if name == "case_files" and name not in old:        # a sweep made before they were recorded
+            continue
         if old.get(name) != new.get(name):
-            what = "the case file's content" if name == "case_sha256" else name
-            out.append(f"{what}: {old.get(name)!r} -> {new.get(name)!r}" if name != "case_sha256"
-                       else f"{what} (edited since the sweep was made)")
+            if name == "case_sha256":
+                out.append("the case file's content (edited since the sweep was made)")
+            elif name == "case_files":
+                a, b = old.get(name) or {}, new.get(name) or {}
+                changed = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+                out.append(f"the case's data files ({', '.join(changed)}: edited, added or removed since the "
+                           "sweep was made)")
+            else:
+                out.append(f"{name}: {old.get(name)!r} -> {new.get(name)!r}")
     if old.get("keys") == new.get("keys") and old.get("runs") != new.get("runs"):
         a, b = old.get("runs") or [], new.get("runs") or []
         if len(a) != len(b):
@@ -276,27 +367,56 @@ def spec_differences(old: dict, new: dict) -> list[str]:
     return out
 
 
+# SLURM's default MaxArraySize (slurm.conf): an --array index above MaxArraySize - 1 is refused
+SLURM_MAX_ARRAY = 1001
+
+
+def _sbatch_path(path: str, tail: str = "") -> str:
+    """A path in an ``#SBATCH`` line as sbatch's parser reads it (slurm src/sbatch/opt.c
+    _get_argument: blanks split words, an unescaped ``#`` starts a comment, ``\\`` escapes, quotes
+    group) and as --output's pattern reads it (``%%`` is a literal ``%``): in double quotes, with
+    ``"`` and ``#`` escaped.  A backslash (it turns off --output's %A/%a) or a line break cannot
+    be written: InputError.  ``tail``: a pattern put after the path as it is (``/%A_%a.out``)."""
+    if "\\" in path or "\n" in path or "\r" in path:
+        raise InputError(f"-o {path}: the sweep folder's path holds a backslash or a line break, which an #SBATCH "
+                         "line cannot hold (SLURM's --output); expected another -o folder")
+    text = path.replace("%", "%%").replace('"', '\\"').replace("#", "\\#")
+    return f'"{text}{tail}"'
+
+
+def check_sweep_path(sweepdir: str) -> None:
+    """The sweep folder can be named in sweep.sbatch (InputError before anything is written)."""
+    _sbatch_path(os.path.join(os.path.abspath(sweepdir), LOGS))
+
+
 def sbatch_script(sweepdir: str, spec: dict) -> str:
     """sweep.sbatch: a SLURM job array, task I = entry I (``sbatch sweep.sbatch``; submitting it
-    again skips the completed entries and resumes the interrupted ones)."""
+    again skips the completed entries and resumes the interrupted ones).  The task runs this
+    Python's sphdvi (``sys.executable -m sphdvi``, found without the submitting shell's PATH) or
+    the sweep's ``--command``, with ``--threads`` SLURM's --cpus-per-task."""
     import shlex
+    import sys
     sweepdir = os.path.abspath(sweepdir)
     n = len(spec["runs"])
-    k = min(int(spec["slurm"]["throttle"]), n)
+    slurm = spec["slurm"]
+    k = min(int(slurm["throttle"]), n)
     name = re.sub(r"[^A-Za-z0-9_.-]", "_", os.path.basename(sweepdir.rstrip(os.sep))) or "sweep"
     keys = ", ".join(spec["keys"])
+    threads = int(spec["threads"])
+    command = slurm.get("command") or f"{shlex.quote(sys.executable)} -m sphdvi"
     return "\n".join([
         "#!/bin/bash",
         f"#SBATCH --job-name=sphdvi-{name}",
         f"#SBATCH --array=0-{n - 1}%{k}",
         "#SBATCH --ntasks=1",
-        f"#SBATCH --cpus-per-task={int(spec['threads'])}",
-        f"#SBATCH --time={spec['slurm']['time']}",
-        f"#SBATCH --output={os.path.join(sweepdir, LOGS)}/%A_%a.out",
+        f"#SBATCH --cpus-per-task={threads}",
+        f"#SBATCH --time={slurm['time']}",
+        f"#SBATCH --output={_sbatch_path(os.path.join(sweepdir, LOGS), '/%A_%a.out')}",
         f"# sphdvi sweep of {spec['case']}: {n} runs ({keys}); written by sphdvi {spec['version']}.",
-        "# Submit with 'sbatch' from an environment where 'sphdvi' is on PATH (SLURM passes it on). Submitting",
-        "# it again skips the completed runs and resumes the interrupted ones; 'sphdvi sweep status' shows them.",
-        f"sphdvi run --manifest {shlex.quote(os.path.join(sweepdir, MANIFEST))} --index $SLURM_ARRAY_TASK_ID",
+        "# Submitting it again skips the completed runs and resumes the interrupted ones; 'sphdvi sweep status'",
+        "# shows them. --threads follows --cpus-per-task (SLURM_CPUS_PER_TASK).",
+        f"{command} run --manifest {shlex.quote(os.path.join(sweepdir, MANIFEST))} --index $SLURM_ARRAY_TASK_ID "
+        f"--threads ${{SLURM_CPUS_PER_TASK:-{threads}}}",
         ""])
 
 
@@ -310,9 +430,13 @@ def manifest_text(keys, runs, statuses) -> str:
     return buf.getvalue()
 
 
-def _own_names(name: str) -> bool:
-    """What ``sweep new`` writes into SWEEPDIR (a folder holding only these may be written again)."""
-    return (name in (MANIFEST, SPEC, SBATCH, LOCK, LOGS) or re.fullmatch(r"run_\d{4,}", name) is not None
+def _own_names(name: str, sweepdir: str) -> bool:
+    """What ``sweep new`` writes into SWEEPDIR (a folder holding only these may be written again):
+    its files, logs/, and run_XXXX folders that are empty (one holding a run is another sweep's)."""
+    if re.fullmatch(r"run_\d{4,}", name):
+        path = os.path.join(sweepdir, name)
+        return os.path.isdir(path) and not os.listdir(path)
+    return (name in (MANIFEST, SPEC, SBATCH, LOCK, LOGS)
             or (name.startswith(".") and name.endswith(".tmp")))
 
 
@@ -334,16 +458,20 @@ def read_spec(sweepdir: str) -> dict | None:
 
 
 def create_sweep(sweepdir: str, spec: dict) -> str:
-    """Write the sweep folder; returns 'created', 'unchanged' (the same spec is there) or
-    'updated' (only --time/--throttle changed: sweep.sbatch is written again).  Another spec
-    there, or a folder holding other files: InputError saying what differs."""
+    """Write the sweep folder; returns 'created', 'unchanged' (the same spec is there),
+    'updated' (only --time/--throttle/--command changed: sweep.sbatch is written again) or
+    'moved' (the same spec, but sweep.sbatch named another folder or Python: written again).
+    Another spec there, or a folder holding other files (a run_XXXX holding a run among them):
+    InputError saying what differs."""
     from .io.atomic import make_folder, write_text_atomic
+    check_sweep_path(sweepdir)
     old = read_spec(sweepdir)
     if old is None and os.path.isdir(sweepdir):
-        others = sorted(n for n in os.listdir(sweepdir) if not _own_names(n))
+        others = sorted(n for n in os.listdir(sweepdir) if not _own_names(n, sweepdir))
         if others:
             raise InputError(f"-o {sweepdir}: holds other files ({', '.join(others[:5])}"
-                             f"{', ...' if len(others) > 5 else ''}) and no {SPEC}; expected a new or empty folder")
+                             f"{', ...' if len(others) > 5 else ''}) and no {SPEC}; expected a new or empty folder "
+                             "(a run_XXXX folder holding a run belongs to another sweep)")
     if old is not None:
         diffs = spec_differences(old, spec)
         if diffs:
@@ -354,16 +482,34 @@ def create_sweep(sweepdir: str, spec: dict) -> str:
     for i in range(len(runs)):
         os.makedirs(os.path.join(sweepdir, run_dir_name(i, len(runs))), exist_ok=True)
     os.makedirs(os.path.join(sweepdir, LOGS), exist_ok=True)    # SLURM does not create --output's folder
-    if old is not None and old.get("slurm") == spec["slurm"]:
-        return "unchanged"
+    if old is not None:
+        spec = dict(spec, version=old.get("version", spec["version"]))
+        if "case_files" not in old:
+            spec.pop("case_files", None)
+    if old is not None and _same_slurm(old.get("slurm"), spec["slurm"]):
+        script = sbatch_script(sweepdir, dict(spec, slurm=old["slurm"]))
+        path = os.path.join(sweepdir, SBATCH)
+        text = None
+        with contextlib.suppress(OSError, UnicodeDecodeError):
+            with open(path, encoding="utf-8") as fh:
+                text = fh.read()
+        if text == script:
+            return "unchanged"
+        write_text_atomic(path, script)
+        return "moved"
     if old is None:
         write_text_atomic(os.path.join(sweepdir, MANIFEST),
                           manifest_text(spec["keys"], runs, ["pending"] * len(runs)))
-    else:
-        spec = dict(spec, version=old.get("version", spec["version"]))
     write_text_atomic(os.path.join(sweepdir, SBATCH), sbatch_script(sweepdir, spec))
     write_text_atomic(os.path.join(sweepdir, SPEC), json.dumps(spec, indent=2) + "\n")   # last: the marker
     return "created" if old is None else "updated"
+
+
+def _same_slurm(old, new) -> bool:
+    """The same job settings (a spec written before --command: no command, the default)."""
+    old = dict(old or {})
+    old.setdefault("command", None)
+    return old == new
 
 
 @dataclass
@@ -390,9 +536,12 @@ class Sweep:
 
 def open_sweep(path: str, option: str = "SWEEPDIR", check_manifest: bool = True) -> Sweep:
     """A sweep from its folder or its manifest (SWEEPDIR/sweep.csv); anything else: InputError.
-    ``check_manifest``: sweep.csv must hold sweep.json's entries (``sweep status`` writes it anew)."""
+    ``check_manifest``: sweep.csv must hold sweep.json's entries (an edited one: InputError;
+    ``sweep status`` writes it anew).  A missing or unreadable sweep.csv (a view of sweep.json
+    and the runs' run.json) is a warning: the next update of the manifest writes it again."""
+    is_manifest = os.path.basename(os.path.abspath(path)) == MANIFEST and not os.path.isdir(path)
     folder = os.path.abspath(path) if os.path.isdir(path) else os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(path) and (not os.path.isfile(path) or os.path.basename(path) != MANIFEST):
+    if not os.path.isdir(path) and not (is_manifest and os.path.isfile(os.path.join(folder, SPEC))):
         raise InputError(f"{option} {path}: not a sweep folder or its {MANIFEST}; expected what 'sphdvi sweep new "
                          "-o SWEEPDIR' wrote")
     spec = read_spec(folder)
@@ -400,7 +549,13 @@ def open_sweep(path: str, option: str = "SWEEPDIR", check_manifest: bool = True)
         raise InputError(f"{option} {path}: no {SPEC} in {folder}: not a sweep made by 'sphdvi sweep new'")
     sweep = Sweep(folder, spec)
     if check_manifest:
-        _check_manifest(sweep, option)
+        try:
+            rows = read_manifest(sweep)
+        except InputError as exc:
+            warnings.warn(f"{exc}: the statuses are read from the runs' run.json; it is written again from "
+                          f"{SPEC} at the next update ('sphdvi sweep status')")
+        else:
+            _check_manifest(sweep, option, rows)
     return sweep
 
 
@@ -409,13 +564,13 @@ def read_manifest(sweep: Sweep) -> list[dict]:
     try:
         with open(sweep.manifest, newline="", encoding="utf-8") as fh:
             return list(csv.DictReader(fh))
-    except OSError as exc:
-        raise InputError(f"{sweep.manifest}: cannot be read ({exc.strerror or exc})") from None
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{sweep.manifest}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
 
 
-def _check_manifest(sweep: Sweep, option: str) -> None:
+def _check_manifest(sweep: Sweep, option: str, rows=None) -> None:
     """sweep.csv holds sweep.json's entries (index, values, dir) in order."""
-    rows = read_manifest(sweep)
+    rows = read_manifest(sweep) if rows is None else rows
     header = ["index", *sweep.keys, "dir", "status"]
     n = len(sweep.runs)
     if not rows or list(rows[0].keys()) != header or len(rows) != n:
@@ -430,56 +585,192 @@ def _check_manifest(sweep: Sweep, option: str) -> None:
                              "new sweep for other values)")
 
 
+_UNLOCKED_WARNED: set = set()      # sweep folders whose lock failed (warned once per process)
+
+
 @contextlib.contextmanager
 def _manifest_lock(sweep: Sweep):
     """SWEEPDIR/.sweep.lock held exclusively (``flock``, blocking): the array tasks that end at once
-    update sweep.csv one after the other."""
+    update sweep.csv one after the other.  A file system without flock (Lustre -o noflock, some
+    NFS mounts): a warning (once), and the update goes on unlocked (each writer reads every
+    entry's run.json, so the next one repairs an update lost meanwhile)."""
     import fcntl
     fd = os.open(os.path.join(sweep.dir, LOCK), os.O_RDWR | os.O_CREAT, 0o644)
     try:
-        with contextlib.suppress(OSError):        # a file system without flock: the rename stays atomic
+        try:
             fcntl.flock(fd, fcntl.LOCK_EX)
+        except OSError as exc:
+            if sweep.dir not in _UNLOCKED_WARNED:
+                _UNLOCKED_WARNED.add(sweep.dir)
+                warnings.warn(f"{os.path.join(sweep.dir, LOCK)}: cannot lock it ({exc.strerror or exc}): "
+                              f"{MANIFEST} is updated without the lock (a status written at the same time by "
+                              "another task may be lost until 'sphdvi sweep status')")
         yield
     finally:
         os.close(fd)                           # releases the lock
 
 
-def update_manifest(sweep: Sweep, statuses: dict) -> None:
-    """Set the ``status`` of the entries ``statuses`` names ({index: status}) in sweep.csv: read,
-    changed and written again (a temporary file renamed over it) under the sweep's lock."""
+def update_manifest(sweep: Sweep, indices=None) -> tuple[list[str], dict]:
+    """Set the ``status`` of the entries ``indices`` (all when None) in sweep.csv from their
+    run.json, read *under* the sweep's lock (so that the last writer writes the current truth,
+    not what it read before another task's update), and write it again (a temporary file renamed
+    over it).  An entry whose run.json cannot be read or belongs to another run keeps its status.
+    Returns every entry's status and {index: message} of those problems."""
     from .io.atomic import write_text_atomic
-    if not statuses:
-        return
+    n = len(sweep.runs)
+    indices = range(n) if indices is None else list(indices)
+    problems = {}
     with _manifest_lock(sweep):
         text = None
-        with contextlib.suppress(OSError):
+        with contextlib.suppress(OSError, UnicodeDecodeError):
             with open(sweep.manifest, encoding="utf-8") as fh:
                 text = fh.read()
         try:
-            _check_manifest(sweep, "")
-            current = [row["status"] for row in read_manifest(sweep)]
+            rows = read_manifest(sweep)
+            _check_manifest(sweep, "", rows)
+            current = [row["status"] for row in rows]
         except (InputError, KeyError):          # missing or edited: written anew from sweep.json
-            current = ["pending"] * len(sweep.runs)
-        new = manifest_text(sweep.keys, sweep.runs, [statuses.get(i, s) for i, s in enumerate(current)])
+            current = ["pending"] * n
+        for i in indices:
+            try:
+                current[i] = entry_status(sweep, i)
+            except InputError as exc:
+                problems[i] = str(exc)
+        new = manifest_text(sweep.keys, sweep.runs, current)
         if new != text:
             write_text_atomic(sweep.manifest, new)
+    return current, problems
 
 
 # ---------------------------------------------------------------------------------
 # one entry: its state, what `sphdvi run --manifest --index` does with it
 # ---------------------------------------------------------------------------------
+REFUSED = ".sweep-refused"      # in a run folder: the message of the start-up that refused the entry
+
+
 def run_info(rundir: str) -> dict | None:
-    """The entry's run.json (None when it has none or it cannot be read)."""
-    from .validation.runs import run_info as read
+    """The entry's run.json (None when it has none); one that exists but cannot be read or is not
+    a run.json: InputError naming it (never taken for "no run yet": the folder holds results)."""
+    path = os.path.join(rundir, "run.json")
     try:
-        meta = read(rundir)
-    except (OSError, ValueError):
+        with open(path, encoding="utf-8") as fh:
+            meta = json.load(fh)
+    except FileNotFoundError:
         return None
-    return meta if isinstance(meta, dict) and meta else None
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc}); the entry's results "
+                         "are left as they are: put a whole run.json back, or move the folder's files away to run "
+                         "the entry again") from None
+    if not isinstance(meta, dict) or "status" not in meta:
+        raise InputError(f"{path}: not a run's run.json (no status); the entry's results are left as they are: "
+                         "move the folder's files away to run the entry again")
+    return meta
+
+
+def entry_sets(sweep: Sweep, index: int) -> tuple[list[str], float | None]:
+    """Entry ``index``'s --set list and --dp, as ``sphdvi run --manifest --index`` runs it."""
+    return _entry_sets(sweep.keys, sweep.runs[index], sweep.spec.get("set"))
+
+
+def _norm_set(item) -> tuple[str, str]:
+    key, _, value = (x.strip() for x in str(item).partition("="))
+    return canonical_key(key), value
+
+
+def _same_number(a, b) -> bool:
+    try:
+        a, b = float(a), float(b)
+    except (TypeError, ValueError):
+        return False
+    return a == b or abs(a - b) <= 1e-9 * max(abs(a), abs(b))
+
+
+def foreign_run(sweep: Sweep, index: int, meta: dict) -> list[str]:
+    """What in run.json says the run in entry ``index``'s folder is not that entry's run: its case
+    (run.json ``case``), --tmax/--tout/--set (``overrides``), dp (``constants``), or for a run.json
+    without ``overrides`` the varied parameters' values (``parameters``); [] when it is the
+    entry's.  Fields run.json lacks are not compared."""
+    from .case.reader import case_name_from_path
+    sets, dp = entry_sets(sweep, index)
+    out = []
+    case = case_name_from_path(sweep.spec.get("case") or "")
+    if meta.get("case") is not None and meta.get("case") != case:
+        out.append(f"case {meta.get('case')!r}, not {case!r}")
+    given = meta.get("overrides")
+    if isinstance(given, dict):
+        for name in ("tmax", "tout"):
+            want, got = sweep.spec.get(name), given.get(name)
+            if (want is None) != (got is None) or (want is not None and not _same_number(want, got)):
+                out.append(f"--{name} {got}, not {want}")
+        if [_norm_set(x) for x in given.get("set") or ()] != [_norm_set(x) for x in sets]:
+            out.append(f"--set {' '.join(map(str, given.get('set') or ())) or '(none)'}, not "
+                       f"{' '.join(sets) or '(none)'}")
+    constants = meta.get("constants") if isinstance(meta.get("constants"), dict) else {}
+    if dp is not None and constants.get("dp") is not None and not _same_number(constants["dp"], dp):
+        out.append(f"dp {constants['dp']}, not {dp:g}")
+    params = meta.get("parameters") if isinstance(meta.get("parameters"), dict) and not isinstance(given, dict) \
+        else {}             # --set says it exactly; the parameters only for a run.json without overrides
+    for key, value in zip(sweep.keys, sweep.runs[index]):
+        got = constants.get("cflnumber") if key == "CFLnumber" else params.get(key)
+        if key == DP_KEY or got is None or isinstance(got, (str, bool)):
+            continue
+        try:
+            float(value)
+        except ValueError:
+            continue
+        if not _same_number(got, value):
+            out.append(f"{key} {got}, not {value}")
+    return out
+
+
+def entry_meta(sweep: Sweep, index: int) -> dict | None:
+    """Entry ``index``'s run.json when it is this entry's run (None: no run yet); InputError when
+    it cannot be read (:func:`run_info`) or the folder holds another run (:func:`foreign_run`:
+    a sweep folder made again where another sweep's runs were, a run copied in by hand)."""
+    rundir = sweep.run_dir(index)
+    meta = run_info(rundir)
+    if meta is None:
+        return None
+    diffs = foreign_run(sweep, index, meta)
+    if diffs:
+        raise InputError(f"{rundir} holds another run than entry {index} ({describe(sweep.keys, sweep.runs[index])}) "
+                         f"of {os.path.join(sweep.dir, SPEC)}: its run.json has {'; '.join(diffs)}; move that "
+                         "folder's files away (or delete them) to run the entry, or make the sweep in another folder")
+    return meta
+
+
+def refused_message(rundir: str) -> str | None:
+    """Why the entry's last start-up refused it (exit 2, before its run.json), or None."""
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        with open(os.path.join(rundir, REFUSED), encoding="utf-8") as fh:
+            return fh.read().strip() or "refused"
+    return None
+
+
+def mark_refused(rundir: str, message: str) -> None:
+    """Record a start-up's refusal (bad input, exit 2) in the run folder, for ``sweep status``."""
+    from .io.atomic import write_text_atomic
+    with contextlib.suppress(OSError):
+        write_text_atomic(os.path.join(rundir, REFUSED), message.strip() + "\n")
+
+
+def clear_refused(rundir: str) -> None:
+    with contextlib.suppress(OSError):
+        os.unlink(os.path.join(rundir, REFUSED))
+
+
+def entry_status(sweep: Sweep, index: int) -> str:
+    """The entry's status: run.json's; ``refused`` when its last start-up refused it on bad
+    input; ``pending`` when it has no run yet.  InputError from :func:`entry_meta`."""
+    meta = entry_meta(sweep, index)
+    if meta:
+        return str(meta.get("status") or "pending")
+    return "refused" if refused_message(sweep.run_dir(index)) is not None else "pending"
 
 
 def run_status(rundir: str) -> str:
-    """The entry's status: run.json's, ``pending`` when it has none."""
+    """The status in a run folder's run.json (``pending`` when it has none); InputError when it
+    cannot be read."""
     meta = run_info(rundir)
     return str(meta.get("status") or "pending") if meta else "pending"
 
@@ -496,11 +787,14 @@ class Action:
     exit_code: int = EXIT_OK
 
 
-def entry_action(rundir: str, retry: bool = False) -> Action:
-    """The entry's next step from its run.json (conventions.md §4.1: "the idempotency marker for sweeps")."""
+def entry_action(sweep: Sweep, index: int, retry: bool = False) -> Action:
+    """The entry's next step from its run.json (conventions.md §4.1: "the idempotency marker for
+    sweeps"), once :func:`entry_meta` has checked that it is this entry's run (InputError when not,
+    or when it cannot be read)."""
     from .io.checkpoint import RESTART_FILE
     from .io.runfolder import earlier_results
-    meta = run_info(rundir)
+    rundir = sweep.run_dir(index)
+    meta = entry_meta(sweep, index)
     if meta is None:
         return Action("fresh", "no run yet", overwrite=bool(earlier_results(rundir)))
     status = str(meta.get("status"))
@@ -519,21 +813,38 @@ def entry_action(rundir: str, retry: bool = False) -> Action:
                   + "; --retry runs it again from the start", exit_code=code)
 
 
+def check_case_unchanged(sweep: Sweep) -> None:
+    """The case file and the data files it names are as when the sweep was made (a new run's
+    gencase reads them again): InputError naming the first that changed."""
+    case = sweep.spec["case"]
+    where = os.path.join(sweep.dir, SPEC)
+    if not os.path.isfile(case):
+        raise InputError(f"{where}: the case file {case} is gone; expected it where it was when the sweep was made")
+    if file_sha256(case) != sweep.spec.get("case_sha256"):
+        raise InputError(f"{case} has changed since the sweep was made ({where}): a new run would differ from "
+                         "those run before; put the file back as it was, or make a new sweep")
+    base = os.path.dirname(case)
+    for rel, digest in (sweep.spec.get("case_files") or {}).items():
+        path = os.path.join(base, rel)
+        try:
+            same = file_sha256(path) == digest
+        except OSError:
+            same = False
+        if not same:
+            raise InputError(f"{path}, a file the case {case} names, has changed (or is gone) since the sweep was "
+                             f"made ({where}): a new run would differ from those run before; put the file back as "
+                             "it was, or make a new sweep")
+
+
 def entry_run_options(sweep: Sweep, index: int, action: Action) -> dict:
     """The options of ``sphdvi run`` for entry ``index`` (keywords of ``sphdvi.cli._run``)."""
     rundir = sweep.run_dir(index)
     if action.kind == "resume":       # the run's own --tmax/--tout/--set are in its run.json
         return dict(source=rundir, outdir=rundir, tmax=None, tout=None, sets=(), resume=True, overwrite=False,
                     dp=None)
-    case = sweep.spec["case"]
-    if not os.path.isfile(case):
-        raise InputError(f"{os.path.join(sweep.dir, SPEC)}: the case file {case} is gone; expected it where it was "
-                         "when the sweep was made")
-    if file_sha256(case) != sweep.spec.get("case_sha256"):
-        raise InputError(f"{case} has changed since the sweep was made ({os.path.join(sweep.dir, SPEC)}): a new run "
-                         "would differ from those run before; put the file back as it was, or make a new sweep")
-    sets, dp = _entry_sets(sweep.keys, sweep.runs[index], sweep.spec.get("set"))
-    return dict(source=case, outdir=rundir, tmax=sweep.spec.get("tmax"), tout=sweep.spec.get("tout"),
+    check_case_unchanged(sweep)
+    sets, dp = entry_sets(sweep, index)
+    return dict(source=sweep.spec["case"], outdir=rundir, tmax=sweep.spec.get("tmax"), tout=sweep.spec.get("tout"),
                 sets=tuple(sets), resume=False, overwrite=action.overwrite, dp=dp)
 
 
@@ -543,16 +854,29 @@ def check_index(sweep: Sweep, index: int) -> None:
         raise InputError(f"--index {index}: the sweep in {sweep.dir} has {n} entries; expected 0 to {n - 1}")
 
 
-def refresh(sweep: Sweep) -> list[str]:
-    """Every entry's status from its run.json (``pending`` without one), written into sweep.csv."""
-    statuses = [run_status(sweep.run_dir(i)) for i in range(len(sweep.runs))]
-    update_manifest(sweep, dict(enumerate(statuses)))
-    return statuses
+def refresh(sweep: Sweep) -> tuple[list[str], dict]:
+    """Every entry's status from its run.json (``pending`` without one), written into sweep.csv
+    (:func:`update_manifest`); and {index: message} of the entries whose run.json cannot be read
+    or is another run's."""
+    return update_manifest(sweep, None)
+
+
+def read_statuses(sweep: Sweep) -> tuple[list[str], dict]:
+    """As :func:`refresh`, without writing sweep.csv (a sweep folder this user cannot write)."""
+    statuses, problems = [], {}
+    for i in range(len(sweep.runs)):
+        try:
+            statuses.append(entry_status(sweep, i))
+        except InputError as exc:
+            statuses.append("?")
+            problems[i] = str(exc)
+    return statuses, problems
 
 
 def sweep_exit_code(codes) -> int:
     """The exit code of a whole sweep: 0 when every run completed, else the worst run's: 3 when
-    one diverged, 2 when one was refused on bad input, 1 (failed, interrupted)."""
+    one diverged, 2 when one was refused on bad input, 1 (failed, interrupted, or run elsewhere
+    by another live process)."""
     codes = set(codes)
     for code in (EXIT_DIVERGED, EXIT_INPUT, EXIT_FAILURE):
         if code in codes:
@@ -570,19 +894,59 @@ def default_jobs(threads: int) -> int:
     return max(1, cpus // max(1, int(threads)))
 
 
-def status_rows(sweep: Sweep, statuses) -> list[list[str]]:
-    """``sweep status``'s table: index, parameters, status, physical_time/TimeMax, runtime_s."""
+FINAL = ("completed", "diverged", "failed")        # statuses whose run.json figures are the run's last
+
+
+def run_progress(rundir: str) -> dict:
+    """A running (or killed) run's progress from the last complete row of its run.csv (run.json is
+    written at the start and the end only): {'time': t, 'steps': n}, {} when it has no row yet."""
+    from .io.atomic import complete_lines
+    try:
+        lines = [ln for ln in complete_lines(os.path.join(rundir, "run.csv")) if ln.strip()]
+    except (OSError, UnicodeDecodeError):
+        return {}
+    if len(lines) < 2:
+        return {}
+    head = [h.strip() for h in lines[0].split(",")]
+    last = lines[-1].split(",")
+    out = {}
+    for name, conv in (("time", float), ("steps", int)):
+        with contextlib.suppress(ValueError, IndexError):
+            out[name] = conv(last[head.index(name)])
+    return out
+
+
+def status_rows(sweep: Sweep, statuses, problems=None) -> list[list[str]]:
+    """``sweep status``'s table: index, parameters, status, t/TimeMax (a running or killed run's
+    t from its run.csv), runtime_s; a folder that holds another run or an unreadable run.json said
+    so (:func:`refused_notes`: why the refused entries were refused)."""
     from .io.runfolder import run_lock_holder
+    problems = problems or {}
     out = [["index", *sweep.keys, "status", "t/TimeMax [s]", "runtime_s"]]
     for i, (values, status) in enumerate(zip(sweep.runs, statuses)):
-        meta = run_info(sweep.run_dir(i)) or {}
+        rundir = sweep.run_dir(i)
+        if i in problems:
+            what = "run.json unreadable" if "cannot be read" in problems[i] or "not a run's" in problems[i] \
+                else "another run in the folder"
+            out.append([str(i), *values, f"? ({what})", "-", "-"])
+            continue
+        meta = run_info(rundir) or {}
         shown = status
-        if status == "running" and run_lock_holder(sweep.run_dir(i)) is None:
-            shown = "running (killed: no process holds it)"
         t, tmax = meta.get("physical_time"), (meta.get("parameters") or {}).get("TimeMax")
+        if status == "running":
+            if run_lock_holder(rundir) is None:
+                shown = "running (killed: no process holds it)"
+            t = run_progress(rundir).get("time", t)
+        runtime = meta.get("runtime_s") if status != "running" else None
         out.append([str(i), *values, shown, f"{t:.6g}/{tmax:.6g}" if t is not None and tmax is not None else "-",
-                    f"{meta['runtime_s']:.3g}" if meta.get("runtime_s") is not None else "-"])
+                    f"{runtime:.3g}" if runtime is not None else "-"])
     return out
+
+
+def refused_notes(sweep: Sweep, statuses) -> list[str]:
+    """``run_0003 refused at its start-up: MESSAGE`` for each entry whose status is ``refused``."""
+    return [f"{os.path.basename(sweep.run_dir(i))} refused at its start-up: {refused_message(sweep.run_dir(i))}"
+            for i, status in enumerate(statuses) if status == "refused"]
 
 
 def format_table(rows) -> str:
@@ -600,47 +964,90 @@ def csv_value(v) -> str:
 
 
 def summary_table(sweep: Sweep) -> list[list[str]]:
-    """One row per run: index, parameters, dir, run.json's status and :data:`COLLECT_FIELDS`."""
+    """One row per run: index, parameters, dir, status and :data:`COLLECT_FIELDS` from run.json
+    (:func:`entry_meta`: InputError for a folder holding another run or an unreadable run.json).
+    A running run (run.json written at its start only) gets its steps and physical_time from its
+    run.csv's last row and no runtime_s / us_per_particle_step (figures of a finished run)."""
     rows = [["index", *sweep.keys, "dir", "status", *COLLECT_FIELDS]]
     for i, values in enumerate(sweep.runs):
-        meta = run_info(sweep.run_dir(i)) or {}
-        rows.append([str(i), *values, os.path.basename(sweep.run_dir(i)), str(meta.get("status") or "pending"),
+        meta = dict(entry_meta(sweep, i) or {})
+        status = str(meta.get("status") or entry_status(sweep, i))
+        if status == "running":
+            progress = run_progress(sweep.run_dir(i))
+            meta.update(steps=progress.get("steps"), physical_time=progress.get("time"), runtime_s=None,
+                        us_per_particle_step=None)
+        rows.append([str(i), *values, os.path.basename(sweep.run_dir(i)), status,
                      *(csv_value(meta.get(f)) for f in COLLECT_FIELDS)])
     return rows
 
 
-def read_run_csv(path: str) -> tuple[list[str], list[list[str]]]:
-    """A run folder's CSV (``,`` or ``;`` separated, as sphdvi's gauge and DtInfo files): header, rows."""
+_POSITION_ROW = re.compile(r"^\s*;\s*Pos[XYZ]\b[^;]*:")      # MeasureTool's ' ;PosX [m]:;x0;x1...'
+
+
+def _guess_separator(header: str, first_row: str | None) -> str:
+    """The separator of a CSV from its column-header line (and the first data row): ``;`` (sphdvi's
+    and DualSPHysics's gauge files, MeasureTool), tab, or ``,`` (bodies.csv, run.csv, measure's
+    default); the one that splits the header into several cells and the row into as many."""
+    def cells(line, sep):
+        return len(next(csv.reader([line], delimiter=sep), []))
+    fits = [sep for sep in (";", "\t", ",") if cells(header, sep) > 1]
+    if first_row is not None:
+        same = [sep for sep in fits if cells(first_row, sep) == cells(header, sep)]
+        fits = same or fits
+    return fits[0] if fits else ","
+
+
+def read_run_csv(path: str, complete_only: bool = True) -> tuple[list[str], list[list[str]]]:
+    """A CSV of a run folder as sphdvi and DualSPHysics write them: gauge files (``;``), bodies.csv
+    and run.csv (``,``), ``sphdvi measure ... --csv`` with either ``--sep`` (MeasureTool's layout:
+    `` ;PosX [m]:;x0;x1...`` / PosY / PosZ rows before the column header, left out here), ``#``
+    comment lines skipped; the separator read from the column-header line.  ``complete_only``: the
+    text after the last line break is left out (the torn last row of a file a running run is
+    appending to).  Returns the header and the rows (a trailing empty cell of DualSPHysics's
+    ``a;b;`` lines dropped)."""
     try:
-        with open(path, newline="", encoding="utf-8") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
             text = fh.read()
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: cannot be read as a CSV text file ({getattr(exc, 'strerror', None) or exc})") from None
-    first = text.split("\n", 1)[0]
-    sep = ";" if first.count(";") > first.count(",") else ("\t" if first.count("\t") > first.count(",") else ",")
-    rows = [r for r in csv.reader(io.StringIO(text), delimiter=sep) if r]
-    if not rows:
+    if "\x00" in text:
+        raise InputError(f"{path}: cannot be read as a CSV text file (it holds NUL bytes)")
+    lines = text.replace("\r\n", "\n").split("\n")
+    if complete_only or lines[-1] == "":
+        lines = lines[:-1]
+    lines = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#") and not _POSITION_ROW.match(ln)]
+    if not lines:
         return [], []
-    return [c.strip() for c in rows[0]], rows[1:]
+    sep = _guess_separator(lines[0], lines[1] if len(lines) > 1 else None)
+    rows = list(csv.reader(lines, delimiter=sep))
+    header = [c.strip() for c in rows[0]]
+    if len(header) > 1 and header[-1] == "":
+        header = header[:-1]
+        rows = [rows[0]] + [r[:-1] if len(r) == len(header) + 1 and r[-1].strip() == "" else r for r in rows[1:]]
+    return header, rows[1:]
 
 
 def file_table(sweep: Sweep, names) -> tuple[list[list[str]], list[str]]:
     """The rows of every run's file(s) ``names`` (relative to the run folder), long format: index,
     the parameters (and ``file`` when several names), then the files' columns (their union, in
     order of appearance; a column named as a parameter gets the file's stem as prefix).  Returns
-    the table and the runs that hold no such file ("run_0003/NAME")."""
+    the table and the runs that hold no such file ("run_0003/NAME"); a name no run folder holds
+    (a typo): InputError.  A folder holding another run or an unreadable run.json: InputError."""
     lead = ["index", *sweep.keys] + (["file"] if len(names) > 1 else [])
     columns: list[str] = []
     body, missing = [], []
     for name in names:
         if os.path.isabs(name) or ".." in name.replace("\\", "/").split("/"):
             raise InputError(f"--file {name}: expected a file name inside each run folder (e.g. bodies.csv)")
+    found = dict.fromkeys(names, 0)
     for i, values in enumerate(sweep.runs):
+        entry_meta(sweep, i)
         for name in names:
             path = os.path.join(sweep.run_dir(i), name)
             if not os.path.isfile(path):
                 missing.append(os.path.join(os.path.basename(sweep.run_dir(i)), name))
                 continue
+            found[name] += 1
             header, rows = read_run_csv(path)
             stem = os.path.splitext(os.path.basename(name))[0]
             header = [f"{stem}.{h}" if h in lead else h for h in header]
@@ -649,6 +1056,10 @@ def file_table(sweep: Sweep, names) -> tuple[list[list[str]], list[str]]:
                     columns.append(h)
             for r in rows:
                 body.append(([str(i), *values] + ([name] if len(names) > 1 else []), dict(zip(header, r))))
+    absent = [n for n, k in found.items() if k == 0]
+    if absent:
+        raise InputError(f"--file {', '.join(absent)}: no run folder of {sweep.dir} holds it (nothing to collect); "
+                         f"expected a file the runs write, e.g. run.csv, a gauge file (Gauges*.csv), bodies.csv")
     table = [lead + columns] + [prefix + [cells.get(c, "") for c in columns] for prefix, cells in body]
     return table, missing
 

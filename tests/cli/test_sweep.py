@@ -158,8 +158,9 @@ def test_sbatch_script(tmp_path):
     lines = (sw / "sweep.sbatch").read_text().splitlines()
     assert lines[0] == "#!/bin/bash"
     for line in ("#SBATCH --array=0-5%4", "#SBATCH --cpus-per-task=2", "#SBATCH --time=1-02:00:00",
-                 "#SBATCH --job-name=sphdvi-sw", f"#SBATCH --output={sw}/logs/%A_%a.out",
-                 f"sphdvi run --manifest {sw}/sweep.csv --index $SLURM_ARRAY_TASK_ID"):
+                 "#SBATCH --job-name=sphdvi-sw", f'#SBATCH --output="{sw}/logs/%A_%a.out"',
+                 f"{sys.executable} -m sphdvi run --manifest {sw}/sweep.csv --index $SLURM_ARRAY_TASK_ID "
+                 "--threads ${SLURM_CPUS_PER_TASK:-2}"):
         assert line in lines, (line, lines)
     # the throttle is N when N is smaller; the default wall time is 24 h
     assert invoke(["sweep", "new", DAMBREAK, "-o", tmp_path / "b", "--vary", "Visco=0.01,0.02"]).exit_code == 0
@@ -245,8 +246,13 @@ def test_manifest_updates_under_the_lock_lose_nothing(tmp_path):
         f"0.0{i}" for i in range(1, 10))]).exit_code == 0
     sweep = sw_mod.open_sweep(str(sw))
     names = ["completed", "diverged", "failed", "interrupted"]
-    threads = [threading.Thread(target=lambda i=i: [sw_mod.update_manifest(sweep, {i: names[(i + k) % 4]})
-                                                    for k in range(20)]) for i in range(9)]
+
+    def task(i):
+        for k in range(20):     # a run.json of status names[(i + k) % 4], then the entry's update
+            (sw / f"run_{i:04d}" / "run.json").write_text(json.dumps({"status": names[(i + k) % 4]}))
+            sw_mod.update_manifest(sweep, [i])
+
+    threads = [threading.Thread(target=task, args=(i,)) for i in range(9)]
     for t in threads:
         t.start()
     for t in threads:
