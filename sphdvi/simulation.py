@@ -629,13 +629,16 @@ def _body_watch(data, params, system, names, mech):
 
 
 def _bodies_domain(data, params):
-    """The simulation domain of a body-only run: along an axis that ``<simulationdomain>`` sets,
-    the case's domain, as an SPH run's; along one it leaves at ``default`` (DualSPHysics's default,
-    the particles' extent plus 0.05 h, which a swinging pendulum leaves at once: DualSPHysics runs
-    no case without fluid), the drawing box ``<definition>`` pointmin..pointmax, outside which the
-    case has nothing; a 2D case widened by h along y as the SPH run's; unbounded along a periodic axis
-    or where the limit cannot be read."""
+    """The simulation domain of a body-only run, (posmin, posmax, what): along an axis that
+    ``<simulationdomain>`` sets to a number, that number, as an SPH run's; where it says ``default``
+    (DualSPHysics's default, the particles' extent plus 0.05 h, which a swinging pendulum leaves at
+    once: DualSPHysics runs no case without fluid), the drawing box ``<definition>``
+    pointmin..pointmax, outside which the case has nothing, and ``default ± v`` / ``default ± v%``
+    relative to that box (JSph::ResizeMapLimits' rule, v % of its extent, on the box a body-only
+    run takes for default); a 2D case widened by h along y as the SPH run's; unbounded along a
+    periodic axis or where the limit cannot be read.  ``what`` says where each limit came from."""
     import xml.etree.ElementTree as ET
+    from .case.reader import parse_domain_spec
     c = data["constants"]
     dom = data.get("domain") or {}
     if dom.get("posmin") is None or dom.get("posmax") is None:
@@ -649,21 +652,37 @@ def _bodies_domain(data, params):
     def attr(path, a):
         el = root.find(path) if root is not None else None
         return None if el is None else el.get(a)
+    what = []
     for i, a in enumerate("xyz"):
-        for bound, key, point in ((lo, "posmin", "pointmin"), (hi, "posmax", "pointmax")):
+        try:
+            box = [float(attr(f"casedef/geometry/definition/{p}", a)) for p in ("pointmin", "pointmax")]
+        except (TypeError, ValueError):
+            box = None
+        parts = []
+        for k, (bound, key) in enumerate(((lo, "posmin"), (hi, "posmax"))):
             spec = attr(f"execution/parameters/simulationdomain/{key}", a)
-            if spec is not None and spec.replace(" ", "").lower() != "default":
+            text = (spec or "default").replace(" ", "").lower()
+            if not text.startswith("default"):
+                parts.append(f"{bound[i]:g}")
                 continue                                # the case's own limit
-            try:
-                bound[i] = float(attr(f"casedef/geometry/definition/{point}", a))
-            except (TypeError, ValueError):
+            if box is None:
                 bound[i] = -np.inf if key == "posmin" else np.inf
+                parts.append("unbounded")
+                continue
+            bound[i] = parse_domain_spec(text, box[k], box[1] - box[0])
+            rel = "" if text == "default" else f" {text[7]} {text[8:]}"
+            if rel.endswith("%"):
+                rel += f" of {box[1] - box[0]:g}"
+            parts.append(f"{bound[i]:g} (<definition>{f' {box[k]:g}' + rel if rel else ''})")
+        what.append(f"{a} {parts[0]} .. {parts[1]}")
     if c["is2d"]:
         lo[1] = min(lo[1], float(c["posy2d"])) - c["h"]
         hi[1] = max(hi[1], float(c["posy2d"])) + c["h"]
+        what[1] = f"y {lo[1]:g} .. {hi[1]:g} (2D: posy2d +- h)"
     for k in periodic_axes(data, params):
         lo["xyz".index(k)], hi["xyz".index(k)] = -np.inf, np.inf
-    return lo, hi
+        what["xyz".index(k)] = f"{k} periodic"
+    return lo, hi, "; ".join(what)
 
 
 def _warm_up_bodies(system, dt: float) -> float:

@@ -134,6 +134,39 @@ def _wrap_angle(a):
 
 
 @njit(cache=True)
+def _locked_rotation(a, nfree_rot, mask, Q1, Q2):
+    """(C, world Jacobian axis ρ, ``Ċ = ρ·(ω1 − ω2)``) of the locked rotation about axis a of
+    the rotation frame (Q1 on body 1, Q2 on body 2, world columns).
+
+    One free axis f (hinge, cylindrical, hinged slider, point-line with one rotation):
+    ``C = s Q1[:, f]·Q2[:, o]`` with o the third axis and s = ±1 so that ρ ≈ +Q2[:, a].  Body 1's
+    free axis does not move under the free rotation, so the two rows' axes ``s Q1[:, f]×Q2[:, o]``
+    stay two perpendicular axes of frame 2 at every angle about f (the dot-1 pairs ``y1·z2``,
+    ``z1·x2`` of a z hinge have the same axis x1 = y2 at ±90°: a singular pair; Chrono's
+    ChLinkMateGeneric::Update uses the relative quaternion's vector part, independent too).
+    Otherwise (all locked, or one locked) the dot-1 rows ``y1·z2``, ``z1·x2``, ``x1·y2``: they have
+    no singular pose on the joint's motion (all locked: axes x, y, z at the locked pose, dependent only
+    ~90° away from it; one locked: |ρ| = 1 wherever C = 0)."""
+    if nfree_rot == 1:
+        f = 0
+        for k in range(3):
+            if mask[3 + k] == 0:
+                f = k
+        o = 3 - a - f
+        sg = 1.0 if (o - f) % 3 == 1 else -1.0      # e_f × e_o = sg e_a
+        al = Q1[:, f].copy()
+        be = Q2[:, o].copy()
+    else:
+        sg = 1.0
+        al = Q1[:, (a + 1) % 3].copy()
+        be = Q2[:, (a + 2) % 3].copy()
+    q = 0.0
+    for c in range(3):
+        q += al[c] * be[c]
+    return sg * q, cross(al, be) * sg
+
+
+@njit(cache=True)
 def build_mate_rows(nr, h, vrec, pos, Rb,
                     m_b1, m_b2, m_p1, m_p2, m_T1, m_T2, m_Q1, m_Q2, m_mask,
                     m_k, m_c, m_rest, m_mmode, m_mval, m_mdval, m_angle, m_lid,
@@ -143,7 +176,8 @@ def build_mate_rows(nr, h, vrec, pos, Rb,
 
     DOF k = 0..2: translation of marker 1 along axis k of the translation frame
     of body 2, ``C = e_k·(P1 − P2)``.  DOF k = 3..5: rotation about axis k of the
-    rotation frame, locked with the dot-1 rows ``y1·z2``, ``z1·x2``, ``x1·y2``.
+    rotation frame, locked by :func:`_locked_rotation` (with one free rotation f: ``±f1·o2``, o the
+    third axis; otherwise the dot-1 rows ``y1·z2``, ``z1·x2``, ``x1·y2``).
     A constrained DOF gives a stabilised bilateral row ``b = clamp(C/h, ±v_rec)``.
     A free DOF gets a motor row (speed: ``b = −ω*(t+h)``; position:
     ``b = clamp((q − q*(t))/h, ±v_rec) − (q*(t+h) − q*(t))/h``) or, with stiffness k and
@@ -204,19 +238,7 @@ def build_mate_rows(nr, h, vrec, pos, Rb,
             else:
                 a = k - 3
                 if rigid:
-                    if a == 0:
-                        al = Q1[:, 1].copy()
-                        be = Q2[:, 2].copy()
-                    elif a == 1:
-                        al = Q1[:, 2].copy()
-                        be = Q2[:, 0].copy()
-                    else:
-                        al = Q1[:, 0].copy()
-                        be = Q2[:, 1].copy()
-                    q = 0.0
-                    for c in range(3):
-                        q += al[c] * be[c]
-                    ax = cross(al, be)
+                    q, ax = _locked_rotation(a, nfree_rot, m_mask[m], Q1, Q2)
                 else:
                     ax = Q2[:, a].copy()
                     q = m_angle[m, a]

@@ -580,6 +580,61 @@ def solve_ccp(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag,
     return it, res
 
 
+# PSOR's creep check (solve_iterative): the mean of its residual over this many steps ...
+PSOR_CREEP_STEPS = 1000
+# ... above this (m/s) is warned about once: sustained over 10 s it moves a resting body by
+# 1e-4 m, TOLERANCES M4's drift bound.  A 5-box stack (0.1 m, 1 kg, μ 0.5, h 1e-3 s) either
+# converges (≥ 400 iterations: residual 1e-10, ~325 sweeps a step once warm) or stalls
+# (≤ 300: mean residual 1e-4–5e-4 m/s, drift 1e-4–6.5e-4 m and ground reaction 3–16 % off
+# the weight over 10 s); BB and APGD reach 1e-10 there in 4–6 iterations.
+PSOR_CREEP_RESIDUAL = 1e-5
+
+
+def solve_iterative(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree,
+                    vout, max_iter, tol, omega, owner=None):
+    """:func:`solve_ccp`, then, for PSOR, the creep check of ``owner`` (a System):
+    :func:`_psor_creep_check`."""
+    it, res = solve_ccp(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma,
+                        vfree, vout, max_iter, tol, omega)
+    if solver == SOLVER_PSOR and owner is not None:
+        _psor_creep_check(owner, res)
+    return it, res
+
+
+def _psor_creep_check(owner, res):
+    """Warn once per ``owner`` (its pending_warnings, for run.log) when PSOR's residual, averaged
+    over PSOR_CREEP_STEPS steps (the last solve of each step: the sliding correction solves a
+    step more than once), is above PSOR_CREEP_RESIDUAL: projected Gauss–Seidel stalls on stacked
+    bodies at too few iterations (Chrono's ChSolverPSOR docs: "convergence might stall"), and
+    its unconverged impulses let a resting stack creep and its reactions swing."""
+    import warnings
+    st = getattr(owner, "_psor_creep", None)
+    if st is None:
+        st = owner._psor_creep = {"t": None, "res": 0.0, "sum": 0.0, "n": 0, "warned": False}
+    if st["warned"]:
+        return
+    if st["t"] is not None and owner.time != st["t"]:
+        st["sum"] += st["res"]
+        st["n"] += 1
+        if st["n"] >= PSOR_CREEP_STEPS:
+            mean = st["sum"] / st["n"]
+            st["sum"], st["n"] = 0.0, 0
+            if mean > PSOR_CREEP_RESIDUAL:
+                st["warned"] = True
+                line = (f"PSOR solver at t={owner.time:.6g} s: its residual averaged "
+                        f"{mean:.3g} m/s over the last {PSOR_CREEP_STEPS} steps (above "
+                        f"{PSOR_CREEP_RESIDUAL:g}) at {owner.max_iter} iterations: projected "
+                        "Gauss-Seidel stalls on bodies resting on each other, which then creep "
+                        "(a 5-box stack at 100 iterations: 6.5e-4 m and ground reaction 16 % off "
+                        "the weight in 10 s); raise maxiter (that stack holds from 400) or use "
+                        "BB or APGD")
+                owner.pending_warnings.append(line)
+                if not owner.defer_warnings:
+                    warnings.warn(line)
+    st["t"] = owner.time
+    st["res"] = res
+
+
 # ------------------------------------------------------- dense / direct path
 @njit(cache=True)
 def assemble_dense(nr, ra, rb, J, MiJ, E):
@@ -1011,23 +1066,58 @@ def solve_dense_ipm(N, r, kind, mu, lo, hi, gamma, max_iter, tol):
     return it, best_res
 
 
-def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree, vout,
-                 max_iter, tol):
-    """Direct path for small mechanisms: the bilateral (and compliance) rows are
-    eliminated exactly with a Cholesky factorisation of their Schur block and
-    the remaining contact/boxed rows solve the reduced CCP
-    ``N' = N_cc − N_cb N_bb⁻¹ N_bc`` with a dense spectral projected gradient and, where that
-    has not reached ``tol`` in ``max_iter`` iterations (an ill-conditioned N': a light body
-    under a heavy one), with the interior-point method :func:`solve_dense_ipm` from its best
-    iterate (up to IPM_MAX_ROWS contact rows).  Robust to large mass ratios and stiff compliance
-    (dense: nr ≲ 1000)."""
+@njit(cache=True)
+def row_islands(nr, nb, ra, rb, MiJ, label):
+    """Split the rows into islands, the connected components of the bodies that the rows link
+    (Chrono::Multicore's and Bullet's simulation islands): a row links the sides whose
+    ``M⁻¹ Jᵀ`` is not zero, so the world, fixed and moving bodies (and locked directions) link
+    nothing and ``N = D M⁻¹ Dᵀ + E`` is block-diagonal by island.  ``label[k]`` receives row k's
+    island (numbered in the order of their first rows; -1: a row that cannot act, no live side);
+    returns the number of islands."""
+    parent = np.arange(nb)
+    live = np.zeros((nr, 2), np.bool_)
+    for k in range(nr):
+        for side in range(2):
+            body = ra[k] if side == 0 else rb[k]
+            if body < 0:
+                continue
+            for c in range(6):
+                if MiJ[k, 6 * side + c] != 0.0:
+                    live[k, side] = True
+                    break
+        if live[k, 0] and live[k, 1]:
+            x = ra[k]
+            while parent[x] != x:
+                parent[x] = parent[parent[x]]
+                x = parent[x]
+            y = rb[k]
+            while parent[y] != y:
+                parent[y] = parent[parent[y]]
+                y = parent[y]
+            if x != y:
+                parent[max(x, y)] = min(x, y)
+    island_of_root = np.full(nb, -1, np.int64)
+    n = 0
+    for k in range(nr):
+        if not (live[k, 0] or live[k, 1]):
+            label[k] = -1
+            continue
+        x = ra[k] if live[k, 0] else rb[k]
+        while parent[x] != x:
+            x = parent[x]
+        if island_of_root[x] < 0:
+            island_of_root[x] = n
+            n += 1
+        label[k] = island_of_root[x]
+    return n
+
+
+def _solve_direct_island(ra, rb, J, MiJ, b, E, kind, mu, lo, hi, g, vfree, max_iter, tol):
+    """solve_direct on the rows of one island (``g`` the warm start in, the impulses out):
+    bilateral rows by Cholesky, the reduced contact CCP by the dense BB and, where that has not
+    converged, the interior-point method.  Returns (iterations, residual, IPM skipped)."""
     from scipy.linalg import cho_factor, cho_solve
-    vout[:, :] = vfree
-    if nr == 0:
-        return 0, 0.0
-    sl = slice(0, nr)
-    ra, rb, J, MiJ, b, E = ra[sl], rb[sl], J[sl], MiJ[sl], b[sl], E[sl]
-    kind, mu, lo, hi, g = kind[sl], mu[sl], lo[sl], hi[sl], gamma[sl]
+    nr = ra.shape[0]
     N = assemble_dense(nr, ra, rb, J, MiJ, E)
     r = np.empty(nr)
     rows_times_v(nr, ra, rb, J, vfree, r)
@@ -1035,7 +1125,7 @@ def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, v
     bil = kind == BILATERAL
     ib = np.nonzero(bil)[0]
     ic = np.nonzero(~bil)[0]
-    it, res = 0, 0.0
+    it, res, skipped = 0, 0.0, False
     if ib.size:
         Nbb = N[np.ix_(ib, ib)]
         reg = 1e-13 * max(np.trace(Nbb) / ib.size, 1e-300)
@@ -1061,8 +1151,85 @@ def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, v
             if res2 < res:
                 res = res2
                 gc = gi
+        elif res > tol:
+            skipped = True
+        # γ = z/s on a boxed row can leave its bound by an ulp: clip it back
+        bx = kc == BOXED
+        gc[bx] = np.minimum(np.maximum(gc[bx], loc[bx]), hic[bx])
         g[ic] = gc
         if ib.size:
             g[ib] = -cho_solve(fac, r[ib] + Nbc @ gc)
+    return it, res, skipped
+
+
+def _warn_island_without_ipm(owner, ra, rb, MiJ):
+    """Warn once per ``owner`` (a System: its pending_warnings, for run.log) that an island of
+    more than IPM_MAX_ROWS contact rows ended its solve without the interior-point finish, when
+    the island's floating bodies span a mass ratio beyond what BB resolves (bodychecks.
+    CONTACT_RATIO_LIMIT): there a heavy body on a light one may be crushed."""
+    import warnings
+    from ..bodychecks import CONTACT_RATIO_LIMIT
+    if owner is None or getattr(owner, "_ipm_island_warned", False):
+        return
+    bodies = sorted({int(x) for side, col in ((ra, 0), (rb, 6)) for k, x in enumerate(side)
+                     if x >= 0 and MiJ[k, col:col + 6].any()})
+    masses = [float(owner.mass[i]) for i in bodies if owner.inv_mass[i] > 0.0]
+    if len(masses) < 2 or max(masses) / min(masses) <= CONTACT_RATIO_LIMIT["bb"]:
+        return
+    owner._ipm_island_warned = True
+    names = [owner.names[i] for i in bodies]
+    shown = ", ".join(names[:12]) + (f" and {len(names) - 12} more" if len(names) > 12 else "")
+    line = (f"direct solver at t={owner.time:.6g} s: an island of {len(names)} bodies in contact "
+            f"({shown}) has more than {IPM_MAX_ROWS} contact rows, so its solve ends without the "
+            f"interior-point finish, and its mass ratio {max(masses) / min(masses):.3g} is above "
+            f"the {CONTACT_RATIO_LIMIT['bb']:g} that the projected gradient resolves: a heavy body "
+            "resting on a light one there may be crushed or launched")
+    owner.pending_warnings.append(line)
+    if not owner.defer_warnings:
+        warnings.warn(line)
+
+
+def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree, vout,
+                 max_iter, tol, owner=None):
+    """Direct path for small mechanisms, island by island (:func:`row_islands`: N is
+    block-diagonal by island, so each island's problem is solved on its own, exactly, at
+    O(Σ n_i³) instead of O(n³)): the bilateral (and compliance) rows are
+    eliminated exactly with a Cholesky factorisation of their Schur block and
+    the remaining contact/boxed rows solve the reduced CCP
+    ``N' = N_cc − N_cb N_bb⁻¹ N_bc`` with a dense spectral projected gradient and, where that
+    has not reached ``tol`` in ``max_iter`` iterations (an ill-conditioned N': a light body
+    under a heavy one), with the interior-point method :func:`solve_dense_ipm` from its best
+    iterate (islands of up to IPM_MAX_ROWS contact rows; a larger one that has not converged is
+    warned about once, through ``owner``, where its mass ratio is beyond BB's limit).  Robust to
+    large mass ratios and stiff compliance (dense: rows per island ≲ 1000).  Returns the largest
+    iteration count and residual of the islands."""
+    vout[:, :] = vfree
+    if nr == 0:
+        return 0, 0.0
+    sl = slice(0, nr)
+    ra, rb, J, MiJ, b, E = ra[sl], rb[sl], J[sl], MiJ[sl], b[sl], E[sl]
+    kind, mu, lo, hi, g = kind[sl], mu[sl], lo[sl], hi[sl], gamma[sl]
+    label = np.empty(nr, np.int64)
+    nisl = row_islands(nr, vfree.shape[0], ra, rb, MiJ, label)
+    it, res = 0, 0.0
+    if nisl == 1 and label.min() == 0:
+        it, res, skipped = _solve_direct_island(ra, rb, J, MiJ, b, E, kind, mu, lo, hi, g, vfree,
+                                                max_iter, tol)
+        if skipped:
+            _warn_island_without_ipm(owner, ra, rb, MiJ)
+    else:
+        g[label < 0] = 0.0              # rows that cannot act
+        order = np.argsort(label, kind="stable")
+        bounds = np.searchsorted(label[order], np.arange(nisl + 1))
+        for q in range(nisl):
+            ix = order[bounds[q]:bounds[q + 1]]
+            gq = g[ix]
+            itq, resq, skipped = _solve_direct_island(ra[ix], rb[ix], J[ix], MiJ[ix], b[ix], E[ix],
+                                                      kind[ix], mu[ix], lo[ix], hi[ix], gq, vfree,
+                                                      max_iter, tol)
+            g[ix] = gq
+            it, res = max(it, itq), max(res, resq)
+            if skipped:
+                _warn_island_without_ipm(owner, ra[ix], rb[ix], MiJ[ix])
     scatter_impulses(nr, ra, rb, MiJ, g, vout)
     return it, res

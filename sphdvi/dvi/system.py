@@ -23,7 +23,7 @@ from ._math import (body_rotations, frame_from_axis, integrate_bodies, np_mat_to
 from ._kernels import (apply_dof_masks, copy_state, gather_warm, prepare_live_rows, scatter_warm,
                        step_end, step_free, step_start)
 from .solvers import (SOLVER_ALIASES, SOLVER_NAMES, max_abs_diff, prepare_rows, row_residuals,
-                      scatter_impulses, sliding_speeds, solve_ccp, solve_direct)
+                      scatter_impulses, sliding_speeds, solve_ccp, solve_direct, solve_iterative)
 
 FLOATING = 0
 FIXED = 1
@@ -1149,11 +1149,11 @@ class System:
         if self.solver.lower() == "direct":
             return solve_direct(nr, nb, self.r_a, self.r_b, self.r_J, self.r_MiJ, self.r_bias,
                                 self.r_E, self.r_kind, self.r_mu, self.r_lo, self.r_hi,
-                                self.r_g, g, vfree, vout, self.max_iter, self.tol)
-        return solve_ccp(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
-                         self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind,
-                         self.r_mu, self.r_lo, self.r_hi, self.r_g, g, vfree, vout,
-                         self.max_iter, self.tol, self.omega)
+                                self.r_g, g, vfree, vout, self.max_iter, self.tol, owner=self)
+        return solve_iterative(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
+                               self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind,
+                               self.r_mu, self.r_lo, self.r_hi, self.r_g, g, vfree, vout,
+                               self.max_iter, self.tol, self.omega, owner=self)
 
     def _solve_rows(self, nr, nb, g, vel6, vfree, vout, friction):
         """The step's CCP with the sliding correction (De Saxcé's fixed point) on frictional

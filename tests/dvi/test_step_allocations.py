@@ -10,6 +10,7 @@ F, T, the imposed velocities, vel6, v_out, six load arrays, the SMC forces, the 
 arrays ...: 114 kB for 200 free bodies, 12 kB for 20 hinged bodies, 46 kB for 20 boxes
 resting on a plane (80 contacts); now 0.3, 0.3 and 3 kB (the contacts' warm-start cache, which
 get_state copies, is a new pair of arrays each step)."""
+import sys
 import tracemalloc
 
 import numpy as np
@@ -49,10 +50,11 @@ def _boxes(n):
 
 @pytest.fixture
 def traced_kernels(monkeypatch):
-    """Wrap every compiled kernel the step calls (system.py's names, rows.*, collision.*) to
-    note the largest traced peak of one call; returns the dict holding it."""
+    """Wrap every compiled kernel the step calls (system.py's names, rows.*, collision.*,
+    solvers.*: solve_iterative calls solve_ccp) to note the largest traced peak of one call;
+    returns the dict holding it."""
     inner = {"peak": 0, "outer": 0}
-    for mod in (SY, SY.rw, SY.col):
+    for mod in (SY, SY.rw, SY.col, sys.modules["sphdvi.dvi.solvers"]):
         for name, fn in list(vars(mod).items()):
             if not isinstance(fn, CPUDispatcher):
                 continue
