@@ -25,10 +25,13 @@ vertices, cylinder rim points, cloud particles) and a signed distance function
 contact is created for each sample of one shape whose distance to the other
 shape, minus its radius, is below the envelope.  Exact special cases:
 sphere/capsule pairs (closest points between segments), cylinder–plane (exact rim
-support point per cap), and box/hull pairs, box–box included (separating-axis test over
-face normals and the cross products of the classes of parallel edges: culls separated
-pairs and adds the edge–edge contact when an edge pair is the axis of least penetration;
-skipped above 4096 edge pairs).  Particle clouds are searched through a body-frame cell grid
+support point per cap), cylinder–box/hull (:func:`_cylinder_polytope`: separating axes;
+the cylinder's exact support line or cap clipped to the polytope's face, or the polytope's
+vertices and edges against the cylinder's exact surface), and box/hull pairs, box–box
+included (separating-axis test over face normals and the cross products of the classes of
+parallel edges: culls separated pairs and adds the edge–edge contact when an edge pair is
+the axis of least penetration; the edge pairs are skipped above 4096 pairs of classes).
+Particle clouds are searched through a body-frame cell grid
 (O(1) per query) and collided as a smooth surface, not a union of spheres (DualSPHysics's
 Chrono collides a triangle mesh): only surface particles are kept; a flat face's particle
 is its tangent plane r in front of it, an edge or corner particle its sphere
@@ -41,9 +44,10 @@ capsule's axis points and a cylinder's rim points (and its exact deepest rim poi
 particles against the capsule's or cylinder's exact surface.  Polytope pairs (box/hull,
 box–box included) with a face axis of least penetration get a clipped face-face manifold of
 ≤ 4 points (:func:`_polytope_manifold`).  Limitations:
-cylinder–box/hull and cylinder–cylinder rely on 16 rim samples per cap (no
-exact rim–edge contact); a cloud's staircase (sloping or curved lattice
-surface) is collided as spheres; no rolling/spinning friction.
+cylinder–cylinder and cylinder–capsule rely on 16 rim samples per cap (no exact
+rim–edge contact); cylinder–box/hull has no rim–edge separating axis (a rim against an
+edge is the edge's point nearest the axis against the exact surface); a cloud's staircase
+(sloping or curved lattice surface) is collided as spheres; no rolling/spinning friction.
 """
 import math
 
@@ -704,7 +708,7 @@ def _support_edge(rep, ne, off, ed_rep, edges, W, L, ext, tol):
 
 @njit(cache=True, inline="always")
 def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, planes, edges,
-                  ed_off, ed_cnt, ed_rep, w_pos, w_R, wa, wb):
+                  ed_off, ed_cnt, ed_rep, cls_cnt, w_pos, w_R, wa, wb):
     """Separating-axis test of two convex polytopes (box/hull) over the face
     normals of both and the cross products of their edges (one per pair of classes of
     parallel edges, ``ed_rep``: a box has 3 × 3).  Returns
@@ -713,8 +717,9 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
     face (side 0: of sa, 1: of sb; its index in ``planes``) is the face axis of least
     penetration (a face of sb only where it beats sa's best by a relative 1e-9, so that a
     face-face rest does not swap the reference face with round-off), for the face-face
-    manifold (:func:`_polytope_manifold`).  Edge pairs are skipped for large hulls (> 4096
-    edge pairs)."""
+    manifold (:func:`_polytope_manifold`).  ``cls_cnt``: per shape, its number of classes of
+    parallel edges; edge pairs are skipped for hulls with more than 4096 pairs of classes (a
+    64-sided prism has 33 classes: 1,089 pairs)."""
     na = samp_cnt[sa]
     nbv = samp_cnt[sb]
     Ra = w_R[sa]
@@ -785,7 +790,7 @@ def _polytope_sat(sa, sb, env, samp_off, samp_cnt, samp_pts, pl_off, pl_cnt, pla
     bL = (0.0, 0.0, 0.0)
     nea = ed_cnt[sa]
     neb = ed_cnt[sb]
-    if nea * neb > 4096:
+    if cls_cnt[sa] * cls_cnt[sb] > 4096:
         return best_face, -1, -1, bL, fside, fplane
     T = v_sub(cb, ca)
     scale2 = 1e300
@@ -873,11 +878,14 @@ def _vertex_key(s, v, s_lo):
 
 
 @njit(cache=True)
-def _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nref_v, fv_idx, fv_edge, ned_r, ned_i):
+def _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nref_v, fv_idx, fv_edge, ned_r, ned_i,
+                  ei_base):
     """Key of a clipped point: the crossing of the current polygon edge (label ``lab``: ≥ 0
     the incident face's edge lab, < 0 the reference face's edge −lab−1) with the reference
     face's side plane j.  Two reference edges meet at a reference vertex.  ned_r, ned_i: the
-    edge counts of the reference and incident shapes."""
+    edge counts of the reference and incident shapes.  ``ei_base`` ≥ 0: the incident polygon
+    is a cylinder's (:func:`_cylinder_polytope`), its edge lab is the incident edge
+    ei_base + lab."""
     if lab < 0:
         j1 = -lab - 1
         if (j1 + 1) % nref_v == j:
@@ -886,7 +894,7 @@ def _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nref_v, fv_idx, fv_edge,
             return _vertex_key(sr, fv_idx[fr_off + j1], s_lo)
         return _EKEY0 + _EKEY_MOD + ((j1 * 61 + j) % 9973)
     er = fv_edge[fr_off + j]
-    ei = fv_edge[fi_off + lab]
+    ei = ei_base + lab if ei_base >= 0 else fv_edge[fi_off + lab]
     if er < 0 or ei < 0:
         return _EKEY0 + _EKEY_MOD + 9973 + ((lab * 61 + j) % 9973)
     if sr == s_lo:
@@ -1037,7 +1045,21 @@ def _polytope_manifold(s1, s2, fside, fplane, env, planes, pl_off, pl_cnt, fv_of
             fw[k, _FP + c] = Wi[v, c]
         iw[k, _IKEY] = _vertex_key(si, v, s_lo)
         iw[k, _ILAB] = k
-    npoly = niv
+    k = _clip_to_face(niv, nrv, fr_off, fv_idx, Wr, nref, offr, env, fw, iw, sr, si, s_lo,
+                      fi_off, fv_edge, ned_r, ned_i, -1, True)
+    return k, nab
+
+
+@njit(cache=True, inline="always")
+def _clip_to_face(npoly, nrv, fr_off, fv_idx, Wr, nref, offr, env, fw, iw, sr, si, s_lo, fi_off,
+                  fv_edge, ned_r, ned_i, ei_base, reduce):
+    """Clipping and reduction of :func:`_polytope_manifold` (also the cylinder's,
+    :func:`_cylinder_polytope`): the incident polygon (rows 0..npoly−1 of fw[:, 0:3], keys
+    iw[:, _IKEY], labels iw[:, _ILAB]) clipped against the side planes of the reference face
+    (fv_idx[fr_off:fr_off + nrv] of the world vertices Wr, outward normal nref, plane
+    nref·x = offr), its points below the face plus the envelope reduced to four (all of them
+    unless ``reduce``); returns their count k (output columns as :func:`_polytope_manifold`'s).
+    ``ei_base``: see :func:`_crossing_key`."""
     ext = 0.0
     pc = 0                           # the current polygon's buffer (0 or 1: fw columns 0 / 3)
     mcl = fw.shape[0]
@@ -1083,13 +1105,14 @@ def _polytope_manifold(s1, s2, fside, fplane, env, planes, pl_off, pl_cnt, fv_of
                     fw[nt, c1 + c] = fw[q, c0 + c] + (fw[q2, c0 + c] - fw[q, c0 + c]) * f
                 lab = iw[q, _ILAB + pc]
                 iw[nt, _IKEY + 1 - pc] = _crossing_key(lab, j, sr, si, s_lo, fr_off, fi_off, nrv,
-                                                       fv_idx, fv_edge, ned_r, ned_i)
+                                                       fv_idx, fv_edge, ned_r, ned_i,
+                                                       ei_base)
                 iw[nt, _ILAB + 1 - pc] = -(j + 1) if inp else lab
                 nt += 1
         npoly = nt
         pc = 1 - pc
         if npoly == 0:
-            return 0, nab
+            return 0
     # points below the reference face + envelope (coincident ones once)
     c0 = 3 * pc
     ncand = 0
@@ -1111,7 +1134,7 @@ def _polytope_manifold(s1, s2, fside, fplane, env, planes, pl_off, pl_cnt, fv_of
         if not dup:
             iw[ncand, _ICAND] = q
             ncand += 1
-    if ncand > 4:
+    if ncand > 4 and reduce:
         _reduce4(fw, iw, ncand, nref, ext, c0, _IKEY + pc)
     else:
         for m in range(ncand):
@@ -1128,7 +1151,312 @@ def _polytope_manifold(s1, s2, fside, fplane, env, planes, pl_off, pl_cnt, fv_of
         fw[k, _FOUT + 3] = g
         iw[k, _IOUT] = iw[q, _IKEY + pc]
         k += 1
-    return k, nab
+    return k
+
+
+# a cylinder against a polytope: its cap is the incident polygon when the cap's normal is
+# within this cosine of the reference face's (standing on its end), else the generator line
+# of its support along the face normal (lying or tilted); the cap polygon has _CYL_RIM points
+_CYL_FLAT = 0.999
+_CYL_RIM = 16
+_CYL_NED = 2 * _CYL_RIM + 2      # incident edge labels: caps 0..2·_CYL_RIM−1, the line after
+_CYL_EKEY = _EKEY0 + _EKEY_MOD + 2 * 9973    # keys of the polytope's edge points
+
+
+@njit(cache=True, inline="always")
+def _cyl_extent(a, L, R, H):
+    """Half extent of a cylinder (axis a, radius R, half length H) along the unit axis L:
+    its support function about the centre, H|a·L| + R√(1 − (a·L)²)."""
+    al = v_dot(a, L)
+    return H * abs(al) + R * math.sqrt(max(1.0 - al * al, 0.0))
+
+
+@njit(cache=True, inline="always")
+def _cyl_axis_sep(L, c, a, R, H, W, nv):
+    """Separation of a cylinder and a polytope (world vertices W[:nv]) along the unit axis L,
+    the larger of its two orientations."""
+    lo = 1e300
+    hi = -1e300
+    for i in range(nv):
+        d = L[0] * W[i, 0] + L[1] * W[i, 1] + L[2] * W[i, 2]
+        lo = min(lo, d)
+        hi = max(hi, d)
+    cc = v_dot(L, c)
+    ext = _cyl_extent(a, L, R, H)
+    return max(lo - (cc + ext), (cc - ext) - hi)
+
+
+@njit(cache=True)
+def _cylinder_polytope(sc, sp, bc, bp, swap, nc, cap, env, keybase, sh_dims, samp_off,
+                       samp_cnt, samp_pts, pl_off, pl_cnt, planes, edges, ed_off, ed_cnt, ed_rep,
+                       fv_off, fv_cnt, fv_idx, fv_edge, w_pos, w_R, wa, fw, iw,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """A cylinder against a box or hull, exactly (Chrono, through Bullet, collides the exact
+    cylinder with a box or hull by GJK–EPA; DualSPHysics's bodies are triangle meshes): a
+    separating-axis test over the polytope's face normals, the
+    cylinder's cap normals, the cross products of its axis with the polytope's edge
+    directions, and the radial directions of the polytope's edges parallel to the axis and
+    of its vertices beside the curved surface.  A face of the polytope that is the axis of
+    least penetration is a plane for the cylinder's exact support along −n (as
+    :func:`_cylinder_plane_support`): the generator line of its deepest rim points (one
+    point for a tilted cylinder, two for one lying on the face, so that it neither rocks
+    nor rolls as a polygon) or, standing on its end (its axis within 2.6° of the normal, as
+    :func:`_cylinder_plane_support`), its cap (its _CYL_RIM rim points, all kept: four of
+    them, changing as the cap tilts, let a wobbling cylinder rock on); that line or cap
+    polygon is clipped to the face (:func:`_clip_to_face`, so that a cylinder
+    lying across the face's edge rests on the part on the face).  Otherwise (a cylinder
+    axis, or nothing on the face) the polytope's vertices and its edges' points nearest the
+    cylinder's axis against the cylinder's exact signed distance (:func:`_cyl_sdf_contact`;
+    an edge along the axis: the ends of its part beside the curved surface; an edge across a
+    cap: the ends of its chord of the cap's disc, against the cap).  ``swap``: the cylinder
+    is the pair's second shape."""
+    c = row3(w_pos, sc)
+    Rc = w_R[sc]
+    a = col(Rc, 2)
+    R = sh_dims[sc, 0]
+    H = sh_dims[sc, 1]
+    Rp = w_R[sp]
+    cp = row3(w_pos, sp)
+    nv = samp_cnt[sp]
+    for i in range(nv):
+        x = v_add(cp, mat_vec(Rp, row3(samp_pts, samp_off[sp] + i)))
+        wa[i, 0] = x[0]
+        wa[i, 1] = x[1]
+        wa[i, 2] = x[2]
+    s_lo = min(sc, sp)
+    # the polytope's faces: the cylinder's deepest point along −n against the face plane
+    best_face = -1e300
+    fplane = -1
+    for p in range(pl_off[sp], pl_off[sp] + pl_cnt[sp]):
+        n = mat_vec(Rp, (planes[p, 0], planes[p, 1], planes[p, 2]))
+        off = v_dot(n, cp) - planes[p, 3]
+        sep = v_dot(n, c) - _cyl_extent(a, n, R, H) - off
+        if sep > env:
+            return nc
+        if sep > best_face:
+            best_face = sep
+            fplane = p
+    # the cylinder's axes
+    best_cyl = -1e300
+    for sg in range(2):
+        sep = _cyl_axis_sep(v_scale(a, 1.0 if sg == 0 else -1.0), c, a, R, H, wa, nv)
+        if sep > env:
+            return nc
+        best_cyl = max(best_cyl, sep)
+    oe = ed_off[sp]
+    ne = ed_cnt[sp]
+    for i in range(ne):
+        if ed_rep[oe + i] != i:
+            continue
+        v0 = row3(wa, edges[oe + i, 0])
+        d = v_sub(row3(wa, edges[oe + i, 1]), v0)
+        L = v_cross(a, d)
+        ln = math.sqrt(v_dot(L, L))
+        if ln > 1e-9 * math.sqrt(v_dot(d, d)):
+            sep = _cyl_axis_sep(v_scale(L, 1.0 / ln), c, a, R, H, wa, nv)
+            if sep > env:
+                return nc
+            best_cyl = max(best_cyl, sep)
+            continue
+        # edges parallel to the axis: the radial direction of each
+        for j in range(i, ne):
+            if ed_rep[oe + j] != i:
+                continue
+            r = v_sub(row3(wa, edges[oe + j, 0]), c)
+            r = v_sub(r, v_scale(a, v_dot(a, r)))
+            ln = math.sqrt(v_dot(r, r))
+            if ln <= 1e-12 * (R + H):
+                continue
+            sep = _cyl_axis_sep(v_scale(r, 1.0 / ln), c, a, R, H, wa, nv)
+            if sep > env:
+                return nc
+            best_cyl = max(best_cyl, sep)
+    reach = R + max(env, 0.0)
+    for i in range(nv):
+        r = v_sub(row3(wa, i), c)
+        h = v_dot(a, r)
+        if abs(h) > H:
+            continue
+        r = v_sub(r, v_scale(a, h))
+        ln = math.sqrt(v_dot(r, r))
+        if ln >= reach or ln <= 1e-12 * (R + H):
+            continue
+        sep = _cyl_axis_sep(v_scale(r, 1.0 / ln), c, a, R, H, wa, nv)
+        if sep > env:
+            return nc
+        best_cyl = max(best_cyl, sep)
+    win = best_face + 0.05 * abs(best_face) + 1e-6 * (1.0 + R + H)
+    if best_cyl <= win and fplane >= 0:
+        # the polytope's face is the reference: the cylinder's support line or cap, clipped
+        n = mat_vec(Rp, (planes[fplane, 0], planes[fplane, 1], planes[fplane, 2]))
+        offr = v_dot(n, cp) - planes[fplane, 3]
+        an = v_dot(a, n)
+        if abs(an) >= _CYL_FLAT:
+            sgc = -1.0 if an > 0.0 else 1.0          # the cap that faces the face
+            base = 0 if sgc < 0.0 else _CYL_RIM
+            u = col(Rc, 0)
+            w = col(Rc, 1)
+            cc = v_add(c, v_scale(a, sgc * H))
+            for k in range(_CYL_RIM):
+                th = 2.0 * math.pi * k / _CYL_RIM
+                x = v_add(cc, v_add(v_scale(u, R * math.cos(th)), v_scale(w, R * math.sin(th))))
+                for q in range(3):
+                    fw[k, _FP + q] = x[q]
+                iw[k, _IKEY] = _vertex_key(sc, base + k, s_lo)
+                iw[k, _ILAB] = k
+            npoly = _CYL_RIM
+        else:
+            rdir = v_sub(v_scale(a, an), n)           # −n projected on the cap plane
+            rdir = v_scale(rdir, R / math.sqrt(v_dot(rdir, rdir)))
+            base = 2 * _CYL_RIM
+            for k in range(2):
+                x = v_add(v_add(c, v_scale(a, H if k == 0 else -H)), rdir)
+                for q in range(3):
+                    fw[k, _FP + q] = x[q]
+                iw[k, _IKEY] = _vertex_key(sc, base + k, s_lo)
+                iw[k, _ILAB] = k
+            npoly = 2
+        k = _clip_to_face(npoly, fv_cnt[fplane], fv_off[fplane], fv_idx, wa, n, offr, env, fw,
+                          iw, sp, sc, s_lo, 0, fv_edge, ed_cnt[sp], _CYL_NED, base, False)
+        for m in range(k):
+            pt = (fw[m, _FOUT], fw[m, _FOUT + 1], fw[m, _FOUT + 2])
+            if swap:      # the normal from the pair's first shape to its second
+                nc = _emit_t(nc, cap, bp, bc, sp, sc, pt, n, fw[m, _FOUT + 3],
+                             keybase + iw[m, _IOUT], c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            else:
+                nc = _emit_t(nc, cap, bc, bp, sc, sp, pt, v_scale(n, -1.0), fw[m, _FOUT + 3],
+                             keybase + iw[m, _IOUT], c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+        if k > 0:
+            return nc
+    # the polytope's vertices and edge points against the cylinder's signed distance
+    for i in range(nv):
+        nc = _cyl_sdf_contact(row3(wa, i), _vertex_key(sp, i, s_lo), sc, sp, bc, bp, swap, nc,
+                              cap, env, keybase, c, Rc, R, H,
+                              c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    p0 = v_sub(c, v_scale(a, H))
+    p1 = v_add(c, v_scale(a, H))
+    for i in range(ne):
+        e0 = row3(wa, edges[oe + i, 0])
+        e1 = row3(wa, edges[oe + i, 1])
+        d = v_sub(e1, e0)
+        dd = v_dot(d, d)
+        if dd <= 1e-300:
+            continue
+        key = _CYL_EKEY + (3 * i) % 42000
+        ad = v_dot(a, d)
+        if ad * ad >= (1.0 - 1e-6) * dd:
+            # an edge along the axis: the ends of its part beside the curved surface (a line
+            # contact), against the curved surface
+            h0 = v_dot(a, v_sub(e0, c))
+            ta = (-H - h0) / ad
+            tb = (H - h0) / ad
+            t_lo = max(min(ta, tb), 0.0)
+            t_hi = min(max(ta, tb), 1.0)
+            if t_lo >= t_hi:
+                continue
+            # its deepest point between the caps (a lateral contact only where the curved
+            # surface is nearer than the caps: not an edge standing on a cap)
+            h_lo = h0 + t_lo * ad
+            h_hi = h0 + t_hi * ad
+            dax = H if h_lo * h_hi <= 0.0 else H - min(abs(h_lo), abs(h_hi))
+            for m in range(2):
+                tt = min(ta, tb) if m == 0 else max(ta, tb)
+                if not (1e-9 < tt < 1.0 - 1e-9):
+                    continue
+                x = v_add(e0, v_scale(d, tt))
+                rel = v_sub(x, c)
+                rr = v_sub(rel, v_scale(a, v_dot(a, rel)))
+                rho = math.sqrt(v_dot(rr, rr))
+                g = rho - R
+                if g >= env or rho <= 1e-14 or -g > dax:
+                    continue
+                nw = v_scale(rr, 1.0 / rho)           # radial (cylinder → polytope)
+                pt = v_sub(x, v_scale(nw, 0.5 * g))
+                if swap:
+                    nc = _emit_t(nc, cap, bp, bc, sp, sc, pt, v_scale(nw, -1.0), g,
+                                 keybase + key + 1 + m, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap,
+                                 c_key)
+                else:
+                    nc = _emit_t(nc, cap, bc, bp, sc, sp, pt, nw, g, keybase + key + 1 + m,
+                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            continue
+        x1, x2 = _closest_segments_t(e0, e1, p0, p1)
+        t = v_dot(v_sub(x1, e0), d) / dd
+        if 1e-9 < t < 1.0 - 1e-9:
+            nc = _cyl_sdf_contact(x1, key, sc, sp, bc, bp, swap, nc, cap, env, keybase, c, Rc,
+                                  R, H, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+        # an edge lying across a cap (parallel to it, nearer the cap than the curved
+        # surface): the ends of its chord of the cap's disc, against the cap's plane
+        if ad * ad > 1e-6 * dd:
+            continue
+        rel = v_sub(x1, c)
+        h = v_dot(a, rel)
+        rr = v_sub(rel, v_scale(a, h))
+        if H - abs(h) >= R - math.sqrt(v_dot(rr, rr)):
+            continue
+        # |perp(e0 + t d − c)|² = R²: a quadratic in t (d ⟂ a)
+        r0 = v_sub(e0, c)
+        r0 = v_sub(r0, v_scale(a, v_dot(a, r0)))
+        bq = v_dot(r0, d) / dd
+        disc = bq * bq - (v_dot(r0, r0) - R * R) / dd
+        if disc <= 0.0:
+            continue
+        sq = math.sqrt(disc)
+        sgn = 1.0 if h >= 0.0 else -1.0
+        for m in range(2):
+            tt = -bq + (sq if m == 1 else -sq)
+            if not (1e-9 < tt < 1.0 - 1e-9):
+                continue
+            x = v_add(e0, v_scale(d, tt))
+            g = sgn * v_dot(a, v_sub(x, c)) - H
+            if g >= env:
+                continue
+            nw = v_scale(a, sgn)                     # outward cap normal (cylinder → polytope)
+            pt = v_sub(x, v_scale(nw, 0.5 * g))
+            if swap:
+                nc = _emit_t(nc, cap, bp, bc, sp, sc, pt, v_scale(nw, -1.0), g,
+                             keybase + key + 1 + m, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            else:
+                nc = _emit_t(nc, cap, bc, bp, sc, sp, pt, nw, g, keybase + key + 1 + m,
+                             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return nc
+
+
+@njit(cache=True, inline="always")
+def _cyl_sdf_contact(x, key, sc, sp, bc, bp, swap, nc, cap, env, keybase, c, Rc, R, H,
+                     c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """A point x of a polytope (world) against the cylinder's exact signed distance
+    (:func:`sdf_local`): a contact when it is within the envelope, its normal the distance's
+    gradient (from the cylinder to the polytope)."""
+    q = mat_t_vec(Rc, v_sub(x, c))
+    rho = math.sqrt(q[0] * q[0] + q[1] * q[1])
+    if rho < 1e-14:
+        rx, ry = 1.0, 0.0
+    else:
+        rx, ry = q[0] / rho, q[1] / rho
+    dr = rho - R
+    dz = abs(q[2]) - H
+    sz = math.copysign(1.0, q[2])
+    if dr > 0.0 or dz > 0.0:
+        er = max(dr, 0.0)
+        ez = max(dz, 0.0)
+        phi = math.sqrt(er * er + ez * ez)
+        gl = (er * rx / phi, er * ry / phi, ez * sz / phi)
+    elif dr > dz:
+        phi = dr
+        gl = (rx, ry, 0.0)
+    else:
+        phi = dz
+        gl = (0.0, 0.0, sz)
+    if phi >= env:
+        return nc
+    gw = mat_vec(Rc, gl)
+    pt = v_sub(x, v_scale(gw, 0.5 * phi))
+    if swap:
+        return _emit_t(nc, cap, bp, bc, sp, sc, pt, v_scale(gw, -1.0), phi, keybase + key,
+                       c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return _emit_t(nc, cap, bc, bp, sc, sp, pt, gw, phi, keybase + key,
+                   c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
 
 
 @njit(cache=True)
@@ -1159,10 +1487,14 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
     maxf = 4
     for p in range(fv_cnt.shape[0]):
         maxf = max(maxf, fv_cnt[p])
+    for s in range(ns):
+        if sh_type[s] == CYLINDER:
+            maxf = max(maxf, _CYL_RIM)   # a cylinder's cap polygon (_cylinder_polytope)
+            break
     mcl = 2 * maxf + 4               # a clipped polygon: ≤ incident + reference vertices
     # the polytope pairs read each shape's offsets and counts from one row (one cache line,
     # not six: the shapes of successive pairs are far apart in memory)
-    meta = np.empty((ns, 6), np.int32)
+    meta = np.empty((ns, 7), np.int32)
     for s in range(ns):
         meta[s, 0] = samp_off[s]
         meta[s, 1] = samp_cnt[s]
@@ -1170,12 +1502,18 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
         meta[s, 3] = pl_cnt[s]
         meta[s, 4] = ed_off[s]
         meta[s, 5] = ed_cnt[s]
+        ncls = 0                     # classes of parallel edges (_polytope_sat)
+        for e in range(ed_cnt[s]):
+            if ed_rep[ed_off[s] + e] == e:
+                ncls += 1
+        meta[s, 6] = ncls
     m_soff = meta[:, 0]
     m_scnt = meta[:, 1]
     m_poff = meta[:, 2]
     m_pcnt = meta[:, 3]
     m_eoff = meta[:, 4]
     m_ecnt = meta[:, 5]
+    m_ccnt = meta[:, 6]
     fw = np.empty((mcl, _NFW))
     iw = np.zeros((mcl, _NIW), np.int64)
     # pairs in the order of their shapes (the sweep's order visits shapes far apart in memory)
@@ -1212,11 +1550,24 @@ def narrow_phase(npair, pairs, env, sh_body, sh_type, sh_dims, samp_off, samp_cn
                 nc = _emit(nc, cap, b1, b2, s1, s2, pt, n, gap, keybase,
                            c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
             continue
+        if ((t1 == CYLINDER and (t2 == BOX or t2 == HULL))
+                or (t2 == CYLINDER and (t1 == BOX or t1 == HULL))):
+            sw = t2 == CYLINDER
+            scy = s2 if sw else s1
+            spo = s1 if sw else s2
+            bcy = b2 if sw else b1
+            bpo = b1 if sw else b2
+            nc = _cylinder_polytope(scy, spo, bcy, bpo, sw, nc, cap, env, keybase, sh_dims,
+                                    m_soff, m_scnt, samp_pts, m_poff, m_pcnt, planes, edges,
+                                    m_eoff, m_ecnt, ed_rep, fv_off, fv_cnt, fv_idx, fv_edge,
+                                    w_pos, w_R, wa, fw, iw,
+                                    c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+            continue
         if (t1 == BOX or t1 == HULL) and (t2 == BOX or t2 == HULL):
             sep, ea, eb, L, fside, fplane = _polytope_sat(s1, s2, env, m_soff, m_scnt,
                                                           samp_pts, m_poff, m_pcnt, planes,
-                                                          edges, m_eoff, m_ecnt, ed_rep, w_pos,
-                                                          w_R, wa, wb)
+                                                          edges, m_eoff, m_ecnt, ed_rep, m_ccnt,
+                                                          w_pos, w_R, wa, wb)
             if sep > env:
                 continue  # a separating axis: no contact (also removes SDF lower-bound ghosts)
             if ea < 0 and fplane >= 0:

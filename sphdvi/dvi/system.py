@@ -411,9 +411,16 @@ class System:
         elif t == col.PLANE:
             crad = 1e6
         elif t == col.HULL:
-            from scipy.spatial import ConvexHull
-            pts = np.asarray(points, float)
-            hull = ConvexHull(pts)
+            from scipy.spatial import ConvexHull, QhullError
+            pts = np.asarray(points, float).reshape(-1, 3)
+            try:
+                hull = ConvexHull(pts)
+            except QhullError:
+                who = self.names[body] if 0 <= body < self.nb else "the world"
+                raise ValueError(
+                    f"hull shape {self.sh_type.shape[0]} of body {body} ({who!r}): its {len(pts)} "
+                    f"points are coplanar or collinear (or fewer than 4): a hull needs points "
+                    f"that span a 3-D solid (a thin plate is a box with a small half extent)") from None
             samples = pts[hull.vertices]
             planes = self._merge_facets(hull.equations)
             edges = self._hull_edges(hull)
