@@ -201,6 +201,8 @@ def mechanism_from_case(data: dict, motions=None) -> dict:
         system["max_iter"] = int(solver["maxiter"])
     if solver.get("tolerance") is not None:
         system["tol"] = float(solver["tolerance"])
+    if solver.get("exactjoints") is not None:    # <solver exactjoints> (sphdvi's): joint-only islands exact
+        system["exact_joints"] = bool(solver["exactjoints"])
     sizes = body_sizes(points, dp)
     return {"bodies": bodies, "links": links, "materials": list(materials.values()), "system": system,
             "mkbounds": mkbounds, "scaleforce": _scale_forces(chrono.get("scaleforce") or [], mkbounds),

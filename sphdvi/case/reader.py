@@ -1104,8 +1104,10 @@ def _read_chrono_solver(reader, s) -> dict:
     under NSC and MINRES under SMC, FunDSPHChrono::GetSolverChIxAuto, with Chrono's iteration settings).
     ``type`` a Chrono solver name (BB, the default; PSOR, APGD; MINRES and Chrono's linear solvers become
     sphdvi's ``direct`` solver, with a warning), ``maxiter`` the iteration limit (default 100),
-    ``tolerance`` the residual (m/s) at which the iterations stop (default 1e-10). Other attributes get
-    the reader's unknown-attribute warning."""
+    ``tolerance`` the residual (m/s) at which the iterations stop (default 1e-10), ``exactjoints`` (default
+    true) whether BB, PSOR and APGD solve the islands of bodies linked only by joints (no contacts) exactly, as
+    ``direct`` does (false: every row iterative; with ``direct`` it has no effect and is warned about).
+    Other attributes get the reader's unknown-attribute warning."""
     out = {}
     if reader.has(s, "type"):
         raw = reader.text_attr(s, "type")
@@ -1122,6 +1124,11 @@ def _read_chrono_solver(reader, s) -> dict:
         out["maxiter"] = reader.integer(s, "maxiter", lo=1)
     if reader.has(s, "tolerance"):
         out["tolerance"] = reader.num(s, "tolerance", nonnegative=True)
+    if reader.has(s, "exactjoints"):
+        out["exactjoints"] = reader.boolean(s, "exactjoints")
+        if out.get("type") == "direct":
+            reader.warn(s, "<solver exactjoints>: the 'direct' solver solves every island exactly; "
+                           "exactjoints only applies to BB, PSOR and APGD and is ignored")
     return out
 
 

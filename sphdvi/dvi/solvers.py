@@ -590,17 +590,6 @@ PSOR_CREEP_STEPS = 1000
 PSOR_CREEP_RESIDUAL = 1e-5
 
 
-def solve_iterative(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree,
-                    vout, max_iter, tol, omega, owner=None):
-    """:func:`solve_ccp`, then, for PSOR, the creep check of ``owner`` (a System):
-    :func:`_psor_creep_check`."""
-    it, res = solve_ccp(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma,
-                        vfree, vout, max_iter, tol, omega)
-    if solver == SOLVER_PSOR and owner is not None:
-        _psor_creep_check(owner, res)
-    return it, res
-
-
 def _psor_creep_check(owner, res):
     """Warn once per ``owner`` (its pending_warnings, for run.log) when PSOR's residual, averaged
     over PSOR_CREEP_STEPS steps (the last solve of each step: the sliding correction solves a
@@ -1232,4 +1221,371 @@ def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, v
             if skipped:
                 _warn_island_without_ipm(owner, ra[ix], rb[ix], MiJ[ix])
     scatter_impulses(nr, ra, rb, MiJ, g, vout)
+    return it, res
+
+
+# ------------------------------------------- joint-only islands, solved exactly
+# The iterative solvers hand every island whose rows are all linear equalities (joints, and the
+# compliance rows of springs, dampers and motors; explicit springs' fixed impulses) to a dense
+# Cholesky solve: there the CCP is a linear system, and BB, PSOR and APGD converge on the
+# out-of-plane rows of a joint chain (Jacobi-scaled condition numbers 1e3–1.6e4 for 2–5 links) too
+# slowly to hold it in its plane in 100 iterations.  Islands with contacts or bounded rows stay
+# iterative.  (Chrono users get the same by choosing a direct sparse solver for such systems.)
+EXACT_JOINT_MAX_ROWS = 600      # larger joint-only islands stay iterative, and so do those whose
+EXACT_JOINT_MAX_WORK = 4.5e6    # envelope factor takes more than this (Σ width², ~ flops: dense
+                                # 240 rows; a chain of n hinges ~330 n, one hub's 100 hinges 4.3e7)
+EXACT_PIVOT_MIN = 1e-11         # a Cholesky pivot below this fraction of its diagonal: redundant
+                                # joint rows (a closed loop), the island stays iterative
+
+
+@njit(cache=True)
+def _is_equality_row(kind, lo, hi):
+    """A row whose CCP set is a point or the whole line: bilateral (K = R, compliance or not), or
+    boxed with lo = hi (an explicit spring's fixed impulse)."""
+    return kind == BILATERAL or (kind == BOXED and lo == hi)
+
+
+@njit(cache=True)
+def plan_exact_islands(nr, nb, ra, rb, MiJ, kind, lo, hi, max_rows, label, xorder, xstart):
+    """The islands (:func:`row_islands`) whose rows are all equalities (:func:`_is_equality_row`)
+    and at most ``max_rows``: ``label[k]`` their number (0 ...) on their rows, -1 on the others
+    (the iterative solver's), ``xorder[xstart[q]:xstart[q+1]]`` island q's rows in row order.
+    Returns (islands, their rows, the largest island's rows); a scene without equality rows (a
+    contacts-only one) returns at once, leaving ``label`` as it is."""
+    found = False
+    for k in range(nr):
+        if _is_equality_row(kind[k], lo[k], hi[k]):
+            found = True
+            break
+    if not found:
+        return 0, 0, 0
+    n = row_islands(nr, nb, ra, rb, MiJ, label)
+    cnt = np.zeros(n, np.int64)
+    ok = np.ones(n, np.bool_)
+    for k in range(nr):
+        q = label[k]
+        if q < 0:
+            continue
+        cnt[q] += 1
+        if not _is_equality_row(kind[k], lo[k], hi[k]):
+            ok[q] = False
+    newid = np.full(n, -1, np.int64)
+    nx = 0
+    for q in range(n):
+        if ok[q] and cnt[q] <= max_rows:
+            newid[q] = nx
+            nx += 1
+    for q in range(nx + 1):
+        xstart[q] = 0
+    big = 0
+    for q in range(n):
+        if newid[q] >= 0:
+            xstart[newid[q] + 1] = cnt[q]
+            big = max(big, cnt[q])
+    for q in range(nx):
+        xstart[q + 1] += xstart[q]
+    fill = xstart[:nx].copy() if nx > 0 else np.zeros(0, np.int64)
+    for k in range(nr):
+        q = label[k]
+        x = newid[q] if q >= 0 else -1
+        label[k] = x
+        if x >= 0:
+            xorder[fill[x]] = k
+            fill[x] += 1
+    return nx, xstart[nx], big
+
+
+@njit(cache=True)
+def _envelope_cholesky(H, n, first):
+    """In-place lower Cholesky factor of H[:n, :n] within its envelope (row i's entries from column
+    ``first[i]``, the first non-zero: the fill stays inside it, so a chain's banded N costs
+    O(n·band²)).  Returns False where a pivot falls below EXACT_PIVOT_MIN of its diagonal (rows
+    that are linearly dependent, up to rounding)."""
+    for i in range(n):
+        fi = first[i]
+        for j in range(fi, i + 1):
+            fj = first[j]
+            v = H[i, j]
+            for k in range(max(fi, fj), j):
+                v -= H[i, k] * H[j, k]
+            if j < i:
+                H[i, j] = v / H[j, j]
+            else:
+                if not v > EXACT_PIVOT_MIN * H[i, i]:
+                    return False
+                H[i, i] = math.sqrt(v)
+    return True
+
+
+@njit(cache=True)
+def _envelope_solve(L, n, first, x):
+    """Solve L Lᵀ x = x in place with the envelope factor of :func:`_envelope_cholesky`."""
+    for i in range(n):
+        v = x[i]
+        for k in range(first[i], i):
+            v -= L[i, k] * x[k]
+        x[i] = v / L[i, i]
+    for i in range(n - 1, -1, -1):
+        x[i] /= L[i, i]
+        xi = x[i]
+        for k in range(first[i], i):
+            x[k] -= L[i, k] * xi
+
+
+@njit(cache=True)
+def _live_side(MiJ, k, side):
+    """Row k's side moves its body (M⁻¹ Jᵀ not zero there: :func:`row_islands`' link)."""
+    for c in range(6):
+        if MiJ[k, 6 * side + c] != 0.0:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _solve_equality_island(rows, ra, rb, J, MiJ, b, E, kind, lo, gamma, vfree, H, vec, iw, loc,
+                           bhead, max_work):
+    """One joint-only island's impulses: fixed rows (boxed, lo = hi) at lo, the bilateral ones
+    from ``(N_bb + εI) γ_b = −(r_b + N_bf γ_f)`` (``r = J v_free + b``, ε as
+    :func:`_solve_direct_island`'s, 1e-13 of the mean diagonal) by an envelope Cholesky
+    factorisation.  N is assembled from each body's rows (``N_ij = Σ J_i M⁻¹ J_jᵀ`` over the bodies
+    rows i and j share, as :func:`assemble_dense`), so a chain costs O(n·band²), not O(n²).
+    Work arrays: ``H`` [n, n], ``vec`` [n], ``iw`` (int [5, 2n]: the bilateral rows, their
+    envelope, then the bodies' row lists: next, row, side), ``loc`` (per row: its place among the
+    bilateral rows, -1 for a fixed one) and ``bhead`` (per body: its list's head; -1 on entry and
+    on return).  Returns False (``gamma`` untouched) where the envelope's factor work
+    ``Σ (p − first[p] + 1)²`` is above ``max_work`` or the rows are dependent
+    (:func:`_envelope_cholesky`)."""
+    n = rows.shape[0]
+    bil = iw[0]
+    first = iw[1]
+    bnext = iw[2]
+    brow = iw[3]
+    bside = iw[4]
+    nbil = 0
+    ne = 0
+    for a in range(n):
+        k = rows[a]
+        if kind[k] == BILATERAL:
+            loc[k] = nbil
+            bil[nbil] = k
+            nbil += 1
+        else:
+            loc[k] = -1
+        for side in range(2):
+            body = ra[k] if side == 0 else rb[k]
+            if body >= 0 and _live_side(MiJ, k, side):
+                brow[ne] = k
+                bside[ne] = side
+                bnext[ne] = bhead[body]
+                bhead[body] = ne
+                ne += 1
+    work = 0.0
+    for p in range(nbil):
+        i = bil[p]
+        # the envelope: the first bilateral row that shares a body with row i
+        fp = p
+        for si in range(2):
+            body = ra[i] if si == 0 else rb[i]
+            if body < 0 or not _live_side(MiJ, i, si):
+                continue
+            e = bhead[body]
+            while e >= 0:
+                q = loc[brow[e]]
+                if q >= 0 and q < fp:
+                    fp = q
+                e = bnext[e]
+        first[p] = fp
+        work += (p - fp + 1.0) ** 2
+    ok = work <= max_work
+    if ok and nbil > 0:
+        tr = 0.0
+        for p in range(nbil):
+            i = bil[p]
+            fp = first[p]
+            for q in range(fp, p + 1):
+                H[p, q] = 0.0
+            v = b[i]
+            for si in range(2):
+                body = ra[i] if si == 0 else rb[i]
+                if body < 0:
+                    continue
+                for c in range(6):
+                    v += J[i, 6 * si + c] * vfree[body, c]
+                if not _live_side(MiJ, i, si):
+                    continue
+                e = bhead[body]
+                while e >= 0:
+                    j = brow[e]
+                    q = loc[j]
+                    if q <= p:
+                        o = 6 * bside[e]
+                        h = 0.0
+                        for c in range(6):
+                            h += J[i, 6 * si + c] * MiJ[j, o + c]
+                        if q >= 0:
+                            H[p, q] += h
+                        else:
+                            v += h * lo[j]
+                    e = bnext[e]
+            vec[p] = -v
+            H[p, p] += E[i]
+            tr += H[p, p]
+        reg = 1e-13 * max(tr / nbil, 1e-300)
+        for p in range(nbil):
+            H[p, p] += reg
+        ok = _envelope_cholesky(H, nbil, first)
+        if ok:
+            _envelope_solve(H, nbil, first, vec)
+    for e in range(ne):
+        k = brow[e]
+        body = ra[k] if bside[e] == 0 else rb[k]
+        bhead[body] = -1
+    if not ok:
+        return False
+    for a in range(n):
+        k = rows[a]
+        if loc[k] < 0:
+            gamma[k] = lo[k]
+        else:
+            gamma[k] = vec[loc[k]]
+    return True
+
+
+@njit(cache=True)
+def solve_ccp_exact_islands(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma,
+                            vfree, vout, max_iter, tol, omega, nx, label, xorder, xstart, H, vec,
+                            iw, loc, bhead, rest, rJ, rf, rk, max_work):
+    """:func:`solve_ccp` with the ``nx`` joint-only islands of :func:`plan_exact_islands` solved
+    exactly (:func:`_solve_equality_island`, with its work arrays ``H`` ... ``bhead``; one whose
+    rows are dependent or whose factor is above ``max_work`` goes back to the others) and the other rows, gathered into the work arrays
+    ``rest`` (int [3, nr]: ra, rb, the row numbers), ``rJ`` ([2, nr, 12]: J, MiJ), ``rf`` ([7, nr]:
+    b, E, μ, lo, hi, diag, γ) and ``rk`` (kind), by the iterative ``solver`` as before.  Returns the iterative solver's iterations and
+    the larger residual (an exact island's: its largest bilateral constraint velocity)."""
+    for q in range(nx):
+        rows = xorder[xstart[q]:xstart[q + 1]]
+        if not _solve_equality_island(rows, ra, rb, J, MiJ, b, E, kind, lo, gamma, vfree, H, vec,
+                                      iw, loc, bhead, max_work):
+            for a in range(rows.shape[0]):
+                label[rows[a]] = -1
+    m = 0
+    for k in range(nr):
+        if label[k] < 0:
+            rest[0, m] = ra[k]
+            rest[1, m] = rb[k]
+            rest[2, m] = k
+            for c in range(12):
+                rJ[0, m, c] = J[k, c]
+                rJ[1, m, c] = MiJ[k, c]
+            rf[0, m] = b[k]
+            rf[1, m] = E[k]
+            rf[2, m] = mu[k]
+            rf[3, m] = lo[k]
+            rf[4, m] = hi[k]
+            rf[5, m] = gdiag[k]
+            rf[6, m] = gamma[k]
+            rk[m] = kind[k]
+            m += 1
+    it = 0
+    res = 0.0
+    if m > 0:
+        it, res = solve_ccp(solver, m, nb, rest[0], rest[1], rJ[0], rJ[1], rf[0], rf[1], rk, rf[2],
+                            rf[3], rf[4], rf[5], rf[6], vfree, vout, max_iter, tol, omega)
+        for p in range(m):
+            gamma[rest[2, p]] = rf[6, p]
+    else:
+        vout[:, :] = vfree
+    # the islands' impulses (their bodies are no other row's), then their residual
+    for k in range(nr):
+        if label[k] < 0:
+            continue
+        xk = gamma[k]
+        if xk == 0.0:
+            continue
+        for side in range(2):
+            body = ra[k] if side == 0 else rb[k]
+            if body >= 0:
+                for c in range(6):
+                    vout[body, c] += MiJ[k, 6 * side + c] * xk
+    for k in range(nr):
+        if label[k] < 0 or kind[k] != BILATERAL:
+            continue
+        u = b[k] + E[k] * gamma[k]
+        for side in range(2):
+            body = ra[k] if side == 0 else rb[k]
+            if body >= 0:
+                for c in range(6):
+                    u += J[k, 6 * side + c] * vout[body, c]
+        if abs(u) > res:
+            res = abs(u)
+    return it, res
+
+
+class _ExactWork:
+    """Work arrays of :func:`solve_iterative`'s exact islands, kept on their owner (a System) and
+    grown when the rows or the largest island outgrow them: a step allocates none of them."""
+
+    def __init__(self):
+        self.cap = -1
+        self.hcap = -1
+        self.bhead = np.zeros(0, np.int64)
+
+    def rows(self, nr):
+        if nr > self.cap:
+            n = max(nr, 2 * self.cap, 64)
+            self.cap = n
+            self.label = np.empty(n, np.int64)
+            self.xorder = np.empty(n, np.int64)
+            self.xstart = np.empty(n + 1, np.int64)
+            self.rest = np.empty((3, n), np.int32)
+            self.rJ = np.empty((2, n, 12))
+            self.rf = np.empty((7, n))
+            self.rk = np.empty(n, np.int8)
+            self.loc = np.empty(n, np.int64)
+        return self
+
+    def bodies(self, nb):
+        if nb > self.bhead.shape[0]:
+            self.bhead = np.full(nb, -1, np.int64)
+        return self
+
+    def dense(self, n):
+        if n > self.hcap:
+            self.hcap = n
+            self.H = np.empty((n, n))
+            self.vec = np.empty(n)
+            self.iw = np.empty((5, 2 * n), np.int64)
+        return self
+
+
+def solve_iterative(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree,
+                    vout, max_iter, tol, omega, owner=None, exact_joints=False):
+    """:func:`solve_ccp`, then, for PSOR, the creep check of ``owner`` (a System):
+    :func:`_psor_creep_check`.  With ``exact_joints`` the islands whose rows are all equalities
+    (joints, springs' and motors' compliance rows: a linear system) of at most
+    EXACT_JOINT_MAX_ROWS rows (and an envelope factor of at most EXACT_JOINT_MAX_WORK) are solved
+    exactly (:func:`solve_ccp_exact_islands`, as ``direct`` solves them) and only the others
+    iteratively; a scene without such an island (contacts in
+    every island) takes :func:`solve_ccp` as it is."""
+    nx = 0
+    if exact_joints and nr > 0:
+        W = getattr(owner, "_exact_work", None) if owner is not None else None
+        if W is None:
+            W = _ExactWork()
+            if owner is not None:
+                owner._exact_work = W
+        W.rows(nr).bodies(nb)
+        nx, _nxr, big = plan_exact_islands(nr, nb, ra, rb, MiJ, kind, lo, hi, EXACT_JOINT_MAX_ROWS,
+                                           W.label, W.xorder, W.xstart)
+    if nx:
+        W.dense(big)
+        it, res = solve_ccp_exact_islands(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi,
+                                          gdiag, gamma, vfree, vout, max_iter, tol, omega, nx,
+                                          W.label, W.xorder, W.xstart, W.H, W.vec, W.iw, W.loc,
+                                          W.bhead, W.rest, W.rJ, W.rf, W.rk,
+                                          EXACT_JOINT_MAX_WORK)
+    else:
+        it, res = solve_ccp(solver, nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma,
+                            vfree, vout, max_iter, tol, omega)
+    if solver == SOLVER_PSOR and owner is not None:
+        _psor_creep_check(owner, res)
     return it, res

@@ -115,6 +115,10 @@ class System:
         stiff or badly scaled mechanisms).
     max_iter, tol : iteration limit and residual tolerance (m/s, see
         :mod:`sphdvi.dvi.solvers`).
+    exact_joints : with psor, apgd or bb, solve the islands that hold only joints (and the
+        compliance rows of springs, dampers and motors: a linear system) exactly, by the
+        Cholesky factorisation of ``direct``, and only the islands with contacts or bounded rows
+        iteratively (:func:`sphdvi.dvi.solvers.solve_iterative`); False: every row iterative.
     omega : PSOR relaxation.
     recovery_speed : max penetration/violation recovery speed (m/s).
     envelope : collision envelope (m): contacts are created for gaps below it.
@@ -148,7 +152,7 @@ class System:
                  omega=1.0, recovery_speed=0.6, envelope=0.002, min_bounce_speed=0.15,
                  contactmethod="nsc", smc_model="hertz", position_projection=False,
                  spring_integration="auto", sliding_passes=4, sliding_tol=1e-4,
-                 residual_warning=0.1):
+                 residual_warning=0.1, exact_joints=True):
         self.gravity = np.asarray(gravity, dtype=np.float64)
         key = str(solver).lower().replace("_", "").replace("-", "")
         if key not in SOLVER_ALIASES:
@@ -156,6 +160,7 @@ class System:
         self.solver = SOLVER_ALIASES[key]
         self.max_iter = int(max_iter)
         self.tol = float(tol)
+        self.exact_joints = bool(exact_joints)
         self.omega = float(omega)
         self.recovery_speed = float(recovery_speed)
         self.envelope = float(envelope)
@@ -1160,7 +1165,8 @@ class System:
         return solve_iterative(SOLVER_NAMES[self.solver.lower()], nr, nb, self.r_a, self.r_b,
                                self.r_J, self.r_MiJ, self.r_bias, self.r_E, self.r_kind,
                                self.r_mu, self.r_lo, self.r_hi, self.r_g, g, vfree, vout,
-                               self.max_iter, self.tol, self.omega, owner=self)
+                               self.max_iter, self.tol, self.omega, owner=self,
+                               exact_joints=self.exact_joints)
 
     def _solve_rows(self, nr, nb, g, vel6, vfree, vout, friction):
         """The step's CCP with the sliding correction (De Saxcé's fixed point) on frictional
