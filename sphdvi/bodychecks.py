@@ -292,7 +292,10 @@ class BodyWatch:
     def _remedy(self) -> str:
         """What the case file can change: the direct solver (exact for joint chains), more iterations."""
         s = self.s
-        out = "" if s.solver == "direct" else "<chrono><solver type=\"direct\"/> (exact for joint chains), "
+        out = "" if s.solver == "direct" else "<chrono><solver type=\"direct\"/> (exact for joint chains, also those "
+        if s.solver != "direct":
+            out += ("with contacts), " if getattr(s, "exact_joints", True)
+                    else "with contacts; or drop exactjoints=\"false\": joint-only chains are then exact), ")
         if s.solver != "direct" and s.max_iter < 1000:
             out += "<solver maxiter=\"1000\"/>, "
         return out + ("or " if out else "")
