@@ -24,7 +24,6 @@ warnings on the bodies.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 from numba import njit
@@ -370,9 +369,7 @@ class BodyWatch:
                     f"{(t - t0) * vrec / d0 if d0 > 0 else 0:.3g} times over); "
                     f"it does not recover (a body driven through a thin wall in one step stays in it): "
                     f"use a smaller DtFixed or thicker walls")
-            s.pending_warnings.append(line)
-            if not s.defer_warnings:
-                warnings.warn(line)
+            s.say(line)
 
 
     def check_contact_ratio(self) -> None:
@@ -424,9 +421,7 @@ class BodyWatch:
                     f"{weight:.3g} N): mass ratio {float(s.mass[heavy] / s.mass[light]):.3g}, above the "
                     f"{limit:.3g} that the '{s.solver}' solver resolves (a light body under a heavy one is crushed "
                     f"or launched); the direct solver (<solver type=\"direct\"/>) holds 1e8")
-            s.pending_warnings.append(line)
-            if not s.defer_warnings:
-                warnings.warn(line)
+            s.say(line)
 
 
 @njit(cache=True)

@@ -596,7 +596,6 @@ def _psor_creep_check(owner, res):
     step more than once), is above PSOR_CREEP_RESIDUAL: projected Gauss–Seidel stalls on stacked
     bodies at too few iterations (Chrono's ChSolverPSOR docs: "convergence might stall"), and
     its unconverged impulses let a resting stack creep and its reactions swing."""
-    import warnings
     st = getattr(owner, "_psor_creep", None)
     if st is None:
         st = owner._psor_creep = {"t": None, "res": 0.0, "sum": 0.0, "n": 0, "warned": False}
@@ -617,9 +616,7 @@ def _psor_creep_check(owner, res):
                         "(a 5-box stack at 100 iterations: 6.5e-4 m and ground reaction 16 % off "
                         "the weight in 10 s); raise maxiter (that stack holds from 400) or use "
                         "BB or APGD")
-                owner.pending_warnings.append(line)
-                if not owner.defer_warnings:
-                    warnings.warn(line)
+                owner.say(line)
     st["t"] = owner.time
     st["res"] = res
 
@@ -1156,7 +1153,6 @@ def _warn_island_without_ipm(owner, ra, rb, MiJ):
     more than IPM_MAX_ROWS contact rows ended its solve without the interior-point finish, when
     the island's floating bodies span a mass ratio beyond what BB resolves (bodychecks.
     CONTACT_RATIO_LIMIT): there a heavy body on a light one may be crushed."""
-    import warnings
     from ..bodychecks import CONTACT_RATIO_LIMIT
     if owner is None or getattr(owner, "_ipm_island_warned", False):
         return
@@ -1173,9 +1169,7 @@ def _warn_island_without_ipm(owner, ra, rb, MiJ):
             f"interior-point finish, and its mass ratio {max(masses) / min(masses):.3g} is above "
             f"the {CONTACT_RATIO_LIMIT['bb']:g} that the projected gradient resolves: a heavy body "
             "resting on a light one there may be crushed or launched")
-    owner.pending_warnings.append(line)
-    if not owner.defer_warnings:
-        warnings.warn(line)
+    owner.say(line)
 
 
 def solve_direct(nr, nb, ra, rb, J, MiJ, b, E, kind, mu, lo, hi, gdiag, gamma, vfree, vout,

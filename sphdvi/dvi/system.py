@@ -1252,6 +1252,11 @@ class System:
                 f"row force {f:.3g} N; bodies {', '.join(bodies) or '?'}: the constraints conflict "
                 "(an imposed velocity into a wall or a joint, redundant or contradicting links) or "
                 "the solver needs more iterations; the forces are not a solution")
+        self.say(line)
+
+    def say(self, line: str) -> None:
+        """A warning of the multibody run: kept for run.log (:meth:`take_warnings`) and, unless a
+        run defers them, raised now as a UserWarning."""
         self.pending_warnings.append(line)
         if not self.defer_warnings:
             warnings.warn(line)
