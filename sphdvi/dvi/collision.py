@@ -432,11 +432,8 @@ def _sphere_vs_cloud(ssp, scl, bsp, bcl, swap, nc, cap, env, keybase, sh_dims, s
     gw = mat_vec(RO, gl)
     pt = v_sub(c, v_scale(gw, 0.5 * (rad + phi)))
     key = keybase + (1 if swap else 0)
-    if swap:
-        return _emit_t(nc, cap, bcl, bsp, scl, ssp, pt, gw, gap, key,
+    return _emit_sided(nc, cap, swap, bsp, bcl, ssp, scl, pt, gw, gap, key,
                        c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-    return _emit_t(nc, cap, bsp, bcl, ssp, scl, pt, v_scale(gw, -1.0), gap, key,
-                   c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
 
 
 # ------------------------------------------------------------- contact output
@@ -510,6 +507,17 @@ def _emit_t(nc, cap, ba, bb, sa, sb, pt, n, gap, key, c_a, c_b, c_sa, c_sb, c_pt
         c_gap[nc] = gap
         c_key[nc] = key
     return nc + 1
+
+
+@njit(cache=True, inline="always")
+def _emit_sided(nc, cap, swap, bx, by, sx, sy, pt, n, gap, key, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key):
+    """Emit a contact found between shape sx (body bx) and shape sy (body by), ``n`` pointing from sy
+    to sx, in the pair's own order: (sy, sx) with ``n`` when the pair was swapped, else (sx, sy)
+    with −n (the normal always from the pair's first shape to its second)."""
+    if swap:
+        return _emit_t(nc, cap, by, bx, sy, sx, pt, n, gap, key, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+    return _emit_t(nc, cap, bx, by, sx, sy, pt, v_scale(n, -1.0), gap, key,
+                   c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
 
 
 @njit(cache=True)
@@ -586,11 +594,7 @@ def _samples_vs_sdf(sp, so, bp, bo, swap, nc, cap, env, keybase,
         gw = mat_vec(RO, gl)
         pt = v_sub(x, v_scale(gw, 0.5 * (rho + phi)))
         key = keybase + (p - samp_off[sp]) * 2 + (1 if swap else 0)
-        if swap:
-            nc = _emit_t(nc, cap, bo, bp, so, sp, pt, gw, gap, key,
-                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-        else:
-            nc = _emit_t(nc, cap, bp, bo, sp, so, pt, v_scale(gw, -1.0), gap, key,
+        nc = _emit_sided(nc, cap, swap, bp, bo, sp, so, pt, gw, gap, key,
                          c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
     return nc
 
@@ -659,11 +663,7 @@ def _cylinder_cloud_support(sc, scl, bc, bcl, swap, nc, cap, env, keybase, sh_di
         gw = mat_vec(RO, gx)
         pt = v_sub(v_add(cO, mat_vec(RO, x)), v_scale(gw, 0.5 * phi))
         key = keybase + 1000000 + 2 * side + (1 if swap else 0)
-        if swap:
-            nc = _emit_t(nc, cap, bcl, bc, scl, sc, pt, gw, phi, key,
-                         c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-        else:
-            nc = _emit_t(nc, cap, bc, bcl, sc, scl, pt, v_scale(gw, -1.0), phi, key,
+        nc = _emit_sided(nc, cap, swap, bc, bcl, sc, scl, pt, gw, phi, key,
                          c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
     return nc
 
@@ -1320,11 +1320,7 @@ def _cylinder_polytope(sc, sp, bc, bp, swap, nc, cap, env, keybase, sh_dims, sam
                           iw, sp, sc, s_lo, 0, fv_edge, ed_cnt[sp], _CYL_NED, base, False)
         for m in range(k):
             pt = (fw[m, _FOUT], fw[m, _FOUT + 1], fw[m, _FOUT + 2])
-            if swap:      # the normal from the pair's first shape to its second
-                nc = _emit_t(nc, cap, bp, bc, sp, sc, pt, n, fw[m, _FOUT + 3],
-                             keybase + iw[m, _IOUT], c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-            else:
-                nc = _emit_t(nc, cap, bc, bp, sc, sp, pt, v_scale(n, -1.0), fw[m, _FOUT + 3],
+            nc = _emit_sided(nc, cap, swap, bc, bp, sc, sp, pt, n, fw[m, _FOUT + 3],
                              keybase + iw[m, _IOUT], c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
         if k > 0:
             return nc
@@ -1372,13 +1368,8 @@ def _cylinder_polytope(sc, sp, bc, bp, swap, nc, cap, env, keybase, sh_dims, sam
                     continue
                 nw = v_scale(rr, 1.0 / rho)           # radial (cylinder → polytope)
                 pt = v_sub(x, v_scale(nw, 0.5 * g))
-                if swap:
-                    nc = _emit_t(nc, cap, bp, bc, sp, sc, pt, v_scale(nw, -1.0), g,
-                                 keybase + key + 1 + m, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap,
-                                 c_key)
-                else:
-                    nc = _emit_t(nc, cap, bc, bp, sc, sp, pt, nw, g, keybase + key + 1 + m,
-                                 c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
+                nc = _emit_sided(nc, cap, swap, bc, bp, sc, sp, pt, v_scale(nw, -1.0), g,
+                                 keybase + key + 1 + m, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
             continue
         x1, x2 = _closest_segments_t(e0, e1, p0, p1)
         t = v_dot(v_sub(x1, e0), d) / dd
@@ -1413,12 +1404,8 @@ def _cylinder_polytope(sc, sp, bc, bp, swap, nc, cap, env, keybase, sh_dims, sam
                 continue
             nw = v_scale(a, sgn)                     # outward cap normal (cylinder → polytope)
             pt = v_sub(x, v_scale(nw, 0.5 * g))
-            if swap:
-                nc = _emit_t(nc, cap, bp, bc, sp, sc, pt, v_scale(nw, -1.0), g,
+            nc = _emit_sided(nc, cap, swap, bc, bp, sc, sp, pt, v_scale(nw, -1.0), g,
                              keybase + key + 1 + m, c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-            else:
-                nc = _emit_t(nc, cap, bc, bp, sc, sp, pt, nw, g, keybase + key + 1 + m,
-                             c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
     return nc
 
 
@@ -1452,11 +1439,8 @@ def _cyl_sdf_contact(x, key, sc, sp, bc, bp, swap, nc, cap, env, keybase, c, Rc,
         return nc
     gw = mat_vec(Rc, gl)
     pt = v_sub(x, v_scale(gw, 0.5 * phi))
-    if swap:
-        return _emit_t(nc, cap, bp, bc, sp, sc, pt, v_scale(gw, -1.0), phi, keybase + key,
+    return _emit_sided(nc, cap, swap, bc, bp, sc, sp, pt, v_scale(gw, -1.0), phi, keybase + key,
                        c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
-    return _emit_t(nc, cap, bc, bp, sc, sp, pt, gw, phi, keybase + key,
-                   c_a, c_b, c_sa, c_sb, c_pt, c_n, c_gap, c_key)
 
 
 @njit(cache=True)
