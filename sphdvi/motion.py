@@ -286,8 +286,10 @@ def _file_values(table, tau: float) -> tuple[np.ndarray, np.ndarray]:
     the file's first row plays at the movement's start (its time looked up is τ + t_0), the
     value is interpolated linearly between rows and held at the last row; the rate is the step's
     displacement over dt there: the slope of the row segment that holds τ, 0 before the first
-    row and from the last row on (strictly rising times: the reader checks them).  One look-up
-    in the table (its kept row) gives both."""
+    row and from the last row on.  A repeated time is a step: the row found is the last of the
+    repeated ones, so the segment is never of zero length (DfGetNewPos steps over it alike; at
+    the repeated time itself it holds the first row's value, this look-up the last's).  One
+    look-up in the table (its kept row) gives both."""
     t, cols = table.times, table.columns
     tf = tau + t[0]
     value = table.at(tf) - cols[:, 0]

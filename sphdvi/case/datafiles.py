@@ -100,7 +100,9 @@ def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.nda
     """A DualSPHysics motion file (``mvrectfile``/``mvrotfile``, JMotionDataFile): rows of
     ``ncols`` numbers (the ``fields`` attribute), of which ``columns`` (name -> 0-based
     column, ``fieldtime`` among them) are used. Checked as DualSPHysics needs them: at
-    least two rows, the used values finite, the times strictly rising. -> (n, ncols)."""
+    least two rows, the used values finite, the times never going back. A repeated time is
+    taken, as JMotionMovActive takes it (its look-up steps over a segment of zero length; the
+    examples' 17_WaveRunup Mov_piston.dat opens with two rows at t = 0). -> (n, ncols)."""
     a, lines = _read_rows(path, ncols, what, finite=False)
     if a.shape[0] < 2:
         found = "no data rows" if a.shape[0] == 0 else f"one data row (line {lines[0]})"
@@ -113,11 +115,11 @@ def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.nda
             raise CaseError(f"{what}: column {col} ({name}) is {a[bad[0], col]}", file=path,
                             line=lines[bad[0]], expected="finite numbers")
     t = a[:, columns.get("fieldtime", 0)]
-    bad = np.flatnonzero(np.diff(t) <= 0)
+    bad = np.flatnonzero(np.diff(t) < 0)
     if bad.size:
         i = bad[0] + 1
-        raise CaseError(f"{what}: time {t[i]:g} does not come after {t[i - 1]:g} (line {lines[i - 1]})",
-                        file=path, line=lines[i], expected="strictly rising times")
+        raise CaseError(f"{what}: time {t[i]:g} comes before {t[i - 1]:g} (line {lines[i - 1]})",
+                        file=path, line=lines[i], expected="times that never go back (a repeated time is a step)")
     return a
 
 

@@ -349,8 +349,13 @@ def read_gauges(reader, el, common: dict, specs: dict) -> dict:
         if dp is None:
             dp = case_dp(reader, el) or 0.0
         check_gauge(reader, c, d, elements, dp or None)
-        if not d.get("output", out["default"].get("output", False)):
+        if "output" not in d and "output" not in out["default"]:
+            # an <output value="false"/> the case gives is the author's choice: no warning then
             reader.warn(c, f"gauge '{name}' writes no file: DualSPHysics's default is <output value=\"false\"/> "
                         "(add <output value=\"true\"/> to it or to <default>); sphdvi does not compute it")
+        if d.get("savevtkpart", out["default"].get("savevtkpart", False)):
+            reader.warn(c, f"gauge '{name}': <savevtkpart> has no effect: sphdvi writes no VTK file of a gauge"
+                        + ("" if d.get("output", out["default"].get("output", False))
+                           else " (and, with <output value=\"false\"/>, computes nothing for it)"))
         out["items"].append(d)
     return out

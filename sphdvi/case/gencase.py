@@ -424,17 +424,38 @@ def particle_inertia(pos: np.ndarray, center: np.ndarray, mpart: float) -> np.nd
     return mpart * (np.eye(3) * rr.sum() - r.T @ r)
 
 
+def _mk_list(values) -> str:
+    """``[51, 52, 53, 60]`` -> ``"51-53, 60"``."""
+    runs, out = [], []
+    for v in sorted(values):
+        if runs and v == runs[-1][1] + 1:
+            runs[-1][1] = v
+        else:
+            runs.append([v, v])
+    for a, b in runs:
+        out.append(str(a) if a == b else f"{a}-{b}")
+    return ", ".join(out)
+
+
 def floating_bodies(case: Case, particles: dict, consts: Constants, primitives, reader) -> list:
     """Mass, centre and inertia of each floating mkbound, from its particles (as GenCase)."""
     bodies = []
     ptype, label, pos = particles["type"], particles["label"], particles["pos"]
     vol = consts.dp ** (2 if consts.is2d else 3)
     for fd in case.floatings:
-        for mkb in fd.mkbound:
+        drawn = [mkb for mkb in fd.mkbound if np.any((ptype == TYPE_FLOATING) & (label == mkb))]
+        if not drawn:
+            mkb = fd.mkbound[0] if len(fd.mkbound) == 1 else f"{fd.mkbound[0]}-{fd.mkbound[-1]}"
+            raise CaseError(f"floating mkbound {mkb} has no particles", file=reader.file, line=fd.line,
+                            element="floating", expected="an mkbound drawn by the geometry commands")
+        missing = [mkb for mkb in fd.mkbound if mkb not in drawn]
+        if missing:
+            # GenCase applies a <floating> to the mk blocks the geometry drew: DualSPHysics's chrono
+            # examples DamBreak1Cube ("51-53", 51 drawn) and ZipLine ("2-20", 2-11 drawn) rely on it
+            reader.warnings.add(f"mkbound {_mk_list(missing)} of this <floating> drew no particles: it applies to "
+                                f"mkbound {_mk_list(drawn)}", file=reader.file, line=fd.line, element="floating")
+        for mkb in drawn:
             sel = np.flatnonzero((ptype == TYPE_FLOATING) & (label == mkb))
-            if sel.size == 0:
-                raise CaseError(f"floating mkbound {mkb} has no particles", file=reader.file, line=fd.line,
-                                element="floating", expected="an mkbound drawn by the geometry commands")
             count = int(sel.size)
             rhopbody = fd.rhopbody if fd.rhopbody is not None else (
                 fd.relativeweight * consts.rhop0 if fd.relativeweight is not None else None)

@@ -134,6 +134,20 @@ CONSTANTS = frozenset({"cflnumber", "gamma", "rhop0", "coefsound", "speedsystem"
                        "coefhdp", "hswl", "gravity", "lattice", "eps", "h", "b", "massbound", "massfluid"})
 
 
+#: keys of DualSPHysics's separate multiphase non-Newtonian build (DualSPHysics-NNewtonian,
+#: examples/mphase_nnewtonian, doc/xml_format/_FmtXML_MphaseNNewtonian.xml), not of DualSPHysics v5.4
+NNEWTONIAN_KEYS = {"RheologyTreatment", "VelocityGradientType", "RelaxationDt"}
+NNEWTONIAN_TEXT = ("DualSPHysics's separate multiphase non-Newtonian build (DualSPHysics-NNewtonian, "
+                   "examples/mphase_nnewtonian), whose rheology sphdvi does not model")
+
+
+def other_build_hint(key: str) -> str | None:
+    """For a key of another DualSPHysics build than v5.4 (the non-Newtonian one): what it is."""
+    if key.strip() in NNEWTONIAN_KEYS:
+        return f"parameter '{key.strip()}' belongs to {NNEWTONIAN_TEXT}"
+    return None
+
+
 def constant_hint(key: str) -> str | None:
     """For a key that is a <constantsdef> constant (e.g. CFLnumber): where it belongs."""
     name = key.strip().lower()

@@ -19,8 +19,9 @@ from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import accinput_mk_attr, parse_mk_range, prop_link_attr, range_filter_attr
 from .normals_xml import read_initialize, read_normals, read_onlypos, read_velocity_profile
 from .outputs_xml import read_outputparts, read_savedt
-from .parameters import (NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency, check_supported, closest_key,
-                         coerce, constant_hint, default_parameters, domain_from_deprecated, parameter_warnings)
+from .parameters import (NNEWTONIAN_TEXT, NOT_SUPPORTED, PARAMETERS, apply_delta_sph, check_consistency,
+                         check_supported, closest_key, coerce, constant_hint, default_parameters,
+                         domain_from_deprecated, other_build_hint, parameter_warnings)
 from .schema import validate_structure
 from .xmldoc import CaseReader, load_xml, strip_disabled
 
@@ -31,7 +32,7 @@ SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", 
                      "savedt", "outputparts"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
     "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
-    "moorings", "forcepoints", "inout", "vres"}
+    "moorings", "forcepoints", "inout", "vres", "nnphases"}
 
 
 def case_name_from_path(path: str) -> str:
@@ -875,7 +876,7 @@ def read_parameters(reader, execution):
             reader.mark(p, "value")
             continue
         if key not in PARAMETERS:
-            const = constant_hint(key)
+            const = other_build_hint(key) or constant_hint(key)
             if const:
                 raise reader.error(p, const)
             hint = closest_key(key)
@@ -1013,6 +1014,9 @@ def read_special(reader, execution) -> dict:
     for c in reader.children(el):
         if c.tag not in SPECIAL_KNOWN:
             raise reader.error(c, f"unknown special section <{c.tag}>", "one of " + ", ".join(sorted(SPECIAL_KNOWN)))
+        if c.tag == "nnphases":
+            raise reader.error(c, f"<special><nnphases> belongs to {NNEWTONIAN_TEXT}",
+                               "supported: " + ", ".join(sorted(SPECIAL_SUPPORTED)))
         if c.tag not in SPECIAL_SUPPORTED:
             raise reader.error(c, f"<special><{c.tag}> is not supported by sphdvi",
                                "supported: " + ", ".join(sorted(SPECIAL_SUPPORTED)))

@@ -2,8 +2,9 @@
 typed attribute access with ``file:line: element:`` errors, unknown-attribute warnings.
 
 DualSPHysics reads its files with TinyXML, which accepts a few things XML does
-not: a blank line before ``<?xml``, and a raw ``<`` or ``&`` inside an
-attribute value (``<abort if="Dp<0.1"/>``). These are repaired before parsing;
+not: a blank line before ``<?xml`` or a comment before it (DesignSPHysics's files),
+a raw ``<`` or ``&`` inside an attribute value (``<abort if="Dp<0.1"/>``), and ``--``
+inside a comment (``<!---walls--->``). These are repaired before parsing;
 anything else that is malformed is reported with its line and column.
 
 Elements whose tag starts with ``_`` and elements with ``active="false"`` are
@@ -22,16 +23,34 @@ from ..errors import CaseError, Warnings
 from .expressions import ExpressionError, Variables
 
 MAX_CASE_BYTES = 64 * 1024 * 1024
-IGNORED_ATTRIBUTES = {"comment", "units_comment", "comment2", "rem"}
+#: note attributes, on any element: ``cmt`` (DualSPHysics's examples, ``<drawbox cmt="piston">``) and
+#: ``objname`` (DesignSPHysics writes it on every object it draws) as well as the comments
+IGNORED_ATTRIBUTES = {"comment", "units_comment", "comment2", "rem", "cmt", "objname"}
 #: attributes GenCase writes itself (its output case files are valid input), per element
 GENERATED_ATTRIBUTES = {"case": {"app", "date"}}
+#: attributes of real DualSPHysics files that DualSPHysics does not read, per element: a block's
+#: ``name`` label (examples/main/04_ExternalForces: ``<setmkfluid mk="0" name="FluidLeft"/>``) and
+#: ``<chrono datadir=".">`` (examples/chrono/06_ZipLine; JChronoObjects takes its data folder from
+#: the case's, not from the XML)
+LABEL_ATTRIBUTES = {"setmkfluid": {"name"}, "setmkbound": {"name"}, "setmkvoid": {"name"},
+                    "chrono": {"datadir"}}
 REQUIRED = object()
 _TRUE = {"true", "1", "yes"}
 _FALSE = {"false", "0", "no"}
 
 
-def _repair_attribute_text(text: str) -> str:
-    """Escape raw ``<`` and stray ``&`` inside quoted attribute values of start tags."""
+def _blank(text: str) -> str:
+    """``text`` with every character but a newline turned into a space (line numbers kept)."""
+    return re.sub(r"[^\n]", " ", text)
+
+
+def _repair_tinyxml_text(text: str) -> str:
+    """What TinyXML (DualSPHysics's XML reader) takes and XML does not, made well-formed, each
+    line kept where it was: a raw ``<`` or a stray ``&`` inside a quoted attribute value of a
+    start tag is escaped; a comment's body loses its hyphens (TinyXML ends a comment at the first
+    ``-->`` and reads nothing in it: ``<!---wall boundaries--->`` is a comment, which XML refuses
+    for its ``--``); an ``<?xml ...?>`` declaration that does not open the file is blanked
+    (DesignSPHysics writes ``<!-- Case name: ... -->`` on the line before it)."""
     out = []
     i = 0
     n = len(text)
@@ -58,9 +77,17 @@ def _repair_attribute_text(text: str) -> str:
         else:
             if c == "<":
                 if text.startswith("<!--", i):
-                    j = text.find("-->", i)
-                    j = n if j < 0 else j + 3
-                    out.append(text[i:j])
+                    j = text.find("-->", i + 4)
+                    if j < 0:
+                        out.append(text[i:])
+                        break
+                    out.append("<!--" + text[i + 4:j].replace("-", " ") + "-->")
+                    i = j + 3
+                    continue
+                if i > 0 and re.match(r"<\?xml\s", text[i:i + 6]):
+                    j = text.find("?>", i)
+                    j = n if j < 0 else j + 2
+                    out.append(_blank(text[i:j]))
                     i = j
                     continue
                 if text.startswith("<![CDATA[", i):
@@ -82,7 +109,7 @@ def parse_xml_text(text: str, file: str) -> etree._Element:
     removed_lines = text[: len(text) - len(stripped)].count("\n")
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False,
                              remove_comments=True, remove_pis=True, load_dtd=False)
-    candidates = [stripped, _repair_attribute_text(stripped)]
+    candidates = [stripped, _repair_tinyxml_text(stripped)]
     first_error = None
     for candidate in candidates:
         try:
@@ -361,6 +388,7 @@ class CaseReader:
             for attr in el.keys():
                 if attr in names or attr in IGNORED_ATTRIBUTES or attr.startswith("_") \
                         or attr == "active" or attr.endswith("_comment") \
-                        or attr in GENERATED_ATTRIBUTES.get(el.tag, ()):
+                        or attr in GENERATED_ATTRIBUTES.get(el.tag, ()) \
+                        or attr in LABEL_ATTRIBUTES.get(el.tag, ()):
                     continue
                 self.warn(el, f"unknown attribute '{attr}' ignored")

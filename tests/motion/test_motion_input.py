@@ -107,8 +107,8 @@ def test_bad_field_attributes(tmp_path, attrs, match):
     ("#t;x;y;z\n0;0;0;0\n", r"one data row \(line 2\)", None),
     ("0;0;0;0\n1;nan;0;0\n2;0;0;0\n", r"column 1 \(fieldx\) is nan", 2),
     ("0;0;0;0\n1;0;0;inf\n", r"column 3 \(fieldz\) is inf", 2),
-    ("0;0;0;0\n0;0.1;0;0\n1;0;0;0\n", r"time 0 does not come after 0 \(line 1\)", 2),
-    ("#h\n1;0;0;0\n0.5;0.1;0;0\n", r"time 0.5 does not come after 1 \(line 2\)", 3),
+    ("#h\n1;0;0;0\n0.5;0.1;0;0\n", r"time 0.5 comes before 1 \(line 2\)", 3),
+    ("0;0;0;0\n1;0;0;0\n1;0.1;0;0\n0.9;0;0;0\n", r"time 0.9 comes before 1 \(line 3\)", 4),
     ("0;0;0;0\n1;0;0\n", "3 column", 2),
     ("0;0;0;0\n1;abc;0;0\n", "'1;abc;0;0' is not numeric", 2),
 ])

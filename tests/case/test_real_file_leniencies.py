@@ -1,0 +1,120 @@
+"""What real DualSPHysics case files hold that sphdvi refused or warned about (an audit of 35
+files: DualSPHysics v5.4's examples, DesignSPHysics's templates, a user's project):
+
+* DesignSPHysics writes ``<!-- Case name: ... -->`` on the line before ``<?xml ...?>``; TinyXML
+  (GenCase's reader) takes a declaration anywhere, XML only first;
+* ``<!---wall boundaries--->``: TinyXML ends a comment at its first ``-->`` and reads nothing in it;
+* label attributes DualSPHysics does not read: ``cmt`` (examples' ``<drawbox cmt="piston">``),
+  ``objname`` (DesignSPHysics, on every object), ``name`` on ``<setmkfluid>``/``<setmkbound>``
+  (examples/main/04_ExternalForces), ``<chrono datadir=".">`` (examples/chrono/06_ZipLine);
+* a ``<floating>`` range naming mk blocks the geometry did not draw (examples/chrono/07
+  DamBreak1Cube: "51-53" with one cube): GenCase applies it to the blocks that exist;
+* a gauge whose ``<output value="false"/>`` the case gives on purpose (examples/others/GaugeSystem);
+* the keys of DualSPHysics's separate non-Newtonian build: named as such, not "did you mean"."""
+from __future__ import annotations
+
+from casetext import case_xml, write_case          # tests/case (on the path: conftest)
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+
+DESIGNSPHYSICS_HEAD = '<!-- Case name: MyCase -->\n'
+
+
+def _gencase(tmp_path, text, name="Case_Def.xml"):
+    path = write_case(tmp_path, text, name)
+    r = CliRunner().invoke(main, ["gencase", path, "-o", str(tmp_path / "out"), "--overwrite"])
+    return r.exit_code, r.output
+
+
+def test_comment_before_the_xml_declaration(tmp_path):
+    code, out = _gencase(tmp_path, DESIGNSPHYSICS_HEAD + case_xml())
+    assert code == 0, out
+    # the lines keep their numbers: an error further down names its own line
+    text = DESIGNSPHYSICS_HEAD + case_xml(parameters='<parameter key="X" value="1"/>')
+    line = next(k for k, s in enumerate(text.splitlines(), 1) if 'key="X"' in s)
+    code, out = _gencase(tmp_path, text)
+    assert code == 2 and "malformed XML" not in out
+    assert f"Case_Def.xml:{line}: <parameter>: unknown parameter key 'X'" in out
+
+
+def test_a_malformed_file_still_names_its_line(tmp_path):
+    code, out = _gencase(tmp_path, DESIGNSPHYSICS_HEAD + case_xml().replace("</mkconfig>", "").replace(
+        '<mkconfig boundcount="240" fluidcount="9" />', '<mkconfig boundcount="240" fluidcount="9">'))
+    assert code == 2 and "malformed XML" in out and "Traceback" not in out
+
+
+def test_comments_with_double_hyphens(tmp_path):
+    text = case_xml(commands="""
+                    <!---fluid--->
+                    <setmkfluid mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="1" y="2" z="2" /></drawbox>
+                    <!-- walls -- three of them - -->
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>bottom | left | right | front | back</boxfill>
+                        <point x="0" y="-1" z="0" /><size x="4" y="2" z="3" /></drawbox>""")
+    code, out = _gencase(tmp_path, text)
+    assert code == 0, out
+
+
+def test_label_attributes_are_not_warned(tmp_path):
+    text = case_xml(commands="""
+                    <setmkfluid mk="0" name="FluidLeft" />
+                    <drawbox cmt="water" objname="Fluid"><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="1" y="2" z="2" /></drawbox>
+                    <setmkbound mk="0" name="Container" />
+                    <drawbox objname="Tank"><boxfill>bottom | left | right | front | back</boxfill>
+                        <point x="0" y="-1" z="0" /><size x="4" y="2" z="3" /></drawbox>""")
+    code, out = _gencase(tmp_path, text)
+    assert code == 0, out
+    assert "unknown attribute" not in out
+    # an attribute that is not a label is still named
+    code, out = _gencase(tmp_path, text.replace('cmt="water"', 'colour="blue"'))
+    assert code == 0 and "unknown attribute 'colour' ignored" in out
+
+
+FLOATING_COMMANDS = """
+                    <setmkfluid mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0" /><size x="1" y="2" z="1" /></drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>bottom | left | right | front | back</boxfill>
+                        <point x="0" y="-1" z="0" /><size x="4" y="2" z="3" /></drawbox>
+                    <setmkbound mk="51" />
+                    <drawbox><boxfill>solid</boxfill><point x="2" y="-1" z="0.5" /><size x="0.2" y="2" z="0.2" /></drawbox>"""
+
+
+def test_floating_range_with_undrawn_blocks(tmp_path):
+    """<floating mkbound="51-53"> with mk 51 alone drawn: one body (51); a warning names 52-53.
+    A <floating> none of whose blocks were drawn stays an error."""
+    floatings = '<floatings><floating mkbound="{}"><massbody value="10" /></floating></floatings>'
+    code, out = _gencase(tmp_path, case_xml(commands=FLOATING_COMMANDS, casedef_extra=floatings.format("51-53")))
+    assert code == 0, out
+    assert "mkbound 52-53 of this <floating> drew no particles: it applies to mkbound 51" in out
+    assert "Floating mkbound 51 (mk 61): 121 particles, mass 10 kg/m" in out
+    assert "Floating mkbound 52" not in out and "Floating mkbound 53" not in out
+    code, out = _gencase(tmp_path, case_xml(commands=FLOATING_COMMANDS, casedef_extra=floatings.format("60-62")))
+    assert code == 2 and "floating mkbound 60-62 has no particles" in out
+
+
+def _gauge_case(output):
+    special = ('<gauges><velocity name="G"><point x="0.5" y="0" z="0.5" />'
+               f'{output}</velocity></gauges>')
+    return case_xml(special=special)
+
+
+def test_explicit_gauge_output_false_is_not_warned(tmp_path):
+    code, out = _gencase(tmp_path, _gauge_case('<output value="false" />'))
+    assert code == 0 and "writes no file" not in out
+    code, out = _gencase(tmp_path, _gauge_case(""))
+    assert code == 0 and "gauge 'G' writes no file" in out
+    code, out = _gencase(tmp_path, _gauge_case('<output value="false" /><savevtkpart value="true" />'))
+    assert code == 0 and "<savevtkpart> has no effect" in out and "computes nothing for it" in out
+    code, out = _gencase(tmp_path, _gauge_case('<output value="true" /><savevtkpart value="true" />'))
+    assert code == 0 and "<savevtkpart> has no effect" in out and "computes nothing" not in out
+
+
+def test_non_newtonian_keys_are_named_as_such(tmp_path):
+    code, out = _gencase(tmp_path, case_xml(parameters='<parameter key="RheologyTreatment" value="2" />'))
+    assert code == 2 and "non-Newtonian build" in out and "ViscoTreatment" not in out
+    code, out = _gencase(tmp_path, case_xml(special='<nnphases><phase mkfluid="0"><rhop value="1000" /></phase>'
+                                                    '</nnphases>'))
+    assert code == 2 and "<special><nnphases> belongs to DualSPHysics's separate multiphase non-Newtonian" in out
