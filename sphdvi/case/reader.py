@@ -886,6 +886,10 @@ def read_parameters(reader, execution):
             reader.warn(p, f"parameter '{key}' given twice; the last value is used")
         raw = reader.raw(p, "value")
         spec = PARAMETERS[key]
+        if key == "DtFixed" and not _is_number(raw):
+            raise reader.error(p, f"parameter DtFixed: value={raw!r} is not a number (DtFixed is one dt in seconds; "
+                                  "a file of dt values, as DualSPHysics before v5 took here, goes in DtFixedFile)",
+                               "a number, or <parameter key=\"DtFixedFile\" value=\"FILE\" />")
         try:
             if spec.kind == "str":
                 value = coerce(key, raw)
@@ -910,6 +914,18 @@ def read_parameters(reader, execution):
     except ValueError as exc:
         raise reader.error(el, str(exc)) from None
     return params, set_keys, domain
+
+
+def _is_number(raw) -> bool:
+    """Whether a parameter's raw value reads as a number (or an expression, ``#...``)."""
+    text = str(raw).strip()
+    if text.startswith("#"):
+        return True
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _expected_for(key):

@@ -118,3 +118,12 @@ def test_non_newtonian_keys_are_named_as_such(tmp_path):
     code, out = _gencase(tmp_path, case_xml(special='<nnphases><phase mkfluid="0"><rhop value="1000" /></phase>'
                                                     '</nnphases>'))
     assert code == 2 and "<special><nnphases> belongs to DualSPHysics's separate multiphase non-Newtonian" in out
+
+
+def test_dtfixed_given_a_file_points_to_dtfixedfile(tmp_path):
+    """examples/others/ExternalDtFile (before v5) gave DtFixed a file; v5.4 refuses it as sphdvi does,
+    and the message now says where a file goes."""
+    code, out = _gencase(tmp_path, case_xml(parameters='<parameter key="DtFixed" value="DtData.txt" />'))
+    assert code == 2 and "goes in DtFixedFile" in out and "Traceback" not in out
+    code, out = _gencase(tmp_path, case_xml(parameters='<parameter key="DtFixed" value="0.0001" />'))
+    assert code == 0, out
