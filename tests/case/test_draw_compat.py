@@ -88,11 +88,11 @@ def test_wavemaker_pattern_keeps_fluid_drawn_before(tmp_path):
 
 
 def test_mask_numbers_beyond_the_faces_are_ignored_and_warned(tmp_path):
-    # a 6-face prism with mask="7" (CasePointAbsorber copies the 7 of a 7-face prism) is closed;
-    # the face that does not exist is warned about (mask="96" passed silently before)
-    for mask in ("7", "96", "1 | 96"):
+    # a 5-face prism with mask="7" is closed; a mask none of whose faces exists is warned about
+    # (mask="96" passed silently before)
+    for mask in ("7", "96"):
         d, w = warnings_of(tmp_path, PRISM.format(mode="face", mask=mask))
-        assert any(f"mask names face {mask.split()[-1]} but this <drawprism> has faces 1 to 5 only"
+        assert any(f"mask names face {mask} but this <drawprism> has faces 1 to 5 only"
                    in m for m in w), w
     d, w = warnings_of(tmp_path, PRISM.format(mode="full", mask="7"))
     assert len(d.pos) == 45
@@ -101,6 +101,17 @@ def test_mask_numbers_beyond_the_faces_are_ignored_and_warned(tmp_path):
                                     in m for m in w)
     d, w = warnings_of(tmp_path, PRISM.format(mode="full", mask="1 | 2"))
     assert w == []
+
+
+@pytest.mark.parametrize("mask", ["1 | 96", "1 | 2 | 6 | 7"])
+def test_mask_number_beyond_the_faces_beside_valid_ones_is_silent(tmp_path, mask):
+    # audit finding 7: CaseFlapBeach_REG and CasePointAbsorber (v5.4) write mask="1 | 2 | 6 | 7"
+    # on 4-point prisms (faces 1 to 6); GenCase is silent, the drawing uses the faces that exist
+    d, w = warnings_of(tmp_path, FLUME.format(mode="full", mask=mask), **FLUME_KW)
+    assert w == []
+    ref = draw(tmp_path, FLUME.format(mode="full", mask=mask.rsplit("|", 1)[0]), **FLUME_KW)
+    assert np.array_equal(d.pos, ref.pos) and np.array_equal(d.mk, ref.mk)
+    assert d.primitives[0]["params"]["mask"] == sorted(int(v) for v in mask.split("|"))
 
 
 @pytest.mark.parametrize("mode,mask,count", [

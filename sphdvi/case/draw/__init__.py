@@ -44,10 +44,11 @@ Surfaces (see :mod:`.raster`)
     nearest nodes). Curved surfaces: the inner shell (inside nodes with an
     outside face-neighbour). Both are closed against face-connected leaks.
 
-Masks (``drawprism``, ``drawpyramid``, ``drawcylinder``)
+Masks (``drawprism``, ``drawbeach``, ``drawpyramid``, ``drawcylinder``)
     ``mask`` lists the numbers (from 1) of the faces left out, joined by ``|``
     (``mask="1 | 2 | 6 | 7"`` leaves out faces 1, 2, 6 and 7; ``0`` none;
-    numbers beyond the shape's faces hide nothing and are warned about). Prism (first polygon, then
+    numbers beyond the shape's faces hide nothing; a mask naming no face of the shape at all is
+    warned about, one beside valid faces passes silently like GenCase's). Prism (first polygon, then
     second polygon): 1 = first polygon, 2 = second polygon, 3, 4, ... = sides
     (side k joins points k-2 and k-1 of each polygon, the last one closes it).
     Pyramid (apex, then base points): 1 = base, 2, 3, ... = sides apex-P1P2,
@@ -61,6 +62,19 @@ Masks (``drawprism``, ``drawpyramid``, ``drawcylinder``)
     piston), and their fillbox seeds (or the fluid drawn before) lie inside
     the masked prism drawn in full mode, so GenCase leaves it hollow. The
     cylinder and pyramid numbering is inferred (caps first, like prisms).
+
+Beach (``drawbeach``, 2D cases only)
+    The closed x-z polygon of the profile points extruded along y across the
+    2D plane; faces and ``mask`` as a prism's (1, 2 the profile polygons, 3...
+    the sides, the last closing the profile). 3D cases are refused (the y
+    extent is not documented).
+
+Extrusion (``drawextrude closed="false"``)
+    The open polyline of the points swept by ``<extrude>``: a surface (the
+    planar-surface rule) in every mode but ``wire`` (its quadrilaterals'
+    edges). ``<layers>`` moves it offset*dp along the face normals
+    (P_i+1 - P_i) x extrude (a mitred parallel curve). ``closed="true"`` is
+    refused.
 
 Ellipsoid
     ``<point>`` (or ``<center>``) + ``<radius x y z>`` (or ``<size>``):
@@ -106,7 +120,7 @@ Commands that draw nothing
     is refused (its node rule is not documented).
 
 Not supported (CaseError "not supported by sphdvi"): see ``UNSUPPORTED``
-(bathymetry, waves, beaches, extrusions, redraw, clipping, patterns, ...)
+(bathymetry, waves, redraw, clipping, patterns, ...)
 and ``<layers>`` of ellipsoids; commands that only tune GenCase's own output or sampling
 (``setdpctes``, ``setshapemode``, ``debugout``, ...) are accepted with no effect.
 """

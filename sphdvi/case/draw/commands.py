@@ -29,7 +29,7 @@ SKIPPED_ATTRS = {"comment", "units_comment", "comment2", "rem", "active"}
 
 #: commands of GenCase that sphdvi does not implement
 UNSUPPORTED = {
-    "drawbathymetry", "drawwave", "drawbeach", "drawextrude", "drawfilevtm", "drawfilecsv",
+    "drawbathymetry", "drawwave", "drawfilevtm", "drawfilecsv",
     "redraw", "redrawbox", "redrawnear", "redrawnearbox", "clipdomain", "clipplane", "clipbox",
     "clipreset", "setpattern", "patterns", "fillfigure", "fillprism",
     "setmknextfluid", "setmknextbound", "setmknextauto", "setmkbackvoid", "setmkbackfluid",
@@ -138,7 +138,8 @@ class GeometryRunner:
                  "drawpoint", "drawpoints", "drawline", "drawlines", "setlinebegin", "drawlineto",
                  "drawtriangle", "drawquadri", "drawtrianglesstrip", "drawtrianglesfan",
                  "drawpolygon", "drawtriangles", "drawfigure", "drawbox", "drawsphere",
-                 "drawellipsoid", "drawcylinder", "drawprism", "drawpyramid", "drawfilestl",
+                 "drawellipsoid", "drawcylinder", "drawprism", "drawpyramid", "drawbeach",
+                 "drawextrude", "drawfilestl",
                  "drawfileply", "drawfilevtk", "fillpoint", "fillvoidpoint", "fillbox", "shapeout"]
         return {n: getattr(self, "cmd_" + n) for n in names}
 
@@ -279,10 +280,12 @@ class GeometryRunner:
         return frozenset(hidden)
 
     def _warn_missing_faces(self, el, hidden: frozenset, nfaces: int) -> None:
-        """A mask that names a face the shape does not have hides nothing there: warned (GenCase's
-        ``mask`` lists face numbers 1..nfaces; ``mask="96"`` on a prism passed silently before)."""
+        """A mask none of whose numbers is a face of the shape hides nothing: warned (GenCase's
+        ``mask`` lists face numbers 1..nfaces; ``mask="96"`` on a prism passed silently before).
+        A number beyond the faces beside valid ones is passed silently, as GenCase does: the
+        official flumes write ``mask="1 | 2 | 6 | 7"`` on 4-point prisms (faces 1 to 6)."""
         extra = sorted(f for f in hidden if f > nfaces)
-        if extra:
+        if extra and len(extra) == len(hidden):
             self.reader.warn(el, f"mask names face{'s' if len(extra) > 1 else ''} "
                                  f"{', '.join(map(str, extra))} but this <{el.tag}> has faces 1 to "
                                  f"{nfaces} only: {'they hide' if len(extra) > 1 else 'it hides'} "
@@ -813,6 +816,92 @@ class GeometryRunner:
         if len(p) > 65:
             raise self.reader.error(el, f"{len(p)} points", "apex + at most 64 base points")
         self._draw_polyhedron(el, p, shapes.pyramid_faces(len(p) - 1), "pyramid")
+
+    def cmd_drawbeach(self, el):
+        """GenCase's ``<drawbeach mask>``: a prism whose cross-section is the closed polygon of the
+        profile points (one x-z plane; GenCase: "the lateral points that form the profile of the
+        beach"), extruded along y. Faces and ``mask`` are those of ``<drawprism>``: 1 and 2 the
+        two profile polygons, 3... the sides from points 1-2 on, the last one closing the profile
+        (XML guide: ``mask="128"``, face 8, hides the closing top line of its 6-point beach; the
+        v5.4 examples hide 1|2 (CasePeriodicity) and 1|2|5 (CaseBowling, the closing side of a
+        3-point ramp)); an open beach is hollow in ``full`` mode like a masked prism.
+
+        How far a beach extends in y is not documented: in a 2D case it crosses the plane
+        y = posy whatever the y of its points (CasePeriodicity and CaseBowling give y = 1 and 2
+        for planes y = 0 and 1), its polygons 1 dp either side; a 3D case is refused.
+        """
+        self._need_pen(el)
+        self._check(el, {"point"})
+        p = self._points(el, least=3)
+        if len(p) > 64:
+            raise self.reader.error(el, f"{len(p)} points", "3 to 64 profile points")
+        if not self.lat.is2d:
+            raise self.reader.error(el, "<drawbeach> in a 3D case is not supported by sphdvi "
+                                        "(GenCase's documentation does not say how far a beach "
+                                        "extends in y)", "a 2D case (pointmin y = pointmax y), "
+                                    "or a <drawprism> with both profiles written out")
+        tol = 1e-9 * max(1.0, float(np.max(np.abs(p))))
+        if np.ptp(p[:, 1]) > tol:
+            raise self.reader.error(el, f"the profile points have different y "
+                                        f"({p[:, 1].min():g} to {p[:, 1].max():g})",
+                                    "a beach profile in one x-z plane (the same y for every point)")
+        m = self.state.matrix
+        if max(abs(m[1, 0]), abs(m[1, 2]), abs(m[0, 1]), abs(m[2, 1])) > 1e-12 * np.abs(m[:3, :3]).max():
+            raise self.reader.error(el, "<drawbeach> under a transformation that tilts the y axis "
+                                        "is not supported by sphdvi",
+                                    "moves, scales and rotations about y only before it")
+        dp, posy = self.lat.dp, float(self.lat.pointmin[1])
+        ya, yb = ((posy - dp - m[1, 3]) / m[1, 1], (posy + dp - m[1, 3]) / m[1, 1])
+        verts = shapes.beach_prism(p, min(ya, yb), max(ya, yb))
+        self._draw_polyhedron(el, verts, shapes.prism_faces(len(p)), "beach")
+
+    def cmd_drawextrude(self, el):
+        """GenCase's ``<drawextrude closed="false">``: the open polyline of the ``<point>``
+        elements swept by the vector ``<extrude>`` (XML guide: "draws an extruded line of points
+        to create a 3-D shape"), a surface of one quadrilateral per segment, drawn like the other
+        open surfaces (``drawtrianglesstrip``): the planar-surface rule in ``full``, ``face`` and
+        ``solid`` modes, its edges in ``wire`` mode. Repeated consecutive points are dropped.
+
+        ``<layers vdp>`` draws it once per offset, moved offset*dp along the face normal
+        (P_i+1 - P_i) x extrude, i.e. outwards by GenCase's counter-clockwise rule, like the
+        outward ``<layers>`` of a box: in CaseStillWedge and CaseWaveTank (mDBC, v5.4) the fluid
+        lies on that side, layers 0, -1, -2 are the wall and +0.5 the boundary for the normals.
+        A layer is the mitred parallel curve, its ends not lengthened and the sweep not widened
+        along the extrusion (the docs leave both open; the 2D examples do not depend on the
+        latter). ``closed="true"`` (undocumented: caps? an inside?) is refused; ``closed``
+        absent means false, like GenCase's other boolean attributes (autofill, advanced).
+        """
+        self._need_pen(el)
+        self._check(el, {"point", "extrude", "layers"})
+        if self.reader.boolean(el, "closed", False):
+            raise self.reader.error(el, "<drawextrude closed=\"true\"> is not supported by sphdvi "
+                                        "(GenCase's documentation does not say how a closed "
+                                        "extrusion is drawn)",
+                                    "closed=\"false\" (an open polyline), or a <drawprism>")
+        pts = self._points(el, least=2)
+        vec = self.reader.vec3(self.reader.child(el, "extrude", required=True))
+        keep = np.r_[True, np.any(pts[1:] != pts[:-1], axis=1)]
+        pts = pts[keep]
+        if len(pts) < 2:
+            raise self.reader.error(el, "all the points coincide", "at least 2 distinct points")
+        elen = float(np.linalg.norm(vec))
+        if not elen > 0 or not np.isfinite(elen):
+            raise self.reader.error(el, f"the <extrude> vector {vec.tolist()} is zero",
+                                    "a non-zero extrusion vector")
+        seg = pts[1:] - pts[:-1]
+        flat = np.linalg.norm(np.cross(seg, vec), axis=1) <= 1e-9 * np.linalg.norm(seg, axis=1) * elen
+        if flat.any():
+            k = int(np.argmax(flat))
+            raise self.reader.error(el, f"the segment from {pts[k].tolist()} to {pts[k + 1].tolist()} "
+                                        "is parallel to the <extrude> vector (it sweeps no area)",
+                                    "points whose segments are not parallel to <extrude>")
+        for layer in self._layers(el):
+            pieces, params, tris = shapes.draw_extrude(
+                self.lat, self.state.matrix, pts, vec, wire=self.state.mode == "wire",
+                offset=layer * self.lat.dp)
+            params["layer"] = layer
+            n = self._paint(el, pieces)
+            self._record(el, "extrude", params, tris, False, n)
 
     # ------------------------------------------------------------ mesh files
     def _draw_file(self, el, kind):

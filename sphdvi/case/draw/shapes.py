@@ -322,3 +322,71 @@ def draw_polyhedron(lat: Lattice, m, verts, faces, *, solid: bool, surface: bool
         pieces += raster.segment_pieces(lat, [w[[a, b]] for a, b in face_edges(shown)])
     params = {"vertices": w.tolist(), "faces": [list(f) for f in faces]}
     return pieces, params, all_tris
+
+
+# ---------------------------------------------------------------- extrusions and beaches
+def offset_polyline(pts: np.ndarray, vec: np.ndarray, offset: float) -> np.ndarray:
+    """The open polyline ``pts`` moved ``offset`` along the normals of its extruded faces.
+
+    Segment i sweeps the face (P_i, P_i+1, P_i+1 + e, P_i + e), whose normal is
+    n_i = (P_i+1 - P_i) x e (GenCase's counter-clockwise rule for triangles). An inner
+    point moves to where both faces it joins lie ``offset`` away (a mitred parallel curve,
+    perpendicular to e), an end point along the normal of its own face; the ends are not
+    lengthened. ``offset = 0`` returns the points unchanged.
+    """
+    pts = np.asarray(pts, dtype=np.float64)
+    if offset == 0:
+        return pts.copy()
+    eu = vec / np.linalg.norm(vec)
+    nrm = np.cross(pts[1:] - pts[:-1], eu)
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    out = pts.copy()
+    out[0] += offset * nrm[0]
+    out[-1] += offset * nrm[-1]
+    for k in range(1, len(pts) - 1):
+        a, b = nrm[k - 1], nrm[k]
+        if np.linalg.norm(np.cross(a, b)) < 1e-9:       # straight on (or folded back)
+            out[k] += offset * b
+            continue
+        out[k] += np.linalg.solve(np.array([a, b, eu]), np.array([offset, offset, 0.0]))
+    return out
+
+
+def extrude_triangles(pts: np.ndarray, vec: np.ndarray) -> np.ndarray:
+    """Triangles (2 per segment) of the open polyline ``pts`` swept by the vector ``vec``."""
+    a, b = pts[:-1], pts[1:]
+    t1 = np.stack([a, b, b + vec], axis=1)
+    t2 = np.stack([a, b + vec, a + vec], axis=1)
+    return np.stack([t1, t2], axis=1).reshape(-1, 3, 3)
+
+
+def draw_extrude(lat: Lattice, m, pts, vec, *, wire: bool, offset: float = 0.0):
+    """GenCase's ``<drawextrude closed="false">``: the open polyline ``pts`` swept by ``vec``
+    (a surface of one quadrilateral per segment), moved ``offset`` along the face normals
+    (``<layers>``, see :func:`offset_polyline`). The surface follows the planar-surface rule of
+    :mod:`.raster`; ``wire`` draws the quadrilaterals' edges instead."""
+    vec = np.asarray(vec, dtype=np.float64)
+    loc = offset_polyline(pts, vec, offset)
+    tris = tf.apply(m, extrude_triangles(loc, vec))
+    if wire:
+        w0, w1 = tf.apply(m, loc), tf.apply(m, loc + vec)
+        segs = [np.array([w0[i], w0[i + 1]]) for i in range(len(loc) - 1)]
+        segs += [np.array([w1[i], w1[i + 1]]) for i in range(len(loc) - 1)]
+        segs += [np.array([w0[i], w1[i]]) for i in range(len(loc))]
+        pieces = raster.segment_pieces(lat, segs)
+    else:
+        pieces = raster.triangle_pieces(lat, tris)
+    world_vec = tf.apply(m, vec) - tf.apply(m, np.zeros(3))
+    params = {"points": tf.apply(m, loc).tolist(), "extrude": world_vec.tolist(), "closed": False}
+    return pieces, params, tris
+
+
+def beach_prism(profile: np.ndarray, y_lo: float, y_hi: float) -> np.ndarray:
+    """The prism vertices of GenCase's ``<drawbeach>``: the closed x-z profile at ``y_lo``
+    (first polygon, face 1) then at ``y_hi`` (second polygon, face 2); faces 3... are the
+    sides, the last one joining the last profile point to the first (:func:`prism_faces`)."""
+    lo = np.array(profile, dtype=np.float64)
+    hi = lo.copy()
+    lo[:, 1] = y_lo
+    hi[:, 1] = y_hi
+    return np.concatenate([lo, hi])
