@@ -117,7 +117,10 @@ def triangle_pieces(lat: Lattice, tris, surface: bool = True, solid: bool = Fals
     itri = np.ascontiguousarray(lat.to_index(tris))
     if not np.all(np.abs(itri) < 1e15):
         raise ValueError("triangle coordinates are not finite or lie absurdly far from the domain")
-    r = world_range(lat, tris, 0.5 + EPS)
+    # a node of the band lies up to SURFACE_HALF from the plane and EDGE_REACH beyond an edge:
+    # on a face oblique to the lattice that is up to ~0.71 beyond the triangle's box along an
+    # axis (a pad of 0.5 dropped 27 of 24,846 band nodes of 200 random triangles)
+    r = world_range(lat, tris, (SURFACE_HALF + EDGE_REACH if surface else 0.5) + EPS)
     if r is None:
         return []
     lo, hi = r
