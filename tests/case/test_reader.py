@@ -555,12 +555,25 @@ def test_analytic_mass_of_a_2d_cylinder(tmp_path, p2, mass, diag):
     assert np.allclose(np.diag(b.analytic["inertia"]), diag, rtol=1e-12)
 
 
-def test_second_order_flap_is_refused(tmp_path):
-    special = ('<wavepaddles><flap><mkbound value="0"/><depth value="1"/><waveorder value="2"/>'
-               '<waveheight value="0.1"/><waveperiod value="1"/><flapaxis0 x="0" y="0" z="0"/>'
-               '<flapaxis1 x="0" y="1" z="0"/></flap></wavepaddles>')
-    with pytest.raises(CaseError, match="second-order generation is not supported for flaps"):
-        build(tmp_path, special=special)
+def test_second_order_flap_is_warned_and_first_order(tmp_path):
+    """DualSPHysics's example main/08_WavesFlap asks <waveorder value="2"> of a <flap>; its format
+    doc gives flaps no <waveorder> (second order is for pistons): warned, generated at first order
+    (it was refused, which stopped the example)."""
+    from sphdvi.case.reader import read_wavepaddles
+    from sphdvi.case.xmldoc import CaseReader
+    from lxml import etree
+    xml = ('<wavepaddles><flap><mkbound value="0"/><depth value="1"/>\n<waveorder value="2"/>'
+           '<waveheight value="0.1"/><waveperiod value="1"/><flapaxis0 x="0" y="0" z="0"/>'
+           '<flapaxis1 x="0" y="1" z="0"/></flap></wavepaddles>')
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    (wp,) = read_wavepaddles(reader, etree.fromstring(xml))
+    assert wp["waveorder"] == 1
+    (w,) = list(reader.warnings)
+    assert ":2: warning: <waveorder>: second-order generation is for pistons" in w
+    # a flap_spectrum asking second order stays an error (sphdvi has no second-order irregular waves)
+    with pytest.raises(CaseError, match="second-order generation of irregular waves"):
+        read_wavepaddles(reader, etree.fromstring(xml.replace("<flap>", "<flap_spectrum>").replace(
+            "</flap>", "</flap_spectrum>")))
 
 
 def test_a_wave_paddles_depth_unlike_the_water_drawn_is_warned(tmp_path):
