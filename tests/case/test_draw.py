@@ -684,17 +684,25 @@ def test_printf_in_predefinition_and_list_calls(tmp_path):
 
 
 def test_box_layers(tmp_path):
+    """A face's layers move it along its normal over the same extent (GenCase v5: a 3 m x 3 m floor
+    with <layers vdp="0,1,2"> at dp 0.0064 wrote 3 x 470^2 particles; they were widened here)."""
     d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="bottom",
                                                    extra='<layers vdp="0,1*,2"/>'))
-    assert len(d.pos) == 25 + 49 + 81
+    assert len(d.pos) == 3 * 25
     assert sorted(set(d.pos[:, 2].tolist())) == [1, 2, 3]
+    assert set(d.pos[:, 0].tolist()) == {3, 4, 5, 6, 7}
     assert [p["params"]["layer"] for p in d.primitives] == [0, 1, 2]
-    # a tank with 3-layer walls keeps its fluid inside
+    # a tank with 3-layer walls keeps its fluid inside; the outer layers leave its edges and
+    # corners open (nodes with two coordinates outside the box are not drawn)
     body = ('<setmkfluid mk="0"/>' + box((3, 3, 3), (4, 4, 4))
             + '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="all",
                                            extra='<layers vdp="0,1,2"/>'))
     d = draw(tmp_path, body)
-    assert d.count_fluid == 27 and d.count_bound == 9 ** 3 - 27
+    assert d.count_fluid == 27 and d.count_bound == 5 ** 3 + 3 * 2 * 2 * 5 ** 2 - 27
+    # a solid box's layers still widen it on every side
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="solid",
+                                                   extra='<layers vdp="0,1"/>'))
+    assert len(d.pos) == 7 ** 3
     # an inward layer that shrinks the box away is skipped with a warning
     d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (2, 2, 2), fill="all",
                                                    extra='<layers vdp="0,-2"/>'))

@@ -112,16 +112,8 @@ def box_corners(size) -> np.ndarray:
     return np.array([[x, y, z] for x in (0.0, sx) for y in (0.0, sy) for z in (0.0, sz)])
 
 
-def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: bool,
-             grow: float = 0.0):
-    """A box with a corner at ``point`` and edges ``size`` (rotated by ``angles`` about
-    ``point``), widened by ``grow`` on every side (``<layers>``)."""
-    full = m @ tf.translation(point)
-    if angles is not None and np.any(angles != 0):
-        full = full @ tf.rotation_xyz(angles)
-    if grow:
-        full = full @ tf.translation([-grow] * 3)
-        size = np.asarray(size, dtype=np.float64) + 2.0 * grow
+def _box_pieces(lat: Lattice, full, size, solid: bool, faces, wire: bool) -> list:
+    """Pieces of the box ``box_corners(size)`` under the transform ``full``."""
     verts = tf.apply(full, box_corners(size))
     pieces = []
     if tf.is_axis_aligned(full):
@@ -155,6 +147,34 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
         if wire:
             segs = [verts[[a, b]] for a, b in face_edges(BOX_FACES.values())]
             pieces += raster.segment_pieces(lat, segs)
+    return pieces
+
+
+def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: bool,
+             grow: float = 0.0):
+    """A box with a corner at ``point`` and edges ``size`` (rotated by ``angles`` about
+    ``point``), drawn ``grow`` outwards (``<layers>``): a solid box (or its wire frame) widened by
+    ``grow`` on every side; its faces each moved ``grow`` along its own normal, over the same
+    extent as at layer 0, as GenCase v5 draws them (a yzhao469/DualSPHysicsAgent_v1 InclinedTrench
+    run: a 3 m x 3 m floor with ``<layers vdp="0,1,2">`` gave 3 x 470^2 particles, the layers not
+    widened). The recorded shape (shapeout, ``norgeometry``) stays the widened box."""
+    full = m @ tf.translation(point)
+    if angles is not None and np.any(angles != 0):
+        full = full @ tf.rotation_xyz(angles)
+    size = np.asarray(size, dtype=np.float64)
+    moved_faces = bool(grow) and bool(faces) and not solid and not wire
+    pieces = []
+    for f in (faces if moved_faces else ()):
+        axis, side = raster.FACE_AXIS[f]
+        shift = np.zeros(3)
+        shift[axis] = grow if side else -grow
+        pieces += _box_pieces(lat, full @ tf.translation(shift), size, False, [f], False)
+    if grow:
+        full = full @ tf.translation([-grow] * 3)
+        size = size + 2.0 * grow
+    if not moved_faces:
+        pieces = _box_pieces(lat, full, size, solid, faces, wire)
+    verts = tf.apply(full, box_corners(size))
     lin = full[:3, :3]
     edge_len = np.linalg.norm(lin, axis=0)
     params = {"vertices": verts.tolist(), "center": verts.mean(axis=0).tolist(),
