@@ -99,8 +99,9 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
         consts = resolve_constants(cdef, drawing.dp, drawing.is2d, drawing.posy2d, fluid_z)
     check_constants(reader, casedef, consts, fluid=bool(fluid_z.size))
     if fluid_z.size and not consts.cs0 > 0:
-        raise reader.error(casedef.find("constantsdef"), "the speed of sound is zero (the fluid has no height)",
-                           'a <speedsound value=".."/> or <hswl value=".."/>')
+        raise reader.error(casedef.find("constantsdef"), f"the speed of sound is zero: {_zero_sound_cause(cdef)}",
+                           'a <speedsound value=".."/> or <b value=".."/> above 0, or coefsound, hswl and '
+                           'speedsystem above 0')
     define_computed_variables(reader, consts)
     case = Case(name=casename, file=os.path.abspath(path), source=text, constantsdef=cdef,
                 boundcount=boundcount, fluidcount=fluidcount)
@@ -118,6 +119,21 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
                          mkinfo=mkinfo, warnings=warnings, primitives=list(drawing.primitives),
                          files=list(drawing.shape_files), normals=normals)
+
+
+def _zero_sound_cause(cdef) -> str:
+    """Which input made c0 = speedsound = coefsound·speedsystem, speedsystem = sqrt(|g|·hswl), zero."""
+    if cdef.speedsound is not None:
+        return "speedsound is 0"
+    if cdef.coefsound == 0:
+        return "coefsound is 0 (speedsound = coefsound·speedsystem)"
+    if cdef.speedsystem is not None:
+        return "speedsystem is 0 (speedsound = coefsound·speedsystem)"
+    if cdef.hswl is not None:
+        return "hswl is 0 (speedsystem = sqrt(|g|·hswl))"
+    if not any(cdef.gravity):
+        return "the gravity is 0 (speedsystem = sqrt(|g|·hswl))"
+    return "the fluid has no height (hswl, auto, is max z - min z of the fluid)"
 
 
 def check_dp(reader, geometry, dp: float, is2d: bool, rhop0: float) -> None:

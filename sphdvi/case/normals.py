@@ -521,8 +521,10 @@ def keep_normals_of(normals: np.ndarray, mkbound: np.ndarray, ptype: np.ndarray,
 
 def layers_needed(h: float, dp: float) -> int:
     """Wall layers a fluid particle dp/2 off a wall reaches (kernel support 2h; its layers at
-    dp, 2 dp, ... from it): 2 in 2D and 3 in 3D at coefh 1."""
-    return max(1, int(math.floor(2.0 * h / dp + 1e-9)))
+    dp, 2 dp, ... from it, each counted if it lies closer than 2h, where the kernel is 0): 2 in
+    2D and 3 in 3D at coefh 1, 3 at h = 2 dp (DualSPHysics's examples/mdbc/04_Dambreak, hdp 2,
+    three layers: its fourth would lie at 2h)."""
+    return max(1, int(math.ceil(2.0 * h / dp - 1e-9)) - 1)
 
 
 def thin_wall_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray,

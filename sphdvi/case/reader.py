@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import CaseError
 from .datafiles import read_dt_table, read_visco_table
+from .expressions import ExpressionError
 from .model import Case, ConstantsDef, FloatingDef, Material
 from .mkrange import accinput_mk_attr, parse_mk_range, prop_link_attr, range_filter_attr
 from .normals_xml import read_initialize, read_normals, read_onlypos, read_velocity_profile
@@ -27,7 +28,7 @@ from .xmldoc import CaseReader, load_xml, strip_disabled
 
 CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initials", "motion",
                     "properties", "normals", "patterns", "vres"}
-EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres"}
+EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres", "uservars", "vtkout"}
 SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout", "initialize",
                      "savedt", "outputparts"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
@@ -94,11 +95,13 @@ def read_constantsdef(reader: CaseReader, casedef) -> ConstantsDef:
     if rg is not None:
         c.rhopgradient = reader.integer(rg, "value", lo=1, hi=3)
     c.gamma = reader.child_value(el, "gamma", 7.0, positive=True)
-    c.coefsound = reader.child_value(el, "coefsound", 20.0, positive=True)
+    # the speed-of-sound inputs may be 0 where they are not used (a case with <b> or <speedsound>
+    # given leaves coefsound, hswl and speedsystem unused); gencase refuses a c0 of 0 with fluid
+    c.coefsound = reader.child_value(el, "coefsound", 20.0, nonnegative=True)
     c.cflnumber = reader.child_value(el, "cflnumber", 0.2, positive=True, hi=10.0)
-    c.hswl = _auto_value(reader, el, "hswl", positive=True)
-    c.speedsystem = _auto_value(reader, el, "speedsystem", positive=True)
-    c.speedsound = _auto_value(reader, el, "speedsound", positive=True)
+    c.hswl = _auto_value(reader, el, "hswl", nonnegative=True)
+    c.speedsystem = _auto_value(reader, el, "speedsystem", nonnegative=True)
+    c.speedsound = _auto_value(reader, el, "speedsound", nonnegative=True)
     c.h = _auto_value(reader, el, "h", positive=True)
     c.b = _auto_value(reader, el, "b", positive=True)
     c.massbound = _auto_value(reader, el, "massbound", positive=True)
@@ -203,6 +206,7 @@ def read_sections(case: Case, root, reader: CaseReader) -> None:
             fd.property = _check_property_names(reader, fd.property, case.materials, fd.line, "floating")
     case.normals = read_normals(reader, casedef)
     execution = root.find("execution")
+    read_uservars(reader, execution)
     params, set_keys, domain = read_parameters(reader, execution)
     case.parameters, case.parameters_set, case.simulationdomain = params, set_keys, domain
     case.special = read_special(reader, execution)
@@ -855,6 +859,40 @@ def load_xml_any(path, reader):
 # ---------------------------------------------------------------------------
 # execution
 # ---------------------------------------------------------------------------
+def read_uservars(reader, execution) -> None:
+    """``<execution><uservars>``: the ``<varnum name value>`` and ``<varstr name value>`` a GenCase
+    output file carries (GenCase's exported variables, JCaseUserVars), which DualSPHysics defines
+    before it evaluates the execution section's expressions (JSph::LoadConfigVars).  sphdvi has
+    the case's own variables already; a listed variable it lacks is defined, one it has with
+    another value keeps the case's value, with a warning.  ``<vtkout>``, GenCase's list of the
+    shape files it wrote, is its record only: read and unused."""
+    if execution is None:
+        return
+    vtkout = reader.child(execution, "vtkout")
+    if vtkout is not None:
+        for el in vtkout.iter():
+            reader.mark(el, *el.attrib)
+    el = reader.child(execution, "uservars")
+    if el is None:
+        return
+    for v in reader.children(el):
+        if v.tag not in ("varnum", "varstr"):
+            raise reader.error(v, f"unknown element <{v.tag}> in <uservars>", '<varnum name="N" value="1.5"/> '
+                                                                               'or <varstr name="S" value="text"/>')
+        name = reader.text_attr(v, "name").strip()
+        value = reader.num(v, "value") if v.tag == "varnum" else reader.text_attr(v, "value")
+        known = reader.vars.values.get(name, None)
+        if known is None:
+            try:
+                reader.vars.define(name, value)
+            except ExpressionError as exc:
+                raise reader.error(v, str(exc), "a variable name: a letter or '_', then letters, digits, '_'") from None
+        elif known != value and not (isinstance(known, (int, float)) and not isinstance(value, str)
+                                     and abs(float(known) - value) <= 1e-9 * max(1.0, abs(value))):
+            reader.warn(v, f"uservars: {name}={value!r} differs from the case's own {name}={known!r}; "
+                           "the case's value is used")
+
+
 def read_parameters(reader, execution):
     params = default_parameters()
     set_keys = []

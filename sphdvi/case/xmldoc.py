@@ -26,8 +26,10 @@ MAX_CASE_BYTES = 64 * 1024 * 1024
 #: note attributes, on any element: ``cmt`` (DualSPHysics's examples, ``<drawbox cmt="piston">``) and
 #: ``objname`` (DesignSPHysics writes it on every object it draws) as well as the comments
 IGNORED_ATTRIBUTES = {"comment", "units_comment", "comment2", "rem", "cmt", "objname"}
-#: attributes GenCase writes itself (its output case files are valid input), per element
-GENERATED_ATTRIBUTES = {"case": {"app", "date"}}
+#: attributes GenCase writes itself (its output case files are valid input), per element; GenCase's
+#: ``<casedef requiredversion="v5.0.295">`` (GenCase_CaseTemplate.xml) is the GenCase version a
+#: case needs, which GenCase checks against its own: sphdvi reads the v5.4 format
+GENERATED_ATTRIBUTES = {"case": {"app", "date"}, "casedef": {"requiredversion"}}
 #: attributes of real DualSPHysics files that DualSPHysics does not read, per element: a block's
 #: ``name`` label (examples/main/04_ExternalForces: ``<setmkfluid mk="0" name="FluidLeft"/>``) and
 #: ``<chrono datadir=".">`` (examples/chrono/06_ZipLine; JChronoObjects takes its data folder from

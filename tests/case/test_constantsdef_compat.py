@@ -62,3 +62,33 @@ def test_coefhdp_is_ignored_and_said(tmp_path):
     r = build(tmp_path, CONSTANTS.replace('<coefh value="1.0" />', '<coefh value="1.0" /><coefhdp value="2" />'))
     assert r.constants.h == pytest.approx(math.sqrt(2) * 0.02)
     assert any("<coefhdp> is ignored" in w and "<hdp value=" in w for w in r.warnings)
+
+
+ZERO_INPUTS = {"coefsound": ('<coefsound value="20" />', '<coefsound value="0" />', "coefsound is 0"),
+               "hswl": ('<hswl value="0" auto="true" />', '<hswl value="0" auto="false" />', "hswl is 0"),
+               "speedsystem": ('<speedsystem value="0" auto="true" />', '<speedsystem value="0" />',
+                               "speedsystem is 0"),
+               "speedsound": ('<speedsound value="0" auto="true" />', '<speedsound value="0" />',
+                              "speedsound is 0")}
+
+
+@pytest.mark.parametrize("name", sorted(ZERO_INPUTS))
+def test_a_zero_sound_input_is_accepted_where_b_makes_it_unused(tmp_path, name):
+    """Real cases give B explicitly and leave coefsound, hswl or speedsound at 0 (JCaseCtes reads them
+    as they are; JSph::ConfigConstants takes c0 from B): read, unused."""
+    old, new, _ = ZERO_INPUTS[name]
+    assert old in CONSTANTS
+    r = build(tmp_path, CONSTANTS.replace(old, new).replace("</constantsdef>", '<b value="1e5" /></constantsdef>'))
+    assert r.constants.b == 1e5 and r.constants.cs0 == pytest.approx(math.sqrt(7 * 1e5 / 1000))
+
+
+@pytest.mark.parametrize("name", sorted(ZERO_INPUTS))
+def test_a_zero_sound_input_that_makes_c0_zero_is_refused_with_its_cause(tmp_path, name):
+    old, new, cause = ZERO_INPUTS[name]
+    with pytest.raises(CaseError, match=rf"<constantsdef>: the speed of sound is zero: {cause}"):
+        build(tmp_path, CONSTANTS.replace(old, new))
+
+
+def test_negative_sound_inputs_are_refused(tmp_path):
+    with pytest.raises(CaseError, match=r"<coefsound>: value='-1' is negative"):
+        build(tmp_path, CONSTANTS.replace('<coefsound value="20" />', '<coefsound value="-1" />'))

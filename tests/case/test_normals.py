@@ -215,6 +215,16 @@ def test_thin_walls_are_found_in_3d(layers, thin):
     assert layers_needed(h, dp) == 3 and layers_needed(dp * np.sqrt(2), dp) == 2      # 3D and 2D, coefh 1
 
 
+@pytest.mark.parametrize("h_dp, need", [(np.sqrt(2), 2), (np.sqrt(3), 3), (1.2 * np.sqrt(3), 4), (2.0, 3),
+                                        (2.0000001, 4), (1.5, 2), (0.5, 1)])
+def test_layers_needed_counts_the_layers_closer_than_2h(h_dp, need):
+    """A fluid particle at rest lies dp from the first layer; layer k (k dp off) carries kernel
+    weight if k dp < 2h.  At h = 2 dp (hdp 2, DualSPHysics's examples/mdbc/04_Dambreak, drawn with
+    three layers) the fourth lies at 2h, where the kernel is 0."""
+    from sphdvi.case.normals import layers_needed
+    assert layers_needed(h_dp * 0.01, 0.01) == need
+
+
 def _dambreak_box(dp=0.02, mirrored=False):
     """GenCase's particles of CaseDambreakMdbc2D's tank scaled to 0.4 x 0.3 m (3 layers drawn
     outwards, each one dp higher than the one inside it) with a 0.2 x 0.2 m water column in its

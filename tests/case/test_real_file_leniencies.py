@@ -10,12 +10,16 @@ files: DualSPHysics v5.4's examples, DesignSPHysics's templates, a user's projec
 * a ``<floating>`` range naming mk blocks the geometry did not draw (examples/chrono/07
   DamBreak1Cube: "51-53" with one cube): GenCase applies it to the blocks that exist;
 * a gauge whose ``<output value="false"/>`` the case gives on purpose (examples/others/GaugeSystem);
-* the keys of DualSPHysics's separate non-Newtonian build: named as such, not "did you mean"."""
+* the keys of DualSPHysics's separate non-Newtonian build: named as such, not "did you mean";
+* a GenCase output file (``Case_out/Case.xml``) given as the case: its ``<execution>`` holds
+  ``<uservars>`` (the exported variables DualSPHysics evaluates the execution section with) and
+  ``<vtkout>`` (GenCase's list of shape files)."""
 from __future__ import annotations
 
 from casetext import case_xml, write_case          # tests/case (on the path: conftest)
 from click.testing import CliRunner
 
+from sphdvi.case.gencase import build_case
 from sphdvi.cli import main
 
 DESIGNSPHYSICS_HEAD = '<!-- Case name: MyCase -->\n'
@@ -70,6 +74,14 @@ def test_label_attributes_are_not_warned(tmp_path):
     # an attribute that is not a label is still named
     code, out = _gencase(tmp_path, text.replace('cmt="water"', 'colour="blue"'))
     assert code == 0 and "unknown attribute 'colour' ignored" in out
+
+
+def test_casedef_requiredversion_is_not_warned(tmp_path):
+    """GenCase_CaseTemplate.xml (v5.0.295): ``<casedef requiredversion="v5.0.295">``."""
+    code, out = _gencase(tmp_path, case_xml().replace("<casedef>", '<casedef requiredversion="v5.0.295">'))
+    assert code == 0 and "unknown attribute" not in out, out
+    code, out = _gencase(tmp_path, case_xml().replace("<casedef>", '<casedef requiredversio="v5.0.295">'))
+    assert code == 0 and "unknown attribute 'requiredversio' ignored" in out
 
 
 FLOATING_COMMANDS = """
@@ -127,3 +139,46 @@ def test_dtfixed_given_a_file_points_to_dtfixedfile(tmp_path):
     assert code == 2 and "goes in DtFixedFile" in out and "Traceback" not in out
     code, out = _gencase(tmp_path, case_xml(parameters='<parameter key="DtFixed" value="0.0001" />'))
     assert code == 0, out
+
+
+def _execution_extra(text, extra):
+    return text.replace("</execution>", extra + "</execution>")
+
+
+GENCASE_OUTPUT_EXTRA = """
+        <uservars>
+            <varstr name="Label" value="tank" />
+            <varnum name="Tend" value="0.75" />
+        </uservars>
+        <vtkout mkboundfirst="11" mkfluidfirst="1">
+            <vtkfile name="Case_Tank.vtk" mk="11" mkbound="0" />
+        </vtkout>"""
+
+
+def test_gencase_output_uservars_and_vtkout(tmp_path):
+    """JCaseUserVars writes ``<varnum|varstr name value>``; JSph::LoadConfigVars defines them before
+    the execution parameters are read, so ``#Tend`` works there."""
+    text = _execution_extra(case_xml(parameters='<parameter key="TimeMax" value="#Tend*2" />'), GENCASE_OUTPUT_EXTRA)
+    code, out = _gencase(tmp_path, text)
+    assert code == 0 and "warning" not in out.lower(), out
+    r = build_case(write_case(tmp_path, text), str(tmp_path / "out2"))
+    assert r.case.parameters["TimeMax"] == 1.5
+
+
+def test_uservars_disagreeing_with_the_case_keep_the_case_value(tmp_path):
+    text = _execution_extra(
+        case_xml(predefinition='<newvar Tend="0.5" />', parameters='<parameter key="TimeMax" value="#Tend*2" />'),
+        GENCASE_OUTPUT_EXTRA)
+    code, out = _gencase(tmp_path, text)
+    assert code == 0 and "uservars: Tend=0.75 differs from the case's own Tend=0.5" in out, out
+    r = build_case(write_case(tmp_path, text), str(tmp_path / "out2"))
+    assert r.case.parameters["TimeMax"] == 1.0
+
+
+def test_uservars_bad_entries(tmp_path):
+    code, out = _gencase(tmp_path, _execution_extra(case_xml(), '<uservars><var name="A" value="1"/></uservars>'))
+    assert code == 2 and "unknown element <var> in <uservars>" in out and "Traceback" not in out
+    code, out = _gencase(tmp_path, _execution_extra(case_xml(), '<uservars><varnum name="1A" value="1"/></uservars>'))
+    assert code == 2 and "'1A' is not a valid variable name" in out
+    code, out = _gencase(tmp_path, _execution_extra(case_xml(), '<uservars><varnum name="A" value="x"/></uservars>'))
+    assert code == 2 and "<varnum>" in out and "Traceback" not in out
