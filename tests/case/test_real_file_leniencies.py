@@ -16,6 +16,8 @@ files: DualSPHysics v5.4's examples, DesignSPHysics's templates, a user's projec
   ``<vtkout>`` (GenCase's list of shape files)."""
 from __future__ import annotations
 
+import numpy as np
+import pytest
 from casetext import case_xml, write_case          # tests/case (on the path: conftest)
 from click.testing import CliRunner
 
@@ -182,3 +184,18 @@ def test_uservars_bad_entries(tmp_path):
     assert code == 2 and "'1A' is not a valid variable name" in out
     code, out = _gencase(tmp_path, _execution_extra(case_xml(), '<uservars><varnum name="A" value="x"/></uservars>'))
     assert code == 2 and "<varnum>" in out and "Traceback" not in out
+
+
+def test_a_gencase_output_file_reads_as_its_case(tmp_path):
+    """GenCase v5.0.222's output for DualSPHysics's examples/main/01_DamBreak (CaseDambreak_out/
+    CaseDambreak.xml in yzhao469/DualSPHysicsAgent_v1, a copy of the v5.4 package with its outputs):
+    its <execution> carries <particles>, <constants>, <motion/> and <vtkout>; sphdvi draws the same
+    particles per mk and the same h and B as that record."""
+    from gencase_outputs import CASEDAMBREAK_OUT      # tests/case (on the path: conftest)
+    path = write_case(tmp_path, CASEDAMBREAK_OUT, "CaseDambreak.xml")
+    r = build_case(path, str(tmp_path / "out"))
+    counts = {int(m): int((r.particles["mk"] == m).sum()) for m in np.unique(r.particles["mk"])}
+    assert counts == {10: 39993, 11: 2383, 20: 810, 1: 128310}
+    assert r.constants.h == pytest.approx(0.014722431864, rel=1e-10)
+    assert r.constants.b == pytest.approx(162005.14286, rel=1e-9)
+    assert not [w for w in r.warnings if "unknown" in w]
