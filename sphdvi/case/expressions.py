@@ -104,8 +104,10 @@ _MAX_POW = 1e6
 
 
 def _to_python(text: str) -> str:
-    """Rewrite the C-like operators of DualSPHysics expressions as Python ones."""
-    s = text.replace("&&", " and ").replace("||", " or ")
+    """Rewrite the C-like operators of DualSPHysics expressions as Python ones.  ``@@`` is ``&&``
+    written without XML's ``&amp;`` (DualSPHysics's examples/others/Variables/GenericWaveTank.xml:
+    ``<abort if="use_beach @@ (ang<2 || ang>90)">``)."""
+    s = text.replace("&&", " and ").replace("@@", " and ").replace("||", " or ")
     s = re.sub(r"!(?!=)", " ~", s)     # C's unary ! (Python's ~ has unary precedence)
     s = s.replace("^", "**")
     s = re.sub(r"\btrue\b", "True", s)

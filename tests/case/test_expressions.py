@@ -57,6 +57,9 @@ def test_expression_values(v, text, value):
     ("!1+1", 1.0),                          # (!1)+1
     ("(2||0)==1", True),                    # || gives 0 or 1
     ("1 || 0 && 0", True),                  # && before ||
+    ("1 || 0 @@ 0", True),                  # @@ is && (GenericWaveTank.xml: "use_beach @@ (ang<2 || ang>90)")
+    ("1 @@ (x1<2 || x1>10)", True),
+    ("0 @@ (x1<2 || x1>10)", False),
     ("x1!=11 || !(x2>21)", False),
 ])
 def test_c_operator_precedence(v, text, value):
