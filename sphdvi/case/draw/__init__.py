@@ -87,7 +87,8 @@ Fills (``fillpoint``, ``fillvoidpoint``, ``fillbox``)
     nodes whose kind is listed in ``<modefill>`` (void, fluid, bound; the
     ``mkfluid``/``mkbound`` attributes restrict fluid/bound nodes to that mk;
     ``border`` alone means void, GenCase users see no difference), limited to
-    the lattice or to the ``fillbox`` box (the node range of a solid box). Every reached node
+    the lattice or to the ``fillbox`` box (the nodes at least dp/2 inside it, as GenCase fills:
+    one layer less than a solid box where a face lies on the lattice). Every reached node
     gets the current pen. A seed outside, or on a node of another kind, fills
     nothing (warning).
 
