@@ -180,3 +180,18 @@ def test_case_variable_named_like_a_computed_builtin_is_kept(tmp_path, kind):
     assert r.exit_code == 0, r.output
     assert "defines a variable 'H' (0.2); it is kept" in r.output
     assert read_case_h5(str(tmp_path / "out" / "CaseH.h5"))["parameters"]["TimeMax"] == pytest.approx(0.2)
+
+
+def test_printf_and_abort_texts_take_hash_expressions(tmp_path):
+    """DualSPHysics's examples/others/Variables/GenericWaveTank.xml prints
+    ``"==>> Ursell number.............: #Ur#"`` and aborts with ``"Beach angle (#ang#) is not in the
+    range"``; ``[expr]`` works as before; a ``#...#`` that is no expression stays as written."""
+    from test_draw import draw
+
+    from sphdvi.errors import CaseError
+    body = ('<newvar wh="0.5" wl="4" ang="95"/><setmkfluid mk="0"/><drawpoint x="0" y="0" z="0"/>'
+            '<printf text="steepness: #wh/wl#, [wl*2]; #nothing here# and # alone"/>')
+    d = draw(tmp_path, body)
+    assert d.messages == ["steepness: 0.125, 8; #nothing here# and # alone"]
+    with pytest.raises(CaseError, match=r"<abort>: Beach angle \(95\) is not in the range"):
+        draw(tmp_path, body + '<abort if="ang>90 @@ 1" text="Beach angle (#ang#) is not in the range"/>')

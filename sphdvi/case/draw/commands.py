@@ -93,6 +93,16 @@ def _point_summary(pts: np.ndarray, keep: int = 100) -> dict:
             "max": pts.max(axis=0).tolist()}
 
 
+def _hash_interpolate(vars_, text: str) -> str:
+    """Each ``#expr#`` in ``text`` replaced by the value of ``expr``, where it is one."""
+    def value(m):
+        try:
+            return vars_.interpolate("[" + m.group(1) + "]")
+        except ExpressionError:
+            return m.group(0)
+    return re.sub(r"#([^#\n]+)#", value, text)
+
+
 def _attr_items(el):
     """User attributes of a variable command (name, value), skipping comments and _private ones."""
     return [(k, v) for k, v in el.attrib.items()
@@ -374,9 +384,12 @@ class GeometryRunner:
         return bool(self.vars.evaluate(c[1:] if c.startswith("#") else c))
 
     def _text(self, el) -> str:
+        """``<printf>``/``<abort>`` text: ``[expr]`` (GenCase_CaseTemplate.xml: ``"It is [Dp]"``) and
+        ``#expr#`` (examples/others/Variables/GenericWaveTank.xml: ``"...parameter: #wheight/wlen#"``)
+        replaced by their values; a ``#...#`` that is no expression of the case stays as written."""
         raw = el.get("text", "")
         self.reader.mark(el, "text")
-        return self.vars.interpolate(raw).replace("\\n", "\n")
+        return _hash_interpolate(self.vars, self.vars.interpolate(raw)).replace("\\n", "\n")
 
     def cmd_printf(self, el):
         if self._condition(el):
