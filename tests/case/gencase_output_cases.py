@@ -1,0 +1,945 @@
+"""GenCase output files (case files GenCase wrote, with its ``<particles>`` and ``<constants>``
+record of what it drew) from public repositories, as test data for
+``test_gencase_outputs_counts.py``.
+
+Each text is the file with its comments, its ``comment=""`` attributes, its disabled entries
+(``#Key`` parameters, ``_name`` elements) and the parameters left at DualSPHysics's defaults
+dropped; the geometry, ``<constantsdef>``, ``<special>`` sections, ``<particles>`` and
+``<constants>`` are kept as GenCase wrote them. The tests parse the record from the text itself.
+"""
+
+#: DualSPHysics/DualSPHysics examples/others/TimeOut/Dam2d.xml, GenCase4 v4.0.059 (29-12-2017):
+#: 2-D dam break with a <timeout> table whose lines carry '%' remarks as element text
+DAM2D_TIMEOUT = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase4 v4.0.059 (29-12-2017)" date="20-02-2018 04:28:26">
+    <casedef>
+        <constantsdef>
+            <lattice bound="1" fluid="1" />
+            <gravity x="0" y="0" z="-9.81" />
+            <rhop0 value="1000" />
+            <hswl value="0" auto="true" />
+            <gamma value="7" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="20" />
+            <speedsound value="0" auto="true" />
+            <coefh value="1.0" />
+            <cflnumber value="0.2" />
+        </constantsdef>
+        <mkconfig boundcount="240" fluidcount="10" />
+        <geometry>
+            <definition dp="0.02" units_comment="metres (m)">
+                <pointmin x="-1" y="0" z="-1" />
+                <pointmax x="4.5" y="0" z="3.5" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setdrawmode mode="full" />
+                    <setmkfluid mk="0" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0" y="-1" z="0" />
+                        <size x="1" y="2" z="2" />
+                    </drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>bottom | left | right | front | back</boxfill>
+                        <point x="0" y="-1" z="0" />
+                        <size x="4" y="2" z="3" />
+                    </drawbox>
+                </mainlist>
+            </commands>
+        </geometry>
+    </casedef>
+    <execution>
+        <special>
+            <timeout>
+                <tout time="0.05" timeout="0.01" />  % First output at t=0.05s. Next, output files are stored at 0.01s.
+                <tout time="0.1" timeout="0.07" />   % Since t=0.1s, output files are stored at 0.07s.
+                <tout time="0.2" timeout="0.001" />  % Since t=0.2s, output files are stored at 0.001s.
+                <tout time="0.3" timeout="0.01" />   % Since t=0.3s, output files are stored at 0.01s.
+            </timeout>
+        </special>
+        <parameters>
+            <parameter key="PosDouble" value="1" />
+            <parameter key="Visco" value="0.02" />
+            <parameter key="TimeMax" value="0.72" />
+            <parameter key="TimeOut" value="0.01" />
+            <parameter key="IncZ" value="0.5" />
+        </parameters>
+        <particles np="5501" nb="501" nbf="501" mkboundfirst="11" mkfluidfirst="1">
+            <_summary>
+                <fixed count="501" id="0-500" mkcount="1" mkvalues="11" />
+                <fluid count="5000" id="501-5500" mkcount="1" mkvalues="1" />
+            </_summary>
+            <fixed mkbound="0" mk="11" begin="0" count="501" />
+            <fluid mkfluid="0" mk="1" begin="501" count="5000" />
+        </particles>
+        <constants>
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.02" units_comment="metres (m)" />
+            <h value="2.8284271247E-002" units_comment="metres (m)" />
+            <b value="1.1099314286E+006" units_comment="Pascal (Pa)" />
+            <massbound value="4.0000000000E-001" units_comment="kg" />
+            <massfluid value="4.0000000000E-001" units_comment="kg" />
+        </constants>
+        <motion />
+    </execution>
+</case>
+"""
+
+#: DualSPHysics/DualSPHysics examples/others/GaugeSystem/GMaxZ_Dam2d.xml, GenCase4 v4.0.059
+#: (29-12-2017): the same dam break with an swl gauge and a maxz gauge
+GMAXZ_DAM2D = DAM2D_TIMEOUT.replace("20-02-2018 04:28:26", "15-02-2018 18:24:10").replace(
+    DAM2D_TIMEOUT[DAM2D_TIMEOUT.index("        <special>"):DAM2D_TIMEOUT.index("        <particles")],
+    """        <special>
+            <gauges>
+                <default>
+                    <savevtkpart value="true" />
+                    <output value="true" />
+                </default>
+                <swl name="Swl_x09">
+                    <pointdp coefdp="0.5" units_comment="m" />
+                    <point0 x="0.9" y="0" z="0" units_comment="m" />
+                    <point2 x="0.9" y="0" z="2.1" units_comment="m" />
+                </swl>
+                <maxz name="MaxX_x09">
+                    <point0 x="0.9" y="0" z="0" units_comment="m" />
+                    <height value="2.1" units_comment="m" />
+                    <distlimit coefdp="2" />
+                </maxz>
+            </gauges>
+        </special>
+        <parameters>
+            <parameter key="Visco" value="0.02" />
+            <parameter key="TimeMax" value="0.72" />
+            <parameter key="TimeOut" value="0.01" />
+            <parameter key="IncZ" value="0.5" />
+        </parameters>
+""")
+
+#: DualSPHysics/DualSPHysics examples/others/GaugeSystem/GVel_Dam2d.xml, GenCase4 v4.0.059
+#: (29-12-2017): the same dam break with two velocity gauges and a <simulationdomain>
+GVEL_DAM2D = DAM2D_TIMEOUT.replace("20-02-2018 04:28:26", "15-02-2018 14:03:19").replace(
+    DAM2D_TIMEOUT[DAM2D_TIMEOUT.index("        <special>"):DAM2D_TIMEOUT.index("        <particles")],
+    """        <special>
+            <gauges>
+                <default>
+                    <savevtkpart value="false" />
+                    <output value="true" />
+                    <outputdt value="0" units_comment="s" />
+                    <outputtime start="0" end="10" units_comment="s" />
+                </default>
+                <velocity name="VelPt1">
+                    <savevtkpart value="true" />
+                    <computedt value="0.01" units_comment="s" />
+                    <computetime start="0.1" end="0.11" units_comment="s" />
+                    <output value="true" />
+                    <outputdt value="0" units_comment="s" />
+                    <outputtime start="0" end="10" units_comment="s" />
+                    <point x="0.9" y="0" z="0.1" units_comment="m" />
+                </velocity>
+                <velocity name="VelPt2">
+                    <savevtkpart value="true" />
+                    <output value="false" />
+                    <point x="1.2" y="0" z="0.1" units_comment="m" />
+                </velocity>
+            </gauges>
+        </special>
+        <parameters>
+            <parameter key="Visco" value="0.02" />
+            <parameter key="TimeMax" value="0.72" />
+            <parameter key="TimeOut" value="0.01" />
+            <simulationdomain>
+                <posmin x="default" y="default" z="default" />
+                <posmax x="default" y="default" z="default + 50%" />
+            </simulationdomain>
+        </parameters>
+""")
+
+#: DualSPHysics/DualSPHysics examples/others/SaveDt/Case5aSvdt_8k.xml (no app attribute: an
+#: output GenCase4 wrote, edited by hand; coefh 0.866025): the 3-D dam break with a building, a
+#: <setmkvoid> cut and <savedt>
+CASE5A_SVDT_8K = """<?xml version="1.0" encoding="UTF-8" ?>
+<case>
+    <casedef>
+        <constantsdef>
+            <lattice bound="1" fluid="1" />
+            <gravity x="0" y="0" z="-9.81" />
+            <rhop0 value="1000" />
+            <hswl value="0" auto="true" />
+            <gamma value="7" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="20" />
+            <speedsound value="0" auto="true" />
+            <coefh value="0.866025" />
+            <cflnumber value="0.2" />
+        </constantsdef>
+        <mkconfig boundcount="240" fluidcount="10" />
+        <geometry>
+            <definition dp="0.0272" units_comment="metres (m)">
+                <pointmin x="-0.05" y="-0.05" z="-0.05" />
+                <pointmax x="2" y="1" z="1" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setshapemode>dp | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <setmkfluid mk="0" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0" y="0" z="0" />
+                        <size x="0.4" y="0.67" z="0.3" />
+                    </drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>bottom | left | right | front | back</boxfill>
+                        <point x="0" y="0" z="0" />
+                        <size x="1.6" y="0.67" z="0.4" />
+                    </drawbox>
+                    <setmkvoid />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0.9" y="0.24" z="0" />
+                        <size x="0.12" y="0.12" z="0.45" />
+                    </drawbox>
+                    <setmkbound mk="1" />
+                    <drawbox>
+                        <boxfill>top | left | right | front | back</boxfill>
+                        <point x="0.9" y="0.24" z="0" />
+                        <size x="0.12" y="0.12" z="0.45" />
+                    </drawbox>
+                    <shapeout file="" />
+                </mainlist>
+            </commands>
+        </geometry>
+    </casedef>
+    <execution>
+        <special>
+            <savedt>
+                <start value="0.01" />
+                <finish value="1" />
+                <interval value="0.005" />
+                <fullinfo value="1" />
+                <alldt value="1" />
+            </savedt>
+        </special>
+        <parameters>
+            <parameter key="PosDouble" value="1" />
+            <parameter key="Visco" value="0.25" />
+            <parameter key="TimeMax" value="1.2" />
+            <parameter key="TimeOut" value="0.01" />
+            <parameter key="IncZ" value="0.1" />
+        </parameters>
+        <particles np="8041" nb="4246" nbf="4246" mkboundfirst="11" mkfluidfirst="1">
+            <fixed mkbound="0" mk="11" begin="0" count="3965" />
+            <fixed mkbound="1" mk="12" begin="3965" count="281" />
+            <fluid mkfluid="0" mk="1" begin="4246" count="3795" />
+        </particles>
+        <constants>
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.0272" units_comment="metres (m)" />
+            <h value="4.0799980977E-002" units_comment="metres (m)" />
+            <b value="1.5247542857E+005" units_comment="metres (m)" />
+            <massbound value="2.0123648000E-002" units_comment="kg" />
+            <massfluid value="2.0123648000E-002" units_comment="kg" />
+        </constants>
+        <motion />
+    </execution>
+</case>
+"""
+
+#: DualSPHysics/DualSPHysics examples/others/GaugeSystem/WallRegAwas2.xml, GenCase4 v4.0.059
+#: (29-12-2017): 2-D wave flume, a piston (moving, mkbound 10) with AWAS, fillbox water
+WALLREGAWAS2 = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase4 v4.0.059 (29-12-2017)" date="19-02-2018 18:54:53">
+    <casedef>
+        <constantsdef>
+            <lattice bound="1" fluid="1" />
+            <gravity x="0" y="0" z="-9.81" />
+            <cflnumber value="0.2" />
+            <hswl value="0" auto="true" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="20" />
+            <speedsound value="0" auto="true" />
+            <coefh value="1.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" />
+        </constantsdef>
+        <mkconfig boundcount="230" fluidcount="10">
+            <mkorientfluid mk="0" orient="Xyz" />
+        </mkconfig>
+        <geometry>
+            <definition dp="0.006">
+                <pointmin x="-1" y="1" z="-1" />
+                <pointmax x="5" y="1" z="5" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setshapemode>real | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <setmkbound mk="10" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="-0.014" y="0" z="0" />
+                        <size x="0.014" y="2" z="0.6" />
+                    </drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>bottom | right</boxfill>
+                        <point x="-0.2" y="0" z="0" />
+                        <size x="3.2" y="2" z="0.6" />
+                    </drawbox>
+                    <setmkfluid mk="0" />
+                    <fillbox x="0.25" y="1" z="0.05">
+                        <modefill>void</modefill>
+                        <point x="-1" y="0" z="-1" />
+                        <size x="6" y="2" z="1.268" />
+                    </fillbox>
+                    <shapeout file="" reset="true" />
+                </mainlist>
+            </commands>
+        </geometry>
+        <motion>
+            <objreal ref="10">
+                <begin mov="1" start="0" />
+                <mvnull id="1" />
+            </objreal>
+        </motion>
+    </casedef>
+    <execution>
+        <special>
+            <wavepaddles>
+                <piston>
+                    <mkbound value="10" />
+                    <depth value="0.266" />
+                    <pistondir x="1" y="0" z="0" />
+                    <waveorder value="1" />
+                    <waveheight value="0.1" />
+                    <waveperiod value="1.3" />
+                    <ramp value="1" />
+                    <awas_zsurf>
+                        <startawas value="2.6" />
+                        <swl value="0.266" />
+                        <gaugex valuedp="5" />
+                        <gaugey value="1" />
+                        <gaugezmin value="0.1" />
+                        <gaugezmax value="0.4" />
+                        <gaugedp value="0.1" />
+                    </awas_zsurf>
+                </piston>
+            </wavepaddles>
+        </special>
+        <parameters>
+            <parameter key="PosDouble" value="1" />
+            <parameter key="StepAlgorithm" value="2" />
+            <parameter key="Visco" value="0.01" />
+            <parameter key="ViscoBoundFactor" value="0" />
+            <parameter key="TimeMax" value="20" />
+            <parameter key="TimeOut" value="0.02" />
+            <parameter key="IncZ" value="0" />
+        </parameters>
+        <particles np="22492" nb="1035" nbf="635" mkboundfirst="11" mkfluidfirst="1">
+            <_summary>
+                <fixed count="635" id="0-634" mkcount="1" mkvalues="11" />
+                <moving count="400" id="635-1034" mkcount="1" mkvalues="21" />
+                <fluid count="21457" id="1035-22491" mkcount="1" mkvalues="1" />
+            </_summary>
+            <fixed mkbound="0" mk="11" begin="0" count="635" />
+            <moving mkbound="10" mk="21" begin="635" count="400" refmotion="0" />
+            <fluid mkfluid="0" mk="1" begin="1035" count="21457" />
+        </particles>
+        <constants>
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.006" units_comment="metres (m)" />
+            <h value="1.0182337649E-002" units_comment="metres (m)" />
+            <b value="1.4126400000E+005" units_comment="Pascal (Pa)" />
+            <massbound value="3.6000000000E-002" units_comment="kg" />
+            <massfluid value="3.6000000000E-002" units_comment="kg" />
+        </constants>
+        <motion>
+            <objreal ref="0">
+                <begin mov="1" start="0" />
+                <mvnull id="1" />
+            </objreal>
+        </motion>
+    </execution>
+</case>
+"""
+
+#: Otor123/DualSPHysics examples/main/01_DamBreak/CaseDambreakVal2D.xml, GenCase v5.4.354.01
+#: (07-04-2025): despite its name, GenCase's output of the 3-D CaseDambreak geometry (a user ran
+#: CaseDambreak_Def under that name); the same counts as v5.0.222's CaseDambreak_out
+CASEDAMBREAK_V54 = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase v5.4.354.01 (07-04-2025)" date="25-07-2025 15:35:48">
+    <casedef>
+        <constantsdef>
+            <gravity x="0" y="0" z="-9.81" />
+            <rhop0 value="1000" />
+            <rhopgradient value="2" />
+            <hswl value="0" auto="true" />
+            <gamma value="7" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="20" />
+            <speedsound value="0" auto="true" />
+            <coefh value="1.0" />
+            <cflnumber value="0.2" />
+        </constantsdef>
+        <mkconfig boundcount="240" fluidcount="9" />
+        <geometry>
+            <definition dp="0.0085" units_comment="metres (m)">
+                <pointmin x="-0.05" y="-0.05" z="-0.05" />
+                <pointmax x="2" y="1" z="1" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setshapemode>dp | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <setmkfluid mk="0" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0" y="0" z="0" />
+                        <size x="0.4" y="0.67" z="0.3" />
+                    </drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>bottom | left | right | front | back</boxfill>
+                        <point x="0" y="0" z="0" />
+                        <size x="1.6" y="0.67" z="0.4" />
+                    </drawbox>
+                    <shapeout file="Box" />
+                    <setmkvoid />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0.9" y="0.24" z="0" />
+                        <size x="0.12" y="0.12" z="0.45" />
+                    </drawbox>
+                    <setmkbound mk="1" />
+                    <drawbox>
+                        <boxfill>top | left | right | front | back</boxfill>
+                        <point x="0.9" y="0.24" z="0" />
+                        <size x="0.12" y="0.12" z="0.45" />
+                    </drawbox>
+                    <setmkbound mk="10" />
+                    <drawbox>
+                        <boxfill>left</boxfill>
+                        <point x="0.9" y="0.24" z="0" />
+                        <size x="0.12" y="0.12" z="0.45" />
+                    </drawbox>
+                    <shapeout file="Building" />
+                </mainlist>
+            </commands>
+        </geometry>
+    </casedef>
+    <execution>
+        <parameters>
+            <parameter key="StepAlgorithm" value="1" />
+            <parameter key="Kernel" value="1" />
+            <parameter key="Visco" value="0.1" />
+            <parameter key="DensityDT" value="2" />
+            <parameter key="TimeMax" value="1.6" />
+            <parameter key="TimeOut" value="0.01" />
+            <simulationdomain>
+                <posmin x="default" y="default" z="default" />
+                <posmax x="default" y="default" z="default + 50%" />
+            </simulationdomain>
+        </parameters>
+        <particles np="171496" nb="43186" nbf="43186" mkboundfirst="10" mkfluidfirst="1">
+            <_summary>
+                <positions units_comment="metres (m)">
+                    <posmin x="0.001" y="0.001" z="0.001" />
+                    <posmax x="1.599" y="0.6725" z="0.4515" />
+                </positions>
+                <fixed count="43186" id="0-43185" mkcount="3" mkvalues="10-11,20" />
+                <fluid count="128310" id="43186-171495" mkcount="1" mkvalues="1" />
+            </_summary>
+            <fixed mkbound="0" mk="10" begin="0" count="39993" />
+            <fixed mkbound="1" mk="11" begin="39993" count="2383" />
+            <fixed mkbound="10" mk="20" begin="42376" count="810" />
+            <fluid mkfluid="0" mk="1" begin="43186" count="128310" />
+        </particles>
+        <constants>
+            <data2d value="false" />
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.0085" units_comment="metres (m)" />
+            <h value="0.014722431864" units_comment="metres (m)" />
+            <b value="162005.14286" units_comment="Pascal (Pa)" />
+            <massbound value="0.000614125" units_comment="kg" />
+            <massfluid value="0.000614125" units_comment="kg" />
+        </constants>
+        <uservars>
+            <varnum name="VResId" value="0" />
+        </uservars>
+        <motion />
+        <vtkout mkboundfirst="10" mkfluidfirst="1">
+            <vtkfile name="CaseDambreakVal2D_Box_Dp.vtk" mk="10" mkbound="0" />
+            <vtkfile name="CaseDambreakVal2D_Building_Dp.vtk" mk="11,20" mkbound="1,10" />
+        </vtkout>
+    </execution>
+</case>
+"""
+
+#: DualSPHysics/DualSPHysics examples/others/RotatedBox/RotatedBox.xml, GenCase4 v4.0.068
+#: (27-04-2018): a box drawn under <rotateline ang="40"> (mkbound 2) next to one drawn unrotated and
+#: then turned by <initials><rotateaxis> (mkbound 3)
+ROTATEDBOX = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase4 v4.0.068 (27-04-2018)" date="07-05-2018 12:03:12">
+    <casedef>
+        <constantsdef>
+            <lattice bound="1" fluid="1" />
+            <gravity x="0" y="0" z="-9.81" />
+            <rhop0 value="1000" />
+            <hswl value="0" auto="true" />
+            <gamma value="7" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="15" />
+            <speedsound value="0" auto="true" />
+            <coefh value="1.0" />
+            <cflnumber value="0.2" />
+        </constantsdef>
+        <mkconfig boundcount="240" fluidcount="3" />
+        <geometry>
+            <definition dp="0.005" units_comment="metres (m)">
+                <pointmin x="-0.2" y="-0.2" z="-0.2" />
+                <pointmax x="3" y="0.7" z="0.3" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setshapemode>real | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <setmkfluid mk="0" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0" y="0" z="0" />
+                        <size x="0.25" y="0.5" z="0.1" />
+                    </drawbox>
+                    <setmkbound mk="2" />
+                    <rotateline ang="40">
+                        <point x="0.45" y="0.145" z="0" />
+                        <point x="0.45" y="0.145" z="1" />
+                    </rotateline>
+                    <drawbox>
+                        <boxfill>all ^ top ^ bottom</boxfill>
+                        <point x="0.45" y="0.04" z="0" />
+                        <size x="0.05" y="0.21" z="0.04" />
+                    </drawbox>
+                    <matrixreset />
+                    <setmkbound mk="3" />
+                    <drawbox>
+                        <boxfill>all ^ top ^ bottom</boxfill>
+                        <point x="0.45" y="0.25" z="0" />
+                        <size x="0.05" y="0.21" z="0.04" />
+                    </drawbox>
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>left | front | back</boxfill>
+                        <point x="0" y="0.0" z="0" />
+                        <size x="0.8" y="0.5" z="0.15" />
+                    </drawbox>
+                    <setmkbound mk="1" />
+                    <drawbox>
+                        <boxfill>bottom</boxfill>
+                        <point x="0" y="0.0" z="0" />
+                        <size x="0.8" y="0.5" z="0.15" />
+                    </drawbox>
+                </mainlist>
+            </commands>
+        </geometry>
+        <initials>
+            <rotateaxis mkbound="3" angle="-40" anglesunits="degrees">
+                <axisp1 x="0.45" y="0.355" z="0" />
+                <axisp2 x="0.45" y="0.355" z="1" />
+            </rotateaxis>
+        </initials>
+    </casedef>
+    <execution>
+        <parameters>
+            <parameter key="StepAlgorithm" value="2" />
+            <parameter key="Visco" value="0.05" />
+            <parameter key="ViscoBoundFactor" value="0" />
+            <parameter key="TimeMax" value="1.2" />
+            <parameter key="TimeOut" value="0.01" />
+            <parameter key="IncZ" value="0" />
+        </parameters>
+        <particles np="129683" nb="30683" nbf="30683" mkboundfirst="4" mkfluidfirst="1">
+            <_summary>
+                <fixed count="30683" id="0-30682" mkcount="4" mkvalues="4-7" />
+                <fluid count="99000" id="30683-129682" mkcount="1" mkvalues="1" />
+            </_summary>
+            <fixed mkbound="0" mk="4" begin="0" count="12630" />
+            <fixed mkbound="1" mk="5" begin="12630" count="16261" />
+            <fixed mkbound="2" mk="6" begin="28891" count="960" />
+            <fixed mkbound="3" mk="7" begin="29851" count="832" />
+            <fluid mkfluid="0" mk="1" begin="30683" count="99000" />
+        </particles>
+        <constants>
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.005" units_comment="metres (m)" />
+            <h value="8.6602540378E-03" units_comment="metres (m)" />
+            <b value="2.9955535714E+04" units_comment="Pascal (Pa)" />
+            <massbound value="1.2500000000E-04" units_comment="kg" />
+            <massfluid value="1.2500000000E-04" units_comment="kg" />
+        </constants>
+        <motion />
+    </execution>
+</case>
+"""
+
+#: yzhao469/DualSPHysicsAgent_v1 examples/others/FtRestrictions/FtSloshing.xml (the DualSPHysics
+#: v5.4 package tree), GenCase4 v4.0.092 (26-03-2019), a DesignSPHysics case: a floating box drawn
+#: before any <setdrawmode>; GenCase wrote mkboundfirst="11" with fluidcount="9"
+FTSLOSHING = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase4 v4.0.092 (26-03-2019)" date="04-04-2019 01:20:26">
+    <casedef>
+        <constantsdef>
+            <gravity x="0" y="0" z="-9.81" />
+            <rhop0 value="1000" />
+            <hswl value="0.4" auto="false" />
+            <gamma value="7" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="20" />
+            <speedsound value="0" auto="true" />
+            <coefh value="1" />
+            <cflnumber value="0.2" />
+            <h value="0" auto="true" units_comment="metres (m)" />
+            <b value="0" auto="true" units_comment="metres (m)" />
+            <massbound value="0" auto="true" units_comment="kg" />
+            <massfluid value="0" auto="true" units_comment="kg" />
+        </constantsdef>
+        <mkconfig boundcount="240" fluidcount="9" />
+        <geometry>
+            <definition dp="0.01" units_comment="metres (m)">
+                <pointmin x="-2" y="0" z="-1" />
+                <pointmax x="2" y="0" z="2" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setshapemode>dp | bound</setshapemode>
+                    <setmkbound mk="0" />
+                    <drawbox objname="Tank">
+                        <boxfill>all</boxfill>
+                        <point x="-0.7" y="-0.1" z="0" />
+                        <size x="1.4" y="0.2" z="0.9" />
+                    </drawbox>
+                    <setmkbound mk="1" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0" y="-0.1" z="0.35" />
+                        <size x="0.2" y="0.2" z="0.1" />
+                    </drawbox>
+                    <setmkfluid mk="0" />
+                    <fillbox x="0" y="0" z="0.1">
+                        <modefill>void</modefill>
+                        <point x="-2" y="-0.1" z="-1" />
+                        <size x="4" y="0.2" z="1.4" />
+                    </fillbox>
+                    <shapeout file="" />
+                </mainlist>
+            </commands>
+        </geometry>
+        <motion>
+            <objreal ref="0">
+                <begin mov="1" start="0" />
+                <mvrectsinu id="1" duration="100">
+                    <freq x="0.5" y="0.0" z="0.0" />
+                    <ampl x="0.07" y="0.0" z="0.0" />
+                    <phase x="0.0" y="0.0" z="0.0" />
+                </mvrectsinu>
+            </objreal>
+        </motion>
+        <floatings>
+            <floating mkbound="1" relativeweight="0.5" />
+        </floatings>
+    </casedef>
+    <execution>
+        <special />
+        <parameters>
+            <parameter key="StepAlgorithm" value="2" />
+            <parameter key="Visco" value="0.05" />
+            <parameter key="DensityDT" value="1" />
+            <parameter key="TimeMax" value="4" />
+            <parameter key="TimeOut" value="0.01" />
+            <simulationdomain>
+                <posmin x="-2" y="-0.1" z="-0.1" />
+                <posmax x="2" y="0.1" z="1" />
+            </simulationdomain>
+        </parameters>
+        <particles np="5976" nb="631" nbf="0" mkboundfirst="11" mkfluidfirst="1">
+            <_summary>
+                <positions units_comment="metres (m)">
+                    <posmin x="-0.7" y="0" z="0" />
+                    <posmax x="0.7" y="0" z="0.9" />
+                </positions>
+                <moving count="460" id="0-459" mkcount="1" mkvalues="11" />
+                <floating count="171" id="460-630" mkcount="1" mkvalues="12" />
+                <fluid count="5345" id="631-5975" mkcount="1" mkvalues="1" />
+            </_summary>
+            <moving mkbound="0" mk="11" begin="0" count="460" refmotion="0" />
+            <floating mkbound="1" mk="12" begin="460" count="171">
+                <massbody value="8.55" units_comment="kg" />
+                <masspart value="0.05" units_comment="kg" />
+                <center x="0.1" y="0" z="0.4" units_comment="metres (m)" />
+                <inertia units_comment="kg*m^2">
+                    <values v11="0.0057" v12="0" v13="6.50521e-20" />
+                    <values v21="0" v22="0.03135" v23="0" />
+                    <values v31="6.50521e-20" v32="0" v33="0.02565" />
+                </inertia>
+            </floating>
+            <fluid mkfluid="0" mk="1" begin="631" count="5345" />
+        </particles>
+        <constants>
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.01" units_comment="metres (m)" />
+            <h value="1.4142135624E-02" units_comment="metres (m)" />
+            <b value="2.2422857143E+05" units_comment="Pascal (Pa)" />
+            <massbound value="1.0000000000E-01" units_comment="kg" />
+            <massfluid value="1.0000000000E-01" units_comment="kg" />
+        </constants>
+        <motion>
+            <objreal ref="0">
+                <begin mov="1" start="0" />
+                <mvrectsinu id="1" duration="100" anglesunits="degrees">
+                    <freq x="0.5" y="0" z="0" units_comment="1/s" />
+                    <ampl x="0.07" y="0" z="0" units_comment="metres (m)" />
+                    <phase x="0" y="0" z="0" units_comment="degrees" />
+                </mvrectsinu>
+            </objreal>
+        </motion>
+        <vtkout mkboundfirst="11" mkfluidfirst="1">
+            <vtkfile name="FtSloshing__Dp.vtk" mk="11-12" mkbound="0-1" />
+        </vtkout>
+    </execution>
+</case>
+"""
+
+#: yzhao469/DualSPHysicsAgent_v1 examples/others/Variables/GenericWaveTank.xml, GenCase
+#: v5.0.165 (24-03-2020): a 2-D flume built with user variables, a <drawextrude> beach of 4 layers
+GENERICWAVETANK = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase v5.0.165 (24-03-2020)" date="24-03-2020 20:29:27">
+    <casedef requiredversion="v5.0.165">
+        <constantsdef>
+            <lattice bound="1" fluid="1" />
+            <gravity x="0.0" y="0.0" z="-9.8065" />
+            <rhop0 value="1000.0" />
+            <hswl value="0.0" auto="true" />
+            <gamma value="7.0" />
+            <speedsystem value="0.0" auto="true" />
+            <coefsound value="20.0" />
+            <speedsound value="0.0" auto="true" />
+            <coefh value="1.2" />
+            <cflnumber value="0.2" />
+            <h value="0.0" auto="true" units_comment="metres (m)" />
+            <b value="0.0" auto="true" units_comment="Pascal (Pa)" />
+            <massbound value="0" auto="true" units_comment="kg" />
+            <massfluid value="0" auto="true" units_comment="kg" />
+        </constantsdef>
+        <mkconfig boundcount="241" fluidcount="2" />
+        <geometry>
+            <predefinition>
+                <newvarcte case3d="false" _rem="Defines case 3D or 2D" />
+                <newvarcte use_awas="true" _rem="Activates the use of AWAS" />
+                <newvarcte use_damping="true" _rem="Activates the use of Damping" />
+                <newvarcte use_beach="true" _rem="Creates an absorption beach" />
+                <newvarcte depth="2.6" _rem="Water level" />
+                <newvarcte wperiod="2.0" wheight="0.14" _rem="Wave parameters: Period and Wave height" />
+                <newvarcte ang="25" _rem="Beach angle (if not beach ang = 90)" />
+                <newvarcte pt="5" _rem="Piston thickness in particles (pt)" />
+                <newvarcte n_up="1" n_down="0" _rem="Number of wave length upstream and downstream" />
+                <newvarcte tankw="1.0" _rem="Basin (tank) width for 3-D cases" />
+                <newvarcte wlen="wavelength(-Gravity_z,depth,wperiod)" _rem="Wave length" _print="1" />
+                <newvarcte sk="wlen*0.3" _rem="Maximum stroke displacement" _print="1" />
+                <newvarcte tankh="depth+wheight*2" _rem="Basin (tank) height" _print="1" />
+                <newvarcte tankx="wlen*(n_up+1+n_down)" _rem="Basin (tank) length" _print="1" />
+                <newvarcte dlen="eval(use_beach,tankh/tandg(ang),wlen*0.5)" _rem="Beach or damping zone length" _print="1" />
+                <newvarcte tankxtot="sk+tankx+dlen" _rem="Total basin (tank) length" _print="1" />
+                <newvarcte modelx="(n_up+0.5)*wlen" _rem="Distance between wave paddle and model center" _print="1" />
+            </predefinition>
+            <definition dp="0.02" units_comment="metres (m)">
+                <pointmin x="#-modelx-sk-Dp" y="#eval(case3d,-tankw/2-Dp*pt,0)" z="#-depth-Dp*pt" />
+                <pointmax x="#-modelx+tankxtot" y="#eval(case3d,tankw/2+Dp*pt,0)" z="#wheight*2+Dp" />
+            </definition>
+            <commands>
+                <list name="TankWall" printcall="false">
+                    <setshapemode if="#walln>0">bound</setshapemode>
+                    <drawpolygon>
+                        <point x="#-sk" y="#wallx" z="#-dpt" />
+                        <point x="#tankx" y="#wallx" z="#-dpt" />
+                        <point x="#tankx+eval(use_beach,(dlen+dpt)/2,dlen+dpt)" y="#wallx" z="#eval(use_beach,tankh/2,-dpt)" />
+                        <point x="#tankx+dlen+dpt" y="#wallx" z="#tankh" />
+                        <point x="#-sk" y="#wallx" z="#tankh" />
+                    </drawpolygon>
+                    <setvar wallx="wallx+wallix" />
+                    <setvar walln="walln+1" />
+                    <setshapemode>actual | bound</setshapemode>
+                </list>
+                <mainlist>
+                    <exportvar vars="depth,wperiod,wheight,use_awas,use_damping,tankx,dlen,modelx" />
+                    <abort if="use_beach @@ (ang<2 || ang>90)" text="Beach angle (#ang#) is not in the range [1-90].\\n It is invalid." />
+                    <newvarcte Ur="(wheight*pow(wlen,2))/(pow(depth,2))" _rem="Ursell number" />
+                    <printf text="==>> Wave steepness parameter..: #wheight/wlen#" />
+                    <printf text="==>> Wave shallowness parameter: #depth/wlen#" />
+                    <printf text="==>> Ursell number.............: #Ur#" />
+                    <newvarcte dpt="(pt-1)*Dp" _rem="Piston thickness in metres" />
+                    <setshapemode>actual | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <move x="#-modelx" y="0" z="#-depth" />
+                    <setmkbound mk="2" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="#-dpt" y="#-0.5*tankw" z="0" />
+                        <size x="#dpt" y="#tankw" z="#tankh" />
+                    </drawbox>
+                    <setmkbound mk="0" />
+                    <drawextrude closed="false">
+                        <point x="#-sk" y="#-0.5*tankw" z="0" />
+                        <point x="#tankx" y="#-0.5*tankw" z="0" />
+                        <point x="#tankx+eval(use_beach,dlen/2,dlen)" y="#-0.5*tankw" z="#eval(use_beach,tankh/2,0)" />
+                        <point x="#tankx+dlen" y="#-0.5*tankw" z="#tankh" />
+                        <extrude x="0" y="#tankw" z="0" />
+                        <layers vdp="0*,-1,-2,-3" />
+                    </drawextrude>
+                    <newvar wallx="-0.5*tankw" wallix="-Dp" walln="0" />
+                    <runlist name="TankWall" times="#eval(case3d,pt,0)" />
+                    <setvar wallx="0.5*tankw" wallix="Dp" walln="0" />
+                    <runlist name="TankWall" times="#eval(case3d,pt,0)" />
+                    <setmkfluid mk="0" />
+                    <fillbox x="#0.5*wlen" y="0" z="#0.5*depth">
+                        <modefill>void</modefill>
+                        <point x="0" y="#-0.5*tankw" z="0" />
+                        <size x="#tankxtot+1" y="#tankw" z="#depth" />
+                    </fillbox>
+                    <matrixreset />
+                    <setmkbound mk="1" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="-0.3" y="#-0.2*tankw" z="-0.2" />
+                        <size x="0.6" y="#0.4*tankw" z="0.4" />
+                    </drawbox>
+                    <shapeout file="" />
+                </mainlist>
+            </commands>
+        </geometry>
+        <motion>
+            <objreal ref="2">
+                <begin mov="1" start="0" />
+                <mvnull id="1" />
+            </objreal>
+        </motion>
+    </casedef>
+    <execution>
+        <special>
+            <wavepaddles>
+                <piston>
+                    <mkbound value="2" />
+                    <start value="0" />
+                    <duration value="0.0" />
+                    <depth value="#depth" />
+                    <pistondir x="1.0" y="0.0" z="0.0" />
+                    <waveorder value="2" />
+                    <waveheight value="#wheight" />
+                    <waveperiod value="#wperiod" />
+                    <phase value="0.0" />
+                    <ramp value="1.0" />
+                    <savemotion xpos="#modelx" zpos="-0.15" />
+                    <awas_zsurf active="#use_awas">
+                        <startawas value="#wperiod" />
+                        <swl value="0" />
+                        <elevation value="2" />
+                        <gaugey value="0" />
+                        <gaugezmin value="#-2*wheight" />
+                        <gaugezmax value="#2*wheight" />
+                        <gaugedp value="0.25" />
+                        <savedata value="0" />
+                        <limitace value="2" />
+                    </awas_zsurf>
+                </piston>
+            </wavepaddles>
+            <damping active="#use_damping">
+                <dampingzone>
+                    <limitmin x="#tankx-modelx" y="0" z="0" />
+                    <limitmax x="#tankx+dlen-modelx" y="0" z="0" />
+                    <overlimit value="1" />
+                    <redumax value="10" />
+                    <factorxyz x="1" y="1" z="1" />
+                </dampingzone>
+            </damping>
+        </special>
+        <parameters>
+            <parameter key="StepAlgorithm" value="2" />
+            <parameter key="Visco" value="0.01" />
+            <parameter key="ViscoBoundFactor" value="0" />
+            <parameter key="DensityDT" value="3" />
+            <parameter key="TimeMax" value="10.0" />
+            <parameter key="TimeOut" value="0.05" />
+            <simulationdomain>
+                <posmin x="default" y="default" z="default" />
+                <posmax x="default" y="default" z="default" />
+            </simulationdomain>
+        </parameters>
+        <particles np="102780" nb="5658" nbf="4938" mkboundfirst="3" mkfluidfirst="1">
+            <_summary>
+                <positions units_comment="metres (m)">
+                    <posmin x="-11.1243" y="0" z="-2.66" />
+                    <posmax x="9.2957" y="0" z="0.28" />
+                </positions>
+                <fixed count="4938" id="0-4937" mkcount="2" mkvalues="3-4" />
+                <moving count="720" id="4938-5657" mkcount="1" mkvalues="5" />
+                <fluid count="97122" id="5658-102779" mkcount="1" mkvalues="1" />
+            </_summary>
+            <fixed mkbound="0" mk="3" begin="0" count="4287" />
+            <fixed mkbound="1" mk="4" begin="4287" count="651" />
+            <moving mkbound="2" mk="5" begin="4938" count="720" refmotion="0" />
+            <fluid mkfluid="0" mk="1" begin="5658" count="97122" />
+        </particles>
+        <constants>
+            <data2d value="true" />
+            <data2dposy value="0" units_comment="metres (m)" />
+            <gravity x="0" y="0" z="-9.8065" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.02" units_comment="metres (m)" />
+            <h value="3.3941125497E-02" units_comment="metres (m)" />
+            <b value="1.4345508571E+06" units_comment="Pascal (Pa)" />
+            <massbound value="4.0000000000E-01" units_comment="kg" />
+            <massfluid value="4.0000000000E-01" units_comment="kg" />
+        </constants>
+        <uservars>
+            <varnum name="depth" value="2.6" />
+            <varnum name="dlen" value="6.17618" />
+            <varnum name="modelx" value="9.27025" />
+            <varnum name="tankx" value="12.3603" />
+            <varnum name="use_awas" value="1" />
+            <varnum name="use_damping" value="1" />
+            <varnum name="wheight" value="0.14" />
+            <varnum name="wperiod" value="2" />
+        </uservars>
+        <motion>
+            <objreal ref="0">
+                <begin mov="1" start="0" />
+                <mvnull id="1" />
+            </objreal>
+        </motion>
+        <vtkout mkboundfirst="3" mkfluidfirst="1">
+            <vtkfile name="GenericWaveTank__Actual.vtk" mk="3-5" mkbound="0-2" />
+        </vtkout>
+    </execution>
+</case>
+"""
