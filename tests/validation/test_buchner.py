@@ -110,17 +110,17 @@ def test_s5_run_at_h_over_dp_60_completes_and_hits_the_wall(run):
 @pytest.mark.slow
 def test_s5m_level_at_h_over_dp_60(run):
     """S5M, mDBC walls (three layers, normals from the tank's outline), H/dp 60 (9,267 particles,
-    ~4 min on 2 threads): the quasi-static level over T = 3-5 within 20 % of the experiment's
-    (measured 0.520 against 0.546, −4.7 %; DBC −35 %)."""
+    ~3 min on 2 threads): the quasi-static level over T = 3-5 within 20 % of the experiment's
+    (measured 0.500 against 0.546, −8.5 %, session 40; −4.7 % before 27b5622's wall layers; DBC −35 %)."""
     e = run(0.01, CASE_MDBC)
     assert abs(e["plateau"]) <= B.PLATEAU_TOL
 
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="S5M at H/dp 60: the probe reads the impact at T = 2.68 (+0.18) and the "
-                   "second peak at T = 6.54 (+0.70, 1.43 against 0.89): the run-up at this resolution climbs higher "
-                   "and falls back later (at H/dp 30 the peak is on time, +0.08)")
+                   reason="S5M at H/dp 60: the probe reads the impact at T = 2.596, +0.103 against the "
+                   "band's ±0.1 (session 40; the second peak on time, T −0.05, 0.97 against 0.89; before 27b5622's "
+                   "wall layers the impact was +0.18 and the second peak +0.70 late)")
 def test_s5m_impact_and_second_peak_at_h_over_dp_60(run):
     e = run(0.01, CASE_MDBC)
     assert abs(e["impact"]) <= B.IMPACT_TOL
