@@ -191,7 +191,7 @@ def test_a_gencase_output_file_reads_as_its_case(tmp_path):
     CaseDambreak.xml in yzhao469/DualSPHysicsAgent_v1, a copy of the v5.4 package with its outputs):
     its <execution> carries <particles>, <constants>, <motion/> and <vtkout>; sphdvi draws the same
     particles per mk and the same h and B as that record."""
-    from gencase_outputs import CASEDAMBREAK_OUT      # tests/case (on the path: conftest)
+    from gencase_output_cases import CASEDAMBREAK_OUT      # tests/case (on the path: conftest)
     path = write_case(tmp_path, CASEDAMBREAK_OUT, "CaseDambreak.xml")
     r = build_case(path, str(tmp_path / "out"))
     counts = {int(m): int((r.particles["mk"] == m).sum()) for m in np.unique(r.particles["mk"])}
