@@ -9,6 +9,7 @@ constants, then :func:`read_sections`.
 """
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -864,15 +865,9 @@ def read_uservars(reader, execution) -> None:
     output file carries (GenCase's exported variables, JCaseUserVars), which DualSPHysics defines
     before it evaluates the execution section's expressions (JSph::LoadConfigVars).  sphdvi has
     the case's own variables already; a listed variable it lacks is defined, one it has with
-    another value keeps the case's value, with a warning.  ``<vtkout>``, GenCase's list of the
-    shape files it wrote, is its record only: read and unused."""
-    if execution is None:
-        return
-    vtkout = reader.child(execution, "vtkout")
-    if vtkout is not None:
-        for el in vtkout.iter():
-            reader.mark(el, *el.attrib)
-    el = reader.child(execution, "uservars")
+    another value keeps the case's value, with a warning.  (``<vtkout>``, GenCase's list of the
+    shape files it wrote, is its record only, as ``<particles>`` and ``<constants>`` are: not read.)"""
+    el = reader.child(execution, "uservars") if execution is not None else None
     if el is None:
         return
     for v in reader.children(el):
@@ -881,16 +876,22 @@ def read_uservars(reader, execution) -> None:
                                                                                'or <varstr name="S" value="text"/>')
         name = reader.text_attr(v, "name").strip()
         value = reader.num(v, "value") if v.tag == "varnum" else reader.text_attr(v, "value")
-        known = reader.vars.values.get(name, None)
+        known = reader.vars.values.get(name)
         if known is None:
             try:
                 reader.vars.define(name, value)
             except ExpressionError as exc:
                 raise reader.error(v, str(exc), "a variable name: a letter or '_', then letters, digits, '_'") from None
-        elif known != value and not (isinstance(known, (int, float)) and not isinstance(value, str)
-                                     and abs(float(known) - value) <= 1e-9 * max(1.0, abs(value))):
+        elif not _same_value(known, value):
             reader.warn(v, f"uservars: {name}={value!r} differs from the case's own {name}={known!r}; "
                            "the case's value is used")
+
+
+def _same_value(a, b) -> bool:
+    """Equal texts, or numbers (booleans as 0/1) equal to GenCase's printed precision."""
+    if isinstance(a, str) or isinstance(b, str):
+        return a == b
+    return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-12)
 
 
 def read_parameters(reader, execution):
