@@ -285,6 +285,10 @@ def check_gauge(reader, c, d: dict, elements: dict, dp) -> None:
             attrs = 'mkbound="N"' if tag == "target" else 'x=".." y=".." z=".."'
             raise reader.error(c, f"{kind} gauge '{name}' has no <{tag}>", f"<{tag} {attrs}/> in <{kind}>")
     if kind == "swl":
+        if "point1" in d:       # DualSPHysics 5.4 runs a case with one (yupengxiang/DualSPHysics F5)
+            reader.warn(elements["point1"], f"swl gauge '{name}': <point1> is not read (the gauge is the "
+                                            "line from <point0> to <point2>); ignored")
+            d.pop("point1")
         length = math.dist(d["point2"], d["point0"])
         if length == 0:
             raise reader.error(elements["point2"], f"swl gauge '{name}': <point2> equals <point0>",

@@ -89,12 +89,13 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     geometry = reader.child(casedef, "geometry", required=True)
     from .draw import run_geometry
     drawing = run_geometry(reader, geometry, casename=casename, outdir=outdir, max_nodes=max_nodes)
+    check_dp(reader, geometry, drawing.dp, drawing.is2d, cdef.rhop0)
     if drawing.pos.shape[0] == 0:
+        check_domain_has_nodes(reader, geometry, drawing)
         raise reader.error(geometry, "the geometry commands created no particles",
                            "drawing commands inside <mainlist> that create particles inside pointmin..pointmax")
     warn_no_fluid(drawing, reader)
     fluid_z = drawing.pos[drawing.is_fluid, 2]
-    check_dp(reader, geometry, drawing.dp, drawing.is2d, cdef.rhop0)
     with np.errstate(over="ignore", invalid="ignore"):      # checked next
         consts = resolve_constants(cdef, drawing.dp, drawing.is2d, drawing.posy2d, fluid_z)
     check_constants(reader, casedef, consts, fluid=bool(fluid_z.size))
@@ -134,6 +135,23 @@ def _zero_sound_cause(cdef) -> str:
     if not any(cdef.gravity):
         return "the gravity is 0 (speedsystem = sqrt(|g|·hswl))"
     return "the fluid has no height (hswl, auto, is max z - min z of the fluid)"
+
+
+def check_domain_has_nodes(reader, geometry, drawing) -> None:
+    """A domain narrower than dp on an axis holds no node there: GenCase places
+    floor((pointmax - pointmin)/dp) nodes per axis (a 3D case with pointmax y = pointmin y + dp/2
+    is empty; a 2D case gives pointmin and pointmax the same y)."""
+    span = np.asarray(drawing.pointmax, float) - np.asarray(drawing.pointmin, float)
+    for a, name in enumerate("xyz"):
+        if a == 1 and drawing.is2d:
+            continue
+        if span[a] < drawing.dp * (1 - 1e-6):
+            el = geometry.find("definition") if geometry.find("definition") is not None else geometry
+            hint = "; for a 2D case give pointmin and pointmax the same y" if a == 1 else ""
+            raise reader.error(el, f"the domain holds no node along {name}: pointmax - pointmin is "
+                                   f"{float(span[a]):g} m, less than dp ({drawing.dp:g} m); GenCase places "
+                                   f"floor((pointmax - pointmin)/dp) nodes per axis{hint}",
+                               f"pointmax {name} at least one dp above pointmin {name}")
 
 
 def check_dp(reader, geometry, dp: float, is2d: bool, rhop0: float) -> None:

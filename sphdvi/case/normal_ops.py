@@ -367,8 +367,12 @@ def plane_cuts(tris: np.ndarray, y0: float, tol: float) -> tuple[np.ndarray, np.
 def apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, triangles, tri_mk) -> None:
     """N to the nearest point of the triangle surface within ``distanceh`` h. Where the
     surface carries the mk it was drawn with (sphdvi's and GenCase's shape files), a
-    particle whose mkbound drew part of it sees that part only; the others see all of it."""
+    particle whose mkbound drew part of it sees that part only; the others see all of it.
+    ``maxsizeh`` (GenCase's maximum normal size, in h; 0: none) leaves a particle whose normal
+    would be longer without one."""
     reach = op["distanceh"] * h
+    if op.get("maxsizeh", 0.0) > 0:
+        reach = min(reach, op["maxsizeh"] * h)
     tris = np.ascontiguousarray(triangles, dtype=np.float64).reshape(-1, 3, 3)
     mk = np.full(len(tris), -1, np.int64) if tri_mk is None else np.asarray(tri_mk, dtype=np.int64)
     if is2d:

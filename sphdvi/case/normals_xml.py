@@ -20,7 +20,7 @@ CHILDREN = {
     "sphere": {"onlypos", "center", "radius", "inside", "maxdisth", "clear"},
     "cylinder": {"onlypos", "center1", "center2", "radius", "inside", "limit1", "limit2", "maxdisth", "clear"},
     "parts": {"onlypos", "maxdisth"},
-    "geometry": {"geometryfile", "distanceh", "svshapes"},
+    "geometry": {"geometryfile", "distanceh", "maxsizeh", "svshapes"},
 }
 
 
@@ -144,6 +144,11 @@ def read_normal_op(reader, el, kind: str, solver: bool = False) -> dict | None:
         if not op["file"]:
             raise reader.error(geo, "empty file name", 'a shape file, e.g. file="[CaseName]_hdp_Actual.vtk"')
         op["distanceh"] = _scalar_el(reader, el, "distanceh", 2.0, positive=True)
+        # GenCase v5.4: "Maximum allowed normal size (H*value) (disabled=0, default=0)"
+        op["maxsizeh"] = _scalar_el(reader, el, "maxsizeh", 0.0)
+        if op["maxsizeh"] < 0:
+            raise reader.error(reader.child(el, "maxsizeh"), f"maxsizeh {op['maxsizeh']:g} is negative",
+                               "0 (no limit) or a positive multiple of h")
         if reader.child(el, "svshapes") is not None:
             _scalar_el(reader, el, "svshapes", False, "bool")
     return None if mkbound is None else op          # read whole (its errors count), then dropped

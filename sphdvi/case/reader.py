@@ -1502,7 +1502,8 @@ GAUGE_COMMON = {"savevtkpart": "bool", "computedt": "dt", "computetime": "window
                 "outputdt": "dt", "outputtime": "window"}
 GAUGE_SPECS = {
     "velocity": {"point": "vec"},
-    "swl": {"point0": "vec", "point2": "vec", "pointdp": "oneof:value,coefdp", "masslimit": "oneof:value,coef"},
+    "swl": {"point0": "vec", "point1": "vec", "point2": "vec", "pointdp": "oneof:value,coefdp",
+            "masslimit": "oneof:value,coef"},
     "maxz": {"point0": "vec", "height": "positive", "distlimit": "oneof:value,coefdp,coefh"},
     "force": {"target": "mkbound"},
     "mesh": {"point": "vec", "vec1": "vec", "vec2": "vec", "vec3": "vec", "size1": "size", "size2": "size",
@@ -1525,7 +1526,7 @@ def read_wavepaddles(reader, el) -> list:
     spec_regular = {**spec_common, "phase": "num", "ramp": "num", "usefiledata": "raw"}
     spec_spectrum = {**spec_common, "spectrum": "str", "discretization": "str", "peakcoef": "num", "waves": "int",
                      "randomseed": "int", "serieini": "raw", "ramptime": "num", "saveserie": "raw",
-                     "saveseriewaves": "raw"}
+                     "saveseriewaves": "raw", "calcserielength": "raw"}
     flap_geometry = {"variabledraft": "num", "flapaxis0": "vec", "flapaxis1": "vec"}
     specs = {"piston": {**spec_regular, "pistondir": "vec"}, "flap": {**spec_regular, **flap_geometry},
              "piston_spectrum": {**spec_spectrum, "pistondir": "vec"},
@@ -1586,7 +1587,9 @@ def read_wavepaddles(reader, el) -> list:
                         ("saveserie", "<saveserie> (the paddle's series written to a file) is not implemented "
                                       "by sphdvi: no file is written"),
                         ("saveseriewaves", "<saveseriewaves> (the series' waves written to a file) is not "
-                                           "implemented by sphdvi: no file is written")):
+                                           "implemented by sphdvi: no file is written"),
+                        ("calcserielength", "<calcserielength> (DualSPHysics prints the length of the "
+                                            "irregular series without repetition) is not implemented by sphdvi")):
             if k in d:
                 reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
         if d.get("fixeddepth", 0.0):

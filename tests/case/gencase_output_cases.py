@@ -1035,3 +1035,282 @@ CASEDAMBREAK_OUT = """<?xml version="1.0" encoding="UTF-8" ?>
     </execution>
 </case>
 """
+
+
+#: feynman0406/DualSPHysicsGPT CaseDambreak_Def_test_out/CaseDambreak_Def.xml, GenCase v5.4.354.01
+#: (07-04-2025): a tank drawn up to pointmax (1.6, 0.01, 0.4) at dp 0.01. Its log
+#: (CaseDambreak_Def.out): "Case domain: (0,0,0)-(159,0,39)", "Domain points: 160 x 1 x 40 =
+#: 6,400": no node on pointmax; the front face (y = 0) covers the one y layer, the fluid drawn
+#: before it included, the back face (y = 0.01) lies outside. 6,400 fixed particles, B = 0.
+CASEDAMBREAK_DEF_V54 = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase v5.4.354.01 (07-04-2025)" date="27-09-2025 00:45:52">
+    <casedef>
+        <constantsdef>
+            <gravity x="0" y="0" z="-9.81" comment="Gravitational acceleration" units_comment="m/s^2" />
+            <rhop0 value="1000" comment="Reference density of the fluid" units_comment="kg/m^3" />
+            <rhopgradient value="2" comment="Initial density gradient 1:Rhop0, 2:Water column, 3:Max. water height (default=2)" />
+            <hswl value="0" auto="true" comment="Max still water level for speed of sound via coefsound" units_comment="m" />
+            <gamma value="7" comment="Tait EOS exponent for water" />
+            <speedsystem value="0" auto="true" comment="Max system speed (auto from dam-break propagation)" />
+            <coefsound value="20" comment="Speedsound = coefsound * speedsystem" />
+            <speedsound value="0" auto="true" comment="Auto speed of sound" />
+            <coefh value="1.0" comment="h = coefh * sqrt(3*dp^2) in 3D" />
+            <_hdp value="2" comment="Alternative: h = hdp * dp" />
+            <cflnumber value="0.2" comment="CFL number" />
+        </constantsdef>
+        <!-- 2D-style: use very thin Y thickness = Dp -->
+        <mkconfig boundcount="20" fluidcount="20" />
+        <geometry>
+            <definition dp="0.01" units_comment="m">
+                <pointmin x="0.0" y="0.0" z="0.0" />
+                <pointmax x="1.6" y="0.01" z="0.4" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <!-- DBC boundary generation (faces), not mDBC -->
+                    <setshapemode>dp | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <!-- Fluid column (left-bottom corner), size 0.4 x (Dp) x 0.3 m -->
+                    <setmkfluid mk="0" />
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0.0" y="0.0" z="0.0" />
+                        <size x="0.4" y="0.01" z="0.3" />
+                    </drawbox>
+                    <!-- Tank walls: bottom, left, right, front, back (top open) -->
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>bottom | left | right | front | back</boxfill>
+                        <point x="0.0" y="0.0" z="0.0" />
+                        <size x="1.6" y="0.01" z="0.4" />
+                    </drawbox>
+                    <shapeout file="Tank" />
+                </mainlist>
+            </commands>
+        </geometry>
+    </casedef>
+    <execution>
+        <parameters>
+            <parameter key="SavePosDouble" value="0" comment="Save double-precision positions (0=off)" />
+            <parameter key="StepAlgorithm" value="1" comment="1:Verlet, 2:Symplectic" />
+            <parameter key="VerletSteps" value="40" comment="Euler warmup steps for Verlet" />
+            <parameter key="Kernel" value="2" comment="1:Cubic Spline, 2:Wendland" />
+            <parameter key="ViscoTreatment" value="1" comment="1:Artificial, 2:Laminar+SPS, 3:Laminar" />
+            <parameter key="Visco" value="0.01" comment="Artificial viscosity coeff (typ. 0.01)" />
+            <parameter key="ViscoBoundFactor" value="1" comment="Multiply viscosity on boundary" />
+            <parameter key="DensityDT" value="2" comment="DDT 0:None, 1:Molteni, 2:Fourtakas, 3:Fourtakas(full)" />
+            <parameter key="DensityDTvalue" value="0.1" comment="DDT coefficient" />
+            <parameter key="Shifting" value="0" comment="0:Off, 1:Ignore bound, 2:Ignore fixed, 3:Full" />
+            <parameter key="ShiftCoef" value="-2" comment="Shifting coefficient" />
+            <parameter key="ShiftTFS" value="0" comment="Free-surface threshold (1.5 for 2D, 2.75 for 3D if enabled)" />
+            <parameter key="RigidAlgorithm" value="1" comment="0:collision-free, 1:SPH, 2:DEM, 3:Chrono" />
+            <parameter key="FtPause" value="0.0" comment="Floating warmup freeze time (s)" />
+            <parameter key="CoefDtMin" value="0.05" comment="dtmin = coefdtmin*h/speedsound" />
+            <parameter key="DtIni" value="0" comment="Use default h/speedsound" />
+            <parameter key="DtMin" value="0" comment="Use default coefdtmin*h/speedsound" />
+            <parameter key="DtFixed" value="0" comment="Fixed dt disabled" />
+            <parameter key="DtFixedFile" value="NONE" comment="External dt schedule disabled" />
+            <parameter key="DtAllParticles" value="0" comment="0:Fluid/Floating only for dt calc" />
+            <parameter key="TimeMax" value="1.0" comment="Total simulation time (s)" />
+            <parameter key="TimeOut" value="0.01" comment="Output interval (s)" />
+            <parameter key="PartsOutMax" value="1" comment="**DEPRECATED** % of fluid allowed outside domain" />
+            <parameter key="RhopOutMin" value="700" comment="Min valid density (kg/m^3)" />
+            <parameter key="RhopOutMax" value="1300" comment="Max valid density (kg/m^3)" />
+            <simulationdomain comment="Defines domain of simulation (default=Uses minimum and maximum position of the generated particles)">
+                <posmin x="default" y="default" z="default" comment="e.g.: x=0.5, y=default-1, z=default-10%" />
+                <posmax x="default" y="default" z="default + 50%" />
+            </simulationdomain>
+        </parameters>
+        <particles np="6400" nb="6400" nbf="6400" mkboundfirst="21" mkfluidfirst="1">
+            <_summary>
+                <positions units_comment="metres (m)">
+                    <posmin x="0" y="0" z="0" />
+                    <posmax x="1.59" y="0" z="0.39" />
+                </positions>
+                <fixed count="6400" id="0-6399" mkcount="1" mkvalues="21" />
+            </_summary>
+            <fixed mkbound="0" mk="21" begin="0" count="6400" />
+        </particles>
+        <constants>
+            <data2d value="false" />
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.01" units_comment="metres (m)" />
+            <h value="0.017320508076" units_comment="metres (m)" />
+            <b value="0" units_comment="Pascal (Pa)" />
+            <massbound value="0.001" units_comment="kg" />
+            <massfluid value="0.001" units_comment="kg" />
+        </constants>
+        <uservars>
+            <varnum name="VResId" value="0" />
+        </uservars>
+        <motion />
+        <vtkout mkboundfirst="21" mkfluidfirst="1">
+            <vtkfile name="CaseDambreak_Def_Tank_Dp.vtk" mk="21" mkbound="0" />
+        </vtkout>
+    </execution>
+</case>
+"""
+
+
+#: feynman0406/DualSPHysicsGPT CaseSloshingHR_Def_from_xml_out_direct/CaseSloshingHR_Def_from_xml.xml,
+#: GenCase v5.4.354.01 (07-04-2025): a 2D tank (boxfill all) with <layers vdp="0,1,2,3"> (5,688
+#: moving particles: closed rings of 1410 + 8k) and, after <setboxlimitmode mode="full">, a fillbox
+#: whose top at 0.093 m (46.5 dp) filled the row at 0.094 m (21,103 = 449 x 47 fluid particles,
+#: depth 0.092 m, b 116,038.28571 Pa). Its SloshingMotionData.dat (a rotation table) is not kept:
+#: the test writes one.
+CASESLOSHINGHR_V54 = """<?xml version="1.0" ?>
+<case app="GenCase v5.4.354.01 (07-04-2025)" date="27-09-2025 00:45:07">
+    <casedef>
+        <constantsdef>
+            <gravity x="0" y="0" z="-9.81" comment="Gravitational acceleration" units_comment="m/s^2" />
+            <rhop0 value="1000" comment="Reference density of the fluid" units_comment="kg/m^3" />
+            <rhopgradient value="2" comment="Initial density gradient 1:Rhop0, 2:Water column, 3:Max. water height (default=2)" />
+            <hswl value="0" auto="true" comment="Maximum still water level to calculate speedofsound using coefsound" units_comment="metres (m)" />
+            <gamma value="7" comment="Polytropic constant for water used in the state equation" />
+            <speedsystem value="0" auto="true" comment="Maximum system speed (by default the dam-break propagation is used)" />
+            <coefsound value="30" comment="Coefficient to multiply speedsystem" />
+            <speedsound value="0" auto="true" comment="Speed of sound to use in the simulation (by default speedofsound=coefsound*speedsystem)" />
+            <hdp value="2" comment="Alternative option to calculate the smoothing length (h=hdp*dp)" />
+            <cflnumber value="0.2" comment="Coefficient to multiply dt" />
+        </constantsdef>
+        <mkconfig boundcount="240" fluidcount="9" />
+        <geometry>
+            <definition dp="0.002" units_comment="metres (m)">
+                <pointmin x="-1" y="0" z="-1" />
+                <pointmax x="1" y="0" z="1" />
+            </definition>
+            <commands>
+                <list name="GeometryForNormals">
+                    <setactive drawpoints="0" drawshapes="1" />
+                    <setshapemode>actual | bound</setshapemode>
+                    <setnormalinvert invert="true" />
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>all</boxfill>
+                        <point x="-0.45" y="-0.1" z="0" />
+                        <size x="0.9" y="0.2" z="0.51" />
+                        <layers vdp="-0.5" />
+                    </drawbox>
+                    <shapeout file="hdp" />
+                    <resetdraw />
+                </list>
+                <mainlist>
+                    <runlist name="GeometryForNormals" />
+                    <setdrawmode mode="full" />
+                    <setmkbound mk="0" />
+                    <drawbox>
+                        <boxfill>all</boxfill>
+                        <point x="-0.45" y="-0.1" z="0" />
+                        <size x="0.9" y="0.2" z="0.51" />
+                        <layers vdp="0,1,2,3" />
+                    </drawbox>
+                    <setboxlimitmode mode="full" />
+                    <setmkfluid mk="0" />
+                    <setactive drawpoints="1" drawshapes="0" />
+                    <fillbox x="0" y="0" z="0.02">
+                        <modefill>void</modefill>
+                        <point x="-0.5" y="-0.1" z="0" />
+                        <size x="1" y="0.2" z="0.093" />
+                    </fillbox>
+                </mainlist>
+            </commands>
+        </geometry>
+        <motion>
+            <objreal ref="0">
+                <begin mov="1" start="0" finish="100" />
+                <mvrotfile id="1" duration="100" anglesunits="degrees">
+                    <file name="SloshingMotionData.dat" />
+                    <axisp1 x="0" y="-1" z="0" />
+                    <axisp2 x="0" y="1" z="0" />
+                </mvrotfile>
+            </objreal>
+        </motion>
+        <normals active="true">
+            <norgeometry comment="Define initial configuration of normals before applying other configurations">
+                <geometryfile file="[CaseName]_hdp_Actual.vtk" comment="File with boundary geometry (VTK format)" />
+                <distanceh v="2.0" comment="Maximum orthogonal distance (H*value) to compute normals data (default=2)" />
+            </norgeometry>
+        </normals>
+    </casedef>
+    <execution>
+        <parameters>
+            <parameter key="SavePosDouble" value="0" comment="Saves particle position using double precision (default=0)" />
+            <parameter key="Boundary" value="2" comment="Boundary method 1:DBC, 2:mDBC (default=1)" />
+            <parameter key="SlipMode" value="1" comment="Slip mode for mDBC 1:DBC vel=0, 2:No-slip, 3:Free Slip (default=1)" />
+            <parameter key="StepAlgorithm" value="2" comment="Step Algorithm 1:Verlet, 2:Symplectic (default=1)" />
+            <parameter key="VerletSteps" value="40" comment="Verlet only: Number of steps to apply Euler timestepping (default=40)" />
+            <parameter key="Kernel" value="2" comment="Interaction Kernel 1:Cubic Spline, 2:Wendland (default=2)" />
+            <parameter key="ViscoTreatment" value="1" comment="Viscosity formulation 1:Artificial, 2:Laminar+SPS, 3:Laminar (default=1)" />
+            <parameter key="Visco" value="0.02" comment="Viscosity value. Typically 0.01 for Artificial and 1e-6 m^2/s (water kinematic viscosity) for Laminar" />
+            <parameter key="ViscoBoundFactor" value="1" comment="Multiply viscosity value with boundary (default=1)" />
+            <parameter key="DensityDT" value="3" comment="Density Diffusion Term 0:None, 1:Molteni, 2:Fourtakas, 3:Fourtakas(full) (default=0)" />
+            <parameter key="DensityDTvalue" value="0.1" comment="DDT value (default=0.1)" />
+            <parameter key="Shifting" value="0" comment="Shifting mode 0:None, 1:Ignore bound, 2:Ignore fixed, 3:Full (default=0)" />
+            <parameter key="ShiftCoef" value="-2" comment="Coefficient for shifting computation (default=-2)" />
+            <parameter key="ShiftTFS" value="0" comment="Threshold to detect free surface. Typically 1.5 for 2D and 2.75 for 3D (default=0)" />
+            <parameter key="RigidAlgorithm" value="1" comment="Rigid Algorithm 0:collision-free, 1:SPH, 2:DEM, 3:Chrono (default=1)" />
+            <parameter key="FtPause" value="0.0" comment="Time to freeze the floatings at simulation start (warmup) (default=0)" units_comment="seconds" />
+            <parameter key="CoefDtMin" value="0.05" comment="Coefficient to calculate minimum time step dtmin=coefdtmin*h/speedsound (default=0.05)" />
+            <parameter key="DtIni" value="0" comment="Initial time step. Use 0 to default use (default=h/speedsound)" units_comment="seconds" />
+            <parameter key="DtMin" value="0" comment="Minimum time step. Use 0 to default use (default=coefdtmin*h/speedsound)" units_comment="seconds" />
+            <parameter key="DtFixed" value="0" comment="Fixed Dt value. Use 0 to disable (default=disabled)" units_comment="seconds" />
+            <parameter key="DtFixedFile" value="NONE" comment="Dt values are loaded from file. Use NONE to disable (default=disabled)" units_comment="milliseconds (ms)" />
+            <parameter key="DtAllParticles" value="0" comment="Velocity of particles used to calculate DT. 1:All, 0:Only fluid/floating (default=0)" />
+            <parameter key="TimeMax" value="8.35" comment="Time of simulation" units_comment="seconds" />
+            <parameter key="TimeOut" value="0.01" comment="Time out data" units_comment="seconds" />
+            <parameter key="RhopOutMin" value="700" comment="Minimum rhop valid (default=700)" units_comment="kg/m^3" />
+            <parameter key="RhopOutMax" value="1300" comment="Maximum rhop valid (default=1300)" units_comment="kg/m^3" />
+            <parameter key="WrnPartsOut" value="1" comment="Active warning according to number of out particles (default=1)" />
+            <parameter key="MinFluidStop" value="0" comment="Minimum proportion of initial fluid particles to continue the simulation 0:Never stops, 0.1:Stops when fluid drops to 10%. (default=0)" />
+            <simulationdomain comment="Defines domain of simulation (default=Uses minimum and maximum position of the generated particles)">
+                <posmin x="default" y="default" z="default" comment="e.g.: x=0.5, y=default-1, z=default-10%" />
+                <posmax x="default" y="default" z="default" />
+            </simulationdomain>
+        </parameters>
+        <particles np="26791" nb="5688" nbf="0" mkboundfirst="10" mkfluidfirst="1">
+            <_summary>
+                <positions units_comment="metres (m)">
+                    <posmin x="-0.456" y="0" z="-0.006" />
+                    <posmax x="0.456" y="0" z="0.516" />
+                </positions>
+                <moving count="5688" id="0-5687" mkcount="1" mkvalues="10" />
+                <fluid count="21103" id="5688-26790" mkcount="1" mkvalues="1" />
+            </_summary>
+            <moving mkbound="0" mk="10" begin="0" count="5688" refmotion="0" />
+            <fluid mkfluid="0" mk="1" begin="5688" count="21103" />
+        </particles>
+        <constants>
+            <data2d value="true" />
+            <data2dposy value="0" units_comment="metres (m)" />
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.002" units_comment="metres (m)" />
+            <h value="0.004" units_comment="metres (m)" />
+            <b value="116038.28571" units_comment="Pascal (Pa)" />
+            <massbound value="0.004" units_comment="kg" />
+            <massfluid value="0.004" units_comment="kg" />
+        </constants>
+        <uservars>
+            <varnum name="VResId" value="0" />
+        </uservars>
+        <motion>
+            <objreal ref="0">
+                <begin mov="1" start="0" finish="100" />
+                <mvrotfile id="1" duration="100" anglesunits="degrees">
+                    <file name="SloshingMotionData.dat" />
+                    <axisp1 x="0" y="-1" z="0" />
+                    <axisp2 x="0" y="1" z="0" />
+                </mvrotfile>
+            </objreal>
+        </motion>
+        <vtkout mkboundfirst="10" mkfluidfirst="1">
+            <vtkfile name="CaseSloshingHR_Def_from_xml_hdp_Actual.vtk" mk="10" mkbound="0" />
+        </vtkout>
+    </execution>
+</case>
+"""

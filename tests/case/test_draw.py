@@ -220,8 +220,11 @@ def test_box_rotated_faces(tmp_path):
 
 
 def test_box_clipped_to_domain(tmp_path):
+    # GenCase's domain: floor((pointmax - pointmin)/dp) nodes per axis, none on pointmax
     d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((-5, -5, -5), (8, 8, 8)), pmax=(2, 2, 2))
-    assert nodes(d) == lattice_box((0, 0, 0), (2, 2, 2))
+    assert nodes(d) == lattice_box((0, 0, 0), (1, 1, 1))
+    d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((-5, -5, -5), (8, 8, 8)), pmax=(2.5, 2.99, 3))
+    assert nodes(d) == lattice_box((0, 0, 0), (1, 1, 2))
     d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((20, 20, 20), (8, 8, 8)), pmax=(2, 2, 2))
     assert len(d.pos) == 0
 
@@ -248,11 +251,11 @@ def test_pointref_alignment(tmp_path):
              pmin=(0.25, 0.25, 0.25), pmax=(2, 2, 2), pointref=(0, 0, 0))
     assert d.origin.tolist() == [0.5, 0.5, 0.5]
     assert d.pos.min(axis=0).tolist() == [0.5, 0.5, 0.5]
-    assert len(d.pos) == 4 ** 3
+    assert len(d.pos) == 3 ** 3 and d.pos.max(axis=0).tolist() == [1.5, 1.5, 1.5]
     d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, 0, 0), (2, 2, 2)), dp=0.5,
              pmin=(0.25, 0.25, 0.25), pmax=(2, 2, 2))
     assert d.pos.min(axis=0).tolist() == [0.25, 0.25, 0.25]
-    assert len(d.pos) == 4 ** 3 and d.pos.max(axis=0).tolist() == [1.75, 1.75, 1.75]
+    assert len(d.pos) == 3 ** 3 and d.pos.max(axis=0).tolist() == [1.25, 1.25, 1.25]
 
 
 def test_2d_layer_only(tmp_path):
@@ -269,7 +272,7 @@ def test_2d_layer_only(tmp_path):
 def test_floating_point_noise_never_loses_nodes(tmp_path):
     # 0.1 steps accumulate noise; every node of 0..3 (31 per axis) must be there
     d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0.3, 0, 0.3), (2.7, 0, 2.7)), dp=0.1,
-             pmin=(0, 0, 0), pmax=(3.0000000001, 0, 3))
+             pmin=(0, 0, 0), pmax=(3.1000000001, 0, 3.1))
     assert len(d.pos) == 28 * 28
 
 
@@ -291,8 +294,12 @@ SPHERE = '<setdrawmode mode="{mode}"/><setmkbound mk="0"/><drawsphere radius="{r
 def test_sphere_solid_and_shell(tmp_path):
     ball = brute(lambda x, y, z: x * x + y * y + z * z <= 4)
     assert len(ball) == 33
-    d = draw(tmp_path, SPHERE.format(mode="full", r=2, c=5))
+    d = draw(tmp_path, SPHERE.format(mode="solid", r=2, c=5))
     assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in ball}
+    # full mode fills CURVED_FULL_REACH = 0.6 dp beyond the surface (GenCase's records)
+    d = draw(tmp_path, SPHERE.format(mode="full", r=2, c=5))
+    assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in
+                        brute(lambda x, y, z: x * x + y * y + z * z <= 2.6 ** 2)}
     d = draw(tmp_path, SPHERE.format(mode="face", r=2, c=5))
     shell = shell_of(ball)
     assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in shell}
@@ -316,15 +323,17 @@ def test_sphere_shell_is_closed(tmp_path):
 
 
 def test_circle_2d(tmp_path):
-    d = draw(tmp_path, SPHERE.format(mode="full", r=2, c=5), pmin=(0, 5, 0), pmax=(10, 5, 10))
+    d = draw(tmp_path, SPHERE.format(mode="solid", r=2, c=5), pmin=(0, 5, 0), pmax=(10, 5, 10))
     assert len(d.pos) == 13
+    d = draw(tmp_path, SPHERE.format(mode="full", r=2, c=5), pmin=(0, 5, 0), pmax=(10, 5, 10))
+    assert len(d.pos) == 21     # within 2.6: the 13 and (+-2, +-1), (+-1, +-2)
     d = draw(tmp_path, SPHERE.format(mode="face", r=2, c=5), pmin=(0, 5, 0), pmax=(10, 5, 10))
     assert len(d.pos) == 8  # the 2D ring: all but the centre and its 4 neighbours
 
 
 def test_sphere_params_after_transform(tmp_path):
     d = draw(tmp_path, '<move x="1" y="0" z="0"/><scale x="2" y="2" z="2"/>'
-             + SPHERE.format(mode="full", r=1, c=2))
+             + SPHERE.format(mode="solid", r=1, c=2))
     p = d.primitives[0]["params"]
     assert p["center"] == [5, 4, 4] and p["radius"] == 2
     assert len(d.pos) == 33
@@ -334,7 +343,7 @@ CYL = '<setdrawmode mode="{mode}"/><setmkbound mk="0"/><drawcylinder radius="1.5
       '<point x="5" y="5" z="2"/><point x="5" y="5" z="6"/></drawcylinder>'
 
 
-@pytest.mark.parametrize("mode,mask,count", [("full", "0", 45), ("solid", "0", 45),
+@pytest.mark.parametrize("mode,mask,count", [("full", "0", 13 * 5), ("solid", "0", 45),
                                              ("face", "0", 9 + 9 + 3 * 8),
                                              ("face", "1 | 2", 5 * 8), ("face", "3", 9 + 9),
                                              ("face", "1", 9 + 4 * 8)])
@@ -352,26 +361,32 @@ def test_cylinder_mask_hides_first_cover(tmp_path):
 
 
 def test_cylinder_oblique_matches_brute_force(tmp_path):
-    body = ('<setmkfluid mk="0"/><drawcylinder radius="2"><point x="2" y="3" z="1"/>'
-            '<point x="8" y="6" z="7"/></drawcylinder>')
-    d = draw(tmp_path, body)
     p1, p2 = np.array([2, 3, 1.0]), np.array([8, 6, 7.0])
     u = (p2 - p1) / np.linalg.norm(p2 - p1)
+    for mode, reach in (("solid", 0.0), ("full", 0.6)):
+        body = (f'<setdrawmode mode="{mode}"/><setmkfluid mk="0"/><drawcylinder radius="2">'
+                '<point x="2" y="3" z="1"/><point x="8" y="6" z="7"/></drawcylinder>')
+        d = draw(tmp_path, body)
 
-    def inside(x, y, z):
-        v = np.array([x, y, z]) - p1
-        t = v @ u
-        return -1e-9 <= t <= np.linalg.norm(p2 - p1) + 1e-9 and v @ v - t * t <= 4 + 1e-9
-    assert nodes(d) == brute(inside, 0, 10)
+        def inside(x, y, z):
+            v = np.array([x, y, z]) - p1
+            t = v @ u
+            return (-reach - 1e-9 <= t <= np.linalg.norm(p2 - p1) + reach + 1e-9
+                    and v @ v - t * t <= (2 + reach) ** 2 + 1e-9)
+        assert nodes(d) == brute(inside, 0, 9)      # the domain's nodes: 0..9
 
 
 def test_ellipsoid_axes_and_foci(tmp_path):
-    body = ('<setmkfluid mk="0"/><drawellipsoid><point x="5" y="5" z="5"/>'
+    body = ('<setdrawmode mode="solid"/><setmkfluid mk="0"/><drawellipsoid><point x="5" y="5" z="5"/>'
             '<radius x="3" y="2" z="1"/></drawellipsoid>')
     d = draw(tmp_path, body)
     exp = brute(lambda x, y, z: x * x / 9 + y * y / 4 + z * z <= 1)
     assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in exp}
-    body = ('<setmkfluid mk="0"/><drawellipsoid radius="2"><point x="4" y="5" z="5"/>'
+    # full mode: each semi-axis 0.6 dp longer
+    d = draw(tmp_path, body.replace("solid", "full"))
+    exp = brute(lambda x, y, z: x * x / 3.6 ** 2 + y * y / 2.6 ** 2 + z * z / 1.6 ** 2 <= 1)
+    assert nodes(d) == {(x + 5, y + 5, z + 5) for x, y, z in exp}
+    body = ('<setdrawmode mode="solid"/><setmkfluid mk="0"/><drawellipsoid radius="2"><point x="4" y="5" z="5"/>'
             '<point x="6" y="5" z="5"/></drawellipsoid>')
     d = draw(tmp_path, body)
     exp = brute(lambda x, y, z: np.hypot(np.hypot(x + 1, y), z) + np.hypot(np.hypot(x - 1, y), z)
@@ -478,7 +493,7 @@ def test_lines_and_points(tmp_path):
 def test_long_line_clipped(tmp_path):
     d = draw(tmp_path, '<setmkbound mk="0"/><drawline><point x="-1e12" y="1" z="1"/>'
              '<point x="1e12" y="1" z="1"/></drawline>')
-    assert nodes(d) == {(x, 1, 1) for x in range(11)}
+    assert nodes(d) == {(x, 1, 1) for x in range(10)}
 
 
 # ---------------------------------------------------------------- transforms
@@ -667,14 +682,14 @@ def test_curved_modes_solid_and_wire(tmp_path):
     solid = draw(tmp_path, SPHERE.format(mode="solid", r=2.5, c=5))
     face = draw(tmp_path, SPHERE.format(mode="face", r=2.5, c=5))
     wire = draw(tmp_path, SPHERE.format(mode="wire", r=2.5, c=5))
-    assert nodes(full) == nodes(solid)
-    assert nodes(face) == nodes(wire) and nodes(face) < nodes(full)
+    assert nodes(solid) < nodes(full)          # full reaches 0.6 dp beyond the surface
+    assert nodes(face) == nodes(wire) and nodes(face) < nodes(solid)
 
 
 def test_void_sphere_carves_a_box(tmp_path):
     d = draw(tmp_path, '<setmkfluid mk="0"/>' + box((0, 0, 0), (10, 10, 10))
-             + '<setmkvoid/>' + SPHERE.format(mode="full", r=2, c=5).replace('<setmkbound mk="0"/>', ""))
-    assert len(d.pos) == 11 ** 3 - 33
+             + '<setmkvoid/>' + SPHERE.format(mode="solid", r=2, c=5).replace('<setmkbound mk="0"/>', ""))
+    assert len(d.pos) == 10 ** 3 - 33
     assert (5, 5, 5) not in nodes(d)
 
 
@@ -686,21 +701,32 @@ def test_printf_in_predefinition_and_list_calls(tmp_path):
 
 
 def test_box_layers(tmp_path):
-    """A face's layers move it along its normal over the same extent (GenCase v5: a 3 m x 3 m floor
-    with <layers vdp="0,1,2"> at dp 0.0064 wrote 3 x 470^2 particles; they were widened here)."""
+    """A face's layers move it along its normal, widened towards its drawn neighbours only (GenCase
+    v5: a 3 m x 3 m floor with <layers vdp="0,1,2"> at dp 0.0064 wrote 3 x 470^2 particles; GenCase
+    v5.4: the 4 layers of a boxfill-all 2D tank closed rings of 1410 + 8k particles, an all^top 3D
+    tank 361,104 with its walls ending at their layer-0 top)."""
     d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="bottom",
                                                    extra='<layers vdp="0,1*,2"/>'))
     assert len(d.pos) == 3 * 25
     assert sorted(set(d.pos[:, 2].tolist())) == [1, 2, 3]
     assert set(d.pos[:, 0].tolist()) == {3, 4, 5, 6, 7}
     assert [p["params"]["layer"] for p in d.primitives] == [0, 1, 2]
-    # a tank with 3-layer walls keeps its fluid inside; the outer layers leave its edges and
-    # corners open (nodes with two coordinates outside the box are not drawn)
+    # a tank with 3-layer walls keeps its fluid inside; its layers are closed shells, edges and
+    # corners included (cubes of 5, 7 and 9 nodes a side)
     body = ('<setmkfluid mk="0"/>' + box((3, 3, 3), (4, 4, 4))
             + '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="all",
                                            extra='<layers vdp="0,1,2"/>'))
     d = draw(tmp_path, body)
-    assert d.count_fluid == 27 and d.count_bound == 5 ** 3 + 3 * 2 * 2 * 5 ** 2 - 27
+    assert d.count_fluid == 27 and d.count_bound == 9 ** 3 - 27
+    # an open tank (no top): the walls' layers do not rise above the layer-0 top (z = 7), its
+    # floor and walls widen towards each other
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="bottom | left | right | front | back",
+                                                   extra='<layers vdp="0,1"/>'))
+    assert len(d.pos) == (5 ** 3 - 3 ** 2 * 4) + (7 * 7 * 6 - 5 * 5 * 5) and d.pos[:, 2].max() == 7
+    # front and back only: moved along y, not widened (no drawn neighbour)
+    d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="front | back",
+                                                   extra='<layers vdp="0,1"/>'))
+    assert len(d.pos) == 4 * 25 and set(d.pos[:, 1].tolist()) == {2, 3, 7, 8}
     # a solid box's layers still widen it on every side
     d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="solid",
                                                    extra='<layers vdp="0,1"/>'))
@@ -709,6 +735,14 @@ def test_box_layers(tmp_path):
     d = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (2, 2, 2), fill="all",
                                                    extra='<layers vdp="0,-2"/>'))
     assert len(d.pos) == 26
+
+
+def test_empty_layers_list_draws_the_shape_once(tmp_path):
+    # <layers vdp=""/>: GenCase v5.4 drew the shape once (yupengxiang/DualSPHysics F2_SLOT_TRANSFER:
+    # its counts with the attribute and without it are the same)
+    plain = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="all"))
+    empty = draw(tmp_path, '<setmkbound mk="0"/>' + box((3, 3, 3), (4, 4, 4), fill="all", extra='<layers vdp=""/>'))
+    assert np.array_equal(plain.pos, empty.pos) and len(empty.pos) == 98
 
 
 def test_sphere_and_cylinder_layers(tmp_path):

@@ -98,7 +98,7 @@ def test_mask_numbers_beyond_the_faces_are_ignored_and_warned(tmp_path):
     d, w = warnings_of(tmp_path, PRISM.format(mode="full", mask="7"))
     assert len(d.pos) == 45
     d, w = warnings_of(tmp_path, CYL.format(mode="full", mask="4 | 5"))
-    assert len(d.pos) == 45 and any("mask names faces 4, 5 but this <drawcylinder> has faces 1 to 3"
+    assert len(d.pos) == 13 * 5 and any("mask names faces 4, 5 but this <drawcylinder> has faces 1 to 3"
                                     in m for m in w)
     d, w = warnings_of(tmp_path, PRISM.format(mode="full", mask="1 | 2"))
     assert w == []
@@ -117,7 +117,7 @@ def test_mask_number_beyond_the_faces_beside_valid_ones_is_silent(tmp_path, mask
 
 @pytest.mark.parametrize("mode,mask,count", [
     ("face", "1 | 2", 5 * 8), ("face", "3", 9 + 9), ("face", "1 | 3", 9), ("face", "2", 9 + 4 * 8),
-    ("full", "2", 9 + 4 * 8), ("full", "3", 9 + 9), ("full", "0", 45), ("full", "1|2|3", 0)])
+    ("full", "2", 9 + 4 * 8), ("full", "3", 9 + 9), ("full", "0", 13 * 5), ("full", "1|2|3", 0)])
 def test_cylinder_mask_faces(tmp_path, mode, mask, count):
     # faces 1 = cover at the first point (z=2), 2 = cover at the second point (z=6), 3 = tube
     d = draw(tmp_path, CYL.format(mode=mode, mask=mask))
@@ -256,31 +256,36 @@ def test_false_printf_and_abort_read_their_text(tmp_path):
 
 
 # ---------------------------------------------------------------- setboxlimitmode
-def test_setboxlimitmode_full_is_the_default(tmp_path):
+FILL_TANK = ('<setmkbound mk="0"/><drawbox><boxfill>bottom | left | right</boxfill><point x="0" y="0" '
+             'z="0"/><size x="6" y="0" z="8"/></drawbox>')
+FILL = ('<setmkfluid mk="0"/><fillbox x="3" y="0" z="1"><modefill>void</modefill><point x="0" y="0" '
+        'z="0"/><size x="6" y="0" z="3.5"/></fillbox>')
+
+
+def test_setboxlimitmode_sets_the_fill_limits(tmp_path):
+    """A fillbox fills the nodes at least dp/2 inside its box (GenCase's default, ``inner``); after
+    <setboxlimitmode mode="full"> every node from the one nearest its min corner to the one nearest
+    its max corner, a top at 3.5 dp filling the row at 4 (GenCase v5.4's CaseSloshingHR record:
+    fill top at 46.5 dp, fluid to the row at 47). A drawbox is not affected."""
+    kw = dict(pmin=(-1, 0, -1), pmax=(8, 0, 10))
+    inner = draw(tmp_path, FILL_TANK + FILL, **kw)
+    assert inner.count_fluid == 5 * 3 and inner.pos[inner.is_fluid, 2].max() == 3
+    explicit = draw(tmp_path, FILL_TANK + '<setboxlimitmode mode="inner"/>' + FILL, **kw)
+    assert np.array_equal(explicit.pos, inner.pos)
+    full = draw(tmp_path, FILL_TANK + '<setboxlimitmode mode="full"/>' + FILL, **kw)
+    assert full.count_fluid == 5 * 4 and full.pos[full.is_fluid, 2].max() == 4
     box = ('<setmkfluid mk="0"/><drawbox><boxfill>solid</boxfill><point x="0.5" y="0.5" '
            'z="0.5"/><size x="2.2" y="2" z="2.5"/></drawbox>')
     plain = draw(tmp_path, box)
-    full = draw(tmp_path, '<setboxlimitmode mode="full"/>' + box)
-    assert np.array_equal(plain.pos, full.pos) and len(full.pos) > 0
+    for mode in ("full", "inner"):
+        other = draw(tmp_path, f'<setboxlimitmode mode="{mode}"/>' + box)
+        assert np.array_equal(plain.pos, other.pos) and len(other.pos) > 0
 
 
-@pytest.mark.parametrize("mode,fragment", [("inner", "not supported"), ("half", "not recognised")])
-def test_setboxlimitmode_refused(tmp_path, mode, fragment):
-    with pytest.raises(CaseError, match=fragment) as e:
-        draw(tmp_path, f'<setboxlimitmode mode="{mode}"/>')
+def test_setboxlimitmode_unknown_mode_refused(tmp_path):
+    with pytest.raises(CaseError, match="not recognised") as e:
+        draw(tmp_path, '<setboxlimitmode mode="half"/>')
     assert e.value.element == "setboxlimitmode" and e.value.line
-
-
-def test_setboxlimitmode_inner_exits_2_from_the_cli(tmp_path):
-    from click.testing import CliRunner
-
-    from sphdvi.cli import main
-    path = write_case(tmp_path, case_xml(commands='<setboxlimitmode mode="inner"/>'))
-    res = CliRunner().invoke(main, ["gencase", path, "-o", str(tmp_path / "out")])
-    assert res.exit_code == 2
-    out = res.output
-    assert "Case_Def.xml:" in out and "<setboxlimitmode>" in out and "inner" in out
-    assert "expected" in out and "Traceback" not in out
 
 
 # ---------------------------------------------------------------- whole cases

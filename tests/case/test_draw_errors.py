@@ -184,4 +184,4 @@ def test_huge_boxes_and_lines_are_clipped(tmp_path):
                                                    fill="all"))
     assert len(d.pos) == 0
     d = draw(tmp_path, '<setmkbound mk="0"/>' + box((-1e300, -1e300, -1e300), (2e300, 2e300, 2e300)))
-    assert len(d.pos) == 11 ** 3
+    assert len(d.pos) == 10 ** 3

@@ -28,6 +28,8 @@ MATCH = {
     "Case5aSvdt_8k": cases.CASE5A_SVDT_8K,        # GenCase4 (no app), setmkvoid, coefh 0.866025
     "WallRegAwas2": cases.WALLREGAWAS2,           # GenCase4 v4.0.059, piston + AWAS, fillbox
     "CaseDambreakVal2D": cases.CASEDAMBREAK_V54,  # GenCase v5.4.354.01
+    "CaseDambreak_Def": cases.CASEDAMBREAK_DEF_V54,     # GenCase v5.4.354.01, no node on pointmax
+    "CaseSloshingHR": cases.CASESLOSHINGHR_V54,   # GenCase v5.4.354.01, layers, setboxlimitmode full
 }
 
 # the record writes 11 significant digits (e.g. h="2.8284271247E-002")
@@ -52,6 +54,8 @@ def record(text: str):
 
 
 def draw(tmp_path, text: str, name: str):
+    if "SloshingMotionData.dat" in text:          # the rotation table the output names (not kept)
+        (tmp_path / "SloshingMotionData.dat").write_text("0 0\n100 0\n")
     r = build_case(write_case(tmp_path, text, name + ".xml"), str(tmp_path / "out"))
     mk = np.asarray(r.particles["mk"])
     return r, {int(m): int((mk == m).sum()) for m in np.unique(mk)}

@@ -254,3 +254,20 @@ def test_geometry_normals_3d_tank_against_the_clamped_point():
     assert near.sum() > 350 and (~near).sum() > 40
     assert np.allclose(n[near], want[near], atol=1e-12)
     assert np.all(n[~near] == 0)
+
+
+def test_geometry_normals_maxsizeh_limits_their_length():
+    """<norgeometry><maxsizeh v=".."> (GenCase v5.4's template: "Maximum allowed normal size
+    (H*value) (disabled=0, default=0)"): a particle whose normal would be longer has none; 0 is no
+    limit."""
+    pos, ptype = tank(DP, 3)
+    mk = np.zeros(len(pos), int)
+    tris = box_triangles(np.array([DP / 2, -1, DP / 2]), np.array([1 - DP, 2, 1.0]), skip=("z1",))
+    full, _ = run_ops([op("geometry", file="hdp", distanceh=4 * DP / H, maxsizeh=0.0)], pos, ptype, mk,
+                      geometry=lambda o: (tris, None))
+    cut, _ = run_ops([op("geometry", file="hdp", distanceh=4 * DP / H, maxsizeh=1.6 * DP / H)], pos, ptype, mk,
+                     geometry=lambda o: (tris, None))
+    length = np.linalg.norm(full, axis=1)
+    assert np.any(length > 1.6 * DP)
+    keep = length <= 1.6 * DP
+    assert np.array_equal(cut[keep], full[keep]) and np.all(cut[~keep] == 0)

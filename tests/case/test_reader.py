@@ -120,13 +120,15 @@ def test_dp_is_defined_for_the_domain_points(tmp_path):
     assert np.array_equal(r.particles["pos"], ref.particles["pos"])
 
 
-def test_a_domain_thinner_than_dp_in_y_is_warned(tmp_path):
-    """pointmax y = 0.001 with dp 0.02 makes a 3D case one layer thick (GenCase's rule: 2D only
-    where pointmin y = pointmax y): warned, with what a 2D case needs; a 2D case is not."""
-    r = build(tmp_path / "a", pointmax=("4.5", "0.001", "3.5"))
-    assert any("the domain is 0.001 m deep in y, less than dp (0.02 m): a 3D case one particle layer thick; "
-               "for a 2D case give pointmin and pointmax the same y" in w and "<pointmax>" in w for w in r.warnings)
-    assert not any("deep in y" in w for w in build(tmp_path / "b").warnings)
+def test_a_domain_thinner_than_dp_in_y_is_an_error(tmp_path):
+    """pointmax y = 0.001 with dp 0.02 leaves a 3D case no node along y (GenCase places
+    floor((pointmax - pointmin)/dp) nodes per axis; 2D only where pointmin y = pointmax y): the
+    error says so, with what a 2D case needs; a 2D case is built."""
+    with pytest.raises(CaseError, match=r"<definition>: the domain holds no node along y: pointmax - pointmin "
+                                        r"is 0.001 m, less than dp \(0.02 m\).*for a 2D case give pointmin "
+                                        r"and pointmax the same y"):
+        build(tmp_path / "a", pointmax=("4.5", "0.001", "3.5"))
+    build(tmp_path / "b")
 
 
 def test_schema_errors_say_what_the_attribute_holds(tmp_path):

@@ -263,3 +263,17 @@ def test_gauge_outside_the_domain_is_warned(tmp_path, gauge, outside):
         assert f"{case.name}:{line_of(case.read_text(), line)}:" in warned[0] and "gauge 'far'" in warned[0]
     else:
         assert not warned, r.output
+
+
+def test_swl_point1_is_warned_and_ignored(tmp_path):
+    """DualSPHysics 5.4 ran a case whose swl gauges carry a <point1> (yupengxiang/DualSPHysics F5
+    C082S1): read, warned as not used, the gauge the line from point0 to point2."""
+    from sphdvi.case.gencase import build_case
+    gauge = f'<swl name="S">\n<point1 x="0.2" y="0" z="1" />\n{SWL}\n</swl>'
+    case = write_case(tmp_path, gauge)
+    res = build_case(str(case))
+    item = res.case.special["gauges"]["items"][0]
+    assert "point1" not in item and item["point0"] == [0.2, 0.0, 0.0] and item["point2"] == [0.2, 0.0, 2.0]
+    line = line_of(case.read_text(), '<point1 x="0.2"')
+    assert any(f"{case.name}:{line}: warning: <point1>" in w and "swl gauge 'S': <point1> is not read" in w
+               for w in res.warnings), list(res.warnings)

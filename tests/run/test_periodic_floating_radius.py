@@ -58,7 +58,7 @@ CASE = """<?xml version="1.0" encoding="UTF-8" ?>
         <constantsdef><gravity x="0" y="0" z="-9.81" /><rhop0 value="1000" /><coefh value="1.0" /><coefsound value="20" /></constantsdef>
         <mkconfig boundcount="240" fluidcount="9" />
         <geometry>
-            <definition dp="0.02"><pointmin x="0" y="0" z="-0.1" /><pointmax x="0.28" y="0" z="1.2" /></definition>
+            <definition dp="0.02"><pointmin x="0" y="0" z="-0.1" /><pointmax x="0.3" y="0" z="1.2" /></definition>
             <commands><mainlist>
                 <setmkfluid mk="0" />
                 <drawbox><boxfill>solid</boxfill><point x="0" y="-1" z="0.02" /><size x="0.28" y="2" z="0.1" /></drawbox>

@@ -5,8 +5,9 @@ Entry point: :func:`run_geometry` (returns a :class:`Drawing`).
 Lattice
     Nodes at ``origin + k*dp``; ``origin`` = ``pointmin``, or with
     ``<pointref>`` the first node >= ``pointmin`` of the lattice through
-    ``pointref`` (not along y in 2D). Only nodes in ``[pointmin, pointmax]``
-    exist; in 2D (``pointmin.y == pointmax.y``) every node has
+    ``pointref`` (not along y in 2D). Each axis holds
+    ``floor((pointmax - pointmin)/dp)`` nodes, none on ``pointmax`` (GenCase's
+    "Domain points"); in 2D (``pointmin.y == pointmax.y``) every node has
     ``y = pointmin.y``. The lattice is a dense ``uint16`` canvas (at most
     ``max_nodes`` nodes); a later drawing overwrites earlier ones, void erases.
 
@@ -19,7 +20,9 @@ Pen
 Draw modes (``setdrawmode``)
     ``full`` = volume including its surface, ``solid`` = volume (nodes inside,
     boundary within 1e-6 dp included), ``face`` = surface only, ``wire`` =
-    edges (polyhedra; curved shapes draw their surface).
+    edges (polyhedra; curved shapes draw their surface). A closed sphere,
+    ellipsoid or cylinder in ``full`` mode fills the nodes within r + 0.6 dp
+    (GenCase's records, ``shapes.CURVED_FULL_REACH``).
     ``drawbox`` with ``<boxfill>`` ignores the mode: ``solid`` = volume,
     ``all`` or any of ``bottom|top|left|right|front|back`` = those faces
     (left/right = x min/max, front/back = y min/max, bottom/top = z min/max),
@@ -32,7 +35,8 @@ Boxes (GenCase's rule, checked against the particle counts GenCase wrote for
 three DualSPHysics example cases, on and off the lattice)
     Volume: every node from the one nearest the min corner to the one
     nearest the max corner (halves round up), i.e. the box widened by dp/2.
-    Face: the node layer nearest the face plane, over the same extent. For a
+    Face: the node layer nearest the face plane, over the same extent (a
+    half-way tie at the extent's upper end taken inwards). For a
     rotated box the volume is the box widened by dp/2 along its own axes and
     the faces follow the planar-surface rule below (GenCase draws rotated
     faces somewhat thicker: 960 vs 832 nodes in its RotatedBox example).
@@ -101,8 +105,11 @@ Fills (``fillpoint``, ``fillvoidpoint``, ``fillbox``)
 
 Layers (``<layers vdp="0,1,-0.5*">`` in drawbox, drawsphere, drawcylinder)
     The shape is drawn once per offset, widened by offset*dp on every side
-    (box), on the radius (sphere), on the radius and at both covers
-    (cylinder); negative offsets shrink it. A trailing ``*`` is ignored.
+    (solid box), on the radius (sphere), on the radius and at both covers
+    (cylinder); negative offsets shrink it. A box's face is moved offset*dp
+    along its normal and widened towards its drawn neighbouring faces only
+    (the layers of an open tank close its corners, its walls do not rise).
+    A trailing ``*`` is ignored; an empty ``vdp`` draws the shape once.
 
 ``resetdraw``
     Back to the initial drawing configuration: no mk selected, ``full`` mode,

@@ -3,7 +3,10 @@
 Nodes sit at ``origin + k*dp`` (``k`` integer, per axis). ``origin`` is
 ``pointmin``, or, when ``<pointref>`` is given, the first node at or above
 ``pointmin`` on the lattice through ``pointref`` (GenCase aligns its lattice on
-``pointref``). Only nodes inside ``[pointmin, pointmax]`` exist. In 2D
+``pointref``). An axis has ``n = floor((pointmax - pointmin)/dp)`` nodes, ``origin + k*dp``
+for ``k = 0 .. n-1``, all in ``[pointmin, pointmax)``: a node on ``pointmax`` does not exist, as
+in GenCase (its logs, v5.0 and v5.4: "Case limits: (-5,0,-5) - (105,0,45)", dp 0.5, "Domain
+points: 220 x 1 x 100"; "(-0.05,-0.05,-0.05) - (2,1,1)", dp 0.0085, "241 x 123 x 123"). In 2D
 (``pointmin.y == pointmax.y``) there is a single y layer at ``pointmin.y``.
 
 The canvas stores one ``uint16`` code per node: 0 = void, otherwise an index
@@ -56,7 +59,7 @@ class Lattice:
                 origin[a] = self.pointref[a] + k * self.dp
         self.origin = origin
         self.counts_float = np.maximum(
-            np.floor((self.pointmax - self.origin) / self.dp + EPS) + 1.0, 0.0)
+            np.floor((self.pointmax - self.pointmin) / self.dp + EPS), 0.0)
         if self.is2d:
             self.counts_float[1] = 1.0
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import transform as tf
-from .lattice import EPS, Lattice, round_idx
+from .lattice import EPS, Lattice, ceil_idx, round_idx
 
 SLAB_NODES = 2_000_000  # nodes evaluated at once by analytic shapes
 SURFACE_HALF = 0.5      # half-width of the node band of a planar surface (lattice units)
@@ -78,9 +78,11 @@ def aligned_box_pieces(lat: Lattice, wmin, wmax, solid: bool, faces, wire: bool)
         lo = [round_idx(v) for v in a]
         hi = [round_idx(v) for v in b]
         pieces.append(box_piece(lat, lo, hi))
-    # faces span the same node range as the volume (nearest nodes, halves rounded up)
+    # faces span the nearest nodes of the box's extent, a half-way tie taken inwards (GenCase
+    # v5.4, yupengxiang/DualSPHysics F1_DUAL_FINITE_CENTER: walls ending at z = 1.0, half-way
+    # between two nodes, stop at the node below)
     ext_lo = [round_idx(v) for v in a]
-    ext_hi = [round_idx(v) for v in b]
+    ext_hi = [ceil_idx(v - 0.5) for v in b]
     for face in faces:
         axis, side = FACE_AXIS[face]
         layer = round_idx(b[axis] if side else a[axis])

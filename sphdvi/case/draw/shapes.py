@@ -154,25 +154,35 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
              grow: float = 0.0):
     """A box with a corner at ``point`` and edges ``size`` (rotated by ``angles`` about
     ``point``), drawn ``grow`` outwards (``<layers>``): a solid box (or its wire frame) widened by
-    ``grow`` on every side; its faces each moved ``grow`` along its own normal, over the same
-    extent as at layer 0, as GenCase v5 draws them (a yzhao469/DualSPHysicsAgent_v1 InclinedTrench
-    run: a 3 m x 3 m floor with ``<layers vdp="0,1,2">`` gave 3 x 470^2 particles, the layers not
-    widened). The recorded shape (shapeout, ``norgeometry``) stays the widened box."""
+    ``grow`` on every side; each drawn face moved ``grow`` along its normal and widened by
+    ``grow`` towards each neighbouring face that is drawn (not towards an open side), so the
+    layers of a tank close its edges and corners and its walls do not rise at an open top.
+    GenCase's records: a floor (``boxfill bottom``) with ``<layers vdp="0,1,2">``, 3 equal layers
+    (a yzhao469/DualSPHysicsAgent_v1 run, GenCase v5.0: 3 x 470^2); a ``boxfill all`` 2D tank,
+    closed rings of 1410 + 8k particles (feynman0406/DualSPHysicsGPT CaseSloshingHR, GenCase
+    v5.4); an ``all^top`` 3D tank (yupengxiang/DualSPHysics F1_DUAL_FINITE_CENTER, GenCase v5.4:
+    361,104, walls ending at their layer-0 top). The recorded shape (shapeout, ``norgeometry``)
+    is the box widened on every side."""
     full = m @ tf.translation(point)
     if angles is not None and np.any(angles != 0):
         full = full @ tf.rotation_xyz(angles)
     size = np.asarray(size, dtype=np.float64)
-    moved_faces = bool(grow) and bool(faces) and not solid and not wire
     pieces = []
-    for f in (faces if moved_faces else ()):
-        axis, side = raster.FACE_AXIS[f]
-        shift = np.zeros(3)
-        shift[axis] = grow if side else -grow
-        pieces += _box_pieces(lat, full @ tf.translation(shift), size, False, [f], False)
+    if grow and faces and not solid and not wire:
+        drawn = {raster.FACE_AXIS[f] for f in faces}
+        for f in faces:
+            axis, _ = raster.FACE_AXIS[f]
+            lo, hi = np.zeros(3), size.copy()
+            for a in range(3):
+                if a == axis or (a, 0) in drawn:
+                    lo[a] -= grow
+                if a == axis or (a, 1) in drawn:
+                    hi[a] += grow
+            pieces += _box_pieces(lat, full @ tf.translation(lo), hi - lo, False, [f], False)
     if grow:
         full = full @ tf.translation([-grow] * 3)
         size = size + 2.0 * grow
-    if not moved_faces:
+    if not pieces:
         pieces = _box_pieces(lat, full, size, solid, faces, wire)
     verts = tf.apply(full, box_corners(size))
     lin = full[:3, :3]
@@ -207,24 +217,43 @@ def unit_sphere_triangles(n: int = NSIDES) -> np.ndarray:
     return np.array(tris)
 
 
-def draw_ellipsoid(lat: Lattice, m, center, radii, *, solid: bool, shell: bool, frame=None):
-    """An ellipsoid with semi-axes ``radii`` along the axes of ``frame`` (default: x, y, z)."""
+#: How far (in dp) beyond its surface a closed sphere, ellipsoid or cylinder is filled in ``full``
+#: mode. GenCase's records: the 2D CaseBowling ball (drawcylinder r 0.25 m at dp 0.01, GenCase
+#: v5.0.278c: 2061 particles, inertia v11 6.76028 kg m^2) and a RootSPHysicsV2_DB case (cylinders of
+#: r 2 and 1 and a sphere of r 1 at dp 0.1, GenCase4 v4.0.062: 630 fixed, 1760 fluid) are the nodes
+#: within r + t dp for every t in [0.56, 0.61] (within r: 1961, 610 and 1587). ``solid`` mode keeps
+#: the nodes within r (no record tells), ``face`` the inner shell.
+CURVED_FULL_REACH = 0.6
+
+
+def reach_local(m: np.ndarray, reach: float) -> float:
+    """A world distance ``reach`` in the frame of ``m`` (its smallest scale)."""
+    sv = np.linalg.svd(m[:3, :3], compute_uv=False)
+    return reach / max(float(sv.min()), 1e-300)
+
+
+def draw_ellipsoid(lat: Lattice, m, center, radii, *, solid: bool, shell: bool, frame=None,
+                   reach: float = 0.0):
+    """An ellipsoid with semi-axes ``radii`` along the axes of ``frame`` (default: x, y, z); its
+    volume drawn ``reach`` (world units) beyond its surface (``full`` mode, see CURVED_FULL_REACH)."""
     center = np.asarray(center, dtype=np.float64)
     radii = np.asarray(radii, dtype=np.float64)
-    full = m @ tf.translation(center) @ (frame if frame is not None else np.eye(4)) \
-        @ tf.scaling(radii)
-    tol = local_tol(full, lat.dp)
+    rot = m @ tf.translation(center) @ (frame if frame is not None else np.eye(4))
+    full = rot @ tf.scaling(radii)
+    drawn = rot @ tf.scaling(radii + reach_local(rot, reach)) if reach else full
+    tol = local_tol(drawn, lat.dp)
 
     def cons(qx, qy, qz):
         return [qx * qx + qy * qy + qz * qz <= (1.0 + tol) ** 2]
-    pieces = raster.analytic_pieces(lat, full, -np.ones(3), np.ones(3), cons, solid=solid,
+    pieces = raster.analytic_pieces(lat, drawn, -np.ones(3), np.ones(3), cons, solid=solid,
                                     shell_faces=(0,) if shell else ())
     tris = tf.apply(full, unit_sphere_triangles())
     return pieces, full, tris
 
 
-def draw_sphere(lat, m, center, radius, *, solid, shell):
-    pieces, full, tris = draw_ellipsoid(lat, m, center, [radius] * 3, solid=solid, shell=shell)
+def draw_sphere(lat, m, center, radius, *, solid, shell, reach: float = 0.0):
+    pieces, full, tris = draw_ellipsoid(lat, m, center, [radius] * 3, solid=solid, shell=shell,
+                                        reach=reach)
     s = tf.uniform_scale(m)
     params = {"center": tf.apply(m, center).tolist(),
               "radius": float(radius * s) if s is not None else None,
@@ -232,9 +261,9 @@ def draw_sphere(lat, m, center, radius, *, solid, shell):
     return pieces, params, tris
 
 
-def draw_ellipsoid_axes(lat, m, center, radii, *, solid, shell, frame=None):
+def draw_ellipsoid_axes(lat, m, center, radii, *, solid, shell, frame=None, reach: float = 0.0):
     pieces, full, tris = draw_ellipsoid(lat, m, center, radii, solid=solid, shell=shell,
-                                        frame=frame)
+                                        frame=frame, reach=reach)
     lin = full[:3, :3]
     world_radii = np.linalg.norm(lin, axis=0)  # full = m @ T @ frame @ diag(radii)
     params = {"center": tf.apply(m, center).tolist(), "radii": world_radii.tolist(),
@@ -266,24 +295,27 @@ def foci_ellipsoid(f1, f2, radius):
 
 
 # ---------------------------------------------------------------- cylinder
-def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, mask=frozenset()):
+def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, mask=frozenset(),
+                  reach: float = 0.0):
     """Cylinder of axis p1->p2. Faces (numbers listed in mask are hidden): 1 = cover at p1,
-    2 = cover at p2, 3 = side (tube). ``shell`` draws the inner shell of the faces not hidden."""
+    2 = cover at p2, 3 = side (tube). ``shell`` draws the inner shell of the faces not hidden;
+    the volume is drawn ``reach`` (world units) beyond the tube and the covers (``full`` mode,
+    see CURVED_FULL_REACH)."""
     p1, p2 = np.asarray(p1, dtype=np.float64), np.asarray(p2, dtype=np.float64)
     L = float(np.linalg.norm(p2 - p1))
     if not L > 0:
         raise ValueError("the two points of the cylinder axis coincide")
     local = tf.translation(p1) @ frame_x_to((p2 - p1) / L)  # local x in [0, L] along the axis
     full = m @ local
-    tol = local_tol(full, lat.dp)
+    tol = local_tol(full, lat.dp) + (reach_local(full, reach) if reach else 0.0)
 
     def cons(qx, qy, qz):
         return [qx >= -tol, qx <= L + tol, qy * qy + qz * qz <= (radius + tol) ** 2]
     drawn = drawn_faces(mask, 3)
     shell_faces = tuple(i for i in range(3) if drawn[i]) if shell else ()
-    pieces = raster.analytic_pieces(lat, full, np.array([0.0, -radius, -radius]),
-                                    np.array([L, radius, radius]), cons, solid=solid,
-                                    shell_faces=shell_faces)
+    pieces = raster.analytic_pieces(lat, full, np.array([-tol, -radius - tol, -radius - tol]),
+                                    np.array([L + tol, radius + tol, radius + tol]), cons,
+                                    solid=solid, shell_faces=shell_faces)
     ang = np.linspace(0, 2 * math.pi, NSIDES + 1)
     ring = np.stack([np.zeros_like(ang), radius * np.cos(ang), radius * np.sin(ang)], axis=1)
     tris = []
