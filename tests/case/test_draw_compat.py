@@ -44,14 +44,16 @@ FLUME_KW = dict(pmin=(-6, 0, -1), pmax=(12, 0, 8))
 def test_prism_mask_lists_hidden_faces(tmp_path, mode):
     d = draw(tmp_path, FLUME.format(mode=mode, mask="1|2|3|6"), **FLUME_KW)
     bound = nodes(d, fluid=False)
-    # bottom z=0 from x=-5 to 4 and the slope z = x - 4 up to (10, 6): nothing else
-    assert bound == {(x, 0, 0) for x in range(-5, 5)} | {(x, 0, x - 4) for x in range(5, 11)}
-    assert not any(z == 6 and x < 10 for x, _, z in bound)          # no lid (face 6)
+    # bottom z=0 from x=-5 to 4 and the slope z = x - 4 up to (10, 6), in 2D as thick as a
+    # 4-connected line (its staircase nodes z = x - 3): nothing else
+    assert bound == ({(x, 0, 0) for x in range(-5, 5)} | {(x, 0, x - 4) for x in range(5, 11)}
+                     | {(x, 0, x - 3) for x in range(4, 10)})
+    assert not any(z == 6 and x < 9 for x, _, z in bound)           # no lid (face 6)
     assert not any(x == -5 and z > 0 for x, _, z in bound)          # no end wall (face 3)
     # the fluid fills the flume above the bottom, left of the slope, up to the fillbox top, the
     # nodes at least dp/2 inside the fill box (x=-2 and z=4 lie on its faces; GenCase fills the nodes at least dp/2 inside a <fillbox> (see test_draw_gencase_counts.py))
-    assert nodes(d, fluid=True) == {(x, 0, z) for z in range(1, 4) for x in range(-1, z + 4)}
-    assert d.count_fluid == 21
+    assert nodes(d, fluid=True) == {(x, 0, z) for z in range(1, 4) for x in range(-1, z + 3)}
+    assert d.count_fluid == 18
     assert d.primitives[0]["params"]["mask"] == [1, 2, 3, 6] and not d.primitives[0]["solid"]
 
 
@@ -59,7 +61,7 @@ def test_prism_mask_is_not_a_bit_set(tmp_path):
     # as bits, 1|2|3|6 = 7 would hide the first three faces (1, 2, 3) and draw the lid
     d = draw(tmp_path, FLUME.format(mode="full", mask="1|2|3"), **FLUME_KW)
     bound = nodes(d, fluid=False)
-    assert (0, 0, 6) in bound and (-5, 0, 3) not in bound and d.count_fluid == 21
+    assert (0, 0, 6) in bound and (-5, 0, 3) not in bound and d.count_fluid == 18
     d = draw(tmp_path, FLUME.format(mode="full", mask="1|2|6"), **FLUME_KW)
     assert (0, 0, 6) not in nodes(d, fluid=False) and (-5, 0, 3) in nodes(d, fluid=False)
     d = draw(tmp_path, FLUME.format(mode="full", mask="0"), **FLUME_KW)

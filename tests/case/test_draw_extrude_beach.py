@@ -73,13 +73,15 @@ def test_extrude_layers_move_along_the_face_normal(tmp_path):
 
 
 def test_extrude_2d_wedge_counts(tmp_path):
-    # CaseStillWedge's profile on a dp = 1 lattice: walls, floor and a 45-degree wedge
+    # CaseStillWedge's profile on a dp = 1 lattice: walls, floor and a 45-degree wedge, its
+    # slopes as thick as 4-connected lines in 2D (the staircase nodes above them)
     pts = [(0, 0, 3), (0, 0, 0), (4, 0, 0), (6, 0, 2), (8, 0, 0), (10, 0, 0), (10, 0, 3)]
     d = draw(tmp_path, extrude(pts, vec=(0, 1, 0)), **KW2)
     want = ({(0, 0, z) for z in range(4)} | {(x, 0, 0) for x in range(5)}
             | {(5, 0, 1), (6, 0, 2), (7, 0, 1), (8, 0, 0), (9, 0, 0)}
+            | {(4, 0, 1), (5, 0, 2), (7, 0, 2), (8, 0, 1)}
             | {(10, 0, z) for z in range(4)})
-    assert d.is2d and nodes(d) == want and len(d.pos) == 17
+    assert d.is2d and nodes(d) == want and len(d.pos) == 21
 
 
 def test_extrude_2d_tank_layers_and_fluid_inside(tmp_path):
@@ -155,8 +157,9 @@ def test_beach_sides_numbered_like_a_prism(tmp_path):
     d = draw(tmp_path, beach(RECT, mask="1|2|5"), **KW2)
     assert nodes(d) == grid(range(0, 5), [0], range(0, 4)) - grid(range(1, 4), [0], range(1, 4))
     ramp = draw(tmp_path, beach([(0, 4), (4, 0), (10, 0)], mask="1|2|5", y=2), **KW2)
-    assert nodes(ramp) == {(x, 0, 4 - x) for x in range(5)} | {(x, 0, 0) for x in range(4, 11)}
-    assert len(ramp.pos) == 11
+    assert nodes(ramp) == ({(x, 0, 4 - x) for x in range(5)} | {(x, 0, 0) for x in range(4, 11)}
+                           | {(x, 0, 5 - x) for x in range(1, 5)})        # the 4-connected staircase
+    assert len(ramp.pos) == 15
 
 
 def test_beach_y_of_points_and_moves(tmp_path):

@@ -53,7 +53,7 @@ def _near_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz, nxv, nyv, nzv
 
 
 @njit(cache=True)
-def raster_triangles(tri, lo, out, wlo, whi, dmax):
+def raster_triangles(tri, lo, out, wlo, whi, dmax, l1band=False):
     """Mark the nodes near triangles (T,3,3).
 
     A node is marked when its signed distance ``w`` to the triangle's plane is
@@ -65,7 +65,6 @@ def raster_triangles(tri, lo, out, wlo, whi, dmax):
     solves the band for the third.
     """
     shape = out.shape
-    h = dmax + max(-wlo, whi)  # a marked node is within this distance of the triangle
     p = np.empty(3)
     for t in range(tri.shape[0]):
         ax, ay, az = tri[t, 0, 0], tri[t, 0, 1], tri[t, 0, 2]
@@ -78,6 +77,10 @@ def raster_triangles(tri, lo, out, wlo, whi, dmax):
         if not nn > 1e-12:
             continue
         n /= nn
+        # l1band: the band's half-widths times |n|_1 (a 4/6-connected digital plane)
+        sc = abs(n[0]) + abs(n[1]) + abs(n[2]) if l1band else 1.0
+        wl, wh = wlo * sc, whi * sc
+        h = dmax + max(-wl, wh)  # a marked node is within this distance of the triangle
         d00 = e1x * e1x + e1y * e1y + e1z * e1z
         d01 = e1x * e2x + e1y * e2y + e1z * e2z
         d11 = e2x * e2x + e2y * e2y + e2z * e2z
@@ -108,8 +111,8 @@ def raster_triangles(tri, lo, out, wlo, whi, dmax):
                 p[b_] = float(j + lo[b_])
                 # w = s + n_c * (p_c - A_c) in (wlo, whi]
                 s = (p[a_] - A[a_]) * n[a_] + (p[b_] - A[b_]) * n[b_]
-                t0 = A[c] + (wlo - s) / n[c]
-                t1 = A[c] + (whi - s) / n[c]
+                t0 = A[c] + (wl - s) / n[c]
+                t1 = A[c] + (wh - s) / n[c]
                 if t0 > t1:
                     t0, t1 = t1, t0
                 k0 = max(int(np.floor(t0)) - lo[c], r0[c])
@@ -118,7 +121,7 @@ def raster_triangles(tri, lo, out, wlo, whi, dmax):
                     p[c] = float(k + lo[c])
                     if _near_triangle(p[0], p[1], p[2], ax, ay, az, bx, by, bz, cx, cy, cz,
                                       n[0], n[1], n[2], e1x, e1y, e1z, e2x, e2y, e2z,
-                                      d00, d01, d11, den, wlo, whi, dmax):
+                                      d00, d01, d11, den, wl, wh, dmax):
                         # (i, j, k) run along axes (c+1, c+2, c)
                         if c == 0:
                             out[k, i, j] = True

@@ -78,15 +78,18 @@ def aligned_box_pieces(lat: Lattice, wmin, wmax, solid: bool, faces, wire: bool)
         lo = [round_idx(v) for v in a]
         hi = [round_idx(v) for v in b]
         pieces.append(box_piece(lat, lo, hi))
-    # faces span the nearest nodes of the box's extent, a half-way tie taken inwards (GenCase
-    # v5.4, yupengxiang/DualSPHysics F1_DUAL_FINITE_CENTER: walls ending at z = 1.0, half-way
-    # between two nodes, stop at the node below)
+    # faces span the nearest nodes of the box's extent (halves rounded up), up to the layer of a
+    # drawn neighbouring face; towards an open side a half-way tie is taken inwards (GenCase v5.4,
+    # yupengxiang/DualSPHysics F1_DUAL_FINITE_CENTER: the walls of an open tank ending at z = 1.0,
+    # half-way between two nodes, stop at the node below)
     ext_lo = [round_idx(v) for v in a]
-    ext_hi = [ceil_idx(v - 0.5) for v in b]
+    ext_hi = [round_idx(v) for v in b]
+    drawn = {FACE_AXIS[f] for f in faces}
+    open_hi = [ext_hi[i] if (i, 1) in drawn else ceil_idx(b[i] - 0.5) for i in range(3)]
     for face in faces:
         axis, side = FACE_AXIS[face]
         layer = round_idx(b[axis] if side else a[axis])
-        lo, hi = list(ext_lo), list(ext_hi)
+        lo, hi = list(ext_lo), list(open_hi)
         lo[axis] = hi[axis] = layer
         pieces.append(box_piece(lat, lo, hi))
     if wire:
@@ -122,7 +125,14 @@ def triangle_pieces(lat: Lattice, tris, surface: bool = True, solid: bool = Fals
     # a node of the band lies up to SURFACE_HALF from the plane and EDGE_REACH beyond an edge:
     # on a face oblique to the lattice that is up to ~0.71 beyond the triangle's box along an
     # axis (a pad of 0.5 dropped 27 of 24,846 band nodes of 200 random triangles)
-    r = world_range(lat, tris, (SURFACE_HALF + EDGE_REACH if surface else 0.5) + EPS)
+    # In 2D the band's half-width is SURFACE_HALF |n|_1 (|nx| + |nz|): an oblique line as thick as
+    # a 4-connected digital line, as GenCase draws 2D cases (CaseBowling's 33.7-degree drawbeach,
+    # GenCase v5.0.278c: 530 wall particles, 430 with the plain band); 3D faces keep the plain
+    # band (GenCase4's RotatedBox, turned 40 degrees: 960 particles, 840 with the plain band, 1168
+    # with the |n|_1 one)
+    l1band = bool(lat.is2d)
+    r = world_range(lat, tris, (SURFACE_HALF * (2 ** 0.5 if l1band else 1.0) + EDGE_REACH
+                                if surface else 0.5) + EPS)
     if r is None:
         return []
     lo, hi = r
@@ -133,7 +143,7 @@ def triangle_pieces(lat: Lattice, tris, surface: bool = True, solid: bool = Fals
         kernels.raster_triangles(itri, lo, out, -2 * EPS, 2 * EPS, 2 * EPS)
     if surface:
         kernels.raster_triangles(itri, lo, out, -SURFACE_HALF + EPS, SURFACE_HALF + EPS,
-                                 EDGE_REACH + EPS)
+                                 EDGE_REACH + EPS, l1band)
     return [Piece("mask", lo, mask=out)]
 
 
