@@ -277,7 +277,8 @@ def coerce(key: str, value):
 def closest_key(key: str) -> str | None:
     """The known key most like ``key`` (for 'did you mean' hints)."""
     import difflib
-    match = difflib.get_close_matches(key, PARAMETERS.keys(), n=1, cutoff=0.6)
+    # 0.75: typos (VerletStep, Shiftcoef) hint; unrelated keys (PeriodicDomain, ShepardSteps) do not
+    match = difflib.get_close_matches(key, PARAMETERS.keys(), n=1, cutoff=0.75)
     if match:
         return match[0]
     lower = {k.lower(): k for k in PARAMETERS}

@@ -919,8 +919,10 @@ def read_parameters(reader, execution):
             if const:
                 raise reader.error(p, const)
             hint = closest_key(key)
-            raise reader.error(p, f"unknown parameter key '{key}'",
-                               f"'{hint}'" if hint else "a DualSPHysics parameter key (the list: sphdvi/case/parameters.py)")
+            raise reader.error(p, f"unknown parameter key '{key}' (DualSPHysics skips a key it does not know; "
+                                  "sphdvi stops, so that a misspelt key is not lost)",
+                               f"'{hint}'" if hint else "a DualSPHysics parameter key (the list: sphdvi/case/parameters.py), "
+                               f"or key=\"#{key}\" to keep it as a remark")
         if key in set_keys:
             reader.warn(p, f"parameter '{key}' given twice; the last value is used")
         raw = reader.raw(p, "value")

@@ -94,7 +94,10 @@ def test_parameters_defaults_and_values(tmp_path):
 
 
 @pytest.mark.parametrize("param, fragment", [
-    ('<parameter key="Visc" value="0.1"/>', "unknown parameter key 'Visc'; expected 'Visco'"),
+    ('<parameter key="Visc" value="0.1"/>', "unknown parameter key 'Visc' (DualSPHysics skips a key it does not "
+                                            "know; sphdvi stops, so that a misspelt key is not lost); expected 'Visco'"),
+    # an unrelated key gets no 'did you mean' (PeriodicDomain was said to be 'ZPeriodicIncY'), but the remark form
+    ('<parameter key="PeriodicDomain" value="1"/>', "or key=\"#PeriodicDomain\" to keep it as a remark"),
     ('<parameter key="Kernel" value="5"/>', "Kernel: 5 is not one of 1, 2"),
     ('<parameter key="StepAlgorithm" value="1.5"/>', "is not an integer"),
     ('<parameter key="TimeMax" value="abc"/>', "is not a number"),
