@@ -181,6 +181,11 @@ def test_the_run_lock_is_reentrant_and_a_stale_lock_file_blocks_nothing(tmp_path
     assert not out.exists()                       # made for the lock, left empty: removed
 
 
+def _default_hup_and_int():
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_interrupted_commands_exit_1_with_a_message(tmp_path):
     """SIGINT, SIGTERM and SIGHUP end gencase, measure and export (report_errors) with exit 1 and
     'interrupted by SIG...', as an interrupted run (README: 1 runtime failure or interruption); gencase
@@ -196,10 +201,12 @@ def test_interrupted_commands_exit_1_with_a_message(tmp_path):
         slow()
     """)
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-        # the child starts with SIGHUP at its default, whatever this process inherited (under nohup
-        # SIGHUP is ignored, and report_errors rightly leaves an ignored SIGHUP ignored)
+        # the child starts with SIGHUP and SIGINT at their defaults, whatever this process inherited
+        # (under nohup SIGHUP is ignored, and report_errors rightly leaves an ignored SIGHUP ignored;
+        # a background job of a shell without job control starts with SIGINT ignored, and Python then
+        # installs no KeyboardInterrupt handler: the suite run that way timed out here)
         proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                text=True, preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_DFL))
+                                text=True, preexec_fn=_default_hup_and_int)
         assert proc.stdout.readline().strip() == "ready"
         proc.send_signal(sig)
         _, err = proc.communicate(timeout=30)
