@@ -77,8 +77,10 @@ def raster_triangles(tri, lo, out, wlo, whi, dmax, l1band=False):
         if not nn > 1e-12:
             continue
         n /= nn
-        # l1band: the band's half-widths times |n|_1 (a 4/6-connected digital plane)
-        sc = abs(n[0]) + abs(n[1]) + abs(n[2]) if l1band else 1.0
+        # l1band (2D cases): the band's half-widths times |nx| + |nz|, the plane's cut with the
+        # y = const lattice as thick as a 4-connected digital line (y does not count); |ny| where
+        # larger (a face lying in, or nearly in, the case's plane keeps a band about it)
+        sc = max(abs(n[0]) + abs(n[2]), abs(n[1])) if l1band else 1.0
         wl, wh = wlo * sc, whi * sc
         h = dmax + max(-wl, wh)  # a marked node is within this distance of the triangle
         d00 = e1x * e1x + e1y * e1y + e1z * e1z

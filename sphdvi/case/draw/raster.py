@@ -125,7 +125,7 @@ def triangle_pieces(lat: Lattice, tris, surface: bool = True, solid: bool = Fals
     # a node of the band lies up to SURFACE_HALF from the plane and EDGE_REACH beyond an edge:
     # on a face oblique to the lattice that is up to ~0.71 beyond the triangle's box along an
     # axis (a pad of 0.5 dropped 27 of 24,846 band nodes of 200 random triangles)
-    # In 2D the band's half-width is SURFACE_HALF |n|_1 (|nx| + |nz|): an oblique line as thick as
+    # In 2D the band's half-width is SURFACE_HALF (|nx| + |nz|) (at most sqrt 2): an oblique line as thick as
     # a 4-connected digital line, as GenCase draws 2D cases (CaseBowling's 33.7-degree drawbeach,
     # GenCase v5.0.278c: 530 wall particles, 430 with the plain band); 3D faces keep the plain
     # band (GenCase4's RotatedBox, turned 40 degrees: 960 particles, 840 with the plain band, 1168

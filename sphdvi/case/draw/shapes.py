@@ -91,8 +91,13 @@ def face_edges(faces):
 
 def local_tol(m: np.ndarray, dp: float) -> float:
     """EPS lattice units expressed in the shape's own frame."""
+    return reach_local(m, EPS * dp)
+
+
+def reach_local(m: np.ndarray, reach: float) -> float:
+    """A world distance ``reach`` in the frame of ``m`` (its smallest scale)."""
     sv = np.linalg.svd(m[:3, :3], compute_uv=False)
-    return EPS * dp / max(float(sv.min()), 1e-300)
+    return reach / max(float(sv.min()), 1e-300)
 
 
 def drawn_faces(hidden, count: int) -> list[bool]:
@@ -168,7 +173,8 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
         full = full @ tf.rotation_xyz(angles)
     size = np.asarray(size, dtype=np.float64)
     pieces = []
-    if grow and faces and not solid and not wire:
+    moved_faces = bool(grow) and bool(faces) and not solid and not wire
+    if moved_faces:
         drawn = {raster.FACE_AXIS[f] for f in faces}
         for f in faces:
             axis, _ = raster.FACE_AXIS[f]
@@ -182,7 +188,7 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
     if grow:
         full = full @ tf.translation([-grow] * 3)
         size = size + 2.0 * grow
-    if not pieces:
+    if not moved_faces:
         pieces = _box_pieces(lat, full, size, solid, faces, wire)
     verts = tf.apply(full, box_corners(size))
     lin = full[:3, :3]
@@ -224,12 +230,6 @@ def unit_sphere_triangles(n: int = NSIDES) -> np.ndarray:
 #: within r + t dp for every t in [0.56, 0.61] (within r: 1961, 610 and 1587). ``solid`` mode keeps
 #: the nodes within r (no record tells), ``face`` the inner shell.
 CURVED_FULL_REACH = 0.6
-
-
-def reach_local(m: np.ndarray, reach: float) -> float:
-    """A world distance ``reach`` in the frame of ``m`` (its smallest scale)."""
-    sv = np.linalg.svd(m[:3, :3], compute_uv=False)
-    return reach / max(float(sv.min()), 1e-300)
 
 
 def draw_ellipsoid(lat: Lattice, m, center, radii, *, solid: bool, shell: bool, frame=None,
