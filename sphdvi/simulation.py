@@ -934,12 +934,14 @@ class SPHRun:
                 normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
                                             Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
             normals0 = self._mdbc_only_on(normals0, p, fluidcount, str(params.get("MdbcMkbound") or "").strip())
-            from .case.normals import layers_needed, mdbc_floating_mask, thin_wall_mkbounds
+            from .case.normals import inward_normal_mkbounds, layers_needed, mdbc_floating_mask, thin_wall_mkbounds
             from .coupling import body_labels
             labels = body_labels(p["mk"], fluidcount)
-            _warn_thin_mdbc_walls(thin_wall_mkbounds(p["pos"], normals0, p["type"], labels, float(c["dp"]),
-                                                     float(c["h"])), layers_needed(float(c["h"]), float(c["dp"])),
-                                  float(c["h"]) / float(c["dp"]))
+            inward = inward_normal_mkbounds(p["pos"], normals0, p["type"], labels, float(c["dp"]), float(c["h"]))
+            _warn_inward_mdbc_normals(inward, float(c["dp"]))
+            thin = thin_wall_mkbounds(p["pos"], normals0, p["type"], labels, float(c["dp"]), float(c["h"]))
+            _warn_thin_mdbc_walls({mk: v for mk, v in thin.items() if mk not in inward},
+                                  layers_needed(float(c["h"]), float(c["dp"])), float(c["h"]) / float(c["dp"]))
             state.mass[mdbc_floating_mask(p["type"], labels, params, normals0)] = float(c["massbound"])
             _warn_undamped_mdbc(params, p, normals0, c)
         # the solids that move boundary particles, and the damping zones: each only when
@@ -1345,6 +1347,18 @@ def _check_boundary_in_domain(p: dict, domain, fluidcount: int) -> None:
                      f"{', '.join(groups)} (first: particle {int(p['idp'][i])} at {_fmt(p['pos'][i])}); "
                      "DualSPHysics excludes them at its first cell division and stops (AbortBoundOut: \"Fixed, "
                      "moving or floating particles were excluded\"): enlarge <simulationdomain> to hold the walls")
+
+
+def _warn_inward_mdbc_normals(inward: dict, dp: float) -> None:
+    """Ghost nodes inside their own wall (:func:`~sphdvi.case.normals.ghosts_in_own_wall`): the
+    surface the normals are computed from lies behind the wall's face layer."""
+    for mk, count in sorted(inward.items()):
+        warnings.warn(f"mDBC on mkbound {mk}: {count} of its particles have their ghost node (r + 2N, where mDBC "
+                      "samples the fluid) on a particle of their own wall: the surface their normals are computed "
+                      f"from lies behind the wall's face layer, not dp/2 = {0.5 * dp:g} m in front of it, and the "
+                      "face layer's normals point back into the wall. Put the surface (the <norgeometry> shapes, "
+                      "a <norplane> point) dp/2 in front of the face layer; a shape's face half-way between two "
+                      "nodes draws its particles on the side the tie rounds to, which may be outside the shape")
 
 
 def _warn_thin_mdbc_walls(thin: dict, need: int, h_dp: float) -> None:

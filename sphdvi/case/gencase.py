@@ -390,10 +390,17 @@ def case_normals(case: Case, particles: dict, consts: Constants, drawing, reader
     pos, ptype = particles["pos"], particles["type"]
     mkbound = np.where(ptype != TYPE_FLUID, particles["label"], -1)
     normals = np.zeros_like(pos)
+    through = []
     empty = apply_normal_ops(
         normals, ops, pos, ptype, mkbound, dp=consts.dp, h=consts.h, is2d=consts.is2d, posy2d=drawing.posy2d,
         geometry=lambda op: geometry_triangles(op, case.name, drawing, reader),
-        computed=functools.cache(lambda: boundary_normals(pos, ptype, consts.dp, consts.is2d)))
+        computed=functools.cache(lambda: boundary_normals(pos, ptype, consts.dp, consts.is2d)), on_surface=through)
+    for op, counts in through:
+        reader.warnings.add(
+            f"the normals geometry passes through {sum(counts.values())} boundary particles (mkbound "
+            + ", ".join(f"{mk}: {n}" for mk, n in sorted(counts.items())) + "): a particle on the surface gets "
+            "no normal, so mDBC leaves it DBC; draw the geometry dp/2 in front of the wall's face layer (the "
+            "particles' surface), as GenCase's examples do", file=reader.file, line=op["line"], element=op["tag"])
     for op in empty:
         reader.warnings.add(f"<{op['tag']}> selects no boundary particle (mkbound '{op['mkbound'] or 'all'}'"
                             f"{' inside its onlypos box' if op.get('onlypos') else ''})",

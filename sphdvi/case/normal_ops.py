@@ -242,14 +242,14 @@ def _nearest_on_segment(p, a, b):
 @njit(cache=True)
 def _nearest_surface(pos, pmk, own, prims, prim_mk, segments, reach):
     """For each particle, the vector to the nearest primitive (triangles, or segments stored
-    as (a, b, b)) within ``reach``; zero where none is. A particle with ``own`` set only sees
-    primitives of its mk ``pmk``."""
+    as (a, b, b)) within ``reach``, zero where none is, and whether one is. A particle with
+    ``own`` set only sees primitives of its mk ``pmk``."""
     n = pos.shape[0]
     out = np.zeros((n, 3))
-    if n == 0:
-        return out
-    best = np.full(n, reach * reach)
     found = np.zeros(n, np.bool_)
+    if n == 0:
+        return out, found
+    best = np.full(n, reach * reach)
     lo = np.empty(3)
     hi = np.empty(3)
     for k in range(3):
@@ -293,7 +293,7 @@ def _nearest_surface(pos, pmk, own, prims, prim_mk, segments, reach):
                             best[i] = d2
                             found[i] = True
                             out[i] = d
-    return out
+    return out, found
 
 
 @njit(cache=True)
@@ -364,12 +364,18 @@ def plane_cuts(tris: np.ndarray, y0: float, tol: float) -> tuple[np.ndarray, np.
     return _plane_cuts(np.ascontiguousarray(tris, dtype=np.float64), float(y0), float(tol))
 
 
-def apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, triangles, tri_mk) -> None:
+# a normal shorter than this many h is a particle on the surface (rounding noise of a zero vector)
+ON_SURFACE_H = 1e-9
+
+
+def apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, triangles, tri_mk) -> dict:
     """N to the nearest point of the triangle surface within ``distanceh`` h. Where the
     surface carries the mk it was drawn with (sphdvi's and GenCase's shape files), a
     particle whose mkbound drew part of it sees that part only; the others see all of it.
     ``maxsizeh`` (GenCase's maximum normal size, in h; 0: none) leaves a particle whose normal
-    would be longer without one."""
+    would be longer without one.  A particle on the surface (closer than ON_SURFACE_H h) has
+    no normal either: its direction is undefined (noise of order 1e-16 m otherwise gave it a
+    ghost node on itself).  Returns mkbound -> how many selected particles lie on the surface."""
     reach = op["distanceh"] * h
     if op.get("maxsizeh", 0.0) > 0:
         reach = min(reach, op["maxsizeh"] * h)
@@ -385,18 +391,25 @@ def apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, triangles, t
     r = np.ascontiguousarray(pos[sel], dtype=np.float64)
     pmk = np.ascontiguousarray(mkbound[sel], dtype=np.int64)
     own = np.isin(pmk, prim_mk[prim_mk >= 0]) if tri_mk is not None else np.zeros(len(r), bool)
-    vec = _nearest_surface(r, pmk, own, np.ascontiguousarray(prims), np.ascontiguousarray(prim_mk),
-                           bool(is2d), float(reach)) if len(prims) else np.zeros_like(r)
-    _write(normals, sel, np.any(vec != 0.0, axis=1), vec, True)
+    if not len(prims):
+        _write(normals, sel, np.zeros(len(r), bool), r, True)
+        return {}
+    vec, found = _nearest_surface(r, pmk, own, np.ascontiguousarray(prims), np.ascontiguousarray(prim_mk),
+                                  bool(is2d), float(reach))
+    off = np.linalg.norm(vec, axis=1) > ON_SURFACE_H * h
+    _write(normals, sel, off, vec, True)
+    mks, counts = np.unique(pmk[found & ~off], return_counts=True)
+    return {int(m): int(c) for m, c in zip(mks, counts)}
 
 
 def apply_normal_ops(normals: np.ndarray, ops: list, pos: np.ndarray, ptype: np.ndarray,
                      mkbound: np.ndarray, *, dp: float, h: float, is2d: bool, posy2d: float = 0.0,
-                     geometry=None, computed=None) -> list:
+                     geometry=None, computed=None, on_surface: list | None = None) -> list:
     """Apply ``ops`` (dicts of :mod:`sphdvi.case.normals_xml`) in order to ``normals`` (N, 3),
     in place. ``geometry(op)`` gives a geometry op's (triangles, their mk or None);
     ``computed()`` the normals derived from the particles (for ``parts``). Returns the ops
-    that selected no particle."""
+    that selected no particle; appends to ``on_surface`` (op, {mkbound: count}) for each
+    geometry op whose surface passes through particles (:func:`apply_geometry`)."""
     pos = np.asarray(pos, dtype=np.float64)
     empty = []
     for op in ops:
@@ -418,7 +431,9 @@ def apply_normal_ops(normals: np.ndarray, ops: list, pos: np.ndarray, ptype: np.
             _write(normals, sel, np.linalg.norm(vec, axis=1) <= _reach(op["maxdisth"], h), vec, True)
         elif kind == "geometry":
             tris, tri_mk = geometry(op)
-            apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, tris, tri_mk)
+            through = apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, tris, tri_mk)
+            if through and on_surface is not None:
+                on_surface.append((op, through))
         else:
             raise ValueError(f"unknown normals operation {kind!r}")
         if is2d:

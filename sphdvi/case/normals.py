@@ -541,8 +541,10 @@ def thin_wall_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, 
     wall = (np.asarray(ptype) <= 1) & (length > 0)
     if need < 2 or not wall.any():
         return {}
-    # face particles with an axis-aligned normal (an edge or a corner is counted by its faces)
-    face = np.flatnonzero(wall & (np.abs(length - 0.5 * dp) < 0.1 * dp))
+    # face particles with an axis-aligned normal (an edge or a corner is counted by its faces);
+    # one whose ghost node lies in its own wall is not a face (:func:`ghosts_in_own_wall`)
+    face = np.flatnonzero(wall & (np.abs(length - 0.5 * dp) < 0.1 * dp)
+                          & ~ghosts_in_own_wall(pos, normals, ptype, mkbound, dp, h))
     u = normals[face] / length[face, None]
     axis = np.argmax(np.abs(u), axis=1)
     along = np.abs(np.abs(u[np.arange(face.size), axis]) - 1.0) <= 1e-6
@@ -572,6 +574,52 @@ def thin_wall_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, 
         sel = thin & (mkbound[face] == mk)
         out[int(mk)] = (int(layers[sel].min()), int(sel.sum()))
     return out
+
+
+def ghosts_in_own_wall(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray,
+                       dp: float, h: float) -> np.ndarray:
+    """The boundary particles whose ghost node r + 2N, where mDBC extrapolates the fluid's
+    density and velocity (English et al. 2022), falls on a lattice node that a particle of the
+    same mkbound holds.  Such normals come from a surface drawn behind the wall's face layer,
+    not dp/2 in front of it (a solid box whose faces fall half-way between nodes, given as its
+    own normals geometry; a tank's geometry on its first layer with pointref at dp/2; a
+    <norplane> point behind the first layer): the layer in front of the surface gets normals
+    dp/2 long pointing back into the wall, and the layer behind it ghost nodes on that layer.  Only normals shorter than
+    the kernel's reach 2h are tested (a particle deeper in the wall samples no fluid, whatever
+    its normal), and only on the lattice (a ghost farther than dp/4 from a node along an axis
+    is not)."""
+    ptype = np.asarray(ptype)
+    length = np.linalg.norm(normals, axis=1)
+    bound = ptype != 3
+    out = np.zeros(len(pos), bool)
+    tested = np.flatnonzero(bound & (length > 0) & (length < 2.0 * h))
+    if not tested.size:
+        return out
+    origin = pos[bound].min(axis=0)
+    rel = (pos[tested] + 2.0 * normals[tested] - origin) / dp
+    ghost = np.rint(rel).astype(np.int64)
+    near = np.all(np.abs(rel - ghost) < 0.25, axis=1)
+    cells = np.rint((pos[bound] - origin) / dp).astype(np.int64)
+    lo = np.minimum(cells.min(axis=0), ghost.min(axis=0))
+    span = np.maximum(cells.max(axis=0), ghost.max(axis=0)) - lo + 1
+    mks, mk_of = np.unique(np.asarray(mkbound)[bound], return_inverse=True)
+    index = {int(m): i for i, m in enumerate(mks)}
+
+    def code(k, m):
+        return (((k[:, 2] - lo[2]) * span[1] + (k[:, 1] - lo[1])) * span[0] + (k[:, 0] - lo[0])) * len(mks) + m
+    held = np.unique(code(cells, mk_of))
+    mk_tested = np.array([index[int(m)] for m in np.asarray(mkbound)[tested]], np.int64)
+    out[tested] = near & np.isin(code(ghost, mk_tested), held)
+    return out
+
+
+def inward_normal_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray,
+                           dp: float, h: float) -> dict:
+    """mkbound -> how many of its particles have their ghost node in their own wall
+    (:func:`ghosts_in_own_wall`)."""
+    inward = ghosts_in_own_wall(pos, normals, ptype, mkbound, dp, h)
+    mks, counts = np.unique(np.asarray(mkbound)[inward], return_counts=True)
+    return {int(m): int(n) for m, n in zip(mks, counts)}
 
 
 def mdbc_floating_mask(ptype: np.ndarray, mkbound: np.ndarray, params: dict,

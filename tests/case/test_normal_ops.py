@@ -271,3 +271,33 @@ def test_geometry_normals_maxsizeh_limits_their_length():
     assert np.any(length > 1.6 * DP)
     keep = length <= 1.6 * DP
     assert np.array_equal(cut[keep], full[keep]) and np.all(cut[~keep] == 0)
+
+
+def test_geometry_through_the_particles_gives_them_no_normal():
+    """A normals geometry drawn through the face layer (DesignSPHysics's mdbc_dist_vdp 0, a
+    solid box as its own geometry) leaves each particle on it without a normal, whose direction
+    is undefined, though rounding makes its vector 6e-17 m rather than 0 (arange's 0.30000000000000004
+    against the surface's 0.3 here): a normal that short gave mDBC a ghost node on the particle itself.
+    The particles on the surface are counted by mkbound, and the layer behind keeps N = dp
+    towards the surface."""
+    xs = np.arange(-DP, 0.4 + 1.5 * DP, DP)
+    ys = np.arange(-DP, 0.3 + 1.5 * DP, DP)
+    zs = np.arange(-DP, 0.2 + DP / 2, DP)
+    g = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
+    wall = (g[:, 0] < DP / 2) | (g[:, 0] > 0.4 - DP / 2) | (g[:, 1] < DP / 2) | (g[:, 1] > 0.3 - DP / 2) \
+        | (g[:, 2] < DP / 2)
+    pos = g[wall]
+    ptype = np.zeros(len(pos), int)
+    mk = np.where(pos[:, 2] < DP / 2, 3, 0)          # the floor mkbound 3, the walls 0
+    tris = box_triangles(np.zeros(3), np.array([0.4, 0.3, 0.5]), skip=("z1",))
+    inner = np.all((pos > -DP / 2) & (pos < np.array([0.4, 0.3, 0.5]) + DP / 2), axis=1)     # the face layer
+    assert ys[7] != 0.3 and ys[7] == pytest.approx(0.3, abs=1e-15)
+    normals, through = np.zeros_like(pos), []
+    apply_normal_ops(normals, [op("geometry", file="hdp", distanceh=1.5 * DP / H)], pos, ptype, mk, dp=DP, h=H,
+                     is2d=False, geometry=lambda o: (tris, None), on_surface=through)
+    assert np.all(normals[inner] == 0.0)
+    assert len(through) == 1
+    assert through[0][1] == {0: int((inner & (mk == 0)).sum()), 3: int((inner & (mk == 3)).sum())}
+    behind = ~inner & (np.linalg.norm(np.clip(pos, 0, [0.4, 0.3, 0.5]) - pos, axis=1) < 1.01 * DP)
+    assert behind.sum() > 100
+    assert np.allclose(np.linalg.norm(normals[behind], axis=1), DP)

@@ -215,6 +215,47 @@ def test_thin_walls_are_found_in_3d(layers, thin):
     assert layers_needed(h, dp) == 3 and layers_needed(dp * np.sqrt(2), dp) == 2      # 3D and 2D, coefh 1
 
 
+def _tank_3d(dp, layers):
+    """A 3D tank 10 dp wide with walls ``layers`` thick and water 4 dp deep, and its mkbounds
+    (0 the walls, none for the water)."""
+    k = np.arange(-(layers - 1), 9 + layers)
+    g = np.stack(np.meshgrid(k, k, np.arange(-(layers - 1), 8), indexing="ij"), axis=-1).reshape(-1, 3)
+    wall = (g[:, 0] <= 0) | (g[:, 0] >= 9) | (g[:, 1] <= 0) | (g[:, 1] >= 9) | (g[:, 2] <= 0)
+    water = ~wall & (g[:, 2] < 5)
+    pos = np.vstack([g[wall], g[water]]) * dp
+    ptype = np.r_[np.zeros(wall.sum(), int), np.full(water.sum(), 3)]
+    return pos, ptype, np.zeros(len(pos), int)
+
+
+def test_normals_into_their_own_wall_are_found_and_not_read_as_a_thin_wall():
+    """Normals from a surface behind the face layer (a solid box whose faces fall half-way
+    between nodes given as its own normals geometry: GenCase's DualSPHysicsGPT Case_Def.xml
+    variant) point back into the wall, dp/2 long, and their ghost nodes r + 2N fall on the next
+    layer: :func:`ghosts_in_own_wall` finds exactly those, and the thin-wall count, which read
+    them as a wall one particle thick (counted along -N it met the water), leaves them out.
+    The normals derived from the particles have none."""
+    from sphdvi.case.normals import ghosts_in_own_wall, inward_normal_mkbounds, thin_wall_mkbounds
+    dp = 0.05
+    h = dp * np.sqrt(3)
+    pos, ptype, mk = _tank_3d(dp, 3)
+    n = boundary_normals(pos, ptype, dp, False)
+    assert not ghosts_in_own_wall(pos, n, ptype, mk, dp, h).any()
+    assert thin_wall_mkbounds(pos, n, ptype, mk, dp, h) == {}
+    length = np.linalg.norm(n, axis=1)
+    face = (ptype == 0) & np.isclose(length, dp / 2) & (np.count_nonzero(np.abs(n) > 1e-12, axis=1) == 1)
+    assert face.sum() == 8 * 8 + 4 * 8 * 7          # the floor and the four walls below the top (z 1 .. 7)
+    bad = n.copy()
+    bad[face] *= -1.0
+    found = ghosts_in_own_wall(pos, bad, ptype, mk, dp, h)
+    assert np.array_equal(found, face)
+    assert inward_normal_mkbounds(pos, bad, ptype, mk, dp, h) == {0: int(face.sum())}
+    assert thin_wall_mkbounds(pos, bad, ptype, mk, dp, h) == {}
+    # another body's ghost nodes may fall on this wall: only a particle's own wall counts
+    other = mk.copy()
+    other[face] = 7
+    assert not ghosts_in_own_wall(pos, bad, ptype, other, dp, h).any()
+
+
 @pytest.mark.parametrize("h_dp, need", [(np.sqrt(2), 2), (np.sqrt(3), 3), (1.2 * np.sqrt(3), 4), (2.0, 3),
                                         (2.0000001, 4), (1.5, 2), (0.5, 1)])
 def test_layers_needed_counts_the_layers_closer_than_2h(h_dp, need):

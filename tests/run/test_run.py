@@ -412,6 +412,43 @@ def normals_geometry(*outlines):
 NORMALS_GEOMETRY = normals_geometry(TANK_OUTLINE, BOX_OUTLINE)
 
 
+@pytest.mark.parametrize("vdp, count", [("-0.5", 60 + 52), ("0", 0)])
+def test_normals_surface_behind_or_through_the_face_layer_is_warned(tmp_path, vdp, count):
+    """The box's normals outline drawn dp/2 inside it (<layers vdp="-0.5">), behind its face
+    layer: the face layer's normals point back into the box and the next ring's ghost nodes
+    fall on it; the run names the mkbound and both rings (60 + 52 particles of the 21 x 11
+    box), and does not take the box for a thin wall. The outline on the face layer itself
+    (vdp 0, DesignSPHysics's mdbc_dist_vdp 0): gencase names the 60 particles it passes
+    through, which get no normal (they keep DBC)."""
+    case = _floating_box_with_normals(
+        tmp_path, '<norgeometry><geometryfile file="[CaseName]_hdp_Actual.vtk"/><distanceh v="2.0"/></norgeometry>')
+    outline = BOX_OUTLINE.replace('<layers vdp="0.5"/>', f'<layers vdp="{vdp}"/>')
+    assert outline != BOX_OUTLINE
+    case.write_text(case.read_text().replace("<mainlist>", normals_geometry(TANK_OUTLINE, outline), 1))
+    out = tmp_path / "out"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = invoke(["run", case, "-o", out, "--tmax", "0.001", "--threads", "1", "-q", "--set", "Boundary=2"])
+    assert r.exit_code == 0, r.output
+    said = [str(w.message) for w in caught]
+    inward = [m for m in said if "ghost node" in m]
+    through = [m for m in r.output.splitlines() if "passes through" in m]     # gencase's, on stderr
+    if count:
+        assert len(inward) == 1 and inward[0].startswith(f"mDBC on mkbound 5: {count} of its particles")
+        assert "dp/2 = 0.005 m in front of it" in inward[0] and not through
+    else:
+        assert not inward and len(through) == 1 and "(mkbound 5: 60)" in through[0]
+        with h5py.File(out / "CaseBoxNormals.h5") as f:
+            normals, ptype, pos = f["normals"][...], f["particles/type"][...], f["particles/pos"][...]
+        x, z = pos[:, 0], pos[:, 2]
+        box = ptype == 2
+        face = box & (np.isclose(x, 0.4) | np.isclose(x, 0.6) | np.isclose(z, 0.25) | np.isclose(z, 0.35))
+        assert face.sum() == 60 and np.all(normals[face] == 0.0)
+        ring = box & ~face & (np.isclose(x, 0.41) | np.isclose(x, 0.59) | np.isclose(z, 0.26) | np.isclose(z, 0.34))
+        assert ring.sum() == 52 and np.allclose(np.abs(normals[ring]).max(axis=1), 0.01)
+    assert not any("mkbound 5" in m and "thick" in m for m in said)
+
+
 def test_case_normals_from_geometry_reach_the_run(tmp_path):
     """DualSPHysics's mDBC set-up: the walls and the S12 box drawn dp/2 in front of their particles
     (GeometryForNormals), ``<normals><norgeometry>`` over that shape file. gencase stores the
