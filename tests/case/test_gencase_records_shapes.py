@@ -5,7 +5,9 @@ the part the record speaks of; the numbers are GenCase's.
 * The domain: an axis holds floor((pointmax - pointmin)/dp) nodes, none on pointmax.
 * A closed sphere or cylinder in ``full`` mode fills the nodes within r + 0.6 dp.
 * ``<layers>`` of a box of faces: each face moved along its normal and widened towards its drawn
-  neighbours only; a face's extent ending half-way between two nodes stops at the inner one.
+  neighbours only.
+* A box's corner half-way between two nodes goes to the node its floating-point lattice
+  coordinate (x - origin)/dp rounds to, with no tolerance: GenCase's "ties" fall either way.
 """
 from __future__ import annotations
 
@@ -109,6 +111,48 @@ def test_open_tank_layers(tmp_path):
     assert len(pos) == 361104
     assert np.allclose(pos.min(axis=0), [-0.015, -0.025, -0.025], atol=1e-6)
     assert np.allclose(pos.max(axis=0), [3.255, 1.025, 0.995], atol=1e-6)
+
+
+def test_box_on_half_node_ties_rounds_as_the_floating_point_value(tmp_path):
+    """yupengxiang/DualSPHysics F1_DUAL_FINITE_INIT_DP001_001 (GenCase v5.4, its
+    native_preflight_audit_001 record): the fluid box from (2.105, 0.005, 0.005), every corner
+    half-way between two nodes of the lattice through 0 at dp 0.01 with pointmin -1, starts at
+    (2.11, 0.0, 0.0) and is 112 x 101 x 56 = 633,472 particles; relative to the lattice origin,
+    2.105 is 310.5 and 0.005 is 100.49999999999999 in double precision. Cut to a 0.2 m cube at
+    the same corner (its far corner, as the record's, 1e-6 m past a tie): 21^3 from (2.11, 0, 0). sphdvi took every tie upwards (20 x 20 x 20
+    from (2.11, 0.01, 0.01)); the whole case is now GenCase's 997,590 particles."""
+    text = case('<definition dp="0.01"><pointref x="0" y="0" z="0"/><pointmin x="-1" y="-1" z="-1"/>'
+                '<pointmax x="3.3" y="1.1" z="1.1"/></definition>',
+                '<setdrawmode mode="full"/><setmkfluid mk="0"/><drawbox><boxfill>solid</boxfill>'
+                '<point x="2.105" y="0.005" z="0.005"/><size x="0.200001" y="0.190001" z="0.190001"/></drawbox>')
+    r = build_case(write_case(tmp_path, text), None)
+    pos = np.asarray(r.particles["pos"])
+    assert len(pos) == 21 ** 3
+    assert np.allclose(pos.min(axis=0), [2.11, 0.0, 0.0], atol=1e-9)
+    assert np.allclose(pos.max(axis=0), [2.31, 0.2, 0.2], atol=1e-9)
+
+
+def test_layers_on_half_node_ties_keep_every_layer(tmp_path):
+    """yupengxiang/DualSPHysics F2_SLOT_TRANSFER anchor (GenCase v5.4, its preflight-v1 record):
+    a tank 1.8 x 0.6 x 0.9 m from the origin, boxfill bottom|left|right|front|back with
+    <layers vdp="0,1,2">, at dp 0.0075 with pointref dp/2 (DesignSPHysics 0.8's default):
+    every face half-way between two nodes. Each layer lies a whole number of nodes from the
+    first, which makes 245 x 85 x 123 - 239 x 79 x 120 = 295,755 particles. GenCase wrote
+    296,421 (no rule found gives it); moved in world coordinates, the layer dp out from the y = 0
+    face came to 25.499999999999996 lattice units against the face's 26.5 and skipped a node:
+    268,389, a wall with a layer missing."""
+    text = case('<definition dp="0.0074999999999999997"><pointmin x="-0.30" y="-0.20" z="-0.20"/>'
+                '<pointmax x="2.00" y="0.80" z="1.30"/><pointref x="0.0037499999999999999" '
+                'y="0.0037499999999999999" z="0.0037499999999999999"/></definition>',
+                '<setdrawmode mode="full"/><setmkbound mk="0"/><drawbox>'
+                '<boxfill>bottom | left | right | front | back</boxfill><point x="0" y="0" z="0"/>'
+                '<size x="1.8" y="0.59999999999999998" z="0.90000000000000002"/><layers vdp="0,1,2"/></drawbox>')
+    r = build_case(write_case(tmp_path, text), None)
+    pos = np.asarray(r.particles["pos"])
+    assert len(pos) == 245 * 85 * 123 - 239 * 79 * 120 == 295755
+    for axis in range(3):
+        rows = np.unique(np.round(pos[:, axis] / 0.0075 - 0.5).astype(int))
+        assert np.array_equal(rows, np.arange(rows[0], rows[-1] + 1))      # no empty row between layers
 
 
 @pytest.mark.parametrize("maxsizeh, with_normal", [('<maxsizeh value="0.0" />', 5676),

@@ -67,15 +67,15 @@ def test_initial_velocity_in_an_sph_run_flies_ballistic(tmp_path, algo):
     0.5 t exactly, the pitch 3t exactly, z = z0 + 2t − g t²/2 within the first-order offset of
     the body solver's semi-implicit Euler step (g t dt)."""
     text = FLOATING_BOX.replace('<pointmax x="1.1" y="0" z="1" />', '<pointmax x="1.1" y="0" z="2" />')
-    text = text.replace('<point x="0.4" y="-1" z="0.25" /><size x="0.2" y="2" z="0.1" />',
-                        '<point x="0.4" y="-1" z="0.75" /><size x="0.2" y="2" z="0.1" />')
+    text = text.replace('<point x="0.4" y="-1" z="0.2500001" /><size x="0.2" y="2" z="0.1" />',
+                        '<point x="0.4" y="-1" z="0.7500001" /><size x="0.2" y="2" z="0.1" />')
     text = text.replace('<floating mkbound="5" rhopbody="500" />',
                         '<floating mkbound="5" rhopbody="500"><linearvelini x="0.5" y="0" z="2" />'
                         '<angularvelini x="0" y="3" z="0" /></floating>')
     # the flight reaches z ~ 1.1: the domain must hold it (a floating particle out of it stops the run)
     text = text.replace("</parameters>", '<simulationdomain><posmin x="default" y="default" z="default" />'
                         '<posmax x="default" y="default" z="2" /></simulationdomain></parameters>')
-    assert text.count('z="0.75"') == 2 and "linearvelini" in text and "simulationdomain" in text
+    assert text.count('z="0.7500001"') == 2 and "linearvelini" in text and "simulationdomain" in text
     case = tmp_path / "CaseBallistic_Def.xml"
     case.write_text(text)
     out = tmp_path / "out"

@@ -34,9 +34,11 @@ Draw modes (``setdrawmode``)
 Boxes (GenCase's rule, checked against the particle counts GenCase wrote for
 three DualSPHysics example cases, on and off the lattice)
     Volume: every node from the one nearest the min corner to the one
-    nearest the max corner (halves round up), i.e. the box widened by dp/2.
-    Face: the node layer nearest the face plane, over the same extent (a
-    half-way tie at the extent's upper end taken inwards). For a
+    nearest the max corner, i.e. the box widened by dp/2; a corner half-way
+    between two nodes goes where its double-precision lattice coordinate
+    (x - origin)/dp rounds, with no tolerance, as GenCase v5.4's do.
+    Face: the node layer nearest the face plane, over the same extent; a
+    ``<layers>`` copy lies a whole number of nodes from the first. For a
     rotated box the volume is the box widened by dp/2 along its own axes and
     the faces follow the planar-surface rule below (GenCase draws rotated
     faces somewhat thicker: 960 vs 832 nodes in its RotatedBox example).

@@ -11,7 +11,7 @@ Rules (lattice units, node ``k`` at ``k``; ``EPS`` = 1e-6):
   mesh files): a node belongs to a triangle when its signed distance to the
   plane is in (-1/2, 1/2] and its projection lies within 1/2 of the triangle.
   For an axis-aligned box this is the node layer nearest the face plane
-  (halves rounded up), over the face's extent rounded to the nearest nodes,
+  (a half-way tie as its floating-point value rounds), over the face's extent rounded to the nearest nodes,
   so the faces of a box meet without gaps.
 * **Curved surfaces** (sphere, ellipsoid, cylinder): the inner shell, i.e. the
   inside nodes with a face-neighbour (4 in 2D, 6 in 3D) outside the shape. It is
@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import transform as tf
-from .lattice import EPS, Lattice, ceil_idx, round_idx
+from .lattice import EPS, Lattice, round_idx
 
 SLAB_NODES = 2_000_000  # nodes evaluated at once by analytic shapes
 SURFACE_HALF = 0.5      # half-width of the node band of a planar surface (lattice units)
@@ -68,28 +68,39 @@ FACE_AXIS = {"left": (0, 0), "right": (0, 1), "front": (1, 0), "back": (1, 1),
              "bottom": (2, 0), "top": (2, 1)}
 
 
-def aligned_box_pieces(lat: Lattice, wmin, wmax, solid: bool, faces, wire: bool):
-    """Pieces of an axis-aligned box (world corners wmin <= wmax)."""
+def aligned_box_pieces(lat: Lattice, wmin, wmax, solid: bool, faces, wire: bool, shift=None):
+    """Pieces of an axis-aligned box (world corners wmin <= wmax); ``shift`` (lo, hi), in
+    lattice units, moves its corners after they are mapped to the lattice (a ``<layers>`` copy:
+    see :func:`sphdvi.case.draw.shapes.draw_box`)."""
     a = lat.to_index(np.asarray(wmin, dtype=np.float64))
     b = lat.to_index(np.asarray(wmax, dtype=np.float64))
+    if shift is not None:
+        a = a + shift[0]
+        b = b + shift[1]
+    return index_box_pieces(lat, a, b, solid, faces, wire)
+
+
+def index_box_pieces(lat: Lattice, a, b, solid: bool, faces, wire: bool):
+    """Pieces of an axis-aligned box with corners a <= b in lattice units. A corner half-way
+    between two nodes goes to the one the floating-point value rounds to, with no tolerance, as
+    GenCase v5.4 does: relative to the lattice origin (pointref + k dp, in double), 0.005 at dp
+    0.01 from pointmin -1 is 100.49999999999999 and takes node 100, 2.105 is 310.5 and takes
+    311 (yupengxiang/DualSPHysics F1_DUAL_FINITE_INIT: 633,472 fluid at x 2.11-3.22, y 0-1,
+    z 0-0.55, and 997,590 in all, GenCase's audit); an open tank's walls ending at z = 1.0 with
+    pointref 0.005 (200.49999999999997) stop at 0.995 (F1_DUAL_FINITE_CENTER: 361,104)."""
     pieces = []
     if solid:
         # GenCase: from the node nearest the min corner to the node nearest the max corner
         lo = [round_idx(v) for v in a]
         hi = [round_idx(v) for v in b]
         pieces.append(box_piece(lat, lo, hi))
-    # faces span the nearest nodes of the box's extent (halves rounded up), up to the layer of a
-    # drawn neighbouring face; towards an open side a half-way tie is taken inwards (GenCase v5.4,
-    # yupengxiang/DualSPHysics F1_DUAL_FINITE_CENTER: the walls of an open tank ending at z = 1.0,
-    # half-way between two nodes, stop at the node below)
+    # faces span the nearest nodes of the box's extent, up to the layer of a drawn neighbouring face
     ext_lo = [round_idx(v) for v in a]
     ext_hi = [round_idx(v) for v in b]
-    drawn = {FACE_AXIS[f] for f in faces}
-    open_hi = [ext_hi[i] if (i, 1) in drawn else ceil_idx(b[i] - 0.5) for i in range(3)]
     for face in faces:
         axis, side = FACE_AXIS[face]
         layer = round_idx(b[axis] if side else a[axis])
-        lo, hi = list(ext_lo), list(open_hi)
+        lo, hi = list(ext_lo), list(ext_hi)
         lo[axis] = hi[axis] = layer
         pieces.append(box_piece(lat, lo, hi))
     if wire:

@@ -117,23 +117,39 @@ def box_corners(size) -> np.ndarray:
     return np.array([[x, y, z] for x in (0.0, sx) for y in (0.0, sy) for z in (0.0, sz)])
 
 
-def _box_pieces(lat: Lattice, full, size, solid: bool, faces, wire: bool) -> list:
-    """Pieces of the box ``box_corners(size)`` under the transform ``full``."""
+def _world_faces(full, faces) -> list:
+    """The world faces of an axis-aligned box's local ``faces`` (axes may be permuted, a
+    negative scale swaps sides)."""
+    lin = full[:3, :3]
+    out = []
+    for f in faces:
+        axis, side = raster.FACE_AXIS[f]
+        waxis = int(np.argmax(np.abs(lin[:, axis])))
+        if lin[waxis, axis] < 0:
+            side = 1 - side
+        out.append([n for n, (a, s) in raster.FACE_AXIS.items() if a == waxis and s == side][0])
+    return out
+
+
+def _box_pieces(lat: Lattice, full, size, solid: bool, faces, wire: bool, base=None) -> list:
+    """Pieces of the box ``box_corners(size)`` under the transform ``full``. ``base`` (full,
+    size): the box this one is a ``<layers>`` copy of; an axis-aligned copy is then the base's
+    corners mapped to the lattice and moved there by the layer's offset, a whole number of dp or
+    half (rounded to 1e-9 dp): each layer lies the same whole number of nodes from the first,
+    whatever side of a half-way tie the first falls (moved in world coordinates, a layer dp out
+    from a face at 26.49999999999999 came to 25.50000000000001 and took the same node as the
+    face's: a wall with a missing layer)."""
     verts = tf.apply(full, box_corners(size))
     pieces = []
-    if tf.is_axis_aligned(full):
-        # map local face names to world faces (axes may be permuted, a negative scale swaps sides)
-        lin = full[:3, :3]
-        world_faces = []
-        for f in faces:
-            axis, side = raster.FACE_AXIS[f]
-            waxis = int(np.argmax(np.abs(lin[:, axis])))
-            if lin[waxis, axis] < 0:
-                side = 1 - side
-            world_faces.append([n for n, (a, s) in raster.FACE_AXIS.items()
-                                if a == waxis and s == side][0])
+    if tf.is_axis_aligned(full) and base is not None:
+        first = tf.apply(base[0], box_corners(base[1]))
+        shift = (np.round((verts.min(axis=0) - first.min(axis=0)) / lat.dp, 9),
+                 np.round((verts.max(axis=0) - first.max(axis=0)) / lat.dp, 9))
+        pieces = raster.aligned_box_pieces(lat, first.min(axis=0), first.max(axis=0), solid,
+                                           _world_faces(full, faces), wire, shift=shift)
+    elif tf.is_axis_aligned(full):
         pieces = raster.aligned_box_pieces(lat, verts.min(axis=0), verts.max(axis=0),
-                                           solid, world_faces, wire)
+                                           solid, _world_faces(full, faces), wire)
     else:
         if solid:
             # the box widened by dp/2 along its own axes, (min - dp/2, max + dp/2] like GenCase
@@ -166,8 +182,9 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
     (a yzhao469/DualSPHysicsAgent_v1 run, GenCase v5.0: 3 x 470^2); a ``boxfill all`` 2D tank,
     closed rings of 1410 + 8k particles (feynman0406/DualSPHysicsGPT CaseSloshingHR, GenCase
     v5.4); an ``all^top`` 3D tank (yupengxiang/DualSPHysics F1_DUAL_FINITE_CENTER, GenCase v5.4:
-    361,104, walls ending at their layer-0 top). The recorded shape (shapeout, ``norgeometry``)
-    is the box widened on every side."""
+    361,104, walls ending at their layer-0 top). An axis-aligned layer is placed on the lattice
+    as a whole number of nodes from the first (:func:`_box_pieces`). The recorded shape
+    (shapeout, ``norgeometry``) is the box widened on every side."""
     full = m @ tf.translation(point)
     if angles is not None and np.any(angles != 0):
         full = full @ tf.rotation_xyz(angles)
@@ -184,12 +201,13 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
                     lo[a] -= grow
                 if a == axis or (a, 1) in drawn:
                     hi[a] += grow
-            pieces += _box_pieces(lat, full @ tf.translation(lo), hi - lo, False, [f], False)
+            pieces += _box_pieces(lat, full @ tf.translation(lo), hi - lo, False, [f], False, base=(full, size))
+    base = (full, size)
     if grow:
         full = full @ tf.translation([-grow] * 3)
         size = size + 2.0 * grow
     if not moved_faces:
-        pieces = _box_pieces(lat, full, size, solid, faces, wire)
+        pieces = _box_pieces(lat, full, size, solid, faces, wire, base=base if grow else None)
     verts = tf.apply(full, box_corners(size))
     lin = full[:3, :3]
     edge_len = np.linalg.norm(lin, axis=0)
