@@ -603,12 +603,11 @@ def ghosts_in_own_wall(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, 
     lo = np.minimum(cells.min(axis=0), ghost.min(axis=0))
     span = np.maximum(cells.max(axis=0), ghost.max(axis=0)) - lo + 1
     mks, mk_of = np.unique(np.asarray(mkbound)[bound], return_inverse=True)
-    index = {int(m): i for i, m in enumerate(mks)}
 
     def code(k, m):
         return (((k[:, 2] - lo[2]) * span[1] + (k[:, 1] - lo[1])) * span[0] + (k[:, 0] - lo[0])) * len(mks) + m
     held = np.unique(code(cells, mk_of))
-    mk_tested = np.array([index[int(m)] for m in np.asarray(mkbound)[tested]], np.int64)
+    mk_tested = np.searchsorted(mks, np.asarray(mkbound)[tested])
     out[tested] = near & np.isin(code(ghost, mk_tested), held)
     return out
 
