@@ -230,19 +230,25 @@ def test_geometry_normals_keep_to_their_own_mk():
     assert np.allclose(n[mk == 2], [0, 0, 1.5 * DP])
 
 
-def test_geometry_normals_3d_tank_against_the_clamped_point():
-    """3D: a tank of two wall layers (floor and four walls, 0.4 x 0.3 m, 0.2 m high) and its inner
-    outline dp/2 in front of them, open at the top (0.5 m, above the walls): every wall particle
-    lies outside the outline's box, so the nearest point of the outline is the particle clamped
-    into that box (faces, edges and corners alike); N within distanceh h = 2 dp, none beyond
-    (the outer layer's edges and corners, 2.1 and 2.6 dp away)."""
+def _tank_walls_3d():
+    """The walls of a 0.4 x 0.3 m tank 0.2 m high, two layers thick (the inner at x, y, z = 0),
+    and the arange of its y nodes."""
     xs = np.arange(-DP, 0.4 + 1.5 * DP, DP)
     ys = np.arange(-DP, 0.3 + 1.5 * DP, DP)
     zs = np.arange(-DP, 0.2 + DP / 2, DP)
     g = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
     wall = (g[:, 0] < DP / 2) | (g[:, 0] > 0.4 - DP / 2) | (g[:, 1] < DP / 2) | (g[:, 1] > 0.3 - DP / 2) \
         | (g[:, 2] < DP / 2)
-    pos = g[wall]
+    return g[wall], ys
+
+
+def test_geometry_normals_3d_tank_against_the_clamped_point():
+    """3D: a tank of two wall layers (floor and four walls, 0.4 x 0.3 m, 0.2 m high) and its inner
+    outline dp/2 in front of them, open at the top (0.5 m, above the walls): every wall particle
+    lies outside the outline's box, so the nearest point of the outline is the particle clamped
+    into that box (faces, edges and corners alike); N within distanceh h = 2 dp, none beyond
+    (the outer layer's edges and corners, 2.1 and 2.6 dp away)."""
+    pos, _ = _tank_walls_3d()
     ptype = np.zeros(len(pos), int)
     lo, hi = np.array([DP / 2, DP / 2, DP / 2]), np.array([0.4 - DP / 2, 0.3 - DP / 2, 0.5])
     tris = box_triangles(lo, hi - lo, skip=("z1",))
@@ -280,13 +286,7 @@ def test_geometry_through_the_particles_gives_them_no_normal():
     against the surface's 0.3 here): a normal that short gave mDBC a ghost node on the particle itself.
     The particles on the surface are counted by mkbound, and the layer behind keeps N = dp
     towards the surface."""
-    xs = np.arange(-DP, 0.4 + 1.5 * DP, DP)
-    ys = np.arange(-DP, 0.3 + 1.5 * DP, DP)
-    zs = np.arange(-DP, 0.2 + DP / 2, DP)
-    g = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
-    wall = (g[:, 0] < DP / 2) | (g[:, 0] > 0.4 - DP / 2) | (g[:, 1] < DP / 2) | (g[:, 1] > 0.3 - DP / 2) \
-        | (g[:, 2] < DP / 2)
-    pos = g[wall]
+    pos, ys = _tank_walls_3d()
     ptype = np.zeros(len(pos), int)
     mk = np.where(pos[:, 2] < DP / 2, 3, 0)          # the floor mkbound 3, the walls 0
     tris = box_triangles(np.zeros(3), np.array([0.4, 0.3, 0.5]), skip=("z1",))

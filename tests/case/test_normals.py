@@ -194,27 +194,6 @@ def test_curved_wall_normals(layers, inner_mean, inner_max):
     assert np.all((n * inward).sum(axis=1) > 0)                 # every one towards the water
 
 
-@pytest.mark.parametrize("layers, thin", [(1, {0: 1}), (2, {0: 2}), (3, {})])
-def test_thin_walls_are_found_in_3d(layers, thin):
-    """A 3D tank whose walls are thinner than the kernel's reach (3 layers at coefh 1: 2h =
-    3.46 dp) is found, with the fewest layers behind a face particle, though its corner
-    particles' normals are longer than dp; with three layers it is not."""
-    from sphdvi.case.normals import layers_needed, thin_wall_mkbounds
-    dp = 0.05
-    h = dp * np.sqrt(3)
-    k = np.arange(-(layers - 1), 9 + layers)
-    g = np.stack(np.meshgrid(k, k, np.arange(-(layers - 1), 8), indexing="ij"), axis=-1).reshape(-1, 3)
-    wall = (g[:, 0] <= 0) | (g[:, 0] >= 9) | (g[:, 1] <= 0) | (g[:, 1] >= 9) | (g[:, 2] <= 0)
-    water = ~wall & (g[:, 2] < 5)
-    pos = np.vstack([g[wall], g[water]]) * dp
-    ptype = np.r_[np.zeros(wall.sum(), int), np.full(water.sum(), 3)]
-    n = boundary_normals(pos, ptype, dp, False)
-    assert np.linalg.norm(n[ptype == 0], axis=1).max() == pytest.approx(dp * (layers - 0.5) * np.sqrt(3))
-    found = thin_wall_mkbounds(pos, n, ptype, np.zeros(len(pos), int), dp, h)
-    assert {mk: fewest for mk, (fewest, _) in found.items()} == thin
-    assert layers_needed(h, dp) == 3 and layers_needed(dp * np.sqrt(2), dp) == 2      # 3D and 2D, coefh 1
-
-
 def _tank_3d(dp, layers):
     """A 3D tank 10 dp wide with walls ``layers`` thick and water 4 dp deep, and its mkbounds
     (0 the walls, none for the water)."""
@@ -225,6 +204,22 @@ def _tank_3d(dp, layers):
     pos = np.vstack([g[wall], g[water]]) * dp
     ptype = np.r_[np.zeros(wall.sum(), int), np.full(water.sum(), 3)]
     return pos, ptype, np.zeros(len(pos), int)
+
+
+@pytest.mark.parametrize("layers, thin", [(1, {0: 1}), (2, {0: 2}), (3, {})])
+def test_thin_walls_are_found_in_3d(layers, thin):
+    """A 3D tank whose walls are thinner than the kernel's reach (3 layers at coefh 1: 2h =
+    3.46 dp) is found, with the fewest layers behind a face particle, though its corner
+    particles' normals are longer than dp; with three layers it is not."""
+    from sphdvi.case.normals import layers_needed, thin_wall_mkbounds
+    dp = 0.05
+    h = dp * np.sqrt(3)
+    pos, ptype, _ = _tank_3d(dp, layers)
+    n = boundary_normals(pos, ptype, dp, False)
+    assert np.linalg.norm(n[ptype == 0], axis=1).max() == pytest.approx(dp * (layers - 0.5) * np.sqrt(3))
+    found = thin_wall_mkbounds(pos, n, ptype, np.zeros(len(pos), int), dp, h)
+    assert {mk: fewest for mk, (fewest, _) in found.items()} == thin
+    assert layers_needed(h, dp) == 3 and layers_needed(dp * np.sqrt(2), dp) == 2      # 3D and 2D, coefh 1
 
 
 def test_normals_into_their_own_wall_are_found_and_not_read_as_a_thin_wall():
