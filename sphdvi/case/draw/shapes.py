@@ -136,9 +136,9 @@ def _box_pieces(lat: Lattice, full, size, solid: bool, faces, wire: bool, base=N
     size): the box this one is a ``<layers>`` copy of; an axis-aligned copy is then the base's
     corners mapped to the lattice and moved there by the layer's offset, a whole number of dp or
     half (rounded to 1e-9 dp): each layer lies the same whole number of nodes from the first,
-    whatever side of a half-way tie the first falls (moved in world coordinates, a layer dp out
-    from a face at 26.49999999999999 came to 25.50000000000001 and took the same node as the
-    face's: a wall with a missing layer)."""
+    whatever side of a half-way tie the first falls (moved in world coordinates, the F2_SLOT
+    tank's face at 26.5 lattice units took node 27, its layer dp out, at 25.499999999999996,
+    node 25: a wall with the layer between missing)."""
     verts = tf.apply(full, box_corners(size))
     pieces = []
     if tf.is_axis_aligned(full) and base is not None:
