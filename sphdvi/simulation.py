@@ -934,12 +934,15 @@ class SPHRun:
                 normals0 = boundary_normals(p["pos"], p["type"], float(c["dp"]), bool(c["is2d"]),
                                             Periodicity(axes, p["pos"], float(c["dp"]), params) if axes else None)
             normals0 = self._mdbc_only_on(normals0, p, fluidcount, str(params.get("MdbcMkbound") or "").strip())
-            from .case.normals import inward_normal_mkbounds, layers_needed, mdbc_floating_mask, thin_wall_mkbounds
+            from .case.normals import (ghosts_in_own_wall, inward_normal_mkbounds, layers_needed,
+                                       mdbc_floating_mask, thin_wall_mkbounds)
             from .coupling import body_labels
             labels = body_labels(p["mk"], fluidcount)
-            inward = inward_normal_mkbounds(p["pos"], normals0, p["type"], labels, float(c["dp"]), float(c["h"]))
+            args = (p["pos"], normals0, p["type"], labels, float(c["dp"]), float(c["h"]))
+            mask = ghosts_in_own_wall(*args)
+            inward = inward_normal_mkbounds(*args, inward=mask)
             _warn_inward_mdbc_normals(inward, float(c["dp"]))
-            thin = thin_wall_mkbounds(p["pos"], normals0, p["type"], labels, float(c["dp"]), float(c["h"]))
+            thin = thin_wall_mkbounds(*args, inward=mask)
             _warn_thin_mdbc_walls({mk: v for mk, v in thin.items() if mk not in inward},
                                   layers_needed(float(c["h"]), float(c["dp"])), float(c["h"]) / float(c["dp"]))
             state.mass[mdbc_floating_mask(p["type"], labels, params, normals0)] = float(c["massbound"])

@@ -392,7 +392,7 @@ def apply_geometry(normals, op, pos, sel, mkbound, h, is2d, posy2d, triangles, t
     pmk = np.ascontiguousarray(mkbound[sel], dtype=np.int64)
     own = np.isin(pmk, prim_mk[prim_mk >= 0]) if tri_mk is not None else np.zeros(len(r), bool)
     if not len(prims):
-        _write(normals, sel, np.zeros(len(r), bool), r, True)
+        normals[sel] = 0.0
         return {}
     vec, found = _nearest_surface(r, pmk, own, np.ascontiguousarray(prims), np.ascontiguousarray(prim_mk),
                                   bool(is2d), float(reach))

@@ -528,7 +528,7 @@ def layers_needed(h: float, dp: float) -> int:
 
 
 def thin_wall_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray,
-                       dp: float, h: float) -> dict:
+                       dp: float, h: float, inward: np.ndarray | None = None) -> dict:
     """Fixed and moving mkbounds with a flat face thinner than the kernel's reach: mkbound ->
     (the fewest layers found behind a face particle, the number of such thin face particles).
     A face particle is a first-layer particle (normal dp/2 long) whose normal is along an axis;
@@ -543,8 +543,9 @@ def thin_wall_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, 
         return {}
     # face particles with an axis-aligned normal (an edge or a corner is counted by its faces);
     # one whose ghost node lies in its own wall is not a face (:func:`ghosts_in_own_wall`)
-    face = np.flatnonzero(wall & (np.abs(length - 0.5 * dp) < 0.1 * dp)
-                          & ~ghosts_in_own_wall(pos, normals, ptype, mkbound, dp, h))
+    if inward is None:
+        inward = ghosts_in_own_wall(pos, normals, ptype, mkbound, dp, h)
+    face = np.flatnonzero(wall & (np.abs(length - 0.5 * dp) < 0.1 * dp) & ~inward)
     u = normals[face] / length[face, None]
     axis = np.argmax(np.abs(u), axis=1)
     along = np.abs(np.abs(u[np.arange(face.size), axis]) - 1.0) <= 1e-6
@@ -584,10 +585,10 @@ def ghosts_in_own_wall(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, 
     not dp/2 in front of it (a solid box whose faces fall half-way between nodes, given as its
     own normals geometry; a tank's geometry on its first layer with pointref at dp/2; a
     <norplane> point behind the first layer): the layer in front of the surface gets normals
-    dp/2 long pointing back into the wall, and the layer behind it ghost nodes on that layer.  Only normals shorter than
-    the kernel's reach 2h are tested (a particle deeper in the wall samples no fluid, whatever
-    its normal), and only on the lattice (a ghost farther than dp/4 from a node along an axis
-    is not)."""
+    dp/2 long pointing back into the wall, and the layer behind it ghost nodes on that layer.
+    Only normals shorter than the kernel's reach 2h are tested (a particle deeper in the wall
+    samples no fluid, whatever its normal), and only on the lattice (a ghost farther than dp/4
+    from a node along an axis is not)."""
     ptype = np.asarray(ptype)
     length = np.linalg.norm(normals, axis=1)
     bound = ptype != 3
@@ -613,10 +614,11 @@ def ghosts_in_own_wall(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, 
 
 
 def inward_normal_mkbounds(pos: np.ndarray, normals: np.ndarray, ptype: np.ndarray, mkbound: np.ndarray,
-                           dp: float, h: float) -> dict:
+                           dp: float, h: float, inward: np.ndarray | None = None) -> dict:
     """mkbound -> how many of its particles have their ghost node in their own wall
-    (:func:`ghosts_in_own_wall`)."""
-    inward = ghosts_in_own_wall(pos, normals, ptype, mkbound, dp, h)
+    (:func:`ghosts_in_own_wall`; ``inward``: that mask, already computed)."""
+    if inward is None:
+        inward = ghosts_in_own_wall(pos, normals, ptype, mkbound, dp, h)
     mks, counts = np.unique(np.asarray(mkbound)[inward], return_counts=True)
     return {int(m): int(n) for m, n in zip(mks, counts)}
 

@@ -38,7 +38,7 @@ def ceil_idx(a: float) -> int:
 def round_idx(a: float) -> int:
     """Nearest node index, an exact half rounded up; no tolerance: a value a rounding error
     below a half (100.49999999999999) rounds down, as GenCase's do (see
-    :func:`sphdvi.case.draw.raster.index_box_pieces`)."""
+    :func:`sphdvi.case.draw.raster.aligned_box_pieces`)."""
     return int(math.floor(a + 0.5))
 
 

@@ -71,23 +71,18 @@ FACE_AXIS = {"left": (0, 0), "right": (0, 1), "front": (1, 0), "back": (1, 1),
 def aligned_box_pieces(lat: Lattice, wmin, wmax, solid: bool, faces, wire: bool, shift=None):
     """Pieces of an axis-aligned box (world corners wmin <= wmax); ``shift`` (lo, hi), in
     lattice units, moves its corners after they are mapped to the lattice (a ``<layers>`` copy:
-    see :func:`sphdvi.case.draw.shapes.draw_box`)."""
-    a = lat.to_index(np.asarray(wmin, dtype=np.float64))
-    b = lat.to_index(np.asarray(wmax, dtype=np.float64))
-    if shift is not None:
-        a = a + shift[0]
-        b = b + shift[1]
-    return index_box_pieces(lat, a, b, solid, faces, wire)
-
-
-def index_box_pieces(lat: Lattice, a, b, solid: bool, faces, wire: bool):
-    """Pieces of an axis-aligned box with corners a <= b in lattice units. A corner half-way
+    see :func:`sphdvi.case.draw.shapes.draw_box`). A corner half-way
     between two nodes goes to the one the floating-point value rounds to, with no tolerance, as
     GenCase v5.4 does: relative to the lattice origin (pointref + k dp, in double), 0.005 at dp
     0.01 from pointmin -1 is 100.49999999999999 and takes node 100, 2.105 is 310.5 and takes
     311 (yupengxiang/DualSPHysics F1_DUAL_FINITE_INIT: 633,472 fluid at x 2.11-3.22, y 0-1,
     z 0-0.55, and 997,590 in all, GenCase's audit); an open tank's walls ending at z = 1.0 with
     pointref 0.005 (200.49999999999997) stop at 0.995 (F1_DUAL_FINITE_CENTER: 361,104)."""
+    a = lat.to_index(np.asarray(wmin, dtype=np.float64))
+    b = lat.to_index(np.asarray(wmax, dtype=np.float64))
+    if shift is not None:
+        a = a + shift[0]
+        b = b + shift[1]
     pieces = []
     if solid:
         # GenCase: from the node nearest the min corner to the node nearest the max corner

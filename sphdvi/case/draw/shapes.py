@@ -141,15 +141,14 @@ def _box_pieces(lat: Lattice, full, size, solid: bool, faces, wire: bool, base=N
     node 25: a wall with the layer between missing)."""
     verts = tf.apply(full, box_corners(size))
     pieces = []
-    if tf.is_axis_aligned(full) and base is not None:
-        first = tf.apply(base[0], box_corners(base[1]))
-        shift = (np.round((verts.min(axis=0) - first.min(axis=0)) / lat.dp, 9),
-                 np.round((verts.max(axis=0) - first.max(axis=0)) / lat.dp, 9))
-        pieces = raster.aligned_box_pieces(lat, first.min(axis=0), first.max(axis=0), solid,
+    if tf.is_axis_aligned(full):
+        corners, shift = verts, None
+        if base is not None:
+            corners = tf.apply(base[0], box_corners(base[1]))
+            shift = (np.round((verts.min(axis=0) - corners.min(axis=0)) / lat.dp, 9),
+                     np.round((verts.max(axis=0) - corners.max(axis=0)) / lat.dp, 9))
+        pieces = raster.aligned_box_pieces(lat, corners.min(axis=0), corners.max(axis=0), solid,
                                            _world_faces(full, faces), wire, shift=shift)
-    elif tf.is_axis_aligned(full):
-        pieces = raster.aligned_box_pieces(lat, verts.min(axis=0), verts.max(axis=0),
-                                           solid, _world_faces(full, faces), wire)
     else:
         if solid:
             # the box widened by dp/2 along its own axes, (min - dp/2, max + dp/2] like GenCase
@@ -191,6 +190,7 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
     size = np.asarray(size, dtype=np.float64)
     pieces = []
     moved_faces = bool(grow) and bool(faces) and not solid and not wire
+    base = (full, size)          # the box its <layers> copies are placed from
     if moved_faces:
         drawn = {raster.FACE_AXIS[f] for f in faces}
         for f in faces:
@@ -201,8 +201,7 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
                     lo[a] -= grow
                 if a == axis or (a, 1) in drawn:
                     hi[a] += grow
-            pieces += _box_pieces(lat, full @ tf.translation(lo), hi - lo, False, [f], False, base=(full, size))
-    base = (full, size)
+            pieces += _box_pieces(lat, full @ tf.translation(lo), hi - lo, False, [f], False, base=base)
     if grow:
         full = full @ tf.translation([-grow] * 3)
         size = size + 2.0 * grow
