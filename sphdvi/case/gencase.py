@@ -571,8 +571,9 @@ def analytic_properties(primitives, mkbound: int, is2d: bool, density, massbody)
     if len(mine) != 1:
         return None
     prim = mine[0]
-    if any(p.get("void") and p.get("line", 0) > prim.get("line", 0) for p in primitives):
-        return None          # something may have been carved out of it
+    later = primitives[next(i for i, p in enumerate(primitives) if p is prim) + 1:]
+    if any(p.get("void") or p.get("redraws") for p in later):
+        return None          # something may have been carved out of it, or redrawn
     shape, par = prim.get("shape"), prim.get("params", {})
     axes = np.eye(3)
     try:

@@ -1314,3 +1314,306 @@ CASESLOSHINGHR_V54 = """<?xml version="1.0" ?>
     </execution>
 </case>
 """
+
+#: DualSPHysics/DualSPHysics examples/others/RedrawGenCase/RedrawSimple.xml, GenCase4 v4.0.055
+#: (10-11-2017): a floor of oblique lines with gaps between them (mkbound 1), the gaps closed by
+#: <redrawnear targettp="void" bordertp="bound" bordermk="1"> (mkbound 2), then a fill
+REDRAWSIMPLE = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase4 v4.0.055 (10-11-2017)" date="10-11-2017 18:48:07">
+    <casedef>
+        <constantsdef>
+            <lattice bound="1" fluid="1" />
+            <gravity x="0" y="0" z="-9.81" />
+            <cflnumber value="0.2" />
+            <hswl value="0" auto="true" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="30" />
+            <speedsound value="0" auto="true" />
+            <coefh value="1.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" />
+        </constantsdef>
+        <mkconfig boundcount="220" fluidcount="8">
+            <mkorientfluid mk="0" orient="Xyz" />
+        </mkconfig>
+        <geometry>
+            <definition dp="0.05" units_comment="metres (m)">
+                <pointmin x="-1" y="0" z="-1" />
+                <pointmax x="36.5" y="0" z="13" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setshapemode>real | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <setmkbound mk="0" />
+                    <drawline>
+                        <point x="0" y="0" z="2" />
+                        <point x="0" y="0" z="0" />
+                    </drawline>
+                    <setmkbound mk="1" />
+                    <drawline>
+                        <point x="0" y="0" z="0" />
+                        <point x="1" y="0" z="0" />
+                    </drawline>
+                    <drawline>
+                        <point x="1.1" y="0" z="0" />
+                        <point x="3" y="0" z="0.5" />
+                    </drawline>
+                    <drawline>
+                        <point x="3.1" y="0" z="0.5" />
+                        <point x="3.5" y="0" z="0.5" />
+                    </drawline>
+                    <drawline>
+                        <point x="3.6" y="0" z="0.6" />
+                        <point x="3.75" y="0" z="0.25" />
+                    </drawline>
+                    <drawlines>
+                        <point x="3.75" y="0" z="0.25" />
+                        <point x="4.5" y="0" z="0.25" />
+                        <point x="6" y="0" z="2" />
+                    </drawlines>
+                    <cellsout file="test_00" />
+                    <setmkbound mk="2" />
+                    <redrawnear times="1" targettp="void" bordertp="bound" bordermk="1" />
+                    <cellsout file="test_01" />
+                    <setmkfluid mk="0" />
+                    <fillbox x="0.5" y="0" z="0.5">
+                        <modefill>void</modefill>
+                        <point x="0" y="-1" z="0" />
+                        <size x="6" y="2" z="1.5" />
+                    </fillbox>
+                    <cellsout file="test_02" />
+                </mainlist>
+            </commands>
+        </geometry>
+    </casedef>
+    <execution>
+        <parameters>
+            <parameter key="StepAlgorithm" value="2" />
+            <parameter key="Visco" value="0.01" />
+            <parameter key="ViscoBoundFactor" value="0" />
+            <parameter key="FtPause" value="1.0" />
+            <parameter key="TimeMax" value="1" />
+            <parameter key="TimeOut" value="0.01" />
+        </parameters>
+        <particles np="2816" nb="552" nbf="552" mkboundfirst="9" mkfluidfirst="1">
+            <_summary>
+                <fixed count="552" id="0-551" mkcount="3" mkvalues="9-11" />
+                <fluid count="2264" id="552-2815" mkcount="1" mkvalues="1" />
+            </_summary>
+            <fixed mkbound="0" mk="9" begin="0" count="40" />
+            <fixed mkbound="1" mk="10" begin="40" count="157" />
+            <fixed mkbound="2" mk="11" begin="197" count="355" />
+            <fluid mkfluid="0" mk="1" begin="552" count="2264" />
+        </particles>
+        <constants>
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.05" units_comment="metres (m)" />
+            <h value="8.4852813742E-002" units_comment="metres (m)" />
+            <b value="1.7027357143E+006" units_comment="Pascal (Pa)" />
+            <massbound value="2.5000000000E+000" units_comment="kg" />
+            <massfluid value="2.5000000000E+000" units_comment="kg" />
+        </constants>
+        <motion />
+    </execution>
+</case>
+"""
+
+#: DualSPHysics/DualSPHysics examples/others/RedrawGenCase/RedrawComplex.xml, GenCase4 v4.0.055
+#: (10-11-2017): the word HELLO! in fluid mk 0-5 over a lattice filled with mkbound 0 by
+#: <redraw/>, then <redraw mkfluid>, <redrawbox>, <redrawnear times> growing each letter, and
+#: <setmkvoid/> with <redrawnear> and <redrawnearbox bordertp="void"> cutting the outlines free
+REDRAWCOMPLEX = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase4 v4.0.055 (10-11-2017)" date="10-11-2017 17:54:37">
+    <casedef>
+        <constantsdef>
+            <gravity x="0" y="0" z="-9.81" />
+            <cflnumber value="0.2" />
+            <hswl value="0" auto="true" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="30" />
+            <speedsound value="0" auto="true" />
+            <coefh value="1.0" />
+            <gamma value="7" />
+            <rhop0 value="1000" />
+        </constantsdef>
+        <mkconfig boundcount="220" fluidcount="8">
+            <mkorientfluid mk="0" orient="Xyz" />
+        </mkconfig>
+        <geometry>
+            <definition dp="0.1" units_comment="metres (m)">
+                <pointmin x="0" y="0" z="0" />
+                <pointmax x="36.5" y="0" z="13" />
+            </definition>
+            <commands>
+                <list name="CharH" printcall="true">
+                    <drawline>
+                        <point x="0" y="0" z="0" />
+                        <point x="0" y="0" z="8" />
+                    </drawline>
+                    <drawline>
+                        <point x="4" y="0" z="0" />
+                        <point x="4" y="0" z="8" />
+                    </drawline>
+                    <drawline>
+                        <point x="-0.2" y="0" z="4" />
+                        <point x="4.2" y="0" z="4" />
+                    </drawline>
+                </list>
+                <list name="CharE" printcall="true">
+                    <drawline>
+                        <point x="0" y="0" z="0" />
+                        <point x="0" y="0" z="8" />
+                    </drawline>
+                    <drawline>
+                        <point x="-0.2" y="0" z="0" />
+                        <point x="4.2" y="0" z="0" />
+                    </drawline>
+                    <drawline>
+                        <point x="-0.2" y="0" z="4" />
+                        <point x="3.5" y="0" z="4" />
+                    </drawline>
+                    <drawline>
+                        <point x="-0.2" y="0" z="8" />
+                        <point x="4.2" y="0" z="8" />
+                    </drawline>
+                </list>
+                <list name="CharL" printcall="true">
+                    <drawline>
+                        <point x="0" y="0" z="0" />
+                        <point x="0" y="0" z="8" />
+                    </drawline>
+                    <drawline>
+                        <point x="-0.2" y="0" z="0" />
+                        <point x="4.2" y="0" z="0" />
+                    </drawline>
+                </list>
+                <list name="CharO" printcall="true">
+                    <drawlines>
+                        <point x="0.5" y="0" z="0" />
+                        <point x="3.5" y="0" z="0" />
+                        <point x="4.0" y="0" z="0.5" />
+                        <point x="4.0" y="0" z="7.5" />
+                        <point x="3.5" y="0" z="8" />
+                        <point x="0.5" y="0" z="8" />
+                        <point x="0.0" y="0" z="7.5" />
+                        <point x="0.0" y="0" z="0.5" />
+                        <point x="0.5" y="0" z="0.0" />
+                    </drawlines>
+                </list>
+                <list name="CharSim" printcall="true">
+                    <drawbox>
+                        <boxfill>solid</boxfill>
+                        <point x="0.4" y="-1" z="2.6" />
+                        <size x="0.8" y="2" z="4.5" />
+                    </drawbox>
+                    <drawcylinder radius="0.5" mask="0">
+                        <point x="0.8" y="-1" z="1.1" />
+                        <point x="0.8" y="1" z="1.1" />
+                    </drawcylinder>
+                </list>
+                <mainlist>
+                    <setshapemode>real | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <setmkbound mk="0" />
+                    <redraw />
+                    <cellsout file="test_00" />
+                    <move x="2.5" y="0" z="2" />
+                    <setmkfluid mk="0" />
+                    <runlist name="CharH" />
+                    <cellsout file="test_01" />
+                    <move x="6.7" y="0" z="0" />
+                    <setmkfluid mk="1" />
+                    <runlist name="CharE" />
+                    <cellsout file="test_02" />
+                    <move x="6.3" y="0" z="0" />
+                    <setmkfluid mk="2" />
+                    <runlist name="CharL" />
+                    <cellsout file="test_03" />
+                    <move x="6.0" y="0" z="0" />
+                    <setmkfluid mk="3" />
+                    <runlist name="CharL" />
+                    <cellsout file="test_04" />
+                    <move x="6.0" y="0" z="0" />
+                    <setmkfluid mk="4" />
+                    <runlist name="CharO" />
+                    <cellsout file="test_05" />
+                    <move x="6.0" y="0" z="0" />
+                    <setmkfluid mk="5" />
+                    <runlist name="CharSim" />
+                    <cellsout file="test_06" />
+                    <redraw mkfluid="0" />
+                    <cellsout file="test_07" />
+                    <matrixreset />
+                    <setmkfluid mk="0" />
+                    <redrawbox mkfluid="5">
+                        <point x="32" y="-1" z="0" />
+                        <size x="4" y="2" z="10" />
+                    </redrawbox>
+                    <cellsout file="test_08" />
+                    <setmkfluid mk="5" />
+                    <redrawnear times="7" targettp="bound" targetmk="0" bordertp="fluid" bordermk="5" />
+                    <cellsout file="test_09" />
+                    <setmkfluid mk="1" />
+                    <redrawnear times="5" targettp="bound" targetmk="0" bordertp="fluid" bordermk="1" />
+                    <cellsout file="test_10" />
+                    <setmkfluid mk="2" />
+                    <redrawnear times="3" targettp="bound" targetmk="0" bordertp="fluid" bordermk="2" />
+                    <cellsout file="test_11" />
+                    <setmkfluid mk="3" />
+                    <redrawnear times="1" targettp="bound" targetmk="0" bordertp="fluid" bordermk="3" />
+                    <cellsout file="test_12" />
+                    <setmkvoid />
+                    <redrawnear times="1" targettp="bound" targetmk="0" bordertp="fluid" />
+                    <cellsout file="test_13" />
+                    <redrawnearbox times="2" targettp="bound" targetmk="0" bordertp="void">
+                        <point x="0" y="-1" z="0" />
+                        <size x="42" y="2" z="13" />
+                    </redrawnearbox>
+                    <cellsout file="test_14" />
+                </mainlist>
+            </commands>
+        </geometry>
+    </casedef>
+    <execution>
+        <parameters>
+            <parameter key="PosDouble" value="1" />
+            <parameter key="StepAlgorithm" value="2" />
+            <parameter key="Visco" value="0.01" />
+            <parameter key="ViscoBoundFactor" value="0" />
+            <parameter key="DensityDT" value="1" />
+            <parameter key="FtPause" value="1.0" />
+            <parameter key="TimeMax" value="3" />
+            <parameter key="TimeOut" value="0.01" />
+        </parameters>
+        <particles np="40958" nb="33268" nbf="33268" mkboundfirst="9" mkfluidfirst="1">
+            <_summary>
+                <fixed count="33268" id="0-33267" mkcount="1" mkvalues="9" />
+                <fluid count="7690" id="33268-40957" mkcount="6" mkvalues="1-6" />
+            </_summary>
+            <fixed mkbound="0" mk="9" begin="0" count="33268" />
+            <fluid mkfluid="0" mk="1" begin="33268" count="511" />
+            <fluid mkfluid="1" mk="2" begin="33779" count="2376" />
+            <fluid mkfluid="2" mk="3" begin="36155" count="917" />
+            <fluid mkfluid="3" mk="4" begin="37072" count="381" />
+            <fluid mkfluid="4" mk="5" begin="37453" count="220" />
+            <fluid mkfluid="5" mk="6" begin="37673" count="3285" />
+        </particles>
+        <constants>
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="1000" units_comment="kg/m^3" />
+            <dp value="0.1" units_comment="metres (m)" />
+            <h value="1.4142135624E-001" units_comment="metres (m)" />
+            <b value="1.1856085714E+007" units_comment="Pascal (Pa)" />
+            <massbound value="1.0000000000E+001" units_comment="kg" />
+            <massfluid value="1.0000000000E+001" units_comment="kg" />
+        </constants>
+        <motion />
+    </execution>
+</case>
+"""

@@ -5,7 +5,7 @@ Redrawing the case must give the same count per mk and the same constants; the r
 from the file's own text, never copied into the test.
 
 The files of the survey that sphdvi refuses on purpose (GenCase's free drawing mode
-``<setfrdrawmode>``, ``<redraw*>`` commands, ``<special><inout>``) are not here; the ones where it
+``<setfrdrawmode>``, ``<special><inout>``) are not here; the ones where it
 draws otherwise than GenCase are the ``xfail(strict=True)`` tests at the end, with the numbers
 measured.
 """
@@ -30,6 +30,8 @@ MATCH = {
     "CaseDambreakVal2D": cases.CASEDAMBREAK_V54,  # GenCase v5.4.354.01
     "CaseDambreak_Def": cases.CASEDAMBREAK_DEF_V54,     # GenCase v5.4.354.01, no node on pointmax
     "CaseSloshingHR": cases.CASESLOSHINGHR_V54,   # GenCase v5.4.354.01, layers, setboxlimitmode full
+    "RedrawSimple": cases.REDRAWSIMPLE,           # GenCase4 v4.0.055, oblique lines, redrawnear
+    "RedrawComplex": cases.REDRAWCOMPLEX,         # GenCase4 v4.0.055, redraw, redrawbox, redrawnear(box)
 }
 
 # the record writes 11 significant digits (e.g. h="2.8284271247E-002")

@@ -126,11 +126,27 @@ Commands that draw nothing
     drawing are not (they may rightly change nothing).
 
 ``setboxlimitmode``
-    ``full`` (GenCase's default, the box rules above) is accepted; ``inner``
-    is refused (its node rule is not documented).
+    ``inner`` (the default) limits a ``<fillbox>`` to the nodes at least dp/2 inside its box,
+    ``full`` to the nodes of a solid ``<drawbox>`` over it.
+
+Lines (``drawline``, ``drawlines``, ``drawlineto``; the edges in ``wire`` mode)
+    The nodes within 0.6 dp of the segment: one node a step along an axis or a 45-degree
+    diagonal, a second one where an oblique line passes near the middle of two (GenCase v4.0's
+    records of DualSPHysics's examples RedrawSimple and RedrawComplex).
+
+Redraw (``redraw``, ``redrawbox``, ``redrawnear``, ``redrawnearbox``; see :mod:`.redraw`)
+    They give the current pen (void erases) to nodes chosen by what they hold. ``redraw`` takes
+    every node holding ``mkfluid``/``mkbound`` (every node, void included, without either);
+    ``redrawbox`` the same within a box (the nodes of a solid ``<drawbox>``; no rotation).
+    ``redrawnear times targettp targetmk bordertp bordermk`` takes, ``times`` passes over, the
+    target nodes (void, fluid or bound, joined by ``|``; of mk ``targetmk`` if given) with a
+    border node among their 26 neighbours (8 in 2D); a pen equal to the border grows it a layer
+    a pass. ``redrawnearbox`` limits the targets to a box. ``<dirfilter>`` other than ``all``
+    is refused (its direction rule is not documented). GenCase v4.0's records of RedrawSimple
+    and RedrawComplex are matched count for count.
 
 Not supported (CaseError "not supported by sphdvi"): see ``UNSUPPORTED``
-(bathymetry, waves, redraw, clipping, patterns, ...)
+(bathymetry, waves, clipping, patterns, ...)
 and ``<layers>`` of ellipsoids; commands that only tune GenCase's own output or sampling
 (``setdpctes``, ``setshapemode``, ``debugout``, ...) are accepted with no effect.
 """

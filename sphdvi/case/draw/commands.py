@@ -13,6 +13,7 @@ import numpy as np
 
 from ..expressions import ExpressionError
 from . import raster, shapes
+from . import redraw as redraw_kernels
 from . import transform as tf
 from .lattice import Canvas, Lattice, ceil_idx, floor_idx, round_idx
 from .shapeout import FORMATS, merge_shapes, write_shapes
@@ -25,12 +26,14 @@ DRAW_MODES = {"full", "face", "solid", "wire"}
 BOX_TOKENS = {"solid", "all", "bottom", "top", "left", "right", "front", "back"}
 FILL_TOKENS = {"void", "border", "fluid", "bound"}
 FILLS = {"fillpoint", "fillbox"}    # _record shapes of the fill commands
+#: _record shapes of the commands that change nodes by what they hold, not by a shape
+REDRAWS = {"redraw", "redrawbox", "redrawnear", "redrawnearbox"}
 SKIPPED_ATTRS = {"comment", "units_comment", "comment2", "rem", "active"}
 
 #: commands of GenCase that sphdvi does not implement
 UNSUPPORTED = {
     "drawbathymetry", "drawwave", "drawfilevtm", "drawfilecsv",
-    "redraw", "redrawbox", "redrawnear", "redrawnearbox", "clipdomain", "clipplane", "clipbox",
+    "clipdomain", "clipplane", "clipbox",
     "clipreset", "setpattern", "patterns", "fillfigure", "fillprism",
     "setmknextfluid", "setmknextbound", "setmknextauto", "setmkbackvoid", "setmkbackfluid",
     "setmkbackbound", "setmkbackclear", "setfrdrawmode", "rotateadv",
@@ -151,7 +154,8 @@ class GeometryRunner:
                  "drawpolygon", "drawtriangles", "drawfigure", "drawbox", "drawsphere",
                  "drawellipsoid", "drawcylinder", "drawprism", "drawpyramid", "drawbeach",
                  "drawextrude", "drawfilestl",
-                 "drawfileply", "drawfilevtk", "fillpoint", "fillvoidpoint", "fillbox", "shapeout"]
+                 "drawfileply", "drawfilevtk", "fillpoint", "fillvoidpoint", "fillbox", "shapeout",
+                 "redraw", "redrawbox", "redrawnear", "redrawnearbox"]
         return {n: getattr(self, "cmd_" + n) for n in names}
 
     def run_commands(self, container, only_variables: bool = False) -> None:
@@ -229,7 +233,8 @@ class GeometryRunner:
                 "mk": int(s.mk) if s.kind in ("fluid", "bound") else -1, "solid": bool(solid),
                 "mode": s.mode, "nodes": nodes, "line": el.sourceline, "params": params}
         self.primitives.append(prim)
-        if nodes == 0 and s.draw_points and s.kind in ("fluid", "bound") and shape not in FILLS:
+        if (nodes == 0 and s.draw_points and s.kind in ("fluid", "bound") and shape not in FILLS
+                and shape not in REDRAWS):
             self._warn_nothing_drawn(el, tris, params)
         if s.draw_shapes and tris is not None and self.keep_shapes:
             tris = np.asarray(tris)
@@ -1059,6 +1064,96 @@ class GeometryRunner:
         if self.lat.is2d:
             lo[1] = hi[1] = 0
         self._fill(el, seed, self._fill_modes(el), lo, hi, "fillbox")
+
+    # ------------------------------------------------------------ redraw
+    def _redraw_box_range(self, el):
+        """Index range (lo, hi) of the nodes of a redraw command's box (those of a solid
+        ``<drawbox>``: from the node nearest the min corner to the node nearest the max corner),
+        or of the whole lattice without a box; None when the box misses the lattice."""
+        if el.tag.endswith("box"):
+            if not tf.is_axis_aligned(self.state.matrix):
+                raise self.reader.error(el, f"<{el.tag}> under a rotation is not supported by sphdvi",
+                                        f"no rotation (matrixreset) before {el.tag}")
+            point, size = self._box_extent(el)
+            corners = self._world(np.array([point, point + size]))
+            lo = [round_idx(v) for v in self.lat.to_index(corners.min(axis=0))]
+            hi = [round_idx(v) for v in self.lat.to_index(corners.max(axis=0))]
+        else:
+            lo, hi = [0, 0, 0], [n - 1 for n in self.lat.shape]
+        if self.lat.is2d:
+            lo[1] = hi[1] = 0
+        return self.lat.clip_range(lo, hi)
+
+    def _redraw_label(self, el, kind_attr: str | None, mk_attr: str | None, prefix: str = ""):
+        """(kinds, mk) named by a redraw command: ``mkfluid``/``mkbound`` (redraw, redrawbox),
+        or ``<prefix>tp`` (void, fluid, bound joined by |) and ``<prefix>mk`` (redrawnear)."""
+        if kind_attr is None:
+            mkfluid = self.reader.integer(el, "mkfluid", None, lo=0)
+            mkbound = self.reader.integer(el, "mkbound", None, lo=0)
+            if mkfluid is not None and mkbound is not None:
+                raise self.reader.error(el, "names both mkfluid and mkbound", "one of them, or neither")
+            if mkfluid is not None:
+                return {"fluid"}, mkfluid
+            if mkbound is not None:
+                return {"bound"}, mkbound
+            return {"void", "fluid", "bound"}, None
+        text = self.reader.text_attr(el, kind_attr)
+        kinds = {t.strip().lower() for t in text.split("|") if t.strip()}
+        if not kinds or kinds - {"void", "fluid", "bound"}:
+            raise self.reader.error(el, f"{kind_attr}={text!r} is not recognised",
+                                    "void, fluid or bound (joined by |)")
+        return kinds, self.reader.integer(el, mk_attr, None, lo=0)
+
+    def _redraw_record(self, el, params: dict, n: int) -> None:
+        """Recorded like a shape; ``redraws`` tells a floating body's analytic mass (gencase)
+        that nodes drawn before may have changed label."""
+        self._record(el, el.tag, params, None, False, n)
+        self.primitives[-1]["redraws"] = True
+
+    def cmd_redraw(self, el):
+        """``<redraw [mkfluid|mkbound]>``: every node holding that label (every node, void
+        included, without one) takes the current pen."""
+        self._need_pen(el)
+        self._check(el, {"point", "size", "endpoint"} if el.tag == "redrawbox" else set())
+        kinds, mk = self._redraw_label(el, None, None)
+        r = self._redraw_box_range(el)
+        n = 0
+        if r is not None and self.state.draw_points:
+            code = self._code()     # first: it may add the pen's label to the table
+            n = redraw_kernels.redraw(self.canvas.codes,
+                                      redraw_kernels.label_selection(self.canvas.labels, kinds, mk),
+                                      r[0], r[1], code)
+        self._redraw_record(el, {"kinds": sorted(kinds), "mk": mk}, n)
+
+    cmd_redrawbox = cmd_redraw
+
+    def cmd_redrawnear(self, el):
+        """``<redrawnear times targettp targetmk bordertp bordermk>``: ``times`` passes, each
+        giving the current pen to the target nodes that touch a border node across a face."""
+        self._need_pen(el)
+        allowed = {"dirfilter"} | ({"point", "size", "endpoint"} if el.tag == "redrawnearbox" else set())
+        self._check(el, allowed)
+        times = self.reader.integer(el, "times", 1, lo=0, hi=1_000_000)
+        tkinds, tmk = self._redraw_label(el, "targettp", "targetmk")
+        bkinds, bmk = self._redraw_label(el, "bordertp", "bordermk")
+        df = self.reader.child(el, "dirfilter")
+        if df is not None and self.reader.element_text(df).strip().lower() != "all":
+            raise self.reader.error(df, f"<dirfilter>{self.reader.element_text(df)}</dirfilter> is not "
+                                        "supported by sphdvi (GenCase's direction rule is not documented)",
+                                    "no <dirfilter>, or all")
+        r = self._redraw_box_range(el)
+        n = 0
+        if r is not None and self.state.draw_points and times > 0:
+            code = self._code()     # first: it may add the pen's label to the table
+            labels = self.canvas.labels
+            n = redraw_kernels.redraw_near(self.canvas.codes,
+                                           redraw_kernels.label_selection(labels, tkinds, tmk),
+                                           redraw_kernels.label_selection(labels, bkinds, bmk),
+                                           times, r[0], r[1], code)
+        self._redraw_record(el, {"times": times, "target": sorted(tkinds), "targetmk": tmk,
+                                 "border": sorted(bkinds), "bordermk": bmk}, n)
+
+    cmd_redrawnearbox = cmd_redrawnear
 
     # ------------------------------------------------------------ shape output
     def cmd_shapeout(self, el):
