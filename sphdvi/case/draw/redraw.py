@@ -64,16 +64,19 @@ def redraw(codes: np.ndarray, selected: np.ndarray, lo, hi, code: int) -> int:
 def redraw_near(codes: np.ndarray, target: np.ndarray, border: np.ndarray, times: int,
                 lo, hi, code: int) -> int:
     """``times`` passes: write ``code`` on the target nodes of the box lo..hi that touch a border
-    node (anywhere on the lattice); returns the number of nodes written in all."""
-    sl = tuple(slice(int(lo[a]), int(hi[a]) + 1) for a in range(3))
-    inside = np.zeros(codes.shape, dtype=np.bool_)
-    inside[sl] = True
+    node (inside the box or next to it); returns the number of nodes written in all. Each pass
+    looks at the box and one node around it only."""
+    wlo = [max(int(lo[a]) - 1, 0) for a in range(3)]
+    whi = [min(int(hi[a]) + 1, codes.shape[a] - 1) for a in range(3)]
+    window = codes[tuple(slice(wlo[a], whi[a] + 1) for a in range(3))]      # a view
+    inner = tuple(slice(int(lo[a]) - wlo[a], int(hi[a]) - wlo[a] + 1) for a in range(3))
+    view = window[inner]
     written = 0
     for _ in range(times):
-        hit = target[codes] & inside & _touching(border[codes]) & (codes != code)
+        hit = target[view] & (view != code) & _touching(border[window])[inner]
         n = int(np.count_nonzero(hit))
         if n == 0:
             break
-        codes[hit] = code
+        view[hit] = code
         written += n
     return written
