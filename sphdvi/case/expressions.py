@@ -206,8 +206,13 @@ class Variables:
 
     @staticmethod
     def _format(value) -> str:
+        """A number as text: a whole number without a decimal point, others to 15 significant
+        digits, so binary rounding noise stays out of the text (``[Dp*3]`` with Dp = 0.1 is
+        "0.3", not "0.30000000000000004": a file name built from it is the one meant)."""
         if isinstance(value, float) and value.is_integer() and abs(value) < 1e15:
             return str(int(value))
+        if isinstance(value, float):
+            return f"{value:.15g}"
         return str(value)
 
     def _eval(self, node):

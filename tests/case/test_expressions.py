@@ -133,6 +133,15 @@ def test_interpolation(v):
     assert v.interpolate("dp is [Dp*100] cm, x3=[x[3]]") == "dp is 1 cm, x3=33"
 
 
+def test_interpolation_leaves_binary_noise_out(v):
+    """[0.1*3] is 0.30000000000000004 in binary: the text is "0.3" (a file name built with it
+    named a file that does not exist); meaningful digits stay (15 significant)."""
+    v.define("a", 0.1)
+    assert v.interpolate("part_[a*3].stl") == "part_0.3.stl"
+    assert v.interpolate("[1/3]") == "0.333333333333333"
+    assert v.interpolate("[a*1e-20]") == "1e-21"
+
+
 def test_delete_pattern(v):
     v.delete("x?")
     assert "x1" not in v.values and "Dp" in v.values
