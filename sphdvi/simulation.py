@@ -38,6 +38,9 @@ import numpy as np
 
 from ._version import __version__
 from .errors import DivergenceError, InputError, SphdviError
+from .run_checks import (and_list, box_text, check_boundary_in_domain, check_initial_density, fmt_vec, outside,
+                         warn_inward_mdbc_normals, warn_thin_mdbc_walls, warn_undamped_mdbc)
+from .run_options import absolute_file_sets, apply_overrides, conflicting_options, resolved_parameters
 from .io.checkpoint import (RESTART_FILE, case_identity, checkpoint_time, load_bodies_checkpoint,
                             load_sph_checkpoint, save_bodies_checkpoint, save_sph_checkpoint)
 from .io.atomic import make_folder, remove_leftover_temporaries
@@ -82,162 +85,6 @@ def default_threads() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover
         return os.cpu_count() or 1
-
-
-# ---------------------------------------------------------------------------------
-# parameters from the case file and the command line
-# ---------------------------------------------------------------------------------
-def absolute_file_sets(sets) -> tuple:
-    """``--set ViscoTime=FILE`` / ``--set DtFixedFile=FILE``: FILE, like every path on the command
-    line, is relative to the current directory; it is made absolute here, so that run.json keeps
-    a path that ``--resume`` finds from any directory (in the XML the value is relative to the
-    case's folder, as DualSPHysics's DirCase).  Without ``--set`` nothing to do: the XML case
-    reader (lxml, the schema; ~40 ms) is imported only when there are keys to look at."""
-    if not sets:
-        return ()
-    from .case.reader import DATA_FILE_KEYS
-    out = []
-    for item in sets or ():
-        key, sep, value = str(item).partition("=")
-        value = value.strip()
-        if sep and key.strip() in DATA_FILE_KEYS and value and value.upper() != "NONE":
-            item = f"{key.strip()}={os.path.abspath(os.path.expanduser(value))}"
-        out.append(item)
-    return tuple(out)
-
-
-# <constantsdef> constants that only the time stepping reads (the particles gencase draws do not
-# depend on them): ``--set`` takes them; key (any letter case) -> the name in the parameters
-RUN_CONSTANTS = {"cflnumber": "CFLnumber"}
-
-
-def _run_constant(key: str, value: str) -> float:
-    """``--set CFLnumber=V``: the case reader's check of <cflnumber> (a finite number, > 0, <= 10)."""
-    try:
-        number = float(value)
-    except ValueError:
-        raise InputError(f"--set {key}: '{value}' is not a number; expected a number > 0 (DualSPHysics's cases "
-                         "use 0.2)") from None
-    if not (math.isfinite(number) and 0 < number <= 10):
-        raise InputError(f"--set {key}: {value}: expected a finite number > 0 and <= 10 (DualSPHysics's cases use 0.2)")
-    return number
-
-
-def conflicting_options(sets, tmax, tout) -> None:
-    """--tmax with --set TimeMax (or --tout with --set TimeOut) of another value: InputError naming both
-    (the option won silently before, and run.json's ``set`` still listed the other value)."""
-    for option, key, value in (("--tmax", "TimeMax", tmax), ("--tout", "TimeOut", tout)):
-        if value is None:
-            continue
-        for item in sets or ():
-            name, _, given = (x.strip() for x in str(item).partition("="))
-            with contextlib.suppress(ValueError):
-                if name == key and float(given) != float(value):
-                    raise InputError(f"{option} {float(value):g} and --set {key}={given} give {key} two values; "
-                                     f"expected one of them")
-
-
-def nested_key_hint(key: str) -> str | None:
-    """A ``--set`` key with a dot or naming a <special> section (``special.shifting.mode``,
-    ``gauges``): the message that such settings are edited in the case file; None otherwise.
-    DualSPHysics's command line has no such keys either: its <special> sections are read from the XML."""
-    from .case.reader import SPECIAL_KNOWN
-    parts = [p for p in key.strip().lower().split(".") if p]
-    sections = [p for p in parts if p in SPECIAL_KNOWN]
-    if "." not in key and not sections and parts != ["special"]:
-        return None
-    where = f"<special><{sections[0]}>" if sections else ("<special>" if "special" in parts else "a nested element")
-    hint = ""
-    if "." not in key:
-        from .case.parameters import closest_key
-        close = closest_key(key)
-        hint = f"; did you mean the parameter '{close}'?" if close else ""
-    return (f"--set {key}: {where} is a section of the case file, not a --set key (--set takes the "
-            f"<parameters> keys and CFLnumber): edit it in the case file and run gencase again (or sphdvi run "
-            f"CASE.xml, which runs gencase){hint}")
-
-
-def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=None) -> dict:
-    """``--set KEY=VALUE`` (a <parameters> key, or CFLnumber: :data:`RUN_CONSTANTS`), ``--tmax``,
-    ``--tout``; raises InputError.
-
-    The checks and warnings are the case reader's: each value as in the XML, then the
-    checks across parameters (RhopOutMin < RhopOutMax) on the result; deprecated keys and
-    keys without effect in sphdvi are warned about (``warnings.warn``)."""
-    from .case.parameters import (DOMAIN_KEYS, PARAMETERS, apply_delta_sph, check_consistency, check_supported,
-                                  closest_key, coerce, constant_hint, parameter_warnings)
-    out = dict(params)
-    given = []
-    for item in sets or ():
-        if "=" not in item:
-            raise InputError(f"--set {item!r}: expected KEY=VALUE")
-        key, value = (s.strip() for s in item.split("=", 1))
-        if key.lower() in RUN_CONSTANTS:
-            out[RUN_CONSTANTS[key.lower()]] = _run_constant(key, value)
-            given.append(RUN_CONSTANTS[key.lower()])
-            continue
-        if key not in PARAMETERS:
-            nested = nested_key_hint(key)
-            if nested:
-                raise InputError(nested)
-            const = constant_hint(key)
-            if const:
-                raise InputError(f"--set {key}: {const} (gencase draws the particles with it: their masses, initial "
-                                 "densities, h, B, c0; --set takes the <parameters> keys and CFLnumber)")
-            hint = closest_key(key)
-            raise InputError(f"--set: unknown parameter '{key}'" + (f"; did you mean '{hint}'?" if hint else ""))
-        if key in DOMAIN_KEYS:
-            raise InputError(f"--set {key}: it shapes the domain gencase writes; put it in the case file "
-                             "(or better a <simulationdomain>) and run gencase again")
-        try:
-            out[key] = coerce(key, value)
-            check_supported(key, out[key])
-        except ValueError as exc:
-            raise InputError(f"--set {key}: {exc}") from None
-        for text in parameter_warnings(key, out[key]):
-            warnings.warn(f"--set {key}: {text}")
-        given.append(key)
-    try:
-        apply_delta_sph(out, given)
-    except ValueError as exc:
-        raise InputError(f"--set: {exc}") from None
-    if str(out.get("MdbcMkbound") or "").strip() and str(out.get("Boundary", 1)).strip() != "2":
-        warnings.warn(f"MdbcMkbound '{str(out['MdbcMkbound']).strip()}' does nothing: it picks the boundaries mDBC "
-                      f"acts on, and Boundary is {out.get('Boundary', 1)} (DBC), not 2 (mDBC); add --set Boundary=2")
-    for option, key, value in (("--tmax", "TimeMax", tmax), ("--tout", "TimeOut", tout)):
-        if value is not None:
-            try:
-                out[key] = coerce(key, value)
-            except ValueError as exc:
-                raise InputError(f"{option} {value}: {exc}") from None
-    if not out["TimeOut"] > 0:
-        raise InputError(f"TimeOut is {out['TimeOut']}: it must be positive; give --tout or correct the case "
-                         "file and run gencase again")
-    try:
-        check_consistency(out)
-    except ValueError as exc:
-        raise InputError(("--set: " if given else "case parameters: ") + str(exc)) from None
-    return out
-
-
-def resolved_parameters(params: dict, constants: dict, sph: bool) -> dict:
-    """run.json's ``parameters`` (the values the run uses), ``parameters_auto`` and ``constants``:
-    DtIni and DtMin given as 0 resolved as DualSPHysics's JSph (DtIni = h/c0, DtMin =
-    CoefDtMin h/c0; its Run.out prints those) and named in ``parameters_auto``; the earlier spelling
-    MdbcFastSingle left out beside MDBCFastSingle; the case's constants (dp, h, B, c0, gamma, rhop0,
-    masses, 2D, ...) with the CFLnumber the run uses (``--set CFLnumber``)."""
-    out = {k: v for k, v in params.items() if k != "MdbcFastSingle"}
-    auto = {}
-    consts = dict(constants)
-    if "CFLnumber" in params:
-        consts["cflnumber"] = params["CFLnumber"]
-    h, c0 = float(consts.get("h") or 0.0), float(consts.get("cs0") or 0.0)
-    if sph and h > 0 and c0 > 0:
-        for key, formula, value in (("DtIni", "h/c0", h / c0),
-                                    ("DtMin", "CoefDtMin*h/c0", float(params.get("CoefDtMin") or 0.0) * h / c0)):
-            if not float(params.get(key) or 0.0):
-                out[key], auto[key] = value, formula
-    return {"parameters": out, "parameters_auto": auto, "constants": consts}
 
 
 # ---------------------------------------------------------------------------------
@@ -896,7 +743,7 @@ class SPHRun:
         self.consts = c
         fluidcount = int(data["json"]["mkconfig"]["fluidcount"])
         if not resume:          # the initial state's densities (a resumed run's are its own)
-            _check_initial_density(p["rhop"][p["type"] == 3], params)
+            check_initial_density(p["rhop"][p["type"] == 3], params)
         state = FluidState(p["pos"], p["vel"], p["rhop"], p["mass"], p["type"], p["idp"], p["mk"],
                            rhop0=c["rhop0"])
         js = data["json"]
@@ -918,7 +765,7 @@ class SPHRun:
                 Periodicity(periodic, p["pos"], float(c["dp"]), params).check_length(2.0 * float(c["h"]))
             except ValueError as exc:
                 raise InputError(str(exc)) from None
-        _check_boundary_in_domain(p, domain, fluidcount)
+        check_boundary_in_domain(p, domain, fluidcount)
         normals0 = None
         if int(params.get("Boundary", 1)) == 2:
             from .case.normals import boundary_normals
@@ -941,12 +788,12 @@ class SPHRun:
             args = (p["pos"], normals0, p["type"], labels, float(c["dp"]), float(c["h"]))
             mask = ghosts_in_own_wall(*args)
             inward = inward_normal_mkbounds(*args, inward=mask)
-            _warn_inward_mdbc_normals(inward, float(c["dp"]))
+            warn_inward_mdbc_normals(inward, float(c["dp"]))
             thin = thin_wall_mkbounds(*args, inward=mask)
-            _warn_thin_mdbc_walls({mk: v for mk, v in thin.items() if mk not in inward},
+            warn_thin_mdbc_walls({mk: v for mk, v in thin.items() if mk not in inward},
                                   layers_needed(float(c["h"]), float(c["dp"])), float(c["h"]) / float(c["dp"]))
             state.mass[mdbc_floating_mask(p["type"], labels, params, normals0)] = float(c["massbound"])
-            _warn_undamped_mdbc(params, p, normals0, c)
+            warn_undamped_mdbc(params, p, normals0, c)
         # the solids that move boundary particles, and the damping zones: each only when
         # the case has it
         self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)
@@ -1039,7 +886,7 @@ class SPHRun:
             return
         s = solver.state
         sel = np.flatnonzero(s.ptype == 1)
-        out = _outside(s.pos[sel], dom)
+        out = outside(s.pos[sel], dom)
         if not out.any():
             return
         from .coupling import body_labels
@@ -1050,8 +897,8 @@ class SPHRun:
                  (("min", s.pos[rows, j] < dom[0][j]), ("max", s.pos[rows, j] > dom[1][j])) if bad.any()]
         raise DivergenceError(
             f"t={solver.time:.6g} s, step {solver.nstep}: moving boundary mkbound {mkb} left the simulation "
-            f"domain {_box(dom)} through its {_and(faces)} face{'s' if len(faces) > 1 else ''}: its "
-            f"particle {int(s.idp[k])} is at {_fmt(s.pos[k])} ({rows.size} moving particles out); DualSPHysics "
+            f"domain {box_text(dom)} through its {and_list(faces)} face{'s' if len(faces) > 1 else ''}: its "
+            f"particle {int(s.idp[k])} is at {fmt_vec(s.pos[k])} ({rows.size} moving particles out); DualSPHysics "
             f"stops too (AbortBoundOut: \"Fixed, moving or floating particles were excluded\"): enlarge "
             f"<simulationdomain> or check the motion")
 
@@ -1071,7 +918,7 @@ class SPHRun:
                     i = bad[0]
                     raise DivergenceError(
                         f"t={sol.time:.6g} s, step {sol.nstep}: particle {int(ev['idp'][i])} at "
-                        f"{_fmt(ev['pos'][i])} has a non-finite value (NaN or inf); cause: the solution blew up "
+                        f"{fmt_vec(ev['pos'][i])} has a non-finite value (NaN or inf); cause: the solution blew up "
                         f"(try a smaller cflnumber or DtFixed, or more viscosity)")
         if sol.n_dtmin > self.dtmin_seen:
             self.dtmin_run += sol.n_dtmin - self.dtmin_seen
@@ -1109,7 +956,7 @@ class SPHRun:
         if not events:
             return "last: none this step"
         ev = events[-1]
-        return (f"last: particle {int(ev['idp'][-1])} at {_fmt(ev['pos'][-1])}, reason {ev['reason'][-1]}")
+        return (f"last: particle {int(ev['idp'][-1])} at {fmt_vec(ev['pos'][-1])}, reason {ev['reason'][-1]}")
 
     def _note_faces(self, ev: dict) -> None:
         """The faces of the simulation domain the particles excluded for their position in ``ev``
@@ -1128,7 +975,7 @@ class SPHRun:
     def _faces(self) -> str:
         order = [f"{a}-{e}" for a in "xyz" for e in ("min", "max")]
         faces = [f for f in order if f in self.out_faces]
-        return _and(faces) + (" faces" if len(faces) > 1 else " face")
+        return and_list(faces) + (" faces" if len(faces) > 1 else " face")
 
     def _excluded_by_reason(self) -> str:
         """The fluid excluded so far by reason (DualSPHysics's "Excluded for: position=.. rhop=..
@@ -1172,7 +1019,7 @@ class SPHRun:
                            np.where((s.ptype == 2)[:, None], sol.ace, 0.0))
             i = int(np.argmax(np.einsum("ij,ij->i", ace, ace)))
             return (f"the force term CFL*sqrt(h/|a|max) = {dt1:.3g} s set dt (the speed term gives {dt2:.3g} s): "
-                    f"largest acceleration on particle {int(s.idp[i])} at {_fmt(s.pos[i])} "
+                    f"largest acceleration on particle {int(s.idp[i])} at {fmt_vec(s.pos[i])} "
                     f"({math.sqrt(float(ace[i] @ ace[i])):.3g} m/s2)")
         term = (f"the speed term CFL*h/(max(c0, 10|v|max) + h*ViscDtMax) = {dt2:.3g} s set dt (the force term "
                 f"gives {dt1:.3g} s)")
@@ -1184,7 +1031,7 @@ class SPHRun:
             speed = np.einsum("ij,ij->i", s.vel, s.vel) * (s.ptype >= sol.dt_vel_type)
             i = int(np.argmax(speed))
             return (f"{term} with 10|v|max = {10.0 * vmax:.3g} m/s > c0 = {c0:.3g} m/s: fastest particle "
-                    f"{int(s.idp[i])} at {_fmt(s.pos[i])} (|v| {vmax:.3g} m/s); the flow is faster than a tenth "
+                    f"{int(s.idp[i])} at {fmt_vec(s.pos[i])} (|v| {vmax:.3g} m/s); the flow is faster than a tenth "
                     f"of the speed of sound: raise coefsound/speedsound")
         return (f"{term} with the speed of sound c0 = {c0:.3g} m/s (10|v|max = {10.0 * vmax:.3g} m/s): DtMin is "
                 f"above the CFL dt of the speed of sound: lower DtMin (or CoefDtMin)")
@@ -1216,7 +1063,7 @@ class SPHRun:
     def _exclusion_cause(self, default: str) -> str:
         """The likely cause of a mass exclusion for the divergence messages: dt raised to DtMin in
         the steps before, or ``default``.  (A density window that excludes the initial fluid
-        does not start: :func:`_check_initial_density`.)"""
+        does not start: :func:`sphdvi.run_checks.check_initial_density`.)"""
         sol = self.solver
         if self.dtmin_run > 0:
             return (f"cause: dt was raised to DtMin ({sol.dtmin:.3g} s) in the last {self.dtmin_run} step(s), "
@@ -1291,122 +1138,6 @@ def min_fluid(params: dict, n0_fluid: int) -> int:
     return int(np.float32(mfs) * np.float32(n0_fluid))
 
 
-def _check_initial_density(rhop_fluid: np.ndarray, params: dict) -> None:
-    """DualSPHysics's JSph::CheckRhoLimits (JSph::LoadCaseParticles): a fluid particle that starts
-    with a density outside [RhopOutMin, RhopOutMax] is an input error; the run does not start."""
-    if rhop_fluid.size == 0:
-        return
-    rmin, rmax = float(params.get("RhopOutMin", 700.0)), float(params.get("RhopOutMax", 1300.0))
-    out = int(np.count_nonzero((rhop_fluid < rmin) | (rhop_fluid > rmax)))
-    if not out:
-        return
-    lo, hi = float(rhop_fluid.min()), float(rhop_fluid.max())
-    raise InputError(f"{out} of {rhop_fluid.size} fluid particles start with a density outside RhopOutMin/RhopOutMax "
-                     f"[{rmin:g}, {rmax:g}] (the initial fluid densities span [{lo:.6g}, {hi:.6g}] kg/m3); "
-                     "DualSPHysics refuses to start such a case too (\"Initial fluid density is out of limits\"): "
-                     "to change the limits modify the value of RhopOutMin and RhopOutMax (<parameters>, or --set)")
-
-
-_BOUNDARY_KINDS = {0: "fixed", 1: "moving", 2: "floating"}
-
-
-def _outside(pos: np.ndarray, domain, tol: float = 0.0) -> np.ndarray:
-    """Rows of ``pos`` outside the box ``domain`` = (posmin, posmax) (beyond ``tol``)."""
-    return np.any((pos < domain[0] - tol) | (pos > domain[1] + tol), axis=1)
-
-
-def _and(items: list) -> str:
-    """'a', 'a and b', 'a, b and c'."""
-    return " and ".join(items) if len(items) < 3 else ", ".join(items[:-1]) + " and " + items[-1]
-
-
-def _box(domain) -> str:
-    return f"{_fmt(domain[0])} - {_fmt(domain[1])}"
-
-
-def _check_boundary_in_domain(p: dict, domain, fluidcount: int) -> None:
-    """Boundary particles (fixed, moving, floating) outside the simulation domain at the start
-    (a <simulationdomain> that cuts the walls) are an input error: DualSPHysics excludes them at
-    its first cell division and aborts (JSph::AbortBoundOut, "Fixed, moving or floating particles
-    were excluded").  The same tolerance as gencase's check of the fluid."""
-    bound = np.flatnonzero(p["type"] != 3)
-    if bound.size == 0:
-        return
-    pos = p["pos"][bound]
-    out = _outside(pos, domain, 1e-9 * max(1.0, float(np.abs(pos).max())))
-    if not out.any():
-        return
-    from .coupling import body_labels
-    rows = bound[out]
-    labels = body_labels(p["mk"][rows], fluidcount)
-    kinds = p["type"][rows]
-    groups = []
-    for mkb in np.unique(labels):
-        sel = labels == mkb
-        groups.append(f"mkbound {int(mkb)} ({_BOUNDARY_KINDS.get(int(kinds[sel][0]), 'boundary')}): "
-                      f"{int(sel.sum())}")
-    i = int(rows[0])
-    raise InputError(f"{rows.size} boundary particles lie outside the simulation domain {_box(domain)}: "
-                     f"{', '.join(groups)} (first: particle {int(p['idp'][i])} at {_fmt(p['pos'][i])}); "
-                     "DualSPHysics excludes them at its first cell division and stops (AbortBoundOut: \"Fixed, "
-                     "moving or floating particles were excluded\"): enlarge <simulationdomain> to hold the walls")
-
-
-def _warn_inward_mdbc_normals(inward: dict, dp: float) -> None:
-    """Ghost nodes inside their own wall (:func:`~sphdvi.case.normals.ghosts_in_own_wall`): the
-    surface the normals are computed from lies behind the wall's face layer."""
-    for mk, count in sorted(inward.items()):
-        warnings.warn(f"mDBC on mkbound {mk}: {count} of its particles have their ghost node (r + 2N, where mDBC "
-                      "samples the fluid) on a particle of their own wall: the surface their normals are computed "
-                      f"from lies behind the wall's face layer, not dp/2 = {0.5 * dp:g} m in front of it, and the "
-                      "face layer's normals point back into the wall. Put the surface (the <norgeometry> shapes, "
-                      "a <norplane> point) dp/2 in front of the face layer; a shape's face half-way between two "
-                      "nodes draws its particles on the side the tie rounds to, which may be outside the shape")
-
-
-def _warn_thin_mdbc_walls(thin: dict, need: int, h_dp: float) -> None:
-    """mDBC on walls thinner than the kernel's reach leaks (:func:`~sphdvi.case.normals.thin_wall_mkbounds`)."""
-    if not thin:
-        return
-    vdp = ",".join(str(k) for k in range(need))
-    one = sorted(mk for mk, (fewest, _) in thin.items() if fewest == 1)
-    more = {mk: v for mk, v in thin.items() if v[0] > 1}
-    if one:
-        warnings.warn(f"mDBC on mkbound {', '.join(map(str, one))}: a wall one particle thick, through which "
-                      "the fluid leaks (S3's dam break at dp 0.02: 200-210 of 5,501 particles out by 0.72 s; "
-                      f"with two or three layers 1-2, DBC 0); draw it with <layers vdp=\"{vdp}\"> (the kernel "
-                      f"reaches 2h = {2 * h_dp:.1f} dp), or keep it DBC (MdbcMkbound)")
-    for mk, (fewest, count) in sorted(more.items()):
-        warnings.warn(f"mDBC on mkbound {mk}: the wall is {fewest} particles thick behind {count} of its face "
-                      f"particles, where the kernel reaches {need} layers (2h = {2 * h_dp:.2f} dp); the fluid leaks "
-                      "through it (a 3D tank with 2 layers on two sides: 35 particles through by 1 s at low "
-                      f"viscosity); draw it {need} layers thick (<layers vdp=\"{vdp}\">, or a larger solid box)")
-
-
-# the share of the fluid within 2h of mDBC walls above which DensityDT 2 with SlipMode 1 is warned about
-UNDAMPED_MDBC_SHARE = 0.5
-
-
-def _warn_undamped_mdbc(params: dict, p: dict, normals, c: dict) -> None:
-    """mDBC SlipMode 1 extrapolates the walls' density along the gradient measured at their ghost
-    nodes, which feeds a pressure mode across a narrow tank (the wall values of a cos(pi y/W) mode
-    come out x1.04 / 1.32 / 1.82 by layer at W = 10 dp), and DensityDT 2 (Fourtakas, as DualSPHysics)
-    is off for a fluid particle with a boundary particle within 2h, so that nothing damps it: a 3D
-    tank 10 dp across grew a 50 Hz mode to a wall force of 140 N on 130 N of water by 0.75 s (still
-    with DensityDT 3 or 1, or SlipMode 2).  Warned when more than half the fluid lies within 2h of
-    mDBC walls."""
-    if int(params.get("SlipMode", 1)) != 1 or int(params.get("DensityDT", 0)) != 2:
-        return
-    walls = (p["type"] != 3) & np.any(normals != 0.0, axis=1)
-    from .sph.cells import share_within
-    share = share_within(p["pos"][p["type"] == 3], p["pos"][walls], 2.0 * float(c["h"]), bool(c["is2d"]))
-    if share > UNDAMPED_MDBC_SHARE:
-        warnings.warn(f"mDBC SlipMode 1 with DensityDT 2: {100 * share:.0f} % of the fluid lies within 2h of mDBC "
-                      "walls, where DensityDT 2 (Fourtakas) is off, as in DualSPHysics; an acoustic mode across a "
-                      "narrow tank can then grow undamped (a 3D tank 10 dp across: wall forces as large as the "
-                      "water's weight). Prefer DensityDT 3 (or 1), SlipMode 2 or 3, or more particles across")
-
-
 def _clean_up_after_failure(*steps) -> None:
     """Run each step (None: skipped) of a failed run's clean-up, whatever the others raise: on a
     full disk they fail too, and a particle file left open crashed the interpreter at exit
@@ -1453,10 +1184,6 @@ def _check_output_space(outdir: str, step_bytes: int, t: float, step: int, part:
     if free < need:
         raise _disk_full(f"too little space left on the device ({free / 2**20:.1f} MiB free, an output needs "
                          f"about {need / 2**20:.1f} MiB)", outdir, t, step, part)
-
-
-def _fmt(v) -> str:
-    return "(" + ", ".join(f"{float(x):.5g}" for x in v) + ")"
 
 
 class _Stop:

@@ -57,9 +57,9 @@ def run_dir_name(index: int, count: int) -> str:
 # ---------------------------------------------------------------------------------
 def canonical_key(key: str) -> str:
     """A varied or fixed key as ``sphdvi run --set`` identifies it: the <constantsdef> constants it
-    takes in any letter case (CFLnumber, :data:`sphdvi.simulation.RUN_CONSTANTS`) under their one
+    takes in any letter case (CFLnumber, :data:`sphdvi.run_options.RUN_CONSTANTS`) under their one
     name; the <parameters> keys as written (case-sensitive, as in the XML)."""
-    from .simulation import RUN_CONSTANTS
+    from .run_options import RUN_CONSTANTS
     key = key.strip()
     return RUN_CONSTANTS.get(key.lower(), key)
 
@@ -208,7 +208,7 @@ def check_entries(case_xml: str, keys, rows, sets, tmax, tout, source: str = "--
     alone where one does (per-key messages; a value valid only with the other values of its
     entry is accepted).  Returns the warnings those checks give (each once), for the command to
     print."""
-    from .simulation import apply_overrides, conflicting_options
+    from .run_options import apply_overrides, conflicting_options
     _check_key_names(keys, sets)
     base = case_parameters(case_xml)
     seen = []
@@ -268,8 +268,8 @@ def describe(keys, row) -> str:
 
 def absolute_values(keys, rows) -> list[list[str]]:
     """Varied file keys (ViscoTime, DtFixedFile) made absolute, as ``--set`` makes them
-    (:func:`sphdvi.simulation.absolute_file_sets`): the runs start from other folders."""
-    from .simulation import absolute_file_sets
+    (:func:`sphdvi.run_options.absolute_file_sets`): the runs start from other folders."""
+    from .run_options import absolute_file_sets
     out = []
     for row in rows:
         new = []
@@ -332,7 +332,7 @@ def make_spec(case_xml: str, keys, rows, sets, tmax, tout, threads: int, time_li
               command: str | None = None) -> dict:
     """sweep.json: everything needed to run entry i (its values: ``runs[i]``, in ``keys`` order);
     the case's checksum and those of the files it names (:func:`case_data_files`)."""
-    from .simulation import absolute_file_sets
+    from .run_options import absolute_file_sets
     return {"format": FORMAT, "version": __version__,
             "case": os.path.abspath(case_xml), "case_sha256": file_sha256(case_xml),
             "case_files": case_data_files(case_xml),

@@ -223,7 +223,7 @@ def test_divergence_cleaning_is_refused_when_switched_on(tmp_path):
                      "divergence cleaning", msg)
     assert "0 (off) or no such parameter" in msg
     from sphdvi.errors import InputError
-    from sphdvi.simulation import apply_overrides
+    from sphdvi.run_options import apply_overrides
     with pytest.raises(InputError, match="--set DivCleaning: DivCleaning=1 is not supported"):
         apply_overrides({"TimeOut": 0.1}, ["DivCleaning=1"])
     assert apply_overrides({"TimeOut": 0.1}, ["DivCleaning=0"])["DivCleaning"] == 0
@@ -239,7 +239,7 @@ def test_deprecated_deltasph_selects_molteni_diffusion(tmp_path):
                                         '<parameter key="DensityDT" value="2"/>')
     assert "'DeltaSPH' and 'DensityDT' cannot be combined" in str(err.value)
     from sphdvi.errors import InputError
-    from sphdvi.simulation import apply_overrides
+    from sphdvi.run_options import apply_overrides
     with pytest.warns(UserWarning, match="'DeltaSPH' is deprecated"):
         p = apply_overrides({"TimeOut": 0.1, "DensityDT": 0}, ["DeltaSPH=0.05"])
     assert p["DensityDT"] == 1 and p["DensityDTvalue"] == 0.05

@@ -286,7 +286,7 @@ def test_tmax_and_set_timemax_of_two_values_are_refused(gcase, tmp_path):
                        (["--tout", "0.01", "--set", "TimeOut=0.025"], "--tout 0.01 and --set TimeOut=0.025")):
         r = invoke(["run", gcase, "-o", tmp_path / "o"] + args + TINY)
         assert_input_error(r, text, "give ", "two values")
-    from sphdvi.simulation import conflicting_options
+    from sphdvi.run_options import conflicting_options
     conflicting_options(["TimeMax=0.02"], 0.02, None)       # the same value: fine
 
 

@@ -160,7 +160,8 @@ def test_symplectic_corrector_sees_the_bodies_at_the_half_step(case_data, tmp_pa
     corrector: the floating particles the corrector's interaction sees are displaced by
     V dt/2 from those the predictor's saw, and the step ends at x^n + dt V^(n+1) (the multibody
     state put back after the half step).  Verlet evaluates once, with the bodies at t^n."""
-    from sphdvi.simulation import SPHRun, apply_overrides, special_parameters
+    from sphdvi.run_options import apply_overrides
+    from sphdvi.simulation import SPHRun, special_parameters
     params = apply_overrides(special_parameters(case_data), ["FtPause=0", f"StepAlgorithm={algo}"])
     sph = SPHRun(case_data, params, str(tmp_path))
     sol, fb = sph.solver, sph.floating

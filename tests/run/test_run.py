@@ -655,17 +655,17 @@ def test_mdbc_on_one_layer_walls_is_warned(tmp_path):
     assert r.exit_code == 0 and not any("particle thick" in str(w.message) or "particles thick" in str(w.message)
                                         for w in caught)
     # a wall thicker than one layer but thinner than the kernel's reach (2 layers where it reaches 3)
-    from sphdvi.simulation import _warn_thin_mdbc_walls
+    from sphdvi.run_checks import warn_thin_mdbc_walls
     with pytest.warns(UserWarning, match=r"mDBC on mkbound 4: the wall is 2 particles thick behind 120 of its face "
                                          r'particles, where the kernel reaches 3 layers.*<layers vdp="0,1,2">'):
-        _warn_thin_mdbc_walls({4: (2, 120)}, 3, 3 ** 0.5)
+        warn_thin_mdbc_walls({4: (2, 120)}, 3, 3 ** 0.5)
 
 
 def test_undamped_mdbc_mode_is_warned():
     """mDBC SlipMode 1 with DensityDT 2 where most of the fluid is within 2h of mDBC walls (a 3D
     tank 10 dp across grew an acoustic mode across it to wall forces of the water's weight) is
     warned about, naming the share and the remedies; DensityDT 3, SlipMode 2, or a wide tank not."""
-    from sphdvi.simulation import _warn_undamped_mdbc
+    from sphdvi.run_checks import warn_undamped_mdbc
     from sphdvi.sph.cells import share_within
     dp, h = 0.02, 0.02 * 2 ** 0.5
     xs = (np.arange(10) + 0.5) * dp
@@ -683,14 +683,14 @@ def test_undamped_mdbc_mode_is_warned():
                            ({"SlipMode": 2, "DensityDT": 2}, False)):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            _warn_undamped_mdbc(params, p, normals, c)
+            warn_undamped_mdbc(params, p, normals, c)
         msgs = [str(w.message) for w in caught]
         assert bool(msgs) == warned, msgs
         if warned:
             assert "52 % of the fluid lies within 2h of mDBC walls" in msgs[0] and "DensityDT 3" in msgs[0]
     with warnings.catch_warnings(record=True) as caught:     # DBC walls (no normal): not counted
         warnings.simplefilter("always")
-        _warn_undamped_mdbc({"SlipMode": 1, "DensityDT": 2}, p, np.zeros_like(normals), c)
+        warn_undamped_mdbc({"SlipMode": 1, "DensityDT": 2}, p, np.zeros_like(normals), c)
     assert not caught
 
 

@@ -224,7 +224,8 @@ def test_gauge_files_start_anew_in_a_new_run(done, tmp_path):
     """RunGauges of a new run (resume=False) rewrites its files: one series, not two."""
     from sphdvi.io.casefile import read_case_h5
     from sphdvi.measure.gauges import RunGauges
-    from sphdvi.simulation import apply_overrides, special_parameters
+    from sphdvi.run_options import apply_overrides
+    from sphdvi.simulation import special_parameters
     out = copy_run(done, tmp_path / "o")
     path = out / "GaugesSWL_Swl_x02.csv"
     assert len(csv_rows(path)) >= 2
@@ -430,7 +431,7 @@ def test_run_and_resume_without_set_do_not_import_the_case_reader(tmp_path):
         assert res.returncode == 0, res.stderr
         assert "READER False" in res.stdout, (args, res.stdout, res.stderr)
     assert nsteps(out / "particles.vtkhdf") == 3
-    from sphdvi.simulation import absolute_file_sets
+    from sphdvi.run_options import absolute_file_sets
     assert absolute_file_sets(()) == ()
     assert absolute_file_sets(["DtFixedFile=dt.csv", "Visco=0.1"]) == (f"DtFixedFile={os.path.abspath('dt.csv')}",
                                                                        "Visco=0.1")

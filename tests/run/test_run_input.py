@@ -91,7 +91,7 @@ def test_set_applies_the_cross_parameter_checks(done, tmp_path):
 
 
 def test_set_warnings_as_the_case_reader():
-    from sphdvi.simulation import apply_overrides
+    from sphdvi.run_options import apply_overrides
     base = {"TimeOut": 0.1, "DensityDT": 0}
     for item, text in (("DeltaSPH=0.05", "'DeltaSPH' is deprecated"),
                        ("FtSaveAce=1", "'FtSaveAce' has no effect"),
@@ -108,7 +108,7 @@ def test_set_warnings_as_the_case_reader():
 
 
 def test_set_of_a_constant_and_of_dem():
-    from sphdvi.simulation import apply_overrides
+    from sphdvi.run_options import apply_overrides
     with pytest.raises(InputError, match=r"'Gamma' is a constant of the case.*<gamma value=.*<constantsdef>"):
         apply_overrides({"TimeOut": 0.1}, ["Gamma=5"])
     assert apply_overrides({"TimeOut": 0.1}, ["CFLnumber=5"])["CFLnumber"] == 5.0   # read by the time step only

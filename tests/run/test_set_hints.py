@@ -32,7 +32,7 @@ def small_case(tmp_path):
                                            ("special=1", "<special>"),
                                            ("foo.bar=2", "a nested element")])
 def test_nested_or_special_keys_are_edited_in_the_case_file(item, section):
-    from sphdvi.simulation import apply_overrides
+    from sphdvi.run_options import apply_overrides
     key = item.split("=")[0]
     with pytest.raises(InputError) as exc:
         apply_overrides({"TimeOut": 0.1}, [item])
@@ -43,7 +43,7 @@ def test_nested_or_special_keys_are_edited_in_the_case_file(item, section):
 
 def test_a_special_section_name_also_points_to_the_parameter_of_that_name():
     """``--set shifting=1``: <special><shifting> is a section; the parameter is 'Shifting'."""
-    from sphdvi.simulation import apply_overrides
+    from sphdvi.run_options import apply_overrides
     with pytest.raises(InputError, match=r"<special><shifting> is a section.*did you mean the parameter 'Shifting'"):
         apply_overrides({"TimeOut": 0.1}, ["shifting=1"])
     assert apply_overrides({"TimeOut": 0.1}, ["Shifting=1"])["Shifting"] == 1      # the parameter itself
@@ -58,7 +58,7 @@ def test_nested_set_exits_2_from_the_command_line(tmp_path):
 
 
 def test_mdbc_mkbound_without_mdbc_warns_that_it_does_nothing():
-    from sphdvi.simulation import apply_overrides
+    from sphdvi.run_options import apply_overrides
     with pytest.warns(UserWarning, match=r"MdbcMkbound '50' does nothing: .*Boundary is 1 \(DBC\), not 2"):
         apply_overrides({"TimeOut": 0.1, "Boundary": 1}, ["MdbcMkbound=50"])
     with pytest.warns(UserWarning, match=r"MdbcMkbound '5' does nothing"):      # Boundary left at its default
