@@ -88,7 +88,7 @@ def gauge_distance(opts: dict, dp: float, h: float) -> float:
 
 class PistonAbsorber:
     """The AWAS correction of one piston (``paddle``: a :class:`sphdvi.motion.WavePaddle` or
-    ``SpectrumPaddle``, ``opts``: the case's ``awas`` dict, see :func:`sphdvi.case.reader._read_awas`).
+    ``SpectrumPaddle``, ``opts``: the case's ``awas`` dict, see :func:`sphdvi.case.wavepaddles_xml._read_awas`).
     ``face_x``: the x of the piston's front face at rest; ``zlim``: the domain's z range (the gauge's
     default); ``dp``, ``h``: the case's. After :meth:`update` at a step's end, ``offset`` and
     ``velocity`` are the correction's displacement and rate, which the paddle adds to its stroke."""

@@ -564,7 +564,7 @@ def test_second_order_flap_is_warned_and_first_order(tmp_path):
     """DualSPHysics's example main/08_WavesFlap asks <waveorder value="2"> of a <flap>; its format
     doc gives flaps no <waveorder> (second order is for pistons): warned, generated at first order
     (it was refused, which stopped the example)."""
-    from sphdvi.case.reader import read_wavepaddles
+    from sphdvi.case.wavepaddles_xml import read_wavepaddles
     from sphdvi.case.xmldoc import CaseReader
     from lxml import etree
     xml = ('<wavepaddles><flap><mkbound value="0"/><depth value="1"/>\n<waveorder value="2"/>'

@@ -9,7 +9,8 @@ import pytest
 from click.testing import CliRunner
 from lxml import etree
 
-from sphdvi.case.reader import read_motion, read_wavepaddles
+from sphdvi.case.reader import read_motion
+from sphdvi.case.wavepaddles_xml import read_wavepaddles
 from sphdvi.case.xmldoc import CaseReader
 from sphdvi.cli import main
 from sphdvi.errors import CaseError

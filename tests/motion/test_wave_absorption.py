@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from sphdvi.case.reader import read_wavepaddles
+from sphdvi.case.wavepaddles_xml import read_wavepaddles
 from sphdvi.case.xmldoc import CaseReader
 from sphdvi.errors import CaseError
 from sphdvi.motion import SpectrumPaddle, WavePaddle, piston_height_to_stroke, wave_number

@@ -9,7 +9,7 @@ import pytest
 from lxml import etree
 from scipy.integrate import quad
 
-from sphdvi.case.reader import read_wavepaddles
+from sphdvi.case.wavepaddles_xml import read_wavepaddles
 from sphdvi.case.xmldoc import CaseReader
 from sphdvi.errors import CaseError
 from sphdvi.motion import SpectrumPaddle, WavePaddle, flap_height_to_stroke, wave_number
