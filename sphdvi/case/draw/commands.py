@@ -1084,9 +1084,10 @@ class GeometryRunner:
             lo[1] = hi[1] = 0
         return self.lat.clip_range(lo, hi)
 
-    def _redraw_label(self, el, kind_attr: str | None, mk_attr: str | None, prefix: str = ""):
-        """(kinds, mk) named by a redraw command: ``mkfluid``/``mkbound`` (redraw, redrawbox),
-        or ``<prefix>tp`` (void, fluid, bound joined by |) and ``<prefix>mk`` (redrawnear)."""
+    def _redraw_label(self, el, kind_attr: str | None, mk_attr: str | None):
+        """(kinds, mk) named by a redraw command: ``mkfluid``/``mkbound`` (redraw, redrawbox;
+        ``kind_attr`` None), or the attributes ``kind_attr`` (void, fluid, bound joined by |) and
+        ``mk_attr`` (redrawnear: targettp/targetmk, bordertp/bordermk)."""
         if kind_attr is None:
             mkfluid = self.reader.integer(el, "mkfluid", None, lo=0)
             mkbound = self.reader.integer(el, "mkbound", None, lo=0)
@@ -1129,7 +1130,8 @@ class GeometryRunner:
 
     def cmd_redrawnear(self, el):
         """``<redrawnear times targettp targetmk bordertp bordermk>``: ``times`` passes, each
-        giving the current pen to the target nodes that touch a border node across a face."""
+        giving the current pen to the target nodes with a border node among their 26 neighbours
+        (8 in 2D)."""
         self._need_pen(el)
         allowed = {"dirfilter"} | ({"point", "size", "endpoint"} if el.tag == "redrawnearbox" else set())
         self._check(el, allowed)
