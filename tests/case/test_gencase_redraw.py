@@ -163,3 +163,26 @@ def test_a_redrawn_floating_body_gets_no_analytic_mass(tmp_path):
     assert plain.bodies[0].analytic["mass"] == pytest.approx(500 * 0.4 * 0.4)
     assert r.bodies[0].analytic is None
     assert len(r.particles["mk"]) == 19 * 19        # 21 x 21 less the outer ring
+
+
+@pytest.mark.parametrize("command, message", [
+    ('<setmkbound mk="1"/><redraw mkfluid="4"/>', "changed no node: no node holds mkfluid 4"),
+    ('<setmkbound mk="1"/><redrawbox mkbound="0"><point x="6" y="6" z="6"/><size x="1" y="1" z="1"/>'
+     '</redrawbox>', "no node holds mkbound 0 (other than the pen's) within its box"),
+    ('<setmkbound mk="0"/><redraw/><redraw/>', "every node already holds the pen's label"),
+    ('<setmkbound mk="1"/><redrawnear targettp="void" bordertp="fluid"/>',
+     "no void node (other than the pen's) touches a fluid node"),
+])
+def test_a_redraw_that_changes_nothing_is_warned(tmp_path, command, message):
+    """A misspelt label, or one not drawn yet, made a redraw do nothing without a word."""
+    from test_draw_compat import warnings_of
+    _, warns = warnings_of(tmp_path, '<setmkbound mk="0"/>' + box((0, 0, 0), (2, 2, 2)) + command, **CUBE)
+    assert any(message in str(w) for w in warns), [str(w) for w in warns]
+
+
+def test_a_redraw_that_changes_nodes_is_not_warned(tmp_path):
+    from test_draw_compat import warnings_of
+    _, warns = warnings_of(tmp_path, '<setmkbound mk="0"/>' + box((0, 0, 0), (2, 2, 2))
+                           + '<setmkbound mk="1"/><redraw mkbound="0"/><redrawnear times="0" '
+                           'targettp="void" bordertp="bound"/>', **CUBE)
+    assert not warns

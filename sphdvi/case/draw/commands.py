@@ -1105,11 +1105,15 @@ class GeometryRunner:
                                     "void, fluid or bound (joined by |)")
         return kinds, self.reader.integer(el, mk_attr, None, lo=0)
 
-    def _redraw_record(self, el, params: dict, n: int) -> None:
+    def _redraw_record(self, el, params: dict, n: int, what: str) -> None:
         """Recorded like a shape; ``redraws`` tells a floating body's analytic mass (gencase)
-        that nodes drawn before may have changed label."""
+        that nodes drawn before may have changed label. A redraw that changes no node is warned
+        about (``what`` says what it looked for): a label misspelt or not drawn yet."""
         self._record(el, el.tag, params, None, False, n)
         self.primitives[-1]["redraws"] = True
+        if n == 0 and self.state.draw_points and params.get("times", 1) > 0:
+            where = " within its box" if el.tag.endswith("box") else ""
+            self.reader.warn(el, f"this <{el.tag}> changed no node: {what}{where}")
 
     def cmd_redraw(self, el):
         """``<redraw [mkfluid|mkbound]>``: every node holding that label (every node, void
@@ -1124,7 +1128,9 @@ class GeometryRunner:
             n = redraw_kernels.redraw(self.canvas.codes,
                                       redraw_kernels.label_selection(self.canvas.labels, kinds, mk),
                                       r[0], r[1], code)
-        self._redraw_record(el, {"kinds": sorted(kinds), "mk": mk}, n)
+        what = ("every node already holds the pen's label" if mk is None else
+                f"no node holds mk{'fluid' if 'fluid' in kinds else 'bound'} {mk} (other than the pen's)")
+        self._redraw_record(el, {"kinds": sorted(kinds), "mk": mk}, n, what)
 
     cmd_redrawbox = cmd_redraw
 
@@ -1152,8 +1158,12 @@ class GeometryRunner:
                                            redraw_kernels.label_selection(labels, tkinds, tmk),
                                            redraw_kernels.label_selection(labels, bkinds, bmk),
                                            times, r[0], r[1], code)
+        def named(kinds, mk):
+            return " or ".join(sorted(kinds)) + ("" if mk is None else f" mk {mk}")
         self._redraw_record(el, {"times": times, "target": sorted(tkinds), "targetmk": tmk,
-                                 "border": sorted(bkinds), "bordermk": bmk}, n)
+                                 "border": sorted(bkinds), "bordermk": bmk}, n,
+                            f"no {named(tkinds, tmk)} node (other than the pen's) touches a "
+                            f"{named(bkinds, bmk)} node")
 
     cmd_redrawnearbox = cmd_redrawnear
 

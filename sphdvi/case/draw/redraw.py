@@ -53,10 +53,10 @@ def _touching(mask: np.ndarray) -> np.ndarray:
 
 def redraw(codes: np.ndarray, selected: np.ndarray, lo, hi, code: int) -> int:
     """Write ``code`` on the nodes of the index box lo..hi (inclusive, clipped) whose code is
-    selected; returns the number of nodes written."""
+    selected; returns the number of nodes changed (those holding ``code`` already are not)."""
     sl = tuple(slice(int(lo[a]), int(hi[a]) + 1) for a in range(3))
     view = codes[sl]
-    hit = selected[view]
+    hit = selected[view] & (view != code)
     view[hit] = code
     return int(np.count_nonzero(hit))
 
