@@ -142,8 +142,8 @@ Redraw (``redraw``, ``redrawbox``, ``redrawnear``, ``redrawnearbox``; see :mod:`
     target nodes (void, fluid or bound, joined by ``|``; of mk ``targetmk`` if given) with a
     border node among their 26 neighbours (8 in 2D); a pen equal to the border grows it a layer
     a pass. ``redrawnearbox`` limits the targets to a box. ``<dirfilter>`` other than ``all``
-    is refused (its direction rule is not documented). GenCase v4.0's records of RedrawSimple
-    and RedrawComplex are matched count for count.
+    is refused (its direction rule is not documented). A redraw that changes no node is warned
+    about. GenCase v4.0's records of RedrawSimple and RedrawComplex are matched count for count.
 
 Not supported (CaseError "not supported by sphdvi"): see ``UNSUPPORTED``
 (bathymetry, waves, clipping, patterns, ...)
