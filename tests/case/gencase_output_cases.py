@@ -1617,3 +1617,144 @@ REDRAWCOMPLEX = """<?xml version="1.0" encoding="UTF-8" ?>
     </execution>
 </case>
 """
+
+
+#: MYF940103/GeoDualSPHysics_v5.2_private examples/Hydromechanic coupling/01_SelfWeightConsolidation_PR/
+#: support/diagnostics/diag2_hydrostatic_constantz_fixeddt_t02/CaseHydrostaticSteady.xml, GenCase
+#: v5.0.278c (30-10-2023): a soil column in a U drawn by <drawbeach>, the lattice cleared by
+#: <setmkvoid/><redraw/>, the walls thickened by a full-mode <fillbox> and <redrawnear times="3">,
+#: the rest of that fill erased by <redraw mkbound="1"> under the void pen, the side walls then
+#: erased by void fills: 40 floor particles and 1000 fluid. The fork's <soils> section and its own
+#: parameters (DPCtes, ArtificialStress, SoilDamping...) are left out; the geometry is the file's.
+HYDROSTATICSTEADY_GEO = """<?xml version="1.0" encoding="UTF-8" ?>
+<case app="GenCase v5.0.278c (30-10-2023)" date="04-06-2026 02:29:43">
+    <casedef>
+        <constantsdef>
+            <gravity x="0" y="0" z="-9.81" />
+            <rhop0 value="2100" />
+            <hswl value="0" auto="true" />
+            <gamma value="7" />
+            <speedsystem value="0" auto="true" />
+            <coefsound value="20" />
+            <speedsound value="0" auto="true" />
+            <hdp value="1.8" />
+            <cflnumber value="0.2" />
+        </constantsdef>
+        <mkconfig boundcount="240" fluidcount="9" />
+        <geometry>
+            <predefinition>
+                <newvarcte sizefx="0.1" _rem="Soil column width" />
+                <newvarcte sizefz="1.0" _rem="Soil column height" />
+                <newvarcte sizebx="0.1" _rem="Boundary width" />
+                <newvarcte sizebz="1.2" _rem="Boundary height" />
+                <newvarcte Dp="0.01" _rem="Particle spacing" />
+            </predefinition>
+            <definition dp="#Dp" units_comment="metres (m)">
+                <pointmin x="#-sizefz/2+Dp/2" y="0" z="#-sizefz/2+Dp/2" />
+                <pointmax x="#sizefz*1.5+Dp/2" y="0" z="#sizebz*1.5+Dp/2" />
+            </definition>
+            <commands>
+                <mainlist>
+                    <setshapemode>actual | bound</setshapemode>
+                    <setnormalinvert invert="false" />
+                    <move x="0" y="-0.1" z="0" />
+                    <setmkbound mk="0" />
+                    <drawbeach mask="1|2|6">
+                        <point x="0" y="0.2" z="#sizebz" />
+                        <point x="0" y="0.2" z="0" />
+                        <point x="#sizebx" y="0.2" z="0" />
+                        <point x="#sizebx" y="0.2" z="#sizebz" />
+                    </drawbeach>
+                    <matrixreset />
+                    <shapeout file="hdp" />
+                    <setmkvoid />
+                    <redraw />
+                    <setshapemode>actual | bound</setshapemode>
+                    <setdrawmode mode="full" />
+                    <setmkbound mk="0" />
+                    <setnormalinvert invert="true" />
+                    <move x="0" y="-0.1" z="0" />
+                    <drawbeach mask="1|2|6">
+                        <point x="#-Dp/2" y="0.2" z="#sizebz+Dp/2" />
+                        <point x="#-Dp/2" y="0.2" z="#-Dp/2" />
+                        <point x="#sizebx+Dp/2" y="0.2" z="#-Dp/2" />
+                        <point x="#sizebx+Dp/2" y="0.2" z="#sizebz+Dp/2" />
+                    </drawbeach>
+                    <shapeout file="Boundary" />
+                    <matrixreset />
+                    <setmkbound mk="1" />
+                    <setboxlimitmode mode="full" />
+                    <fillbox x="#-1.5*Dp" y="0" z="#-1.5*Dp">
+                        <modefill>void</modefill>
+                        <point x="#-Dp*10" y="-1" z="#-Dp*10" />
+                        <size x="#(sizebx+Dp*20)" y="2" z="#(sizebz+Dp*10)" />
+                    </fillbox>
+                    <setboxlimitmode mode="full" />
+                    <setmkbound mk="0" />
+                    <redrawnear times="3" targettp="bound" targetmk="1" bordertp="bound" bordermk="0" />
+                    <setmkvoid />
+                    <redraw mkbound="1" />
+                    <setmkfluid mk="0" />
+                    <fillbox x="#Dp/2" y="0" z="#Dp/2">
+                        <modefill>void</modefill>
+                        <point x="#-Dp/2" y="-1" z="#-Dp/2" />
+                        <size x="#(sizefx)" y="2" z="#(sizefz)" />
+                    </fillbox>
+                    <setmkvoid />
+                    <fillbox x="#-Dp/2" y="0" z="#Dp/2">
+                        <modefill>bound</modefill>
+                        <point x="#-Dp*10.5" y="-1" z="#-Dp*10.5" />
+                        <size x="#Dp*10" y="2" z="#(sizebz+Dp*10.5)" />
+                    </fillbox>
+                    <setmkvoid />
+                    <fillbox x="#sizebx+Dp" y="0" z="#Dp">
+                        <modefill>bound</modefill>
+                        <point x="#sizefx+Dp/2" y="-1" z="#-Dp*10" />
+                        <size x="#(Dp*10)" y="2" z="#(sizebz+Dp*10)" />
+                    </fillbox>
+                </mainlist>
+            </commands>
+        </geometry>
+    </casedef>
+    <execution>
+        <parameters>
+            <parameter key="Boundary" value="2" />
+            <parameter key="StepAlgorithm" value="2" />
+            <parameter key="Visco" value="0.4" />
+            <parameter key="CoefDtMin" value="0.001" />
+            <parameter key="DtIni" value="0.000001" />
+            <parameter key="DtMin" value="0.00000001" />
+            <parameter key="DtFixed" value="0.000001" />
+            <parameter key="TimeMax" value="0.2" />
+            <parameter key="TimeOut" value="0.02" />
+            <parameter key="RhopOutMax" value="3000" />
+        </parameters>
+        <particles np="1040" nb="40" nbf="40" mkboundfirst="10" mkfluidfirst="1">
+            <_summary>
+                <positions units_comment="metres (m)">
+                    <posmin x="0.005" y="0" z="-0.035" />
+                    <posmax x="0.095" y="0" z="0.995" />
+                </positions>
+                <fixed count="40" id="0-39" mkcount="1" mkvalues="10" />
+                <fluid count="1000" id="40-1039" mkcount="1" mkvalues="1" />
+            </_summary>
+            <fixed mkbound="0" mk="10" begin="0" count="40" />
+            <fluid mkfluid="0" mk="1" begin="40" count="1000" />
+        </particles>
+        <constants>
+            <data2d value="true" />
+            <data2dposy value="0" units_comment="metres (m)" />
+            <gravity x="0" y="0" z="-9.81" units_comment="m/s^2" />
+            <cflnumber value="0.2" />
+            <gamma value="7" />
+            <rhop0 value="2100" units_comment="kg/m^3" />
+            <dp value="0.01" units_comment="metres (m)" />
+            <h value="0.018" units_comment="metres (m)" />
+            <b value="1165428" units_comment="Pascal (Pa)" />
+            <massbound value="0.21" units_comment="kg" />
+            <massfluid value="0.21" units_comment="kg" />
+        </constants>
+        <motion />
+    </execution>
+</case>
+"""
