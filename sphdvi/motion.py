@@ -19,7 +19,12 @@ Movements (DualSPHysics ``JMotion``; times τ measured from the start of the mov
   interpolated linearly from a file of ``fields`` columns, its first row played at the movement's
   start and the displacement measured from it, the velocity the slope of the rows' segment (0
   outside the file's times); ``fieldtime``, ``fieldx``... are 0-based column indices
-  (DualSPHysics's JMotionDataFile).
+  (DualSPHysics's JMotionDataFile);
+* ``mvrotadvfile``: three Euler angles from a file (``fieldang1``-``3``; ``axes`` such as XYZ,
+  ``intrinsic`` or about the fixed axes, each turn right-handed), the object turned about
+  ``center`` to the orientation they give relative to the file's first row's
+  (:func:`_from_euler_file`; DualSPHysics applies the angles step by step and does not publish how:
+  this is sphdvi's reading, exact whatever the step).
 
 A movement ends after ``duration`` and continues with ``next``; the chain starts at
 ``begin start`` and stops at ``finish``. A negative duration is DualSPHysics's "flash"
@@ -174,6 +179,9 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
     if kind in ("mvrectfile", "mvrotfile"):
         state.update(carried)
         return _from_file(m, tau)
+    if kind == "mvrotadvfile":
+        state.update(carried)
+        return _from_euler_file(m, tau)
     raise ValueError(f"unsupported movement {kind}")
 
 
@@ -314,6 +322,60 @@ def _from_file(m, tau) -> Rigid:
     units = _angle_units(m)
     c = fields["fieldang"]
     return _rotational(m, float(value[c]) * units, float(rate[c]) * units, circular=False)
+
+
+_AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
+
+
+def euler_turns(angles, axes: str, intrinsic: bool) -> list:
+    """The three elementary turns of Euler angles, as (axis index, angle) in the order their
+    matrices multiply, R = R_1 R_2 R_3 (each R_k right-handed about a coordinate axis, as
+    DualSPHysics's JMatrix4 MatrixRotX/Y/Z): intrinsic ``axes`` "XYZ" with angles (a, b, c) is
+    Rx(a) Ry(b) Rz(c) (each turn about the axes the earlier ones left); extrinsic (about the
+    fixed axes, the first angle's turn applied first) Rz(c) Ry(b) Rx(a)."""
+    turns = [(_AXIS_INDEX[a], float(x)) for a, x in zip(axes, angles)]
+    return turns if intrinsic else turns[::-1]
+
+
+def euler_matrix(angles, axes: str, intrinsic: bool) -> np.ndarray:
+    """The rotation matrix of three Euler angles [rad] (:func:`euler_turns`)."""
+    R = np.eye(3)
+    for i, a in euler_turns(angles, axes, intrinsic):
+        R = R @ _rotation(_EYE[i], a)
+    return R
+
+
+def euler_rate(angles, rates, axes: str, intrinsic: bool) -> np.ndarray:
+    """The angular velocity ω (fixed axes) of Euler angles changing at ``rates``: with
+    R = R_1 R_2 R_3, Ṙ Rᵀ = [ω]ₓ for ω = ȧ_1 e_1 + R_1 ȧ_2 e_2 + R_1 R_2 ȧ_3 e_3."""
+    w = np.zeros(3)
+    R = np.eye(3)
+    for (i, a), (_, r) in zip(euler_turns(angles, axes, intrinsic), euler_turns(rates, axes, intrinsic)):
+        w += r * R[:, i]
+        R = R @ _rotation(_EYE[i], a)
+    return w
+
+
+def _from_euler_file(m, tau) -> Rigid:
+    """An ``mvrotadvfile`` ``tau`` seconds after it started: the orientation its file's Euler angles
+    give (each angle interpolated linearly, :func:`_file_values`), relative to its first row's, about
+    ``center``: x = c + R(τ) R(0)ᵀ (x0 − c); an angle without a column stays 0."""
+    from .case.datafiles import EULER_FIELDS
+    table, fields = _load_table(m)
+    value, rate = _file_values(table, tau)
+    units = _angle_units(m)
+    first = np.zeros(3)
+    a, w = np.zeros(3), np.zeros(3)
+    for k, name in enumerate(EULER_FIELDS):
+        if name in fields:
+            j = fields[name]
+            first[k] = table.columns[j, 0] * units
+            a[k], w[k] = first[k] + value[j] * units, rate[j] * units
+    axes, intrinsic = m["axes"], bool(m["intrinsic"])
+    R0 = _of_movement(m, "euler0", lambda _: euler_matrix(first, axes, intrinsic))
+    R = euler_matrix(a, axes, intrinsic) @ R0.T
+    c = np.asarray(m.get("center", (0.0, 0.0, 0.0)), float)
+    return Rigid(R=R, d=c - R @ c, W=euler_rate(a, w, axes, intrinsic), c=c)
 
 
 def chain_transform(chain: dict, t: float, walks: dict | None = None) -> Rigid:
@@ -738,6 +800,103 @@ class SpectrumPaddle(_Paddle):
         return np.cos(a) @ self.amp
 
 
+def group_velocity(omega, k, depth: float):
+    """Linear waves' group velocity c_g = (ω/k)/2 · (1 + 2kd / sinh 2kd) (Dean & Dalrymple 1991 §4)."""
+    omega, k = np.asarray(omega, float), np.asarray(k, float)
+    kd2 = 2.0 * k * depth
+    with np.errstate(over="ignore"):
+        ratio = np.where(kd2 < 700.0, kd2 / np.sinh(np.minimum(kd2, 700.0)), 0.0)
+    return 0.5 * omega / k * (1.0 + ratio)
+
+
+def newwave_crest(hs: float, nwaves: float) -> float:
+    """The crest of a NewWave group (Tromans, Anaturk & Hagemeijer 1991): the most probable largest
+    crest of ``nwaves`` waves of a narrow-band sea of spectral height Hs, √(2 m0 ln N) with
+    m0 = Hs²/16, i.e. Hs √(ln N / 8) (half the Rayleigh H_max = Hs √(ln N / 2))."""
+    if not nwaves > 1:
+        raise ValueError(f"the number of waves of the sea state must be above 1 (got {nwaves:g})")
+    return hs * math.sqrt(math.log(nwaves) / 8.0)
+
+
+class FocusedPaddle(SpectrumPaddle):
+    """A focused wave group from a piston (``<piston_focused>``), first order (NewWave, Tromans et
+    al. 1991): the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: the
+    spectrum, its discretisation, ``waves``, ``peakcoef``) take amplitudes a_i = A E_i / Σ E_j (E_i the
+    energy of wave i's bin, S(f_i) Δf_i) and phases that put every crest at the focus together:
+    η(x, τ) = Σ a_i cos(ω_i (τ − t_f) − k_i (x − x_f) + φ_f), A = :func:`newwave_crest` of
+    ``waveheight`` (Hs) over ``maxwaveh nwaves`` waves (1000), or over ``maxwaveh time`` / Tz
+    waves (Tz = √(m0/m2) of the components), φ_f = ``fphase`` (degrees; 0: a crest, 180: a
+    trough). Each wave is made by Biesel's stroke, as :class:`SpectrumPaddle` (``gainstroke`` scales
+    it).
+
+    x_f is ``xf``, a coordinate along ``pistondir``; the distance to the focus is counted from the
+    piston's front face at rest (:meth:`place`, the run's start; 0 until then). The focus time
+    t_f = ``fpretime`` + (x_f − face) / c_g,min after ``start``: the extra time, plus the time the
+    slowest group (the highest frequency's) takes to reach the focus, so that every wave has
+    left the paddle before the group forms. (DualSPHysics's own rule for t_f is not published;
+    this is sphdvi's.) A linear ramp over ``ramptime`` starts the motion from rest; ``fmovtime``
+    (seconds after ``start``, 0: never) stops the paddle, the motion ramped down to the piston's
+    rest position over the ``fmovramp`` seconds before it (0: it stops where it is)."""
+
+    def __init__(self, spec: dict, g: float = 9.81):
+        from .wavespectra import components
+        self._set_geometry(spec)
+        self.g = g
+        d = self.depth = spec["depth"]
+        comp = components(spec["spectrum"], spec["waveheight"], spec["waveperiod"], int(spec["waves"]),
+                          spec["discretization"], spec["peakcoef"], int(spec["randomseed"]))
+        self.components = comp
+        self.omega = 2 * np.pi * comp["f"]
+        self.k = np.array([wave_number(1.0 / f, d, g) for f in comp["f"]])
+        energy = comp["amp"] ** 2
+        maxwaveh = spec.get("maxwaveh") or {"nwaves": 1000}
+        if "time" in maxwaveh:
+            m0, m2 = float(np.sum(energy)), float(np.sum(energy * comp["f"] ** 2))
+            self.nwaves = float(maxwaveh["time"]) / math.sqrt(m0 / m2)
+        else:
+            self.nwaves = float(maxwaveh["nwaves"])
+        self.crest = newwave_crest(spec["waveheight"], self.nwaves)
+        self.amp = self.crest * energy / float(np.sum(energy)) * self.gain
+        self.half_stroke = self.amp / np.array([self._height_to_stroke(k, d) for k in self.k])
+        self.cg_min = float(np.min(group_velocity(self.omega, self.k, d)))
+        self.xf = float(spec["xf"])
+        self.fphase = math.radians(spec.get("fphase", 0.0))
+        self.pretime = spec.get("fpretime", 5.0)
+        self.t0 = 0.0
+        self.ramp_time = spec.get("ramptime", 0.0)
+        self.fmovtime = spec.get("fmovtime", 0.0)
+        self.fmovramp = min(spec.get("fmovramp", 0.0), self.fmovtime) if self.fmovtime > 0 else 0.0
+        if self.fmovtime > 0:
+            self.duration = self.fmovtime if self.duration <= 0 else min(self.duration, self.fmovtime)
+        self.place(0.0, check=False)
+
+    def place(self, face: float, check: bool = True) -> None:
+        """Count the distance to the focus from ``face``, the piston's front face along ``pistondir``
+        at rest: sets the focus distance, the focus time and the waves' phases (ValueError with
+        ``check``: the focus is not in front of the face)."""
+        self.face = float(face)
+        self.distance = self.xf - self.face
+        if check and not self.distance > 0:
+            raise ValueError(f"the focus xf={self.xf:g} m is not in front of the piston's face at {self.face:g} m "
+                             f"along its direction")
+        self.focus_time = self.pretime + self.distance / self.cg_min
+        self.phase = self.k * self.distance - self.omega * self.focus_time + self.fphase
+        self.offset = (float(np.sum(self.half_stroke * np.sin(self.phase)))
+                       if self.ramp_time <= 0 else 0.0)
+
+    def _ramp(self, tau):
+        """The start ramp (``ramptime``) times the end ramp (``fmovramp`` before ``fmovtime``), and its rate."""
+        r, dr = SpectrumPaddle._ramp(self, tau)
+        if self.fmovramp > 0 and tau > self.fmovtime - self.fmovramp:
+            e = max(0.0, (self.fmovtime - tau) / self.fmovramp)
+            return r * e, dr * e - (r / self.fmovramp if e > 0 else 0.0)
+        return r, dr
+
+    def elevation_at(self, x: float, t) -> np.ndarray:
+        """η at the coordinate ``x`` along ``pistondir`` (the focus is at x = ``xf``), without the ramps."""
+        return self.elevation(float(x) - self.face, t)
+
+
 SOLITARY_THEORIES = {1: "Rayleigh", 2: "Boussinesq", 3: "KdV"}
 GORING_THETA = 3.8        # Goring (1978): the motion spans tanh θ from -0.999 to 0.999
 
@@ -848,6 +1007,8 @@ def make_paddle(spec: dict, g: float = 9.81) -> _Paddle:
     """The paddle of a ``<wavepaddles>`` entry."""
     if spec["type"] == "piston_solitary":
         return SolitaryPaddle(spec, g)
+    if spec["type"] == "piston_focused":
+        return FocusedPaddle(spec, g)
     return SpectrumPaddle(spec, g) if spec["type"].endswith("_spectrum") else WavePaddle(spec, g)
 
 
@@ -862,6 +1023,16 @@ class MotionSet:
     @property
     def mkbounds(self):
         return sorted(set(self.motions) | set(self.paddles))
+
+    def place_paddles(self, pos: np.ndarray, labels: np.ndarray) -> None:
+        """Tell each paddle that counts distances from its face (a focused piston) where that face is
+        at rest: the largest coordinate along its direction of its particles (``labels``: each
+        particle's mkbound, -1 for fluid)."""
+        for mkb, paddle in self.paddles.items():
+            if isinstance(paddle, FocusedPaddle):
+                mine = labels == mkb
+                if mine.any():
+                    paddle.place(float((pos[mine] @ paddle.direction).max()))
 
     def transform(self, mkbound: int, t: float) -> Rigid:
         base = motion_transform(self.motions[mkbound], t, self._walks) if mkbound in self.motions else Rigid()

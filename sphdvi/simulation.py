@@ -728,6 +728,16 @@ class ExclusionWarnings:
 class SPHRun:
     """One SPH run: the solver, its motion/body hook, the output schedule and the checks."""
 
+    @staticmethod
+    def _place_paddles(motions, p: dict, fluidcount: int) -> None:
+        """The paddles that count distances from their face (focused pistons) learn where it is."""
+        from .coupling import body_labels
+        labels = np.where(p["type"] != 3, body_labels(p["mk"], fluidcount), -1)
+        try:
+            motions.place_paddles(p["pos"], labels)
+        except ValueError as exc:
+            raise InputError(f"<piston_focused>: {exc}") from None
+
     def __init__(self, data: dict, params: dict, outdir: str, resume: bool = False):
         from .motion import MotionSet
         from .sph.solver import SPHSolver
@@ -749,6 +759,7 @@ class SPHRun:
         js = data["json"]
         motions = MotionSet(js.get("motions", []), js.get("special", {}).get("wavepaddles", []),
                             g=float(np.linalg.norm(c["gravity"])))
+        self._place_paddles(motions, p, fluidcount)
         domain = (np.asarray(data["domain"]["posmin"], float), np.asarray(data["domain"]["posmax"], float))
         if c["is2d"]:
             domain[0][1] -= c["h"]

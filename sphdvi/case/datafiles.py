@@ -127,26 +127,35 @@ def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.nda
 MOTION_FILE_ALIASES = {"mvfile": "mvrectfile", "mvpredef": "mvrectfile"}
 
 
+#: an ``mvrotadvfile``'s angle columns, in the order of its ``axes``
+EULER_FIELDS = ("fieldang1", "fieldang2", "fieldang3")
+
+
 def motion_file_columns(tag: str, given: dict, ncols: int | None = None) -> tuple[int, dict]:
     """(number of columns, {fieldtime/fieldx/.../fieldang: 0-based column}) of a file movement
-    (``tag`` ``mvrectfile`` or ``mvrotfile``) from the columns ``given``: time defaults to
-    column 0 and an ``mvrotfile``'s angle to 1 (DualSPHysics's layout); without ``fields``
-    (``ncols``) the file has as many columns as the last one used."""
+    (``tag`` ``mvrectfile``, ``mvrotfile`` or ``mvrotadvfile``) from the columns ``given``: time
+    defaults to column 0, an ``mvrotfile``'s angle to 1 (DualSPHysics's layout), an
+    ``mvrotadvfile``'s three angles to 1, 2, 3 when it names none (an angle it does not name
+    stays 0); without ``fields`` (``ncols``) the file has as many columns as the last one used."""
     cols = dict(given)
     cols.setdefault("fieldtime", 0)
     if tag == "mvrotfile":
         cols.setdefault("fieldang", 1)
+    if tag == "mvrotadvfile" and not any(k in cols for k in EULER_FIELDS):
+        cols.update({k: i + 1 for i, k in enumerate(EULER_FIELDS)})
     return (int(ncols) if ncols else max(2, 1 + max(cols.values()))), cols
 
 
 def read_motion_file(reader, m, tag: str) -> dict:
     """Read and check the ``<file>`` of movement element ``m`` (``tag``: ``mvrectfile``, its
-    aliases included, or ``mvrotfile``): ``fields`` is the number of columns of the file,
-    ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``) 0-based column indices,
+    aliases included, ``mvrotfile`` or ``mvrotadvfile``): ``fields`` is the number of columns of
+    the file, ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``; ``fieldang1``-``3``)
+    0-based column indices,
     as DualSPHysics's JMotion reads them. The file is read and checked now."""
     f = reader.child(m, "file", True)
     path = reader.resolve_path(f, "name")
-    names = ("fieldtime", "fieldx", "fieldy", "fieldz") if tag == "mvrectfile" else ("fieldtime", "fieldang")
+    names = {"mvrectfile": ("fieldtime", "fieldx", "fieldy", "fieldz"),
+             "mvrotadvfile": ("fieldtime", *EULER_FIELDS)}.get(tag, ("fieldtime", "fieldang"))
     given = {k: reader.integer(f, k, lo=0) for k in names if f.get(k) is not None}
     ncols, cols = motion_file_columns(tag, given,
                                       reader.integer(f, "fields", lo=2) if f.get("fields") is not None else None)

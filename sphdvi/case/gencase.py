@@ -692,6 +692,12 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
                             line=wp["line"], element=wp["type"],
                             expected=f'<motion><objreal ref="{wp["mkbound"]}"> with an <mvnull>')
         _warn_paddle_depth(wp, pos, ptype, label, reader)
+        if wp["type"] == "piston_focused":
+            try:
+                focused_paddle(wp, pos, ptype, label)
+            except ValueError as exc:
+                raise CaseError(str(exc), file=reader.file, line=wp["line"], element="xf",
+                                expected="a focus in front of the piston, along its <pistondir>") from None
     chrono = case.special.get("chrono")
     floating_labels = {b.mkbound for b in bodies}
     if chrono:
@@ -761,6 +767,17 @@ def gauge_extent_points(g: dict) -> list:
                 far += mesh_length(g.get(f"size{k}")) * v / n
         return [g["point"], far]
     return []
+
+
+def focused_paddle(wp: dict, pos, ptype, label):
+    """The :class:`sphdvi.motion.FocusedPaddle` of a ``<piston_focused>``, its face placed from the
+    particles of its mkbound (ValueError: the focus is not in front of it)."""
+    from ..motion import FocusedPaddle
+    paddle = FocusedPaddle(wp)
+    mine = (ptype != TYPE_FLUID) & (label == wp["mkbound"])
+    if mine.any():
+        paddle.place(float((pos[mine] @ paddle.direction).max()))
+    return paddle
 
 
 def _warn_paddle_depth(wp: dict, pos, ptype, label, reader) -> None:
@@ -882,6 +899,12 @@ def summary(result: GenCaseResult) -> str:
             a = b.analytic
             diag = ", ".join(f"{a['inertia'][i][i]:.6g}" for i in range(3))
             lines.append(f"    analytic {a['shape']}: mass {a['mass']:.6g} {unit}, inertia diag ({diag})")
+    for wp in case.special.get("wavepaddles", []):
+        if wp["type"] == "piston_focused":
+            f = focused_paddle(wp, p["pos"], p["type"], p["label"])
+            lines.append(f"Focused group (mkbound {wp['mkbound']}): crest {f.crest:.4g} m at x = {f.xf:g} m, "
+                         f"t = {f.start + f.focus_time:.4g} s ({f.distance:.4g} m from the piston's face; "
+                         f"{f.amp.size} waves, the largest crest of {f.nwaves:.4g})")
     if result.normals is not None:
         bound = np.asarray(p["type"]) != TYPE_FLUID
         has = bound & np.any(result.normals != 0.0, axis=1)

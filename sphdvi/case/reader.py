@@ -456,8 +456,8 @@ MOVEMENTS = {
     "mvrectsinu": ("freq", "ampl", "phase"), "mvrotsinu": ("freq", "ampl", "phase", "axisp1", "axisp2"),
     "mvcirsinu": ("freq", "ampl", "phase", "ref", "axisp1", "axisp2"),
     "mvrectfile": ("file",), "mvrotfile": ("file", "axisp1", "axisp2"),
+    "mvrotadvfile": ("file",),          # and <center>, <intrinsic>, <axes>: _read_euler_axes
 }
-_ANGULAR = {"mvrot", "mvrotace", "mvcir", "mvcirace", "mvrotsinu", "mvcirsinu", "mvrotfile"}
 
 
 def read_motion(reader, casedef) -> list:
@@ -495,7 +495,8 @@ def _refuse_unsupported_movement(reader, m) -> None:
     """DualSPHysics v5.4's file movements that sphdvi does not implement: a clear error."""
     if m.tag in UNSUPPORTED_MOVEMENTS:
         raise reader.error(m, f"<{m.tag}> ({UNSUPPORTED_MOVEMENTS[m.tag]}, DualSPHysics v5.4) is not supported by "
-                           "sphdvi", "mvrectfile for positions from a file, mvrotfile for an angle about one axis")
+                           "sphdvi", "mvrectfile for positions from a file, mvrotfile for an angle about one axis, "
+                           "mvrotadvfile for three Euler angles")
 
 
 def _read_movement_chain(reader, obj, is2d=False):
@@ -531,6 +532,8 @@ def _read_movement_chain(reader, obj, is2d=False):
                 d[part] = reader.num(c, "v")
             else:
                 d[part] = reader.vec3(c).tolist()
+        if tag == "mvrotadvfile":
+            d.update(_read_euler_axes(reader, m))
         if "axisp1" in d and "axisp2" in d:
             p1, p2 = np.asarray(d["axisp1"]), np.asarray(d["axisp2"])
             if not np.linalg.norm(p2 - p1) > 1e-12 * max(1.0, np.abs(p1).max(), np.abs(p2).max()):
@@ -561,8 +564,25 @@ def _read_movement_chain(reader, obj, is2d=False):
     return chain
 
 
-UNSUPPORTED_MOVEMENTS = {"mvrotadvfile": "three Euler angles from a file",
-                         "mvpathfile": "positions and Euler angles from a file"}
+UNSUPPORTED_MOVEMENTS = {"mvpathfile": "positions and Euler angles from a file"}
+
+
+def _read_euler_axes(reader, m) -> dict:
+    """An ``mvrotadvfile``'s ``<axes value="XYZ">`` (three of X, Y, Z, no two in a row the same: Tait-Bryan
+    or proper Euler angles), ``<intrinsic value>`` (true: each turn about the axes as the earlier
+    turns left them; false: about the fixed axes) and ``<center>`` (the point the object turns
+    about; the origin when absent), as DualSPHysics's JMotionMovRotAdvFile writes them."""
+    el = reader.child(m, "axes", True)
+    axes = reader.text_attr(el, "value").strip().upper()
+    if len(axes) != 3 or any(a not in "XYZ" for a in axes) or axes[0] == axes[1] or axes[1] == axes[2]:
+        raise reader.error(el, f"axes value={axes!r}", "three of X, Y, Z, no two in a row the same (e.g. XYZ, ZYX, ZXZ)")
+    intrinsic = reader.boolean(reader.child(m, "intrinsic", True), "value")
+    c = reader.child(m, "center")
+    center = reader.vec3(c).tolist() if c is not None else [0.0, 0.0, 0.0]
+    for e in reader.children(m):
+        if e.tag not in ("file", "axes", "intrinsic", "center"):
+            raise reader.error(e, f"unknown element <{e.tag}> in <{m.tag}>", "<file>, <axes>, <intrinsic>, <center>")
+    return {"axes": axes, "intrinsic": intrinsic, "center": center}
 
 
 def _movement_timing(reader, m, tag) -> dict:
@@ -595,6 +615,10 @@ def _warn_dropped_y(reader, m, d) -> None:
         what = ", ".join(f"<{p}> y={d[p][1]:g}" for p in bad) or None
     elif tag == "mvrectfile" and "fieldy" in d.get("fields", {}):
         what = "the file's y column (fieldy)"
+    elif tag == "mvrotadvfile":
+        from .datafiles import EULER_FIELDS
+        turns = [a for a, f in zip(d["axes"], EULER_FIELDS) if a != "Y" and f in d["fields"]]
+        what = f"angles about {' and '.join(sorted(set(turns)))} from the file" if turns else None
     elif "axisp1" in d:
         axis = np.asarray(d["axisp2"], float) - np.asarray(d["axisp1"], float)
         if abs(axis[0]) > 1e-12 * np.linalg.norm(axis) or abs(axis[2]) > 1e-12 * np.linalg.norm(axis):
@@ -636,7 +660,7 @@ def _check_zero_loop(reader, movs, elements, first) -> None:
                                "a positive duration in the loop, or a movement without next")
 
 
-_TURNING = {"mvrot", "mvrotace", "mvrotsinu", "mvrotfile"}
+_TURNING = {"mvrot", "mvrotace", "mvrotsinu", "mvrotfile", "mvrotadvfile"}
 
 
 def _event_span(movs, event) -> tuple[float, float, bool]:

@@ -1,6 +1,6 @@
 """``<special><wavepaddles>``: the wave makers of a case as DualSPHysics reads them (regular
-``<piston>`` and ``<flap>``, irregular ``<piston_spectrum>`` and ``<flap_spectrum>``,
-``<piston_solitary>``; active absorption ``<awas_zsurf>``), with the warnings on waves outside a
+``<piston>`` and ``<flap>``, irregular ``<piston_spectrum>`` and ``<flap_spectrum>``, a focused group
+``<piston_focused>``, ``<piston_solitary>``; active absorption ``<awas_zsurf>``), with the warnings on waves outside a
 theory's range. Called by :mod:`sphdvi.case.reader`; :mod:`sphdvi.motion` generates the motion."""
 from __future__ import annotations
 
@@ -48,9 +48,13 @@ def read_wavepaddles(reader, el) -> list:
                      "randomseed": "int", "serieini": "raw", "ramptime": "num", "saveserie": "raw",
                      "saveseriewaves": "raw", "calcserielength": "raw"}
     flap_geometry = {"variabledraft": "num", "flapaxis0": "vec", "flapaxis1": "vec"}
+    spec_focused = {**spec_spectrum, "pistondir": "vec", "xf": "num", "fphase": "num", "maxwaveh": "raw",
+                    "fpretime": "num", "fmovtime": "num", "fmovramp": "num"}
+    for k in ("serieini", "saveserie", "saveseriewaves", "calcserielength"):
+        del spec_focused[k]
     specs = {"piston": {**spec_regular, "pistondir": "vec"}, "flap": {**spec_regular, **flap_geometry},
              "piston_spectrum": {**spec_spectrum, "pistondir": "vec"},
-             "flap_spectrum": {**spec_spectrum, **flap_geometry}}
+             "flap_spectrum": {**spec_spectrum, **flap_geometry}, "piston_focused": spec_focused}
     out = []
     for c in reader.children(el):
         if c.tag == "piston_solitary":
@@ -59,10 +63,12 @@ def read_wavepaddles(reader, el) -> list:
         if c.tag not in specs:
             raise reader.error(c, f"<wavepaddles><{c.tag}> is not supported by sphdvi",
                                "<piston> or <flap> (regular waves), <piston_spectrum> or <flap_spectrum> "
-                               "(irregular), <piston_solitary> (solitary waves)")
-        spectral = c.tag.endswith("_spectrum")
+                               "(irregular), <piston_focused> (a focused group), <piston_solitary> (solitary waves)")
+        focused = c.tag == "piston_focused"
+        spectral = c.tag.endswith("_spectrum") or focused
         d = {"type": c.tag, "line": c.sourceline}
-        d.update(_value_children(reader, c, specs[c.tag], required=("mkbound", "depth", "waveheight", "waveperiod")))
+        d.update(_value_children(reader, c, specs[c.tag], required=("mkbound", "depth", "waveheight", "waveperiod")
+                                 + (("xf",) if focused else ())))
         d.setdefault("waveorder", 1)
         if d["waveorder"] not in (1, 2):
             raise reader.error(c, f"waveorder {d['waveorder']}", "1 or 2")
@@ -95,8 +101,13 @@ def read_wavepaddles(reader, el) -> list:
         if c.tag.startswith("piston") and "pistondir" in d and not any(d["pistondir"]):
             raise reader.error(reader.child(c, "pistondir"), "<pistondir> is the zero vector",
                                "the direction of the piston's stroke, e.g. x=1 y=0 z=0")
+        if focused:         # the defaults DualSPHysics's format gives a focused piston
+            d.setdefault("discretization", "regular")
+            d.setdefault("waves", 128)
         if spectral:
             _read_spectrum_options(reader, c, d)
+        if focused:
+            _read_focus_options(reader, c, d)
         if "awas_zsurf" in d:
             d["awas"] = _read_awas(reader, reader.child(c, "awas_zsurf"), d)
             del d["awas_zsurf"]
@@ -126,8 +137,8 @@ def read_wavepaddles(reader, el) -> list:
         if "awas" in d:
             _check_awas_start(reader, c, d)
         try:       # the stroke from the wave theory: fails here, not at the first step of the run
-            from ..motion import SpectrumPaddle, WavePaddle
-            (SpectrumPaddle if spectral else WavePaddle)(d)
+            from ..motion import make_paddle
+            make_paddle(d)
         except (ArithmeticError, ValueError, CaseError) as exc:
             raise reader.error(c, f"cannot compute the paddle's stroke: {exc}",
                                "a wave period and depth of a real wave") from None
@@ -279,6 +290,45 @@ def _read_spectrum_options(reader, c, d: dict) -> None:
             reader.warn(el, "<serieini autofit> is not needed by sphdvi: the paddle starts from where it is "
                             "drawn without a jump (the ramp of <ramptime> starts the series from rest; without "
                             "one the series less its value at serieini is played); autofit is ignored")
+
+
+def _read_focus_options(reader, c, d: dict) -> None:
+    """The focus of a ``<piston_focused>`` (in place): ``xf``; ``fphase`` (degrees, 0); ``maxwaveh``
+    ``nwaves`` (1000) or ``time`` (s), the sea state whose largest crest the group is; ``fpretime`` (5 s),
+    ``fmovtime`` and ``fmovramp`` (0, 0), each checked."""
+    d.setdefault("fphase", 0.0)
+    d.setdefault("fpretime", 5.0)
+    d.setdefault("fmovtime", 0.0)
+    d.setdefault("fmovramp", 0.0)
+    for k, what in (("fpretime", "seconds before the slowest group's arrival at the focus"),
+                    ("fmovtime", "seconds after start; 0: the paddle never stops"),
+                    ("fmovramp", "seconds of the final ramp")):
+        if d[k] < 0:
+            raise reader.error(reader.child(c, k), f"<{k}> value={d[k]:g} is negative", f"{k} >= 0 ({what})")
+    if d["fmovramp"] > 0 and d["fmovtime"] <= 0:
+        raise reader.error(reader.child(c, "fmovramp"), f"<fmovramp> value={d['fmovramp']:g} without <fmovtime>",
+                           "a <fmovtime> (the end of the motion) for the final ramp to end at")
+    raw = d.pop("maxwaveh", None)
+    if raw is None:
+        d["maxwaveh"] = {"nwaves": 1000}
+        return
+    el = reader.child(c, "maxwaveh")
+    given = [k for k in ("nwaves", "time") if raw.get(k) is not None]
+    if len(given) != 1:
+        raise reader.error(el, "<maxwaveh> needs one of nwaves and time" if not given
+                           else "<maxwaveh> gives both nwaves and time",
+                           "nwaves=\"N\" (the group is the largest of N waves of the sea state) or time=\"T\" "
+                           "(of the waves in T seconds)")
+    if given[0] == "nwaves":
+        n = reader.integer(el, "nwaves")
+        if n < 2:
+            raise reader.error(el, f"<maxwaveh> nwaves={n}", "at least 2 waves")
+        d["maxwaveh"] = {"nwaves": n}
+    else:
+        t = reader.num(el, "time")
+        if not t > 0:
+            raise reader.error(el, f"<maxwaveh> time={t:g}", "a positive duration [s]")
+        d["maxwaveh"] = {"time": t}
 
 
 def read_piston_solitary(reader, c) -> dict:

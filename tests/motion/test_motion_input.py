@@ -412,10 +412,10 @@ def test_mvnull_reads_no_duration_and_no_next(tmp_path):
     assert m["movements"][0]["duration"] == 0.0 and m["movements"][0]["next"] is None
 
 
-@pytest.mark.parametrize("tag", ["mvrotadvfile", "mvpathfile"])
+@pytest.mark.parametrize("tag", ["mvpathfile"])
 @pytest.mark.parametrize("nested", [False, True])
 def test_v54_file_movements_are_reported_as_not_supported(tmp_path, tag, nested):
-    """<mvrotadvfile>/<mvpathfile> were refused as an "unknown motion element"."""
+    """<mvpathfile> was refused as an "unknown motion element" (<mvrotadvfile>: test_motion_euler.py)."""
     body = f'<{tag} id="1" duration="1"><file name="a.csv"/></{tag}>'
     begin = '<begin mov="1" start="0"/>'
     if nested:

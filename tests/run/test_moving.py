@@ -140,6 +140,53 @@ def test_spectrum_paddle_follows_its_series(tmp_path, tag, extra):
     assert moved > 1e-3
 
 
+def test_euler_file_motion_moves_the_particles(tmp_path):
+    """An <mvrotadvfile> (a Y angle from a file, about the paddle's centre) through the run: the
+    particles at the motion's exact transform."""
+    (tmp_path / "euler.csv").write_text("time;ay;ax;az\n0;0;0;0\n0.2;6;0;0\n")
+    motion = ('<mvrotadvfile id="1" duration="10" anglesunits="degrees"><file name="euler.csv" fields="4" '
+              'fieldang1="1" fieldang2="2" fieldang3="3"/><center x="-0.04" y="0" z="0.27"/>'
+              '<intrinsic value="true"/><axes value="YXZ"/></mvrotadvfile>')
+    out = run_case(tmp_path, motion)
+    p0, res = moving_positions(out)
+    from sphdvi.motion import chain_transform
+    from sphdvi.validation.runs import case_data
+    (m,) = case_data(out)["json"]["motions"]
+    for t, x, _, _ in res:
+        expect = chain_transform(m, t).apply(p0)[0]
+        assert np.allclose(x, expect, atol=1e-12)
+    assert float(np.abs(res[-1][1] - p0).max()) > 0.01
+
+
+def test_focused_paddle_counts_its_focus_from_its_face(tmp_path):
+    """A <piston_focused> moves its particles with FocusedPaddle's stroke, its focus distance
+    counted from the piston's front face at rest (x = -0.02 here), not from x = 0."""
+    special = ('<wavepaddles><piston_focused><mkbound value="10"/><depth value="0.3"/><spectrum value="jonswap"/>'
+               '<waveheight value="0.02"/><waveperiod value="1.0"/><waves value="20"/><xf value="1.0"/>'
+               '<fpretime value="0"/></piston_focused></wavepaddles>')
+    out = run_case(tmp_path, '<mvnull id="1" />', special, dtfixed=2e-4)
+    p0, res = moving_positions(out)
+    from sphdvi.validation.runs import case_data
+    paddle = MotionSet([], case_data(out)["json"]["special"]["wavepaddles"]).paddles[10]
+    assert paddle.distance == pytest.approx(1.0)
+    paddle.place(float(p0[:, 0].max()))
+    assert paddle.distance == pytest.approx(1.02)
+    for t, x, _, _ in res:
+        assert np.allclose(x, p0 + paddle.transform(t).d, atol=1e-12)
+    assert float(np.abs(res[-1][1] - p0).max()) > 1e-5
+
+
+def test_focus_behind_the_piston_is_a_case_error(tmp_path):
+    """xf behind the piston's face (here at x = -0.02) is exit 2 at gencase, naming <xf> and its line."""
+    special = ('<wavepaddles><piston_focused><mkbound value="10"/><depth value="0.3"/><spectrum value="jonswap"/>'
+               '<waveheight value="0.02"/><waveperiod value="1.0"/><xf value="-0.1"/></piston_focused></wavepaddles>')
+    case = tmp_path / "CaseMoving_Def.xml"
+    case.write_text(TANK.replace("MOTION", '<mvnull id="1" />').replace("SPECIAL", special))
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2
+    assert "<xf>: the focus xf=-0.1 m is not in front of the piston's face at -0.02 m" in r.output
+
+
 def test_damping_zone_reduces_velocity():
     from sphdvi.sph.damping import DampingZone
     from sphdvi.sph.state import FluidState
