@@ -236,7 +236,11 @@ AWAS_SPECTRUM = AWAS_PISTON.replace("<piston>", "<piston_spectrum>").replace("</
     '<ramp value="0"/>', "")
 
 
-@pytest.mark.parametrize("special", [AWAS_PISTON, AWAS_SPECTRUM], ids=["regular", "irregular"])
+AWAS_FOCUSED = AWAS_SPECTRUM.replace("piston_spectrum>", "piston_focused>").replace(
+    '<waves value="20"/>', '<waves value="20"/><xf value="0.8"/><fpretime value="0"/>')
+
+
+@pytest.mark.parametrize("special", [AWAS_PISTON, AWAS_SPECTRUM, AWAS_FOCUSED], ids=["regular", "irregular", "focused"])
 def test_absorbing_piston_moves_with_its_correction(tmp_path, special):
     """With <awas_zsurf> the piston's particles move as the theory's stroke plus the absorber's
     correction: at the start its gauge reads the still water where the target already has the
