@@ -694,10 +694,11 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
         _warn_paddle_depth(wp, pos, ptype, label, reader)
         if wp["type"] == "piston_focused":
             try:
-                focused_paddle(wp, pos, ptype, label)
+                paddle = focused_paddle(wp, pos, ptype, label)
             except ValueError as exc:
                 raise CaseError(str(exc), file=reader.file, line=wp["line"], element="xf",
                                 expected="a focus in front of the piston, along its <pistondir>") from None
+            _warn_focus_too_late(wp, paddle, case.parameters.get("TimeMax"), reader)
     chrono = case.special.get("chrono")
     floating_labels = {b.mkbound for b in bodies}
     if chrono:
@@ -778,6 +779,21 @@ def focused_paddle(wp: dict, pos, ptype, label):
     if mine.any():
         paddle.place(float((pos[mine] @ paddle.direction).max()))
     return paddle
+
+
+def _warn_focus_too_late(wp: dict, paddle, tmax, reader) -> None:
+    """A focused group whose focus time comes after the paddle stops (``fmovtime``, ``duration``) or
+    after the run's end (TimeMax) is warned about, with the time sphdvi's rule gives."""
+    tf = paddle.start + paddle.focus_time
+    ends = [(paddle.start + paddle.duration, "the paddle stops (<fmovtime>/<duration>)")] if paddle.duration > 0 else []
+    if tmax is not None and tmax > 0:
+        ends.append((float(tmax), "the run ends (TimeMax)"))
+    for t_end, what in ends:
+        if tf > t_end:
+            reader.warnings.add(f"the group focuses at t = {tf:.4g} s ({paddle.distance:.4g} m from the piston, "
+                                f"<fpretime> plus the time the slowest of its waves takes to get there), after "
+                                f"{what} at {t_end:g} s: the focus is not reached; move <xf> closer, or give more time",
+                                file=reader.file, line=wp.get("line"), element=wp["type"])
 
 
 def _warn_paddle_depth(wp: dict, pos, ptype, label, reader) -> None:

@@ -122,6 +122,8 @@ def read_wavepaddles(reader, el) -> list:
                         ("calcserielength", "<calcserielength> (DualSPHysics prints the length of the "
                                             "irregular series without repetition) is not implemented by sphdvi")):
             if k in d:
+                for el in reader.children(c, k):          # each <savemotion> line, as the format doc writes several
+                    reader.mark(el, *el.keys())
                 reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
         if d.get("fixeddepth", 0.0):
             reader.warn(reader.child(c, "fixeddepth"), "<fixeddepth> (the fluid depth without the paddle) is not "
@@ -294,8 +296,9 @@ def _read_spectrum_options(reader, c, d: dict) -> None:
 
 def _read_focus_options(reader, c, d: dict) -> None:
     """The focus of a ``<piston_focused>`` (in place): ``xf``; ``fphase`` (degrees, 0); ``maxwaveh``
-    ``nwaves`` (1000) or ``time`` (s), the sea state whose largest crest the group is; ``fpretime`` (5 s),
-    ``fmovtime`` and ``fmovramp`` (0, 0), each checked."""
+    ``nwaves`` (1000) or ``time`` (s; 0: not used), the sea state whose largest crest the group is, the
+    time deciding when positive (the two on one element or on two, as DualSPHysics's format doc writes
+    them); ``fpretime`` (5 s), ``fmovtime`` and ``fmovramp`` (0, 0), each checked."""
     d.setdefault("fphase", 0.0)
     d.setdefault("fpretime", 5.0)
     d.setdefault("fmovtime", 0.0)
@@ -308,27 +311,20 @@ def _read_focus_options(reader, c, d: dict) -> None:
     if d["fmovramp"] > 0 and d["fmovtime"] <= 0:
         raise reader.error(reader.child(c, "fmovramp"), f"<fmovramp> value={d['fmovramp']:g} without <fmovtime>",
                            "a <fmovtime> (the end of the motion) for the final ramp to end at")
-    raw = d.pop("maxwaveh", None)
-    if raw is None:
-        d["maxwaveh"] = {"nwaves": 1000}
-        return
-    el = reader.child(c, "maxwaveh")
-    given = [k for k in ("nwaves", "time") if raw.get(k) is not None]
-    if len(given) != 1:
-        raise reader.error(el, "<maxwaveh> needs one of nwaves and time" if not given
-                           else "<maxwaveh> gives both nwaves and time",
-                           "nwaves=\"N\" (the group is the largest of N waves of the sea state) or time=\"T\" "
-                           "(of the waves in T seconds)")
-    if given[0] == "nwaves":
-        n = reader.integer(el, "nwaves")
-        if n < 2:
-            raise reader.error(el, f"<maxwaveh> nwaves={n}", "at least 2 waves")
-        d["maxwaveh"] = {"nwaves": n}
-    else:
-        t = reader.num(el, "time")
-        if not t > 0:
-            raise reader.error(el, f"<maxwaveh> time={t:g}", "a positive duration [s]")
-        d["maxwaveh"] = {"time": t}
+    d.pop("maxwaveh", None)
+    nwaves, time = 1000, 0.0
+    for el in reader.children(c, "maxwaveh"):       # DualSPHysics's format doc writes one of each
+        reader.mark(el, *el.keys())
+        if el.get("nwaves") is not None:
+            nwaves = reader.integer(el, "nwaves")
+            if nwaves < 2:
+                raise reader.error(el, f"<maxwaveh> nwaves={nwaves}", "at least 2 waves")
+        if el.get("time") is not None:
+            time = reader.num(el, "time")
+            if time < 0:
+                raise reader.error(el, f"<maxwaveh> time={time:g} is negative",
+                                   "a duration [s] (0: the number of waves nwaves decides)")
+    d["maxwaveh"] = {"time": time} if time > 0 else {"nwaves": nwaves}
 
 
 def read_piston_solitary(reader, c) -> dict:

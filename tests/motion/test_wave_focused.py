@@ -138,12 +138,21 @@ def test_reader_defaults(tmp_path):
     assert (d["maxwaveh"], d["discretization"], d["waves"], d["fmovramp"]) == ({"time": 600.0}, "cosstretched", 40, 2.0)
 
 
+@pytest.mark.parametrize("inner, expect", [
+    ('<maxwaveh nwaves="500"/><maxwaveh time="0"/>', {"nwaves": 500}),     # DualSPHysics's format doc: both
+    ('<maxwaveh nwaves="500" time="600"/>', {"time": 600.0}),               # a positive time decides
+    ('<maxwaveh time="0"/>', {"nwaves": 1000}),
+    ("<maxwaveh/>", {"nwaves": 1000}),
+])
+def test_maxwaveh_as_dualsphysics_writes_it(tmp_path, inner, expect):
+    (d,), reader = paddles(tmp_path, '<xf value="6"/>' + inner)
+    assert d["maxwaveh"] == expect and not reader.warnings
+
+
 @pytest.mark.parametrize("inner, element, match", [
     ("", "piston_focused", "missing <xf>"),
-    ('<xf value="6"/><maxwaveh nwaves="100" time="60"/>', "maxwaveh", "both nwaves and time"),
-    ('<xf value="6"/><maxwaveh/>', "maxwaveh", "one of nwaves and time"),
     ('<xf value="6"/><maxwaveh nwaves="1"/>', "maxwaveh", "nwaves=1"),
-    ('<xf value="6"/><maxwaveh time="0"/>', "maxwaveh", "time=0"),
+    ('<xf value="6"/><maxwaveh time="-1"/>', "maxwaveh", "time=-1 is negative"),
     ('<xf value="6"/><fpretime value="-1"/>', "fpretime", "negative"),
     ('<xf value="6"/><fmovramp value="2"/>', "fmovramp", "without <fmovtime>"),
     ('<xf value="6"/><serieini value="2"/>', "serieini", "unknown element <serieini>"),
@@ -158,3 +167,21 @@ def test_second_order_is_refused_as_for_spectra(tmp_path):
     with pytest.raises(CaseError, match="second-order generation of irregular waves") as e:
         paddles(tmp_path, '<xf value="6"/>', waveorder=2)
     assert e.value.element == "waveorder"
+
+
+def test_gencase_warns_of_a_focus_after_the_paddle_stops(tmp_path):
+    """DualSPHysics's format-doc numbers (x_f 12.5 m, T_p 1.5 s, fpretime 0) focus at 31.8 s by sphdvi's
+    rule, after their fmovtime (30 s) and a TimeMax of 30 s: both are warned about, naming the time."""
+    from click.testing import CliRunner
+
+    from run.test_run import REPO
+    from sphdvi.cli import main
+    text = (REPO / "cases" / "waveflume2d" / "CaseWaveFocused2D_Def.xml").read_text()
+    text = (text.replace('<xf value="2"', '<xf value="12.5"').replace('<waveperiod value="1.4"', '<waveperiod value="1.5"')
+            .replace('<fmovtime value="8"', '<fmovtime value="30"').replace('value="8" />', 'value="30" />'))
+    case = tmp_path / "Late_Def.xml"
+    case.write_text(text)
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out"), "--dp", "0.05"])
+    assert r.exit_code == 0, r.output
+    late = [line for line in r.output.splitlines() if "the focus is not reached" in line]
+    assert len(late) == 2 and "after the paddle stops" in late[0] and "after the run ends (TimeMax) at 30 s" in late[1]
