@@ -637,6 +637,22 @@ class _Paddle:
         return tau / self.ramp_time, 1.0 / self.ramp_time
 
     absorber = None     # a sphdvi.wave_absorption.PistonAbsorber when the piston absorbs (AWAS)
+    face = 0.0          # the paddle's front face at rest, a coordinate along :attr:`heading` (:meth:`place`)
+
+    @property
+    def heading(self) -> np.ndarray:
+        """The direction its waves run: a piston's ``pistondir``; +x for a flap."""
+        return self.direction if self.kind == "piston" else _EYE[0]
+
+    def place(self, face: float, check: bool = True) -> None:
+        """Where the paddle's front face is at rest (a coordinate along :attr:`heading`), from which
+        the distances of ``<savemotion xpos>`` are counted."""
+        self.face = float(face)
+
+    def orbital_velocity(self, x: float, z: float, t):
+        """The theory's (u along the heading, w up) at a distance ``x`` in front of the paddle and ``z``
+        below the still water (negative), without the ramp and the evanescent modes."""
+        raise NotImplementedError(f"no orbital velocity for a {self.spec['type']} paddle")
 
     def mean_position(self) -> float:
         """The theory's mean displacement once the ramp is over (m), about which the paddle moves."""
@@ -719,6 +735,25 @@ class WavePaddle(_Paddle):
             eta = eta + (H * H * self.k / 16.0) * (2.0 + math.cosh(2 * kd)) * _coth_over_sinh2(kd) * np.cos(2 * theta)
         return eta
 
+    def orbital_velocity(self, x: float, z: float, t):
+        """(u, w) of the progressive wave of :meth:`elevation` at a distance ``x`` and ``z`` below the still
+        water: a ω cosh k(z+d)/sinh kd cos θ, −a ω sinh k(z+d)/sinh kd sin θ (a = H/2), with ``order`` 2's
+        Stokes term (3/16) H² ω k cosh 2k(z+d)/sinh⁴ kd cos 2θ (Dean & Dalrymple 1991 §11) when the
+        paddle generates second order."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        theta = self.omega * (t - self.start) + self.phase - self.k * float(x)
+        H = self.height * self.gain
+        ch, sh = _depth_ratios(self.k, float(z), self.depth)
+        u = 0.5 * H * self.omega * ch * np.cos(theta)
+        w = -0.5 * H * self.omega * sh * np.sin(theta)
+        if self.second:
+            ch2, sh2 = _depth_ratios(2 * self.k, float(z), self.depth)
+            # cosh 2k(z+d)/sinh⁴ kd = [cosh 2k(z+d)/sinh 2kd] · 2 coth kd/sinh² kd
+            amp2 = 0.1875 * H * H * self.omega * self.k * 2.0 * _coth_over_sinh2(self.k * self.depth)
+            u = u + amp2 * ch2 * np.cos(2 * theta)
+            w = w - amp2 * sh2 * np.sin(2 * theta)
+        return u, w
+
     def stroke_amplitude(self) -> float:
         """The theoretical stroke's amplitude S/2 (m)."""
         return 0.5 * self.stroke
@@ -798,6 +833,23 @@ class SpectrumPaddle(_Paddle):
         tau = t - self.start
         a = np.outer(tau + self.t0, self.omega) + self.phase - self.k * float(x)
         return np.cos(a) @ self.amp
+
+    def orbital_velocity(self, x: float, z: float, t):
+        """(u, w) of the linear waves of :meth:`elevation` at a distance ``x`` and ``z`` below the still
+        water: Σ a_i ω_i cosh k_i(z+d)/sinh k_i d cos θ_i, −Σ a_i ω_i sinh k_i(z+d)/sinh k_i d sin θ_i."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        a = np.outer(t - self.start + self.t0, self.omega) + self.phase - self.k * float(x)
+        ch, sh = _depth_ratios(self.k, float(z), self.spec["depth"])
+        return np.cos(a) @ (self.amp * self.omega * ch), -(np.sin(a) @ (self.amp * self.omega * sh))
+
+
+def _depth_ratios(k, z: float, d: float):
+    """cosh k(z+d)/sinh kd and sinh k(z+d)/sinh kd for z in [−d, 0], without overflow in deep water."""
+    k = np.asarray(k, dtype=float)
+    e = np.exp(k * z)                        # the deep-water decay, both ratios' limit
+    q = np.exp(-2.0 * k * (z + d))
+    r = 1.0 / (-np.expm1(-2.0 * k * d))
+    return e * (1.0 + q) * r, e * (1.0 - q) * r
 
 
 def group_velocity(omega, k, depth: float):
@@ -1025,14 +1077,13 @@ class MotionSet:
         return sorted(set(self.motions) | set(self.paddles))
 
     def place_paddles(self, pos: np.ndarray, labels: np.ndarray) -> None:
-        """Tell each paddle that counts distances from its face (a focused piston) where that face is
-        at rest: the largest coordinate along its direction of its particles (``labels``: each
-        particle's mkbound, -1 for fluid)."""
+        """Tell each paddle where its front face is at rest (a focused piston counts its focus from it,
+        every paddle its ``<savemotion xpos>``): the largest coordinate along its :attr:`heading` of
+        its particles (``labels``: each particle's mkbound, -1 for fluid)."""
         for mkb, paddle in self.paddles.items():
-            if isinstance(paddle, FocusedPaddle):
-                mine = labels == mkb
-                if mine.any():
-                    paddle.place(float((pos[mine] @ paddle.direction).max()))
+            mine = labels == mkb
+            if mine.any():
+                paddle.place(float((pos[mine] @ paddle.heading).max()))
 
     def transform(self, mkbound: int, t: float) -> Rigid:
         base = motion_transform(self.motions[mkbound], t, self._walks) if mkbound in self.motions else Rigid()

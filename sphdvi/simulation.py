@@ -760,6 +760,9 @@ class SPHRun:
         motions = MotionSet(js.get("motions", []), js.get("special", {}).get("wavepaddles", []),
                             g=float(np.linalg.norm(c["gravity"])))
         self._place_paddles(motions, p, fluidcount)
+        if any(paddle.spec.get("savemotion") for paddle in motions.paddles.values()):
+            from .io.paddle_motion import write_paddle_motions
+            write_paddle_motions(outdir, motions, float(params["TimeMax"]), float(params["TimeOut"]))
         domain = (np.asarray(data["domain"]["posmin"], float), np.asarray(data["domain"]["posmax"], float))
         if c["is2d"]:
             domain[0][1] -= c["h"]

@@ -113,8 +113,6 @@ def read_wavepaddles(reader, el) -> list:
             del d["awas_zsurf"]
         for k, what in (("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
                                         "regular-wave theory"),
-                        ("savemotion", "<savemotion> (the paddle motion written to a file) is not implemented "
-                                       "by sphdvi: no file is written"),
                         ("saveserie", "<saveserie> (the paddle's series written to a file) is not implemented "
                                       "by sphdvi: no file is written"),
                         ("saveseriewaves", "<saveseriewaves> (the series' waves written to a file) is not "
@@ -122,9 +120,9 @@ def read_wavepaddles(reader, el) -> list:
                         ("calcserielength", "<calcserielength> (DualSPHysics prints the length of the "
                                             "irregular series without repetition) is not implemented by sphdvi")):
             if k in d:
-                for el in reader.children(c, k):          # each <savemotion> line, as the format doc writes several
-                    reader.mark(el, *el.keys())
                 reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
+        if "savemotion" in d:
+            d["savemotion"] = _read_savemotion(reader, c, d, spectral)
         if d.get("fixeddepth", 0.0):
             reader.warn(reader.child(c, "fixeddepth"), "<fixeddepth> (the fluid depth without the paddle) is not "
                         "implemented by sphdvi: the stroke follows <depth>; <fixeddepth> is ignored")
@@ -294,6 +292,35 @@ def _read_spectrum_options(reader, c, d: dict) -> None:
                             "one the series less its value at serieini is played); autofit is ignored")
 
 
+def _read_savemotion(reader, c, d: dict, spectral: bool) -> list:
+    """Every ``<savemotion>`` line of a paddle (DualSPHysics's format doc: each writes a file of the
+    paddle's displacement and the theory's elevation and velocity): ``xpos`` (a coordinate along the
+    paddle's direction, 0 by default), ``zpos`` (the depth of the velocity's point below the still
+    water, as a negative z; none: no velocity); a regular paddle's ``periods`` and ``periodsteps``,
+    an irregular or focused one's ``time`` and ``timedt`` (each by default from TimeMax and TimeOut)."""
+    out = []
+    timing = ("time", "timedt") if spectral else ("periods", "periodsteps")
+    for el in reader.children(c, "savemotion"):
+        reader.mark(el, "comment")
+        for k in el.keys():
+            if k not in (*timing, "xpos", "zpos", "comment") and not k.endswith("_comment"):
+                raise reader.error(el, f"unknown attribute {k!r} of <savemotion> in <{c.tag}>",
+                                   ", ".join((*timing, "xpos", "zpos")))
+        e = {"line": el.sourceline, "xpos": reader.num(el, "xpos", 0.0)}
+        if el.get("zpos") is not None:
+            e["zpos"] = reader.num(el, "zpos")
+            if not -d["depth"] <= e["zpos"] <= 0.0:
+                raise reader.error(el, f"zpos={e['zpos']:g} is not in the water (depth {d['depth']:g} m)",
+                                   f"-{d['depth']:g} <= zpos <= 0 (the point's z below the still water)")
+        for k in timing:
+            if el.get(k) is not None:
+                e[k] = reader.integer(el, k, lo=1) if k == "periodsteps" else reader.num(el, k)
+                if not e[k] > 0:
+                    raise reader.error(el, f"{k}={e[k]:g}", f"{k} > 0")
+        out.append(e)
+    return out
+
+
 def _read_focus_options(reader, c, d: dict) -> None:
     """The focus of a ``<piston_focused>`` (in place): ``xf``; ``fphase`` (degrees, 0); ``maxwaveh``
     ``nwaves`` (1000) or ``time`` (s; 0: not used), the sea state whose largest crest the group is, the
@@ -383,7 +410,10 @@ def read_piston_solitary(reader, c) -> dict:
     d["solitary"] = waves
     d["waves"] = n
     if "savemotion" in d:
-        reader.warn(reader.child(c, "savemotion"), "<savemotion> (the paddle motion written to a file) is not "
-                    "implemented by sphdvi: no file is written; <savemotion> is ignored")
+        for el in reader.children(c, "savemotion"):
+            reader.mark(el, *el.keys())
+        reader.warn(reader.child(c, "savemotion"), "<savemotion> of a solitary-wave paddle is not implemented by "
+                    "sphdvi: no file is written; <savemotion> is ignored")
+        del d["savemotion"]
     d["duration"], d["gainstroke"] = 0.0, 1.0
     return d

@@ -23,6 +23,13 @@ RUN_OUTPUT_FILES = ("particles.vtkhdf", RESTART_FILE, "run.json", "run.log", "ru
 EXPORT_SETS = {"particles.pvd": re.compile(r"Part_\d{4,}\.vtp"), "isosurface.pvd": re.compile(r"Iso_\d{4,}\.vtp")}
 
 
+def is_run_output(name: str) -> bool:
+    """Whether a file name in OUT is one a run writes: RUN_OUTPUT_FILES, the gauges'
+    Gauges<Type>_<name>.csv and the paddles' PaddleMotion_mkbound<mk>_<n>.csv."""
+    return name in RUN_OUTPUT_FILES or (name.endswith(".csv") and "_" in name
+                                        and name.startswith(("Gauges", "PaddleMotion_")))
+
+
 def export_files(folder: str) -> list[str]:
     """The files `sphdvi export` wrote into ``folder`` (paths, sorted): each collection
     (particles.pvd, isosurface.pvd) with its numbered .vtp parts; other files are not
@@ -53,8 +60,7 @@ def earlier_results(outdir: str) -> list[str]:
     """The names of the files of an earlier run in ``outdir`` (sorted; [] when none)."""
     if not os.path.isdir(outdir):
         return []
-    return sorted(name for name in os.listdir(outdir)
-                  if name in RUN_OUTPUT_FILES or (name.startswith("Gauges") and "_" in name and name.endswith(".csv")))
+    return sorted(name for name in os.listdir(outdir) if is_run_output(name))
 
 
 def check_new_run_folder(outdir: str, overwrite: bool, command: str = "run") -> None:
@@ -289,7 +295,7 @@ class SetAside:
         if not self.moved:
             return
         for name in set(os.listdir(self.outdir)) - self._before:
-            if name in RUN_OUTPUT_FILES or name.endswith(CASE_OUTPUT_SUFFIXES) or \
+            if is_run_output(name) or name.endswith(CASE_OUTPUT_SUFFIXES) or \
                     (name.startswith("Gauges") and name.endswith(".csv")):
                 with contextlib.suppress(OSError):
                     os.unlink(os.path.join(self.outdir, name))
