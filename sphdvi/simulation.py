@@ -760,7 +760,8 @@ class SPHRun:
         motions = MotionSet(js.get("motions", []), js.get("special", {}).get("wavepaddles", []),
                             g=float(np.linalg.norm(c["gravity"])))
         self._place_paddles(motions, p, fluidcount)
-        if any(paddle.spec.get("savemotion") for paddle in motions.paddles.values()):
+        if any(paddle.spec.get(k) for paddle in motions.paddles.values()
+               for k in ("savemotion", "saveserie", "saveseriewaves")):
             from .io.paddle_motion import write_paddle_motions
             write_paddle_motions(outdir, motions, float(params["TimeMax"]), float(params["TimeOut"]))
         domain = (np.asarray(data["domain"]["posmin"], float), np.asarray(data["domain"]["posmax"], float))

@@ -113,16 +113,16 @@ def read_wavepaddles(reader, el) -> list:
             del d["awas_zsurf"]
         for k, what in (("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
                                         "regular-wave theory"),
-                        ("saveserie", "<saveserie> (the paddle's series written to a file) is not implemented "
-                                      "by sphdvi: no file is written"),
-                        ("saveseriewaves", "<saveseriewaves> (the series' waves written to a file) is not "
-                                           "implemented by sphdvi: no file is written"),
                         ("calcserielength", "<calcserielength> (DualSPHysics prints the length of the "
                                             "irregular series without repetition) is not implemented by sphdvi")):
             if k in d:
                 reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
         if "savemotion" in d:
             d["savemotion"] = _read_savemotion(reader, c, d, spectral)
+        for k, attrs in (("saveserie", ("timemin", "timemax", "timedt", "xpos")),
+                         ("saveseriewaves", ("timemin", "timemax", "xpos"))):
+            if k in d:
+                d[k] = _read_serie_window(reader, reader.child(c, k), attrs)
         if d.get("fixeddepth", 0.0):
             reader.warn(reader.child(c, "fixeddepth"), "<fixeddepth> (the fluid depth without the paddle) is not "
                         "implemented by sphdvi: the stroke follows <depth>; <fixeddepth> is ignored")
@@ -319,6 +319,25 @@ def _read_savemotion(reader, c, d: dict, spectral: bool) -> list:
                     raise reader.error(el, f"{k}={e[k]:g}", f"{k} > 0")
         out.append(e)
     return out
+
+
+def _read_serie_window(reader, el, attrs) -> dict:
+    """An irregular paddle's ``<saveserie timemin timemax timedt xpos>`` (the series over a window, written
+    to a file) or ``<saveseriewaves timemin timemax xpos>`` (its waves by zero up-crossing): timemax
+    required, timemin 0, timedt 0.05 s, xpos 0."""
+    for k in el.keys():
+        if k not in (*attrs, "comment") and not k.endswith("_comment"):
+            raise reader.error(el, f"unknown attribute {k!r} of <{el.tag}>", ", ".join(attrs))
+    reader.mark(el, "comment")
+    e = {"timemin": reader.num(el, "timemin", 0.0, nonnegative=True), "timemax": reader.num(el, "timemax"),
+         "xpos": reader.num(el, "xpos", 0.0)}
+    if "timedt" in attrs:
+        e["timedt"] = reader.num(el, "timedt", 0.05)
+        if not e["timedt"] > 0:
+            raise reader.error(el, f"timedt={e['timedt']:g}", "timedt > 0")
+    if not e["timemax"] > e["timemin"]:
+        raise reader.error(el, f"timemax={e['timemax']:g} is not after timemin={e['timemin']:g}", "timemax > timemin")
+    return e
 
 
 def _read_focus_options(reader, c, d: dict) -> None:

@@ -1,4 +1,6 @@
-"""``<savemotion>``: each line of a wave paddle (``<piston>``, ``<flap>``, ``<piston_spectrum>``,
+"""``<savemotion>``, ``<saveserie>``, ``<saveseriewaves>``: what a wave paddle's case asks to be written.
+
+Each ``<savemotion>`` line of a wave paddle (``<piston>``, ``<flap>``, ``<piston_spectrum>``,
 ``<flap_spectrum>``, ``<piston_focused>``) writes ``PaddleMotion_mkbound<mk>_<n>.csv`` into OUT at the
 run's start (n: the line's place among the paddle's ``<savemotion>`` lines, from 1): one row per
 time from 0, ``;``-separated, of the paddle's displacement at the still-water level and its rate
@@ -8,7 +10,11 @@ DualSPHysics's format documents what such a file holds, not its name or columns:
 
 Times: a regular paddle's ``periods`` wave periods (TimeMax's worth by default) at ``periodsteps`` rows a
 period (one per TimeOut by default); an irregular or focused one's ``time`` (TimeMax) at ``timedt``
-(TimeOut).  ``xpos`` is a coordinate along the paddle's heading, counted from its front face at rest."""
+(TimeOut).  ``xpos`` is a coordinate along the paddle's heading, counted from its front face at rest.
+
+An irregular paddle's ``<saveserie timemin timemax timedt xpos>`` writes the same columns over that window
+to ``PaddleSerie_mkbound<mk>.csv``; its ``<saveseriewaves timemin timemax xpos>`` the waves of the theory's
+elevation there by zero up-crossing (start, period, height) to ``PaddleSerieWaves_mkbound<mk>.csv``."""
 from __future__ import annotations
 
 import math
@@ -38,7 +44,12 @@ def motion_times(paddle, entry: dict, tmax: float, tout: float) -> np.ndarray:
 
 def motion_table(paddle, entry: dict, tmax: float, tout: float) -> tuple[list, np.ndarray]:
     """(column names, rows) of one ``<savemotion>`` line."""
-    t = motion_times(paddle, entry, tmax, tout)
+    return theory_table(paddle, motion_times(paddle, entry, tmax, tout), entry)
+
+
+def theory_table(paddle, t: np.ndarray, entry: dict) -> tuple[list, np.ndarray]:
+    """(column names, rows) of the paddle's theory at the times ``t``: displacement, rate, a flap's
+    angle, the elevation at ``entry["xpos"]`` and with ``entry["zpos"]`` the velocity there."""
     x, v = np.array([paddle.theory_position(ti) for ti in t]).T.reshape(2, -1)
     names, cols = ["time [s]", "stroke [m]", "stroke_vel [m/s]"], [t, x, v]
     if paddle.kind == "flap":
@@ -54,15 +65,49 @@ def motion_table(paddle, entry: dict, tmax: float, tout: float) -> tuple[list, n
     return names, np.column_stack(cols)
 
 
+def zero_upcrossing_waves(t: np.ndarray, eta: np.ndarray) -> np.ndarray:
+    """The waves of a record by zero up-crossing (Goda 2000 §2.2): rows of (start time, period, height),
+    each from one up-crossing of the mean level to the next (times interpolated linearly), its height
+    the largest less the smallest elevation between them."""
+    eta = np.asarray(eta, float) - float(np.mean(eta))
+    i = np.flatnonzero((eta[:-1] < 0.0) & (eta[1:] >= 0.0))
+    tc = t[i] - eta[i] * (t[i + 1] - t[i]) / (eta[i + 1] - eta[i])
+    rows = [(tc[k], tc[k + 1] - tc[k], float(np.ptp(eta[i[k] + 1:i[k + 1] + 1])))
+            for k in range(len(i) - 1)]
+    return np.array(rows, float).reshape(-1, 3)
+
+
+def serie_waves_table(paddle, entry: dict) -> tuple[list, np.ndarray]:
+    """(column names, rows) of ``<saveseriewaves>``: the waves of the theory's elevation at ``xpos``
+    over [timemin, timemax], sampled at Tp/200."""
+    step = float(paddle.spec["waveperiod"]) / 200.0
+    t = entry["timemin"] + np.arange(int((entry["timemax"] - entry["timemin"]) / step) + 1) * step
+    eta = np.asarray(paddle.elevation(entry.get("xpos", 0.0) - paddle.face, t), float).reshape(-1)
+    waves = zero_upcrossing_waves(t, eta)
+    return ["wave", "t_start [s]", "period [s]", "height [m]"], np.column_stack([np.arange(1, len(waves) + 1), waves])
+
+
+def _write(outdir: str, name: str, names: list, rows: np.ndarray) -> None:
+    lines = [";".join(names)] + [";".join(f"{v:.9g}" for v in row) for row in rows]
+    write_text_atomic(os.path.join(outdir, name), "\n".join(lines) + "\n")
+
+
 def write_paddle_motions(outdir: str, motions, tmax: float, tout: float) -> list[str]:
-    """Write the files of every paddle's ``<savemotion>`` lines (``motions``: a
-    :class:`sphdvi.motion.MotionSet`, its paddles placed); the names written."""
+    """Write the files of every paddle's ``<savemotion>`` lines, ``<saveserie>`` and ``<saveseriewaves>``
+    (``motions``: a :class:`sphdvi.motion.MotionSet`, its paddles placed); the names written."""
     written = []
     for mkb, paddle in sorted(motions.paddles.items()):
-        for n, entry in enumerate(paddle.spec.get("savemotion") or [], start=1):
-            names, rows = motion_table(paddle, entry, float(tmax), float(tout))
-            lines = [";".join(names)] + [";".join(f"{v:.9g}" for v in row) for row in rows]
-            name = file_name(mkb, n)
-            write_text_atomic(os.path.join(outdir, name), "\n".join(lines) + "\n")
-            written.append(name)
+        spec = paddle.spec
+        for n, entry in enumerate(spec.get("savemotion") or [], start=1):
+            written.append(file_name(mkb, n))
+            _write(outdir, written[-1], *motion_table(paddle, entry, float(tmax), float(tout)))
+        if spec.get("saveserie"):
+            e = spec["saveserie"]
+            t = e["timemin"] + np.arange(int(math.floor((e["timemax"] - e["timemin"]) / e["timedt"] + 1e-9)) + 1) \
+                * e["timedt"]
+            written.append(f"PaddleSerie_mkbound{mkb}.csv")
+            _write(outdir, written[-1], *theory_table(paddle, t, e))
+        if spec.get("saveseriewaves"):
+            written.append(f"PaddleSerieWaves_mkbound{mkb}.csv")
+            _write(outdir, written[-1], *serie_waves_table(paddle, spec["saveseriewaves"]))
     return written

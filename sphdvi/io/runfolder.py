@@ -25,9 +25,9 @@ EXPORT_SETS = {"particles.pvd": re.compile(r"Part_\d{4,}\.vtp"), "isosurface.pvd
 
 def is_run_output(name: str) -> bool:
     """Whether a file name in OUT is one a run writes: RUN_OUTPUT_FILES, the gauges'
-    Gauges<Type>_<name>.csv and the paddles' PaddleMotion_mkbound<mk>_<n>.csv."""
+    Gauges<Type>_<name>.csv and the paddles' PaddleMotion_, PaddleSerie_ and PaddleSerieWaves_ files."""
     return name in RUN_OUTPUT_FILES or (name.endswith(".csv") and "_" in name
-                                        and name.startswith(("Gauges", "PaddleMotion_")))
+                                        and name.startswith(("Gauges", "PaddleMotion_", "PaddleSerie")))
 
 
 def export_files(folder: str) -> list[str]:

@@ -136,3 +136,54 @@ def test_the_run_writes_the_files_and_overwrite_sets_them_aside(tmp_path):
     r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q", "--overwrite"])
     assert r.exit_code == 0, r.output
     assert (out / "PaddleMotion_mkbound10_2.csv").is_file()
+
+
+def test_the_run_writes_the_series_files(tmp_path):
+    from run.test_moving import TANK
+    special = ('<wavepaddles><piston_spectrum><mkbound value="10"/><depth value="0.3"/><spectrum value="jonswap"/>'
+               '<waveheight value="0.02"/><waveperiod value="1.0"/><waves value="20"/>'
+               '<saveserie timemin="5" timemax="6" timedt="0.1" xpos="0.5"/>'
+               '<saveseriewaves timemax="100"/></piston_spectrum></wavepaddles>')
+    case = tmp_path / "CaseMoving_Def.xml"
+    case.write_text(TANK.replace("MOTION", '<mvnull id="1" />').replace("SPECIAL", special))
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q"])
+    assert r.exit_code == 0, r.output
+    serie = np.genfromtxt(out / "PaddleSerie_mkbound10.csv", delimiter=";", skip_header=1)
+    np.testing.assert_allclose(serie[:, 0], 5 + 0.1 * np.arange(11), atol=1e-12)
+    waves = (out / "PaddleSerieWaves_mkbound10.csv").read_text().splitlines()
+    assert waves[0] == "wave;t_start [s];period [s];height [m]" and len(waves) > 50
+
+
+def test_serie_lines(tmp_path):
+    (d,), reader = paddles(tmp_path, "piston_spectrum", '<saveserie timemin="0" timemax="300" timedt="0.05" xpos="0"/>'
+                                                       '<saveseriewaves timemin="10" timemax="1000" xpos="2"/>')
+    assert d["saveserie"] == {"timemin": 0.0, "timemax": 300.0, "timedt": 0.05, "xpos": 0.0}
+    assert d["saveseriewaves"] == {"timemin": 10.0, "timemax": 1000.0, "xpos": 2.0} and not reader.warnings
+    with pytest.raises(CaseError, match="timemax=5 is not after timemin=10") as e:
+        paddles(tmp_path, "piston_spectrum", '<saveseriewaves timemin="10" timemax="5"/>')
+    assert e.value.element == "saveseriewaves"
+    with pytest.raises(CaseError, match="unknown attribute 'timedt' of <saveseriewaves>"):
+        paddles(tmp_path, "piston_spectrum", '<saveseriewaves timemax="5" timedt="0.1"/>')
+
+
+def test_zero_upcrossing_of_a_sine():
+    from sphdvi.io.paddle_motion import zero_upcrossing_waves
+    t = np.linspace(0.0, 10.0, 100001)
+    waves = zero_upcrossing_waves(t, 0.3 * np.sin(2 * np.pi * t / 1.25 + 0.4))
+    assert len(waves) == 7
+    np.testing.assert_allclose(waves[:, 1], 1.25, rtol=1e-6)
+    np.testing.assert_allclose(waves[:, 2], 0.6, rtol=1e-6)
+
+
+def test_serie_waves_give_the_sea_state():
+    """Over 1,000 s the significant height H1/3 of the zero up-crossing waves is within 10 % of the
+    case's Hm0 (narrow-band theory: H1/3 ≈ 0.95-1.0 Hm0) and their mean period that of Tz = √(m0/m2)."""
+    from sphdvi.io.paddle_motion import serie_waves_table
+    p = SpectrumPaddle({**SPECTRUM, "waves": 100})
+    names, rows = serie_waves_table(p, {"timemin": 0.0, "timemax": 1000.0, "xpos": 1.0})
+    h = np.sort(rows[:, 3])[::-1]
+    h13 = h[: len(h) // 3].mean()
+    assert 0.9 * 0.04 < h13 < 1.1 * 0.04
+    e, f = p.amp ** 2, p.components["f"]
+    assert rows[:, 2].mean() == pytest.approx(math.sqrt(np.sum(e) / np.sum(e * f * f)), rel=0.05)
