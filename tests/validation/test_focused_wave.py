@@ -5,7 +5,8 @@ focused at x = 2 m) against the linear sum of the group's waves at three gauges
 Measured (README): A/dp 1.4 (dp 0.02) crest −9.0 % of A, 0.045 s early, correlation ≥ 0.965, rms
 ≤ 12.5 % of A; A/dp 2.8 (dp 0.01) crest −2.8 %, 0.040 s early, correlation ≥ 0.974, rms ≤ 10.3 %.
 Slow: dp 0.02 is 4,926 particles and 39,250 steps (about 2 minutes on 1 thread), dp 0.01 18,851
-particles and 79,899 steps (16 minutes on 1 thread beside another run; about 6 on 2 quiet threads)."""
+particles and 79,899 steps (16 minutes on 1 thread beside another run; the two runs of this file, 10 minutes
+on 2 threads)."""
 import pytest
 
 from sphdvi.validation.focused import GAUGES, focused_errors
