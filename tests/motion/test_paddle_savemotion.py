@@ -119,36 +119,36 @@ def test_focused_table_peaks_at_the_focus():
     assert rows[i, names.index("eta [m]")] == pytest.approx(p.crest, rel=1e-5)      # sampled every 1 ms
 
 
-def test_the_run_writes_the_files_and_overwrite_sets_them_aside(tmp_path):
+def run_tank(tmp_path, special, *options):
+    """``sphdvi run`` of test_moving's tank with ``special`` (its piston mkbound 10) into tmp_path/out."""
     from run.test_moving import TANK
-    special = ('<wavepaddles><piston><mkbound value="10"/><depth value="0.3"/><waveheight value="0.02"/>'
-               '<waveperiod value="1.0"/><savemotion xpos="1" zpos="-0.1"/>'
-               '<savemotion periods="2" periodsteps="10"/></piston></wavepaddles>')
     case = tmp_path / "CaseMoving_Def.xml"
     case.write_text(TANK.replace("MOTION", '<mvnull id="1" />').replace("SPECIAL", special))
     out = tmp_path / "out"
-    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q"])
+    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q", *options])
     assert r.exit_code == 0, r.output
+    return out
+
+
+def test_the_run_writes_the_files_and_overwrite_sets_them_aside(tmp_path):
+    special = ('<wavepaddles><piston><mkbound value="10"/><depth value="0.3"/><waveheight value="0.02"/>'
+               '<waveperiod value="1.0"/><savemotion xpos="1" zpos="-0.1"/>'
+               '<savemotion periods="2" periodsteps="10"/></piston></wavepaddles>')
+    out = run_tank(tmp_path, special)
     first = np.genfromtxt(out / "PaddleMotion_mkbound10_1.csv", delimiter=";", skip_header=1)
     assert first.shape == (5, 6)          # TimeMax 0.2 s, TimeOut 0.05 s
     second = (out / "PaddleMotion_mkbound10_2.csv").read_text().splitlines()
     assert second[0] == "time [s];stroke [m];stroke_vel [m/s];eta [m]" and len(second) == 22
-    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q", "--overwrite"])
-    assert r.exit_code == 0, r.output
+    run_tank(tmp_path, special, "--overwrite")
     assert (out / "PaddleMotion_mkbound10_2.csv").is_file()
 
 
 def test_the_run_writes_the_series_files(tmp_path):
-    from run.test_moving import TANK
     special = ('<wavepaddles><piston_spectrum><mkbound value="10"/><depth value="0.3"/><spectrum value="jonswap"/>'
                '<waveheight value="0.02"/><waveperiod value="1.0"/><waves value="20"/>'
                '<saveserie timemin="5" timemax="6" timedt="0.1" xpos="0.5"/>'
                '<saveseriewaves timemax="100"/></piston_spectrum></wavepaddles>')
-    case = tmp_path / "CaseMoving_Def.xml"
-    case.write_text(TANK.replace("MOTION", '<mvnull id="1" />').replace("SPECIAL", special))
-    out = tmp_path / "out"
-    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q"])
-    assert r.exit_code == 0, r.output
+    out = run_tank(tmp_path, special)
     serie = np.genfromtxt(out / "PaddleSerie_mkbound10.csv", delimiter=";", skip_header=1)
     np.testing.assert_allclose(serie[:, 0], 5 + 0.1 * np.arange(11), atol=1e-12)
     waves = (out / "PaddleSerieWaves_mkbound10.csv").read_text().splitlines()
