@@ -893,7 +893,6 @@ class FocusedPaddle(SpectrumPaddle):
     def __init__(self, spec: dict, g: float = 9.81):
         from .wavespectra import components
         self._set_geometry(spec)
-        self.g = g
         d = self.depth = spec["depth"]
         comp = components(spec["spectrum"], spec["waveheight"], spec["waveperiod"], int(spec["waves"]),
                           spec["discretization"], spec["peakcoef"], int(spec["randomseed"]))
