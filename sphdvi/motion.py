@@ -909,7 +909,8 @@ class FocusedPaddle(SpectrumPaddle):
         self.crest = newwave_crest(spec["waveheight"], self.nwaves)
         self.amp = self.crest * energy / float(np.sum(energy)) * self.gain
         self.half_stroke = self.amp / np.array([self._height_to_stroke(k, d) for k in self.k])
-        self.cg_min = float(np.min(group_velocity(self.omega, self.k, d)))
+        cg = group_velocity(self.omega, self.k, d)
+        self.cg_min, self.cg_max = float(np.min(cg)), float(np.max(cg))
         self.xf = float(spec["xf"])
         self.fphase = math.radians(spec.get("fphase", 0.0))
         self.pretime = spec.get("fpretime", 5.0)

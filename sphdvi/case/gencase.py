@@ -782,18 +782,23 @@ def focused_paddle(wp: dict, pos, ptype, label):
 
 
 def _warn_focus_too_late(wp: dict, paddle, tmax, reader) -> None:
-    """A focused group whose focus time comes after the paddle stops (``fmovtime``, ``duration``) or
-    after the run's end (TimeMax) is warned about, with the time sphdvi's rule gives."""
+    """A focused group that cannot form is warned about, with the times of sphdvi's rule: the paddle
+    stopping (``duration``; ``fmovtime`` less its ``fmovramp``) before its last waves leave it (the
+    fastest group's, which left at t_f − distance/c_g,max), or the run ending (TimeMax) before t_f."""
     tf = paddle.start + paddle.focus_time
-    ends = [(paddle.start + paddle.duration, "the paddle stops (<fmovtime>/<duration>)")] if paddle.duration > 0 else []
-    if tmax is not None and tmax > 0:
-        ends.append((float(tmax), "the run ends (TimeMax)"))
-    for t_end, what in ends:
-        if tf > t_end:
-            reader.warnings.add(f"the group focuses at t = {tf:.4g} s ({paddle.distance:.4g} m from the piston, "
-                                f"<fpretime> plus the time the slowest of its waves takes to get there), after "
-                                f"{what} at {t_end:g} s: the focus is not reached; move <xf> closer, or give more time",
+    last = tf - paddle.distance / paddle.cg_max
+    if paddle.duration > 0:
+        stop = paddle.start + paddle.duration - paddle.fmovramp
+        if stop < last:
+            reader.warnings.add(f"the paddle stops moving at t = {stop:.4g} s (<fmovtime>/<duration>, less <fmovramp>), "
+                                f"before the group's last (fastest) waves leave it at {last:.4g} s for the focus at "
+                                f"t = {tf:.4g} s: the group does not form fully; give the paddle more time",
                                 file=reader.file, line=wp.get("line"), element=wp["type"])
+    if tmax is not None and tmax > 0 and tf > tmax:
+        reader.warnings.add(f"the group focuses at t = {tf:.4g} s ({paddle.distance:.4g} m from the piston, "
+                            f"<fpretime> plus the time the slowest of its waves takes to get there), after the run "
+                            f"ends (TimeMax {tmax:g} s): move <xf> closer, or run longer",
+                            file=reader.file, line=wp.get("line"), element=wp["type"])
 
 
 def _warn_paddle_depth(wp: dict, pos, ptype, label, reader) -> None:

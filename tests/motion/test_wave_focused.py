@@ -169,19 +169,27 @@ def test_second_order_is_refused_as_for_spectra(tmp_path):
     assert e.value.element == "waveorder"
 
 
-def test_gencase_warns_of_a_focus_after_the_paddle_stops(tmp_path):
-    """DualSPHysics's format-doc numbers (x_f 12.5 m, T_p 1.5 s, fpretime 0) focus at 31.8 s by sphdvi's
-    rule, after their fmovtime (30 s) and a TimeMax of 30 s: both are warned about, naming the time."""
+def test_gencase_warns_when_the_group_cannot_form(tmp_path):
+    """DualSPHysics's format-doc numbers (x_f 12.5 m, T_p 1.5 s, fpretime 0, fmovtime 30 s) in W7's flume
+    focus at 31.65 s by sphdvi's rule, after a TimeMax of 30 s: warned; the paddle stopping at 30 s (its
+    ramp down from 29 s) is not, its last (fastest) waves having left it at 23.8 s. Stopped at 20 s it is
+    warned about too."""
     from click.testing import CliRunner
 
     from run.test_run import REPO
     from sphdvi.cli import main
     text = (REPO / "cases" / "waveflume2d" / "CaseWaveFocused2D_Def.xml").read_text()
     text = (text.replace('<xf value="2"', '<xf value="12.5"').replace('<waveperiod value="1.4"', '<waveperiod value="1.5"')
-            .replace('<fmovtime value="8"', '<fmovtime value="30"').replace('value="8" />', 'value="30" />'))
-    case = tmp_path / "Late_Def.xml"
-    case.write_text(text)
-    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out"), "--dp", "0.05"])
-    assert r.exit_code == 0, r.output
-    late = [line for line in r.output.splitlines() if "the focus is not reached" in line]
-    assert len(late) == 2 and "after the paddle stops" in late[0] and "after the run ends (TimeMax) at 30 s" in late[1]
+            .replace('<parameter key="TimeMax" value="8"', '<parameter key="TimeMax" value="30"'))
+
+    def warnings(fmovtime):
+        case = tmp_path / "Late_Def.xml"
+        case.write_text(text.replace('<fmovtime value="8"', f'<fmovtime value="{fmovtime}"'))
+        r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out"), "--dp", "0.05"])
+        assert r.exit_code == 0, r.output
+        return [line for line in r.output.splitlines() if "warning: <piston_focused>" in line]
+
+    (late,) = warnings(30)
+    assert "the group focuses at t = 31.6" in late and "after the run ends (TimeMax 30 s)" in late
+    stop, late = warnings(20)
+    assert "the paddle stops moving at t = 19 s" in stop and "before the group's last (fastest) waves leave it at 23.79 s" in stop
