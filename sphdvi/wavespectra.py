@@ -136,3 +136,19 @@ def spectral_height(amp) -> float:
     """Hm0 = 4 √m0 of a set of linear waves of amplitudes ``amp`` (m0 = Σ a²/2)."""
     amp = np.asarray(amp, dtype=float)
     return 4.0 * math.sqrt(0.5 * float(np.sum(amp * amp)))
+
+
+def repetition_period(f, tmax: float, rtol: float = 1e-9) -> float | None:
+    """The shortest T <= ``tmax`` after which waves of frequencies ``f`` all repeat (every f_i T a whole
+    number, to ``rtol`` of a cycle), or None: their sum (the series) does not repeat within ``tmax``.
+    T is a multiple of 1/(f_1 − f_0), so those are the candidates."""
+    f = np.sort(np.asarray(f, dtype=float))
+    if f.size == 1:
+        return float(1.0 / f[0]) if 1.0 / f[0] <= tmax else None
+    base = 1.0 / (f[1] - f[0])
+    for m in range(1, int(tmax / base + 1e-9) + 1):
+        cycles = f * (m * base)
+        if np.all(np.abs(cycles - np.round(cycles)) <= rtol * np.maximum(1.0, cycles)):
+            return float(m * base)
+    return None
+

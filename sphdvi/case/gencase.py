@@ -921,6 +921,14 @@ def summary(result: GenCaseResult) -> str:
             diag = ", ".join(f"{a['inertia'][i][i]:.6g}" for i in range(3))
             lines.append(f"    analytic {a['shape']}: mass {a['mass']:.6g} {unit}, inertia diag ({diag})")
     for wp in case.special.get("wavepaddles", []):
+        if wp.get("calcserielength"):
+            from ..motion import SpectrumPaddle
+            from ..wavespectra import repetition_period
+            tmax = wp["calcserielength"]
+            period = repetition_period(SpectrumPaddle(wp).components["f"], tmax)
+            lines.append(f"Irregular series (mkbound {wp['mkbound']}): " + (
+                f"repeats every {period:.6g} s" if period is not None else
+                f"does not repeat within {tmax:g} s ({wp['discretization']} discretization)"))
         if wp["type"] == "piston_focused":
             f = focused_paddle(wp, p["pos"], p["type"], p["label"])
             lines.append(f"Focused group (mkbound {wp['mkbound']}): crest {f.crest:.4g} m at x = {f.xf:g} m, "

@@ -113,12 +113,15 @@ def read_wavepaddles(reader, el) -> list:
             del d["awas_zsurf"]
         for k, what in (("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
                                         "regular-wave theory"),
-                        ("calcserielength", "<calcserielength> (DualSPHysics prints the length of the "
-                                            "irregular series without repetition) is not implemented by sphdvi")):
+):
             if k in d:
                 reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
         if "savemotion" in d:
             d["savemotion"] = _read_savemotion(reader, c, d, spectral)
+        if "calcserielength" in d:
+            el = reader.child(c, "calcserielength")
+            reader.mark(el, "comment")
+            d["calcserielength"] = reader.num(el, "timemax", positive=True)
         for k, attrs in (("saveserie", ("timemin", "timemax", "timedt", "xpos")),
                          ("saveseriewaves", ("timemin", "timemax", "xpos"))):
             if k in d:

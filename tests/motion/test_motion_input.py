@@ -343,11 +343,12 @@ def test_unimplemented_spectrum_options_warn(tmp_path):
              '<calcserielength timemax="1000"/>')     # _FmtXML_WavePaddles.xml (27-03-2023) lists it
     (d,), reader = spectrum_paddles(tmp_path, inner)
     text = "\n".join(reader.warnings)
-    assert len(reader.warnings) == 3          # <saveserie>, <saveseriewaves>: read (test_paddle_savemotion.py)
-    for tag, line in (("serieini", 3), ("fixeddepth", 6), ("calcserielength", 7)):
+    assert len(reader.warnings) == 2          # <saveserie>, <saveseriewaves>, <calcserielength>: read
+    for tag, line in (("serieini", 3), ("fixeddepth", 6)):
         assert f"case.xml:{line}: warning: <{tag}>" in text
     assert "autofit is ignored" in text
     assert d["saveserie"]["timemax"] == 100.0 and d["saveseriewaves"]["xpos"] == 2.0
+    assert d["calcserielength"] == 1000.0
 
 
 @pytest.mark.parametrize("inner, expect", [

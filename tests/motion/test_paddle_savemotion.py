@@ -187,3 +187,30 @@ def test_serie_waves_give_the_sea_state():
     assert 0.9 * 0.04 < h13 < 1.1 * 0.04
     e, f = p.amp ** 2, p.components["f"]
     assert rows[:, 2].mean() == pytest.approx(math.sqrt(np.sum(e) / np.sum(e * f * f)), rel=0.05)
+
+
+def test_series_repetition_period():
+    """<calcserielength>: 40 regular waves over 0.5-3 fp sit at odd multiples of Δf/2, so the series repeats
+    every 2/Δf; stretched bins (irrational edges) do not repeat within 1,000 s."""
+    from sphdvi import wavespectra as ws
+    reg = ws.components("jonswap", 0.04, 1.4, 40, "regular")
+    df = reg["df"][0]
+    assert ws.repetition_period(reg["f"], 1000.0) == pytest.approx(2 / df, rel=1e-12)
+    assert ws.repetition_period(reg["f"], 1.9 / df) is None
+    assert ws.repetition_period(ws.components("jonswap", 0.04, 1.4, 40, "stretched")["f"], 1000.0) is None
+    assert ws.repetition_period([0.5], 10.0) == 2.0
+
+
+def test_calcserielength_is_read_and_reported(tmp_path):
+    (d,), reader = paddles(tmp_path, "piston_spectrum", '<calcserielength timemax="1000" comment="x"/>')
+    assert d["calcserielength"] == 1000.0 and not reader.warnings
+    with pytest.raises(CaseError, match="timemax"):
+        paddles(tmp_path, "piston_spectrum", '<calcserielength timemax="0"/>')
+    from run.test_run import REPO
+    text = (REPO / "cases" / "waveflume2d" / "CaseWaveIrregular2D_Def.xml").read_text()
+    case = tmp_path / "Serie_Def.xml"
+    case.write_text(text.replace('<discretization value="stretched"', '<discretization value="regular"')
+                    .replace("<waves value=\"50\" />", '<waves value="50" /><calcserielength timemax="1000"/>'))
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out"), "--dp", "0.04"])
+    assert r.exit_code == 0, r.output
+    assert "Irregular series (mkbound 10): repeats every 56 s" in r.output
