@@ -111,11 +111,9 @@ def read_wavepaddles(reader, el) -> list:
         if "awas_zsurf" in d:
             d["awas"] = _read_awas(reader, reader.child(c, "awas_zsurf"), d)
             del d["awas_zsurf"]
-        for k, what in (("usefiledata", "<usefiledata> is not implemented by sphdvi: the paddle follows the "
-                                        "regular-wave theory"),
-):
-            if k in d:
-                reader.warn(reader.child(c, k), f"{what}; <{k}> is ignored")
+        if "usefiledata" in d:
+            reader.warn(reader.child(c, "usefiledata"), "<usefiledata> is not implemented by sphdvi: the paddle "
+                        "follows the regular-wave theory; <usefiledata> is ignored")
         if "savemotion" in d:
             d["savemotion"] = _read_savemotion(reader, c, d, spectral)
         if "calcserielength" in d:
@@ -295,6 +293,14 @@ def _read_spectrum_options(reader, c, d: dict) -> None:
                             "one the series less its value at serieini is played); autofit is ignored")
 
 
+def _only_attributes(reader, el, allowed, where: str = "") -> None:
+    """An attribute of ``el`` other than ``allowed`` (and the comments) is a case error naming it."""
+    for k in el.keys():
+        if k not in (*allowed, "comment") and not k.endswith("_comment"):
+            raise reader.error(el, f"unknown attribute {k!r} of <{el.tag}>{where}", ", ".join(allowed))
+    reader.mark(el, "comment")
+
+
 def _read_savemotion(reader, c, d: dict, spectral: bool) -> list:
     """Every ``<savemotion>`` line of a paddle (DualSPHysics's format doc: each writes a file of the
     paddle's displacement and the theory's elevation and velocity): ``xpos`` (a coordinate along the
@@ -304,11 +310,7 @@ def _read_savemotion(reader, c, d: dict, spectral: bool) -> list:
     out = []
     timing = ("time", "timedt") if spectral else ("periods", "periodsteps")
     for el in reader.children(c, "savemotion"):
-        reader.mark(el, "comment")
-        for k in el.keys():
-            if k not in (*timing, "xpos", "zpos", "comment") and not k.endswith("_comment"):
-                raise reader.error(el, f"unknown attribute {k!r} of <savemotion> in <{c.tag}>",
-                                   ", ".join((*timing, "xpos", "zpos")))
+        _only_attributes(reader, el, (*timing, "xpos", "zpos"), f" in <{c.tag}>")
         e = {"line": el.sourceline, "xpos": reader.num(el, "xpos", 0.0)}
         if el.get("zpos") is not None:
             e["zpos"] = reader.num(el, "zpos")
@@ -328,10 +330,7 @@ def _read_serie_window(reader, el, attrs) -> dict:
     """An irregular paddle's ``<saveserie timemin timemax timedt xpos>`` (the series over a window, written
     to a file) or ``<saveseriewaves timemin timemax xpos>`` (its waves by zero up-crossing): timemax
     required, timemin 0, timedt 0.05 s, xpos 0."""
-    for k in el.keys():
-        if k not in (*attrs, "comment") and not k.endswith("_comment"):
-            raise reader.error(el, f"unknown attribute {k!r} of <{el.tag}>", ", ".join(attrs))
-    reader.mark(el, "comment")
+    _only_attributes(reader, el, attrs)
     e = {"timemin": reader.num(el, "timemin", 0.0, nonnegative=True), "timemax": reader.num(el, "timemax"),
          "xpos": reader.num(el, "xpos", 0.0)}
     if "timedt" in attrs:
