@@ -39,7 +39,12 @@ def motion_times(paddle, entry: dict, tmax: float, tout: float) -> np.ndarray:
         period = float(paddle.spec["waveperiod"])
         steps = entry.get("periodsteps") or max(1, round(period / tout))
         end, step = entry.get("periods", tmax / period) * period, period / steps
-    return np.arange(int(math.floor(end / step + 1e-9)) + 1) * step
+    return time_grid(0.0, end, step)
+
+
+def time_grid(start: float, end: float, step: float) -> np.ndarray:
+    """start, start + step, ... up to ``end`` (within 1e-9 of a step)."""
+    return start + np.arange(int(math.floor((end - start) / step + 1e-9)) + 1) * step
 
 
 def motion_table(paddle, entry: dict, tmax: float, tout: float) -> tuple[list, np.ndarray]:
@@ -80,8 +85,7 @@ def zero_upcrossing_waves(t: np.ndarray, eta: np.ndarray) -> np.ndarray:
 def serie_waves_table(paddle, entry: dict) -> tuple[list, np.ndarray]:
     """(column names, rows) of ``<saveseriewaves>``: the waves of the theory's elevation at ``xpos``
     over [timemin, timemax], sampled at Tp/200."""
-    step = float(paddle.spec["waveperiod"]) / 200.0
-    t = entry["timemin"] + np.arange(int((entry["timemax"] - entry["timemin"]) / step) + 1) * step
+    t = time_grid(entry["timemin"], entry["timemax"], float(paddle.spec["waveperiod"]) / 200.0)
     eta = np.asarray(paddle.elevation(entry.get("xpos", 0.0) - paddle.face, t), float).reshape(-1)
     waves = zero_upcrossing_waves(t, eta)
     return ["wave", "t_start [s]", "period [s]", "height [m]"], np.column_stack([np.arange(1, len(waves) + 1), waves])
@@ -103,8 +107,7 @@ def write_paddle_motions(outdir: str, motions, tmax: float, tout: float) -> list
             _write(outdir, written[-1], *motion_table(paddle, entry, float(tmax), float(tout)))
         if spec.get("saveserie"):
             e = spec["saveserie"]
-            t = e["timemin"] + np.arange(int(math.floor((e["timemax"] - e["timemin"]) / e["timedt"] + 1e-9)) + 1) \
-                * e["timedt"]
+            t = time_grid(e["timemin"], e["timemax"], e["timedt"])
             written.append(f"PaddleSerie_mkbound{mkb}.csv")
             _write(outdir, written[-1], *theory_table(paddle, t, e))
         if spec.get("saveseriewaves"):
