@@ -699,6 +699,11 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
                 raise CaseError(str(exc), file=reader.file, line=wp["line"], element="xf",
                                 expected="a focus in front of the piston, along its <pistondir>") from None
             _warn_focus_too_late(wp, paddle, case.parameters.get("TimeMax"), reader)
+            water = pos[ptype == TYPE_FLUID] @ paddle.direction
+            if water.size and paddle.xf > float(water.max()):
+                reader.warnings.add(f"the focus xf={paddle.xf:g} m lies beyond the water drawn (it ends at "
+                                    f"{float(water.max()):.4g} m along the piston's direction)",
+                                    file=reader.file, line=wp.get("line"), element="xf")
     chrono = case.special.get("chrono")
     floating_labels = {b.mkbound for b in bodies}
     if chrono:

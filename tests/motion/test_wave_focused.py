@@ -173,7 +173,7 @@ def test_gencase_warns_when_the_group_cannot_form(tmp_path):
     """DualSPHysics's format-doc numbers (x_f 12.5 m, T_p 1.5 s, fpretime 0, fmovtime 30 s) in W7's flume
     focus at 31.65 s by sphdvi's rule, after a TimeMax of 30 s: warned; the paddle stopping at 30 s (its
     ramp down from 29 s) is not, its last (fastest) waves having left it at 23.8 s. Stopped at 20 s it is
-    warned about too."""
+    warned about too. A focus past the water's end (W7's flume is 6 m long) is warned about."""
     from click.testing import CliRunner
 
     from run.test_run import REPO
@@ -187,9 +187,16 @@ def test_gencase_warns_when_the_group_cannot_form(tmp_path):
         case.write_text(text.replace('<fmovtime value="8"', f'<fmovtime value="{fmovtime}"'))
         r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out"), "--dp", "0.05"])
         assert r.exit_code == 0, r.output
-        return [line for line in r.output.splitlines() if "warning: <piston_focused>" in line]
+        return [line for line in r.output.splitlines() if "warning: <piston_focused>" in line
+                or "warning: <xf>" in line]
 
-    (late,) = warnings(30)
+    found = warnings(30)
+    assert len(found) == 2
+    (beyond,) = [w for w in found if "beyond the water" in w]
+    (late,) = [w for w in found if "focuses at" in w]
+    assert "the focus xf=12.5 m lies beyond the water drawn (it ends at 5.9" in beyond    # W7's flume is 6 m long
     assert "the group focuses at t = 31.6" in late and "after the run ends (TimeMax 30 s)" in late
-    stop, late = warnings(20)
+    found = warnings(20)
+    assert len(found) == 3
+    (stop,) = [w for w in found if "stops moving" in w]
     assert "the paddle stops moving at t = 19 s" in stop and "before the group's last (fastest) waves leave it at 23.79 s" in stop
