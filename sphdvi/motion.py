@@ -788,16 +788,8 @@ class SpectrumPaddle(_Paddle):
     The linear wave it makes at a distance x from the paddle is :meth:`elevation`."""
 
     def __init__(self, spec: dict, g: float = 9.81):
-        from .wavespectra import components
-        self._set_geometry(spec)
-        d = spec["depth"]
-        comp = components(spec["spectrum"], spec["waveheight"], spec["waveperiod"], int(spec["waves"]),
-                          spec["discretization"], spec["peakcoef"], int(spec["randomseed"]))
-        self.components = comp
-        self.omega = 2 * np.pi * comp["f"]
-        self.k = np.array([wave_number(1.0 / f, d, g) for f in comp["f"]])
-        self.amp = comp["amp"] * self.gain
-        self.half_stroke = self.amp / np.array([self._height_to_stroke(k, d) for k in self.k])
+        comp = self._set_waves(spec, g)
+        self._set_amplitudes(comp["amp"] * self.gain)
         self.phase = comp["phase"]
         self.t0 = spec.get("serieini", 0.0)
         self.ramp_time = spec.get("ramptime", 0.0)
@@ -805,6 +797,24 @@ class SpectrumPaddle(_Paddle):
         # where it is drawn; with one (r(0) = 0) it moves about its rest position
         self.offset = (float(np.sum(self.half_stroke * np.sin(self.omega * self.t0 + self.phase)))
                        if self.ramp_time <= 0 else 0.0)
+
+    def _set_waves(self, spec: dict, g: float) -> dict:
+        """The paddle's geometry and the sea state's waves (:func:`sphdvi.wavespectra.components`):
+        their frequencies ω_i and wave numbers k_i; returns the components."""
+        from .wavespectra import components
+        self._set_geometry(spec)
+        comp = components(spec["spectrum"], spec["waveheight"], spec["waveperiod"], int(spec["waves"]),
+                          spec["discretization"], spec["peakcoef"], int(spec["randomseed"]))
+        self.components = comp
+        self.omega = 2 * np.pi * comp["f"]
+        self.k = np.array([wave_number(1.0 / f, spec["depth"], g) for f in comp["f"]])
+        return comp
+
+    def _set_amplitudes(self, amp: np.ndarray) -> None:
+        """The waves' amplitudes a_i and Biesel's half strokes S_i/2 = a_i / (H/S)(k_i d) that make them."""
+        d = self.spec["depth"]
+        self.amp = amp
+        self.half_stroke = amp / np.array([self._height_to_stroke(k, d) for k in self.k])
 
     def mean_position(self) -> float:
         """The theory's mean displacement once the ramp is over (m): −(the series' value at serieini)
@@ -891,14 +901,7 @@ class FocusedPaddle(SpectrumPaddle):
     rest position over the ``fmovramp`` seconds before it (0: it stops where it is)."""
 
     def __init__(self, spec: dict, g: float = 9.81):
-        from .wavespectra import components
-        self._set_geometry(spec)
-        d = self.depth = spec["depth"]
-        comp = components(spec["spectrum"], spec["waveheight"], spec["waveperiod"], int(spec["waves"]),
-                          spec["discretization"], spec["peakcoef"], int(spec["randomseed"]))
-        self.components = comp
-        self.omega = 2 * np.pi * comp["f"]
-        self.k = np.array([wave_number(1.0 / f, d, g) for f in comp["f"]])
+        comp = self._set_waves(spec, g)
         energy = comp["amp"] ** 2
         maxwaveh = spec.get("maxwaveh") or {"nwaves": 1000}
         if "time" in maxwaveh:
@@ -907,9 +910,8 @@ class FocusedPaddle(SpectrumPaddle):
         else:
             self.nwaves = float(maxwaveh["nwaves"])
         self.crest = newwave_crest(spec["waveheight"], self.nwaves)
-        self.amp = self.crest * energy / float(np.sum(energy)) * self.gain
-        self.half_stroke = self.amp / np.array([self._height_to_stroke(k, d) for k in self.k])
-        cg = group_velocity(self.omega, self.k, d)
+        self._set_amplitudes(self.crest * energy / float(np.sum(energy)) * self.gain)
+        cg = group_velocity(self.omega, self.k, spec["depth"])
         self.cg_min, self.cg_max = float(np.min(cg)), float(np.max(cg))
         self.xf = float(spec["xf"])
         self.fphase = math.radians(spec.get("fphase", 0.0))

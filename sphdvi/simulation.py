@@ -730,7 +730,8 @@ class SPHRun:
 
     @staticmethod
     def _place_paddles(motions, p: dict, fluidcount: int) -> None:
-        """The paddles that count distances from their face (focused pistons) learn where it is."""
+        """Each wave paddle learns where its front face is at rest (a focused piston counts its focus
+        from it, every paddle its ``<savemotion xpos>``); a focus behind the face is an InputError."""
         from .coupling import body_labels
         labels = np.where(p["type"] != 3, body_labels(p["mk"], fluidcount), -1)
         try:
