@@ -779,13 +779,16 @@ class WavePaddle(_Paddle):
 
 
 class SpectrumPaddle(_Paddle):
-    """Irregular long-crested waves from a piston or flap (``<piston_spectrum>``/``<flap_spectrum>``),
-    first order: the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: amplitude
+    """Irregular long-crested waves from a piston or flap (``<piston_spectrum>``/``<flap_spectrum>``):
+    the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: amplitude
     a_i, frequency f_i, phase φ_i) each made by Biesel's stroke S_i = 2 a_i / (H/S)(k_i d), so that
-    X(τ) = r(τ) [Σ S_i/2 sin(ω_i (τ + t0) + φ_i) − X_0] (times ``gainstroke``), t0 = ``serieini``, r a
-    linear ramp over ``ramptime`` seconds; X_0 = Σ S_i/2 sin(ω_i t0 + φ_i) without a ramp (the paddle
-    starts where it is drawn), 0 with one (it starts from rest and moves about its rest position).
-    The linear wave it makes at a distance x from the paddle is :meth:`elevation`."""
+    X(τ) = r(τ) [Σ S_i/2 sin(ω_i (τ + t0) + φ_i) + X2(τ + t0) − X_0] (times ``gainstroke``), t0 = ``serieini``,
+    r a linear ramp over ``ramptime`` seconds; X_0 the bracket's value at τ = 0 without a ramp (the
+    paddle starts where it is drawn), 0 with one (it starts from rest and moves about its rest
+    position). X2, on a piston with ``waveorder`` 2 only, is the second-order stroke that makes the
+    waves' bound sum- and difference-frequency waves without free ones (Madsen 1971 extended to
+    irregular waves: :mod:`sphdvi.wave_second_order`). The waves it makes at a distance x from the
+    paddle are :meth:`elevation`."""
 
     def __init__(self, spec: dict, g: float = 9.81):
         comp = self._set_waves(spec, g)
@@ -793,10 +796,8 @@ class SpectrumPaddle(_Paddle):
         self.phase = comp["phase"]
         self.t0 = spec.get("serieini", 0.0)
         self.ramp_time = spec.get("ramptime", 0.0)
-        # without a ramp the series is shifted by its start value so that the paddle starts from
-        # where it is drawn; with one (r(0) = 0) it moves about its rest position
-        self.offset = (float(np.sum(self.half_stroke * np.sin(self.omega * self.t0 + self.phase)))
-                       if self.ramp_time <= 0 else 0.0)
+        self._set_second_order(spec, g)
+        self._set_start()
 
     def _set_waves(self, spec: dict, g: float) -> dict:
         """The paddle's geometry and the sea state's waves (:func:`sphdvi.wavespectra.components`):
@@ -814,43 +815,121 @@ class SpectrumPaddle(_Paddle):
         """The waves' amplitudes a_i and Biesel's half strokes S_i/2 = a_i / (H/S)(k_i d) that make them."""
         d = self.spec["depth"]
         self.amp = amp
-        self.half_stroke = amp / np.array([self._height_to_stroke(k, d) for k in self.k])
+        self.height_to_stroke = np.array([self._height_to_stroke(k, d) for k in self.k])
+        self.half_stroke = amp / self.height_to_stroke
+
+    def _set_second_order(self, spec: dict, g: float) -> None:
+        """``waveorder`` 2 on a piston: the stroke adds the second-order term that makes the waves'
+        bound sum- and difference-frequency waves and no free ones
+        (:class:`sphdvi.wave_second_order.SecondOrderSea`); ``gainstroke`` scales it with the rest of
+        the stroke, as the regular piston's."""
+        self.g = g
+        self._sea = None
+        self.second_order = spec.get("waveorder", 1) == 2 and self.kind == "piston"
+        if self.second_order:
+            self._sea = self._second_order_sea(with_paddle=True)
+
+    def _set_start(self) -> None:
+        """Once the phases are known: without a ramp the oscillating series is shifted by its start
+        value so that the paddle starts from where it is drawn; with one (r(0) = 0) it moves about its
+        rest position. A second-order piston's subharmonic drift starts from rest
+        (:class:`sphdvi.wave_second_order.SubharmonicStroke`)."""
+        self.offset = self._series_from_rest(0.0)[0] if self.ramp_time <= 0 else 0.0
+        if self.second_order:
+            from .wave_second_order import SubharmonicStroke
+            a0 = self.complex_amplitudes() * np.exp(1j * self.omega * self.t0)
+            self._drift = SubharmonicStroke(self._sea.paddle_diff / self.gain, a0, self.omega, self.ramp_time)
+
+    def _second_order_sea(self, with_paddle: bool = False):
+        """The sea's second-order kernels (built once; the paddle's with ``with_paddle``)."""
+        if self._sea is None:
+            from .wave_second_order import SecondOrderSea
+            self._sea = SecondOrderSea(self.omega, self.spec["depth"],
+                                       self.height_to_stroke if with_paddle else None, self.g)
+        return self._sea
+
+    def complex_amplitudes(self) -> np.ndarray:
+        """A_n = a_n e^{iφ_n}: η1 = Re Σ A_n e^{i(ω_n (τ + t0) − k_n x)}."""
+        return self.amp * np.exp(1j * self.phase)
 
     def mean_position(self) -> float:
         """The theory's mean displacement once the ramp is over (m): −(the series' value at serieini)
         without a ramp, 0 with one."""
         return -self.offset
 
-    def _series(self, tau: float):
+    def _series_from_rest(self, tau: float):
+        """The oscillating stroke: Σ S_i/2 sin(ω_i (τ + t0) + φ_i), plus on a second-order piston its
+        superharmonic stroke, and its rate."""
         a = self.omega * (tau + self.t0) + self.phase
-        return (float(np.dot(self.half_stroke, np.sin(a))) - self.offset,
-                float(np.dot(self.half_stroke * self.omega, np.cos(a))))
+        x = float(np.dot(self.half_stroke, np.sin(a)))
+        v = float(np.dot(self.half_stroke * self.omega, np.cos(a)))
+        if self.second_order:
+            x2, v2 = self._sea.superharmonic_stroke(self.complex_amplitudes(), tau + self.t0)
+            x, v = x + float(x2) / self.gain, v + float(v2) / self.gain
+        return x, v
+
+    def _end_ramp(self, tau):
+        """A ramp that brings the paddle back to rest at its end, and its rate: none here."""
+        return 1.0, 0.0
+
+    def theory_position(self, t: float):
+        """The oscillating stroke under the ramps (:meth:`_Paddle.theory_position`), plus on a
+        second-order piston its subharmonic drift from rest (under the end ramp)."""
+        x, v = _Paddle.theory_position(self, t)
+        if not self.second_order:
+            return x, v
+        tau, moving = self._clock(t)
+        if tau == 0.0:
+            return x, v
+        s, ds = self._drift(tau)
+        e, de = self._end_ramp(tau)
+        return x + e * s, (v + e * ds + de * s) if moving else 0.0
+
+    def _series(self, tau: float):
+        x, v = self._series_from_rest(tau)
+        return x - self.offset, v
 
     def stroke_amplitude(self) -> float:
         """The stroke's significant amplitude 2σ, σ² = Σ (S_i/2)²/2 (as Hs/2 = 2σ of the elevation) (m)."""
         return 2.0 * math.sqrt(0.5 * float(np.sum(self.half_stroke ** 2)))
 
     def max_acceleration(self) -> float:
-        """A bound on the stroke's acceleration, Σ (S_i/2) ω_i² (m/s²)."""
-        return float(np.sum(self.half_stroke * self.omega ** 2))
+        """A bound on the stroke's acceleration, Σ (S_i/2) ω_i², plus on a second-order piston
+        ½ Σ |G±_ij| a_i a_j (ω_i ± ω_j)² of its second-order term (m/s²)."""
+        bound = float(np.sum(self.half_stroke * self.omega ** 2))
+        if self.second_order:
+            sea, a = self._sea, np.outer(self.amp, self.amp)
+            w = self.omega
+            bound += 0.5 * float(np.sum(np.abs(sea.paddle_sum) * a * np.add.outer(w, w) ** 2)
+                                 + np.sum(np.abs(sea.paddle_diff) * a * np.subtract.outer(w, w) ** 2)) / self.gain
+        return bound
 
     def elevation(self, x, t, order: int = 1) -> np.ndarray:
         """The linear progressive wave η(x, t) = Σ a_i cos(ω_i (τ + t0) + φ_i − k_i x) at a distance
         ``x`` [m] in front of the paddle (along its stroke), without the ramp and the local
-        evanescent modes: what the paddle makes once the ramp is over and the waves have arrived
-        (first order: ``order`` is accepted for the regular paddle's signature)."""
+        evanescent modes: what the paddle makes once the ramp is over and the waves have arrived;
+        ``order`` 2 adds the waves' bound sum- and difference-frequency waves (Dean & Sharma 1981:
+        :meth:`sphdvi.wave_second_order.SecondOrderSea.elevation`), as the regular paddle adds Stokes's."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         tau = t - self.start
         a = np.outer(tau + self.t0, self.omega) + self.phase - self.k * float(x)
-        return np.cos(a) @ self.amp
+        eta = np.cos(a) @ self.amp
+        if order == 2:
+            eta = eta + self._second_order_sea().elevation(self.complex_amplitudes(), float(x), tau + self.t0)
+        return eta
 
     def orbital_velocity(self, x: float, z: float, t):
         """(u, w) of the linear waves of :meth:`elevation` at a distance ``x`` and ``z`` below the still
-        water: Σ a_i ω_i cosh k_i(z+d)/sinh k_i d cos θ_i, −Σ a_i ω_i sinh k_i(z+d)/sinh k_i d sin θ_i."""
+        water: Σ a_i ω_i cosh k_i(z+d)/sinh k_i d cos θ_i, −Σ a_i ω_i sinh k_i(z+d)/sinh k_i d sin θ_i;
+        a second-order piston's adds the bound waves' flow."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         a = np.outer(t - self.start + self.t0, self.omega) + self.phase - self.k * float(x)
         ch, sh = _depth_ratios(self.k, float(z), self.spec["depth"])
-        return np.cos(a) @ (self.amp * self.omega * ch), -(np.sin(a) @ (self.amp * self.omega * sh))
+        u, w = np.cos(a) @ (self.amp * self.omega * ch), -(np.sin(a) @ (self.amp * self.omega * sh))
+        if self.second_order:
+            u2, w2 = self._sea.velocity(self.complex_amplitudes(), float(x), float(z), t - self.start + self.t0)
+            u, w = u + u2, w + w2
+        return u, w
 
 
 def _depth_ratios(k, z: float, d: float):
@@ -881,8 +960,8 @@ def newwave_crest(hs: float, nwaves: float) -> float:
 
 
 class FocusedPaddle(SpectrumPaddle):
-    """A focused wave group from a piston (``<piston_focused>``), first order (NewWave, Tromans et
-    al. 1991): the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: the
+    """A focused wave group from a piston (``<piston_focused>``) (NewWave, Tromans et al. 1991;
+    ``waveorder`` 2 adds the group's second-order stroke, as :class:`SpectrumPaddle`'s): the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: the
     spectrum, its discretisation, ``waves``, ``peakcoef``) take amplitudes a_i = A E_i / Σ E_j (E_i the
     energy of wave i's bin, S(f_i) Δf_i) and phases that put every crest at the focus together:
     η(x, τ) = Σ a_i cos(ω_i (τ − t_f) − k_i (x − x_f) + φ_f), A = :func:`newwave_crest` of
@@ -922,6 +1001,7 @@ class FocusedPaddle(SpectrumPaddle):
         self.fmovramp = min(spec.get("fmovramp", 0.0), self.fmovtime) if self.fmovtime > 0 else 0.0
         if self.fmovtime > 0:
             self.duration = self.fmovtime if self.duration <= 0 else min(self.duration, self.fmovtime)
+        self._set_second_order(spec, g)
         self.place(0.0, check=False)
 
     def place(self, face: float, check: bool = True) -> None:
@@ -935,20 +1015,35 @@ class FocusedPaddle(SpectrumPaddle):
                              f"along its direction")
         self.focus_time = self.pretime + self.distance / self.cg_min
         self.phase = self.k * self.distance - self.omega * self.focus_time + self.fphase
-        self.offset = (float(np.sum(self.half_stroke * np.sin(self.phase)))
-                       if self.ramp_time <= 0 else 0.0)
+        self._set_start()
 
-    def _ramp(self, tau):
-        """The start ramp (``ramptime``) times the end ramp (``fmovramp`` before ``fmovtime``), and its rate."""
-        r, dr = SpectrumPaddle._ramp(self, tau)
+    def _end_ramp(self, tau):
+        """The end ramp (``fmovramp`` before ``fmovtime``) and its rate."""
         if self.fmovramp > 0 and tau > self.fmovtime - self.fmovramp:
             e = max(0.0, (self.fmovtime - tau) / self.fmovramp)
-            return r * e, dr * e - (r / self.fmovramp if e > 0 else 0.0)
-        return r, dr
+            return e, (-1.0 / self.fmovramp if e > 0 else 0.0)
+        return 1.0, 0.0
 
-    def elevation_at(self, x: float, t) -> np.ndarray:
-        """η at the coordinate ``x`` along ``pistondir`` (the focus is at x = ``xf``), without the ramps."""
-        return self.elevation(float(x) - self.face, t)
+    def _ramp(self, tau):
+        """The start ramp (``ramptime``) times the end ramp, and its rate."""
+        r, dr = SpectrumPaddle._ramp(self, tau)
+        e, de = self._end_ramp(tau)
+        return r * e, dr * e + r * de
+
+    def elevation_at(self, x: float, t, order: int | None = None) -> np.ndarray:
+        """η at the coordinate ``x`` along ``pistondir`` (the focus is at x = ``xf``), without the ramps,
+        to ``order`` (the paddle's ``waveorder`` by default: a second-order group's with its bound waves)."""
+        return self.elevation(float(x) - self.face, t, self.spec.get("waveorder", 1) if order is None else order)
+
+    def focus_crest(self, order: int | None = None) -> float:
+        """The crest at the focus: A at first order; at second order the largest of :meth:`elevation_at`
+        there within half a peak period of the focus time (sampled every Tp/2000)."""
+        order = self.spec.get("waveorder", 1) if order is None else order
+        if order == 1:
+            return self.crest
+        tp = float(self.spec["waveperiod"])
+        t = self.start + self.focus_time + np.linspace(-0.5, 0.5, 2001) * tp
+        return float(np.max(self.elevation_at(self.xf, t, order)))
 
 
 SOLITARY_THEORIES = {1: "Rayleigh", 2: "Boussinesq", 3: "KdV"}

@@ -936,7 +936,8 @@ def summary(result: GenCaseResult) -> str:
                 f"does not repeat within {tmax:g} s ({wp['discretization']} discretization)"))
         if wp["type"] == "piston_focused":
             f = focused_paddle(wp, p["pos"], p["type"], p["label"])
-            lines.append(f"Focused group (mkbound {wp['mkbound']}): crest {f.crest:.4g} m at x = {f.xf:g} m, "
+            second = f" (with its bound waves {f.focus_crest(2):.4g} m)" if f.second_order else ""
+            lines.append(f"Focused group (mkbound {wp['mkbound']}): crest {f.crest:.4g} m{second} at x = {f.xf:g} m, "
                          f"t = {f.start + f.focus_time:.4g} s ({f.distance:.4g} m from the piston's face; "
                          f"{f.amp.size} waves, the largest crest of {f.nwaves:.4g})")
     if result.normals is not None:

@@ -79,16 +79,13 @@ def read_wavepaddles(reader, el) -> list:
                         ("ramptime", "seconds")):
             if d.get(k, 0.0) < 0:
                 raise reader.error(reader.child(c, k), f"<{k}> value={d[k]:g} is negative", f"{k} >= 0 ({what})")
-        if c.tag == "flap" and d["waveorder"] == 2:
+        if c.tag.startswith("flap") and d["waveorder"] == 2:
             # DualSPHysics's own example main/08_WavesFlap (CaseFlapBeach_REG) asks for it; its format
             # doc (_FmtXML_WavePaddles.xml) gives <waveorder> to pistons only, and its wave generation
             # (Altomare et al. 2017) is second order for pistons: the flap moves at first order
-            reader.warn(reader.child(c, "waveorder"), "second-order generation is for pistons (DualSPHysics's format "
-                        "gives a <flap> no <waveorder>): this flap generates first-order waves")
+            reader.warn(reader.child(c, "waveorder"), f"second-order generation is for pistons (DualSPHysics's format "
+                        f"gives a <{c.tag}> no <waveorder>): this flap generates first-order waves")
             d["waveorder"] = 1
-        if spectral and d["waveorder"] == 2:
-            raise reader.error(reader.child(c, "waveorder"), "second-order generation of irregular waves is not "
-                               "implemented by sphdvi", "waveorder 1 (first order: the spectrum's linear waves)")
         if c.tag.startswith("flap") and ("flapaxis0" not in d or "flapaxis1" not in d):
             raise reader.error(c, "missing <flapaxis0>/<flapaxis1>", "the two points of the hinge axis")
         if c.tag.startswith("flap") and not d.get("variabledraft", 0.0) > -d["depth"]:

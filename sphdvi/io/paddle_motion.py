@@ -5,7 +5,8 @@ Each ``<savemotion>`` line of a wave paddle (``<piston>``, ``<flap>``, ``<piston
 run's start (n: the line's place among the paddle's ``<savemotion>`` lines, from 1): one row per
 time from 0, ``;``-separated, of the paddle's displacement at the still-water level and its rate
 (the ramps included, without an absorber's correction), a flap's angle, the theory's elevation at
-``xpos`` and, with ``zpos``, its velocity there (:meth:`sphdvi.motion._Paddle.orbital_velocity`).
+``xpos`` and, with ``zpos``, its velocity there (:meth:`sphdvi.motion._Paddle.orbital_velocity`), both
+to the paddle's ``waveorder`` (a second-order piston's with its bound waves).
 DualSPHysics's format documents what such a file holds, not its name or columns: these are sphdvi's.
 
 Times: a regular paddle's ``periods`` wave periods (TimeMax's worth by default) at ``periodsteps`` rows a
@@ -52,6 +53,12 @@ def motion_table(paddle, entry: dict, tmax: float, tout: float) -> tuple[list, n
     return theory_table(paddle, motion_times(paddle, entry, tmax, tout), entry)
 
 
+def theory_elevation(paddle, distance: float, t: np.ndarray) -> np.ndarray:
+    """The theory's elevation ``distance`` in front of the paddle at the times ``t``, to the order the
+    paddle generates (``waveorder``: a second-order paddle's with its bound waves)."""
+    return np.asarray(paddle.elevation(distance, t, order=paddle.spec.get("waveorder", 1)), float).reshape(-1)
+
+
 def theory_table(paddle, t: np.ndarray, entry: dict) -> tuple[list, np.ndarray]:
     """(column names, rows) of the paddle's theory at the times ``t``: displacement, rate, a flap's
     angle, the elevation at ``entry["xpos"]`` and with ``entry["zpos"]`` the velocity there."""
@@ -62,7 +69,7 @@ def theory_table(paddle, t: np.ndarray, entry: dict) -> tuple[list, np.ndarray]:
         cols.append(np.degrees(np.arctan2(x, paddle.hinge_depth)))
     distance = entry.get("xpos", 0.0) - paddle.face
     names.append("eta [m]")
-    cols.append(np.asarray(paddle.elevation(distance, t), float).reshape(-1))
+    cols.append(theory_elevation(paddle, distance, t))
     if "zpos" in entry:
         u, w = paddle.orbital_velocity(distance, entry["zpos"], t)
         names += ["u [m/s]", "w [m/s]"]
@@ -86,8 +93,7 @@ def serie_waves_table(paddle, entry: dict) -> tuple[list, np.ndarray]:
     """(column names, rows) of ``<saveseriewaves>``: the waves of the theory's elevation at ``xpos``
     over [timemin, timemax], sampled at Tp/200."""
     t = time_grid(entry["timemin"], entry["timemax"], float(paddle.spec["waveperiod"]) / 200.0)
-    eta = np.asarray(paddle.elevation(entry.get("xpos", 0.0) - paddle.face, t), float).reshape(-1)
-    waves = zero_upcrossing_waves(t, eta)
+    waves = zero_upcrossing_waves(t, theory_elevation(paddle, entry.get("xpos", 0.0) - paddle.face, t))
     return ["wave", "t_start [s]", "period [s]", "height [m]"], np.column_stack([np.arange(1, len(waves) + 1), waves])
 
 

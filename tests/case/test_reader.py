@@ -575,10 +575,13 @@ def test_second_order_flap_is_warned_and_first_order(tmp_path):
     assert wp["waveorder"] == 1
     (w,) = list(reader.warnings)
     assert ":2: warning: <waveorder>: second-order generation is for pistons" in w
-    # a flap_spectrum asking second order stays an error (sphdvi has no second-order irregular waves)
-    with pytest.raises(CaseError, match="second-order generation of irregular waves"):
-        read_wavepaddles(reader, etree.fromstring(xml.replace("<flap>", "<flap_spectrum>").replace(
-            "</flap>", "</flap_spectrum>")))
+    # a flap_spectrum asking second order: the same (its format gives it no <waveorder> either)
+    reader = CaseReader(str(tmp_path / "case.xml"), base_dir=str(tmp_path))
+    (wp,) = read_wavepaddles(reader, etree.fromstring(xml.replace("<flap>", "<flap_spectrum>").replace(
+        "</flap>", '<spectrum value="jonswap"/></flap_spectrum>')))
+    assert wp["waveorder"] == 1
+    assert any("second-order generation is for pistons (DualSPHysics's format gives a <flap_spectrum>" in w
+               for w in reader.warnings)
 
 
 def test_a_wave_paddles_depth_unlike_the_water_drawn_is_warned(tmp_path):

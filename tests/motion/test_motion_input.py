@@ -325,7 +325,7 @@ def test_spectrum_paddle_read_with_dualsphysics_defaults(tmp_path):
     ('<discretization value="even"/>', None, "unknown discretization 'even'", "discretization"),
     ('<waves value="0"/>', None, "<waves> value=0", "waves"),
     ('<peakcoef value="0.5"/>', None, "<peakcoef> value=0.5", "peakcoef"),
-    ('<waveorder value="2"/>', None, "second-order generation of irregular waves", "waveorder"),
+    ('<waveorder value="3"/>', None, "waveorder 3", "piston_spectrum"),
     ('<serieini value="-1"/>', None, "<serieini> value=-1 is negative", "serieini"),
     ('<ramptime value="-2"/>', None, "<ramptime> value=-2 is negative", "ramptime"),
     ('<ramp value="2"/>', None, "unknown element <ramp> in <piston_spectrum>", "ramp"),

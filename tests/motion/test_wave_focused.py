@@ -163,10 +163,9 @@ def test_reader_refusals(tmp_path, inner, element, match):
     assert e.value.element == element
 
 
-def test_second_order_is_refused_as_for_spectra(tmp_path):
-    with pytest.raises(CaseError, match="second-order generation of irregular waves") as e:
-        paddles(tmp_path, '<xf value="6"/>', waveorder=2)
-    assert e.value.element == "waveorder"
+def test_second_order_is_read(tmp_path):
+    (d,), reader = paddles(tmp_path, '<xf value="6"/>', waveorder=2)
+    assert d["waveorder"] == 2 and FocusedPaddle(d).second_order
 
 
 def test_gencase_warns_when_the_group_cannot_form(tmp_path):
@@ -200,3 +199,22 @@ def test_gencase_warns_when_the_group_cannot_form(tmp_path):
     assert len(found) == 3
     (stop,) = [w for w in found if "stops moving" in w]
     assert "the paddle stops moving at t = 19 s" in stop and "before the group's last (fastest) waves leave it at 23.79 s" in stop
+
+
+def test_gencase_prints_the_second_order_crest(tmp_path):
+    """W8's case (W7's group at second order): gencase prints the linear crest A and the crest with the
+    group's bound waves, a few per cent higher."""
+    import re
+
+    from click.testing import CliRunner
+
+    from run.test_run import REPO
+    from sphdvi.cli import main
+    case = REPO / "cases" / "waveflume2d" / "CaseWaveFocused2ndOrder2D_Def.xml"
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "out"), "--dp", "0.04"])
+    assert r.exit_code == 0, r.output
+    (line,) = [ln for ln in r.output.splitlines() if ln.startswith("Focused group")]
+    m = re.search(r"crest ([\d.]+) m \(with its bound waves ([\d.]+) m\) at x = 2 m", line)
+    assert m, line
+    linear, second = float(m.group(1)), float(m.group(2))
+    assert linear == pytest.approx(0.02788, abs=1e-5) and 1.02 < second / linear < 1.08
