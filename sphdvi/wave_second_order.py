@@ -196,10 +196,12 @@ class SecondOrderSea:
             return self.bilinear(zn, *kernels[0]), self.bilinear(zn, *kernels[1])
         return self._by_chunks(evaluate, t)
 
-    def superharmonic_stroke(self, amplitudes, t):
-        """The piston's superharmonic stroke ½ Re[zᵀ G⁺ z] and its rate at time t (the paddle at x = 0)."""
-        zn = self.phasors(amplitudes, 0.0, t)
-        return self.bilinear(zn, self.paddle_sum, np.zeros_like(self.paddle_sum), dz=1j * self.omega * zn)
+    def superharmonic_stroke(self, amplitudes, t: float):
+        """The piston's superharmonic stroke ½ Re[zᵀ G⁺ z] and its rate Re[żᵀ G⁺ z] (G⁺ symmetric) at
+        time t (the paddle at x = 0): one matrix-vector product."""
+        zn = np.asarray(amplitudes) * np.exp(1j * self.omega * float(t))
+        gz = self.paddle_sum @ zn
+        return 0.5 * float(np.real(zn @ gz)), float(np.real((1j * self.omega * zn) @ gz))
 
 
 class SubharmonicStroke:
@@ -234,7 +236,8 @@ class SubharmonicStroke:
 
     @staticmethod
     def _form(m, u) -> float:
-        return 0.5 * float(np.real(u @ m @ np.conj(u)))
+        """½ Re[uᵀ M ū]."""
+        return 0.5 * float(np.real(u @ (m @ np.conj(u))))
 
     def _moment(self, tau: float) -> float:
         """∫_0^τ s S(s) ds."""

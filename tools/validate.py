@@ -154,6 +154,16 @@ def _wave_flume_case(name, paddle, xml):
                 "incident wave height within 10 % of the target (judgement; DualSPHysics advises H/dp >= 10)")
 
 
+def _focused_case(name, title, xml, target):
+    """W7/W8: the same flume and focused group, generated to first or second order."""
+    return Case(name, title, case_path("waveflume2d", xml), [Resolution("A/dp 1.4", 0.02), Resolution("A/dp 2.8", 0.01)],
+                score_focused, [("crest %", "crest", PCT), ("focus time s", "focus_time", "{:+.3f}"),
+                                ("trough %", "trough", PCT), ("corr min", "corr_min", "{:.3f}"),
+                                ("rms WG1 %A", "rms_WG1", PCT), ("rms WG2 %A", "rms_WG2", PCT),
+                                ("rms WG3 %A", "rms_WG3", PCT)],
+                "rms_max", lambda e: abs(e["crest"]) <= 0.10 and e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15, target)
+
+
 def _front_case(name, title, file):
     """S3/S3M: the dam-break front against Martin & Moyce, at a/dp 25 (not scored) and 50."""
     return Case(name, title, case_path("dambreak2d", file),
@@ -375,27 +385,14 @@ def cases() -> list:
              "H_max", lambda e: e["H_max"] <= 0.10 and abs(e["celerity"]) <= 0.03,
              "crest height within 10 % of H at the three gauges and crest speed within 3 % of sqrt(g(h + H)) "
              "(judgement, as W1)"),
-        Case("W7", "focused wave group from a piston (<piston_focused>, NewWave of JONSWAP Hs = 0.03 m, Tp = 1.4 s "
-             "in d = 0.3 m, focused at x = 2 m)",
-             case_path("waveflume2d", "CaseWaveFocused2D_Def.xml"),
-             [Resolution("A/dp 1.4", 0.02), Resolution("A/dp 2.8", 0.01)],
-             score_focused, [("crest %", "crest", PCT), ("focus time s", "focus_time", "{:+.3f}"),
-                             ("trough %", "trough", PCT), ("corr min", "corr_min", "{:.3f}"),
-                             ("rms WG1 %A", "rms_WG1", PCT), ("rms WG2 %A", "rms_WG2", PCT),
-                             ("rms WG3 %A", "rms_WG3", PCT)],
-             "rms_max", lambda e: abs(e["crest"]) <= 0.10 and e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15,
-             "crest at the focus within 10 % of the group's A, elevation against the linear group: correlation "
-             ">= 0.9, rms within 15 % of A (judgement, as W1 and W4)"),
-        Case("W8", "W7's focused wave group generated to second order (<piston_focused> waveorder 2)",
-             case_path("waveflume2d", "CaseWaveFocused2ndOrder2D_Def.xml"),
-             [Resolution("A/dp 1.4", 0.02), Resolution("A/dp 2.8", 0.01)],
-             score_focused, [("crest %", "crest", PCT), ("focus time s", "focus_time", "{:+.3f}"),
-                             ("trough %", "trough", PCT), ("corr min", "corr_min", "{:.3f}"),
-                             ("rms WG1 %A", "rms_WG1", PCT), ("rms WG2 %A", "rms_WG2", PCT),
-                             ("rms WG3 %A", "rms_WG3", PCT)],
-             "rms_max", lambda e: abs(e["crest"]) <= 0.10 and e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15,
-             "as W7, against the group with its bound waves (second-order theory): crest within 10 %, "
-             "correlation >= 0.9, rms within 15 % of A (judgement, as W7)"),
+        _focused_case("W7", "focused wave group from a piston (<piston_focused>, NewWave of JONSWAP Hs = 0.03 m, "
+                      "Tp = 1.4 s in d = 0.3 m, focused at x = 2 m)", "CaseWaveFocused2D_Def.xml",
+                      "crest at the focus within 10 % of the group's A, elevation against the linear group: "
+                      "correlation >= 0.9, rms within 15 % of A (judgement, as W1 and W4)"),
+        _focused_case("W8", "W7's focused wave group generated to second order (<piston_focused> waveorder 2)",
+                      "CaseWaveFocused2ndOrder2D_Def.xml",
+                      "as W7, against the group with its bound waves (second-order theory): crest within 10 %, "
+                      "correlation >= 0.9, rms within 15 % of A (judgement, as W7)"),
         Case("W4", "irregular waves from a piston (<piston_spectrum>: JONSWAP Hs = 0.04 m, Tp = 1.4 s, d = 0.3 m)",
              case_path("waveflume2d", "CaseWaveIrregular2D_Def.xml"),
              [Resolution("Hs/dp 2", 0.02), Resolution("Hs/dp 4", 0.01)],

@@ -1,12 +1,15 @@
 """W7: a focused wave group from a piston (NewWave of JONSWAP Hs = 0.03 m, Tp = 1.4 s in d = 0.3 m,
 focused at x = 2 m) against the linear sum of the group's waves at three gauges
-(sphdvi.validation.focused).
+(sphdvi.validation.focused); W8: the same group generated to second order, against the group with its
+bound waves.
 
-Measured (README): A/dp 1.4 (dp 0.02) crest −9.0 % of A, 0.045 s early, correlation ≥ 0.965, rms
+Measured (README): W7 A/dp 1.4 (dp 0.02) crest −9.0 % of A, 0.045 s early, correlation ≥ 0.965, rms
 ≤ 12.5 % of A; A/dp 2.8 (dp 0.01) crest −2.8 %, 0.040 s early, correlation ≥ 0.974, rms ≤ 10.3 %.
+W8 A/dp 1.4 crest −20.8 % of the second-order crest, 0.031 s early, correlation ≥ 0.981, rms ≤ 10.5 %;
+A/dp 2.8 crest −11.3 %, 0.026 s early, correlation ≥ 0.994, rms ≤ 6.6 %.
 Slow: dp 0.02 is 4,926 particles and 39,250 steps (about 2 minutes on 1 thread), dp 0.01 18,851
-particles and 79,899 steps (16 minutes on 1 thread beside another run; the two runs of this file, 10 minutes
-on 2 threads)."""
+particles and 79,899 steps (16 minutes on 1 thread beside another run, 14 on 2 threads; the four runs of
+this file, about 25 minutes on 2 threads)."""
 import pytest
 
 from sphdvi.validation.focused import GAUGES, focused_errors
@@ -15,10 +18,11 @@ from run.test_run import REPO
 from validation._caseruns import cached_runs
 
 CASE = REPO / "cases" / "waveflume2d" / "CaseWaveFocused2D_Def.xml"
+CASE2 = REPO / "cases" / "waveflume2d" / "CaseWaveFocused2ndOrder2D_Def.xml"        # W8: second order
 
 
 def report(dp, case, e):
-    return (f"W7 dp {dp}: crest {100 * e['crest']:+.1f} % of A, at {e['focus_time']:+.3f} s from t_f, trough "
+    return (f"{'W8' if case == CASE2 else 'W7'} dp {dp}: crest {100 * e['crest']:+.1f} % of A, at {e['focus_time']:+.3f} s from t_f, trough "
             f"{100 * e['trough']:+.1f} %; correlation " + " / ".join(f"{e[f'corr_{n}']:.3f}" for n in GAUGES) +
             ", rms " + " / ".join(f"{100 * e[f'rms_{n}']:.1f}" for n in GAUGES) + " % of A")
 
@@ -52,16 +56,49 @@ def test_the_focused_groups_errors_fall_with_dp(run):
     assert fine["corr_min"] > coarse["corr_min"]
 
 
-def test_the_scorer_reads_the_linear_group_as_exact(tmp_path):
-    """Gauge files holding the theory's own elevation (on a still level of 0.3 m) score as no
-    error: crest, focus time, rms 0 and correlation 1 (the scorer, without a run)."""
+@pytest.mark.slow
+def test_the_second_order_group_fits_its_theory_at_a_over_dp_2_8(run):
+    """W8 (W7's group generated to second order) against the group with its bound waves: focus time
+    within 0.1 s, correlation >= 0.9, rms within 15 % of A (W7's judgement); and it fits its theory
+    closer than W7's first-order generation fits the linear group, at every gauge and in the trough
+    (measured: correlation >= 0.994 against 0.974, rms <= 6.6 % against 10.3 %, trough -2.3 % against
+    -11.0 %)."""
+    e, first = run(0.01, CASE2), run(0.01, CASE)
+    assert abs(e["focus_time"]) <= 0.1
+    assert e["corr_min"] >= 0.9
+    assert e["rms_max"] <= 0.15
+    for n in GAUGES:
+        assert e[f"rms_{n}"] < first[f"rms_{n}"] and e[f"corr_{n}"] > first[f"corr_{n}"]
+    assert abs(e["trough"]) < abs(first["trough"])
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="W8's crest at the focus is 11.3 % below the second-order theory's at "
+                   "A/dp 2.8 (20.8 % at 1.4): the SPH rounds the group's sharper second-order crest (W7's "
+                   "first-order crest is 2.8 % below the linear one); 10 % is W7's judgement")
+def test_the_second_order_crest_within_10_percent(run):
+    assert abs(run(0.01, CASE2)["crest"]) <= 0.10
+
+
+@pytest.mark.slow
+def test_the_second_order_groups_errors_fall_with_dp(run):
+    coarse, fine = run(0.02, CASE2), run(0.01, CASE2)
+    assert abs(fine["crest"]) < abs(coarse["crest"])
+    assert fine["rms_max"] < coarse["rms_max"]
+    assert fine["corr_min"] > coarse["corr_min"]
+
+
+@pytest.mark.parametrize("case", [CASE, CASE2], ids=["W7", "W8"])
+def test_the_scorer_reads_the_theorys_group_as_exact(tmp_path, case):
+    """Gauge files holding the theory's own elevation (on a still level of 0.3 m; W8's with the bound
+    waves) score as no error: crest, focus time, rms 0 and correlation 1 (the scorer, without a run)."""
     import numpy as np
     from click.testing import CliRunner
 
     from sphdvi.cli import main
     from sphdvi.validation.focused import focused_paddle
 
-    r = CliRunner().invoke(main, ["gencase", str(CASE), "-o", str(tmp_path), "--dp", "0.04"])
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path), "--dp", "0.04"])
     assert r.exit_code == 0, r.output
     paddle = focused_paddle(str(tmp_path))
     t = np.arange(0.0, 8.0, 0.005)
