@@ -107,8 +107,9 @@ class SecondOrderSea:
             setattr(self, f"{name}_diff", kernels["diff"][name])
         for name in ("eta", "paddle"):
             pair = (kernels["sum"][name], kernels["diff"][name])
-            setattr(self, f"{name}_sum", None if pair[0] is None else symmetric(*pair)[0])
-            setattr(self, f"{name}_diff", None if pair[1] is None else symmetric(*pair)[1])
+            pair = (None, None) if pair[0] is None else symmetric(*pair)
+            setattr(self, f"{name}_sum", pair[0])
+            setattr(self, f"{name}_diff", pair[1])
 
     def _pair_kernels(self, wa, ka, wb, kb, c1a, flux: bool) -> dict:
         """The kernels of the ordered pairs of unit signed terms a (ω_a, k_a) and b (ω_b, k_b): each
@@ -145,17 +146,10 @@ class SecondOrderSea:
 
     # -- evaluation --------------------------------------------------------------------------
     @staticmethod
-    def bilinear(z, g_sum, g_diff, dz=None):
-        """½ Re[zᵀ G⁺ z + zᵀ G⁻ z̄] for z of shape (N,) or (T, N); with ``dz`` (ż) also its rate
-        ½ Re[żᵀG⁺z + zᵀG⁺ż + żᵀG⁻z̄ + zᵀG⁻ conj(ż)]."""
+    def bilinear(z, g_sum, g_diff):
+        """½ Re[zᵀ G⁺ z + zᵀ G⁻ z̄] for z of shape (N,) or (T, N)."""
         z = np.asarray(z)
-        zs, zd = z @ g_sum.T, np.conj(z) @ g_diff.T     # (G z)_n = Σ_m G_nm z_m
-        value = 0.5 * np.real(np.sum(z * zs, axis=-1) + np.sum(z * zd, axis=-1))
-        if dz is None:
-            return value
-        rate = 0.5 * np.real(np.sum(dz * zs, axis=-1) + np.sum(z * (dz @ g_sum.T), axis=-1)
-                             + np.sum(dz * zd, axis=-1) + np.sum(z * (np.conj(dz) @ g_diff.T), axis=-1))
-        return value, rate
+        return 0.5 * np.real(np.sum(z * (z @ g_sum.T), axis=-1) + np.sum(z * (np.conj(z) @ g_diff.T), axis=-1))
 
     CHUNK = 4096        # times evaluated at once: (T, N) complex arrays stay within a few MB
 

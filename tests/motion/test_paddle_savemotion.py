@@ -110,6 +110,21 @@ def test_table_columns():
     assert motion_table(p, {}, 2.6, 0.1)[0] == ["time [s]", "stroke [m]", "stroke_vel [m/s]", "angle [deg]", "eta [m]"]
 
 
+@pytest.mark.parametrize("make", [lambda o: WavePaddle({**REGULAR, "waveorder": o}),
+                                  lambda o: SpectrumPaddle({**SPECTRUM, "waveorder": o})], ids=["regular", "irregular"])
+def test_a_second_order_pistons_table_carries_its_bound_waves(make):
+    """The elevation and velocity columns of a second-order piston are its theory's to second order
+    (the bound waves), a first-order one's linear."""
+    for order in (1, 2):
+        p = make(order)
+        names, rows = motion_table(p, {"xpos": 0.8, "zpos": -0.15, "time": 6.0, "timedt": 0.05,
+                                       "periods": 4, "periodsteps": 20}, 9.0, 0.1)
+        t = rows[:, 0]
+        np.testing.assert_allclose(rows[:, names.index("eta [m]")], p.elevation(0.8, t, order=order), atol=1e-15)
+        np.testing.assert_allclose(rows[:, names.index("u [m/s]")], p.orbital_velocity(0.8, -0.15, t)[0], atol=1e-15)
+    assert not np.allclose(p.elevation(0.8, t, order=2), p.elevation(0.8, t), atol=1e-5)
+
+
 def test_focused_table_peaks_at_the_focus():
     from test_wave_focused import spec
     p = FocusedPaddle(spec())
