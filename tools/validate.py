@@ -16,6 +16,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
                                              # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
                                              # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
+                                             # W9: W4's sea generated to second order (the same times)
     python tools/validate.py W3 --fine       # also the resolutions run only on request (W3 depth/dp 40, dp 0.01: ~15 min on 2 threads)
     python tools/validate.py S9 --csv s9.csv --keep runs/
     python tools/validate.py S16M --dp 0.02 --dp 0.01 --threads 2     # some of a case's resolutions
@@ -152,6 +153,15 @@ def _wave_flume_case(name, paddle, xml):
                                    ("refl (own k) %", "reflection_fitted_k", "{:.1f} %")],
                 "H_incident", lambda e: abs(e["H_incident"]) <= 0.10,
                 "incident wave height within 10 % of the target (judgement; DualSPHysics advises H/dp >= 10)")
+
+
+def _irregular_case(name, title, xml, target):
+    """W4/W9: the same flume and irregular sea, generated to first or second order (slow)."""
+    return Case(name, title, case_path("waveflume2d", xml), [Resolution("Hs/dp 2", 0.02), Resolution("Hs/dp 4", 0.01)],
+                score_irregular_waves, [("corr WG1", "WG1_corr", "{:.3f}"), ("corr WG3", "WG3_corr", "{:.3f}"),
+                                        ("rms WG1 %", "WG1_rms", PCT), ("rms WG3 %", "WG3_rms", PCT),
+                                        ("lag WG1 s", "WG1_lag", "{:+.2f}"), ("lag WG3 s", "WG3_lag", "{:+.2f}")],
+                "rms_max", lambda e: e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15, target, slow=True)
 
 
 def _focused_case(name, title, xml, target):
@@ -393,15 +403,13 @@ def cases() -> list:
                       "CaseWaveFocused2ndOrder2D_Def.xml",
                       "as W7, against the group with its bound waves (second-order theory): crest within 10 %, "
                       "correlation >= 0.9, rms within 15 % of A (judgement, as W7)"),
-        Case("W4", "irregular waves from a piston (<piston_spectrum>: JONSWAP Hs = 0.04 m, Tp = 1.4 s, d = 0.3 m)",
-             case_path("waveflume2d", "CaseWaveIrregular2D_Def.xml"),
-             [Resolution("Hs/dp 2", 0.02), Resolution("Hs/dp 4", 0.01)],
-             score_irregular_waves, [("corr WG1", "WG1_corr", "{:.3f}"), ("corr WG3", "WG3_corr", "{:.3f}"),
-                                     ("rms WG1 %", "WG1_rms", PCT), ("rms WG3 %", "WG3_rms", PCT),
-                                     ("lag WG1 s", "WG1_lag", "{:+.2f}"), ("lag WG3 s", "WG3_lag", "{:+.2f}")],
-             "rms_max", lambda e: e["corr_min"] >= 0.9 and e["rms_max"] <= 0.15,
-             "surface elevation against the linear sum of the sea state's waves: correlation >= 0.9, rms "
-             "within 15 % (judgement, as W3)", slow=True),
+        _irregular_case("W4", "irregular waves from a piston (<piston_spectrum>: JONSWAP Hs = 0.04 m, Tp = 1.4 s, "
+                        "d = 0.3 m)", "CaseWaveIrregular2D_Def.xml",
+                        "surface elevation against the linear sum of the sea state's waves: correlation >= 0.9, rms "
+                        "within 15 % (judgement, as W3)"),
+        _irregular_case("W9", "W4's irregular sea generated to second order (<piston_spectrum> waveorder 2)",
+                        "CaseWaveIrregular2ndOrder2D_Def.xml",
+                        "as W4, against the sea state to second order (the linear waves and their bound waves)"),
         Case("W3", "waves from a measured flap motion (Hadzic et al. 2005 flume): wave probes",
              case_path("flapwaves2d", "CaseFlapWavesHadzic2D_Def.xml"),
              [Resolution("depth/dp 10", 0.04), Resolution("depth/dp 20", 0.02),

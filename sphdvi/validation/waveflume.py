@@ -110,7 +110,8 @@ STILL_UNTIL = 0.2          # s: the gauges' still-water reading, before the firs
 def irregular_errors(outdir: str) -> dict:
     """W4: at each gauge, over t ≥ IRREGULAR_FROM, the SPH surface elevation (the gauge's level less
     its mean over t ≤ STILL_UNTIL) against the linear sum of the paddle's waves at the gauge
-    (:meth:`sphdvi.motion.SpectrumPaddle.elevation`), scored as W3 scores its probes
+    (:meth:`sphdvi.motion.SpectrumPaddle.elevation`; W9, the sea generated to second order, against
+    the waves with their bound waves), scored as W3 scores its probes
     (:func:`sphdvi.validation.flapwaves.probe_scores`): ``<g>_corr``, ``<g>_rms`` (rms ratio − 1),
     ``<g>_lag`` (the best shift, s; positive: the SPH wave is late), ``<g>_corr_lag`` ...;
     ``corr_min``, ``rms_max`` (largest |<g>_rms|)."""
@@ -123,7 +124,7 @@ def irregular_errors(outdir: str) -> dict:
     for name, x in IRREGULAR_GAUGES.items():
         t, eta = gauge_elevation(outdir, name, STILL_UNTIL)
         t_pred = t[t >= IRREGULAR_FROM]
-        s = probe_scores(t, eta, t_pred, paddle.elevation(x, t_pred))
+        s = probe_scores(t, eta, t_pred, paddle.elevation(x, t_pred, order=spec.get("waveorder", 1)))
         out.update({f"{name}_{k}": v for k, v in s.items()})
     out["corr_min"] = min(out[f"{n}_corr"] for n in IRREGULAR_GAUGES)
     out["rms_max"] = max(abs(out[f"{n}_rms"]) for n in IRREGULAR_GAUGES)
