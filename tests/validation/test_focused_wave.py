@@ -49,8 +49,9 @@ def test_the_group_focuses_at_a_over_dp_2_8(run):
 
 
 @pytest.mark.slow
-def test_the_focused_groups_errors_fall_with_dp(run):
-    coarse, fine = run(0.02, CASE), run(0.01, CASE)
+@pytest.mark.parametrize("case", [CASE, CASE2], ids=["W7", "W8"])
+def test_the_focused_groups_errors_fall_with_dp(run, case):
+    coarse, fine = run(0.02, case), run(0.01, case)
     assert abs(fine["crest"]) < abs(coarse["crest"])
     assert fine["rms_max"] < coarse["rms_max"]
     assert fine["corr_min"] > coarse["corr_min"]
@@ -78,14 +79,6 @@ def test_the_second_order_group_fits_its_theory_at_a_over_dp_2_8(run):
                    "first-order crest is 2.8 % below the linear one); 10 % is W7's judgement")
 def test_the_second_order_crest_within_10_percent(run):
     assert abs(run(0.01, CASE2)["crest"]) <= 0.10
-
-
-@pytest.mark.slow
-def test_the_second_order_groups_errors_fall_with_dp(run):
-    coarse, fine = run(0.02, CASE2), run(0.01, CASE2)
-    assert abs(fine["crest"]) < abs(coarse["crest"])
-    assert fine["rms_max"] < coarse["rms_max"]
-    assert fine["corr_min"] > coarse["corr_min"]
 
 
 @pytest.mark.parametrize("case", [CASE, CASE2], ids=["W7", "W8"])
