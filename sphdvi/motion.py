@@ -658,6 +658,11 @@ class _Paddle:
         """The theory's mean displacement once the ramp is over (m), about which the paddle moves."""
         return 0.0
 
+    def drift_position(self, t: float) -> float:
+        """The part of the theory's displacement at t that is a deliberate slow drift, not motion about
+        :meth:`mean_position` (m): none here; a second-order irregular piston's subharmonic stroke."""
+        return 0.0
+
     def theory_position(self, t: float):
         """The wave theory's paddle displacement at the free surface and its rate (m, m/s)."""
         tau, moving = self._clock(t)
@@ -884,6 +889,13 @@ class SpectrumPaddle(_Paddle):
         s, ds = self._drift(tau)
         e, de = self._end_ramp(tau)
         return x + e * s, (v + e * ds + de * s) if moving else 0.0
+
+    def drift_position(self, t: float) -> float:
+        """A second-order piston's subharmonic stroke at t (its drift from rest, under the end ramp)."""
+        if not self.second_order:
+            return 0.0
+        tau, _ = self._clock(t)
+        return self._end_ramp(tau)[0] * self._drift(tau)[0] if tau > 0.0 else 0.0
 
     def _series(self, tau: float):
         x, v = self._series_from_rest(tau)

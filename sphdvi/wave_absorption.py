@@ -16,8 +16,9 @@ trapezoidal rule (X = X_theory + C, C' = u_r). Two safeguards, as DualSPHysics's
 
 * drift correction (``<correction coefstroke coefperiod powerfunc>``): once the piston is more than
   coefstroke stroke amplitudes from the theory's mean position (its rest position, or where the
-  series without a ramp centres it: ``paddle.mean_position()``) it is brought back by that distance
-  over coefperiod wave periods along 1 − (1 − τ/T_c)^p;
+  series without a ramp centres it: ``paddle.mean_position()``; a second-order irregular piston's
+  deliberate subharmonic drift, ``paddle.drift_position(t)``, is not counted) it is brought back by
+  that distance over coefperiod wave periods along 1 − (1 − τ/T_c)^p;
 * acceleration limit (``limitace``): once AWAS runs, a step's change of the piston's mean velocity is
   held to limitace times the theoretical stroke's peak acceleration.
 
@@ -174,7 +175,7 @@ class PistonAbsorber:
         c_new = c_old + 0.5 * (ur + (self.ur if active else 0.0)) * dt
         self.ur = ur
         if self.corr_limit > 0:
-            drift = x_theory + c_new - self.paddle.mean_position()
+            drift = x_theory + c_new - self.paddle.mean_position() - self.paddle.drift_position(t)
             if math.isnan(self.corr_start) and abs(drift) > self.corr_limit:
                 self.corr_start = t - dt
                 self.corr_sign = -1.0 if drift > 0 else 1.0
