@@ -787,13 +787,13 @@ class SpectrumPaddle(_Paddle):
     """Irregular long-crested waves from a piston or flap (``<piston_spectrum>``/``<flap_spectrum>``):
     the sea state's N linear waves (:func:`sphdvi.wavespectra.components`: amplitude
     a_i, frequency f_i, phase φ_i) each made by Biesel's stroke S_i = 2 a_i / (H/S)(k_i d), so that
-    X(τ) = r(τ) [Σ S_i/2 sin(ω_i (τ + t0) + φ_i) + X2(τ + t0) − X_0] (times ``gainstroke``), t0 = ``serieini``,
-    r a linear ramp over ``ramptime`` seconds; X_0 the bracket's value at τ = 0 without a ramp (the
-    paddle starts where it is drawn), 0 with one (it starts from rest and moves about its rest
-    position). X2, on a piston with ``waveorder`` 2 only, is the second-order stroke that makes the
-    waves' bound sum- and difference-frequency waves without free ones (Madsen 1971 extended to
-    irregular waves: :mod:`sphdvi.wave_second_order`). The waves it makes at a distance x from the
-    paddle are :meth:`elevation`."""
+    X(τ) = r(τ) [Σ S_i/2 sin(ω_i (τ + t0) + φ_i) + X2⁺(τ + t0) − X_0] + D(τ) (times ``gainstroke``),
+    t0 = ``serieini``, r a linear ramp over ``ramptime`` seconds; X_0 the bracket's value at τ = 0
+    without a ramp (the paddle starts where it is drawn), 0 with one (it starts from rest and moves
+    about its rest position). On a piston with ``waveorder`` 2 only, X2⁺ is the superharmonic
+    stroke and D the subharmonic drift, started from rest, that make the waves' bound sum- and
+    difference-frequency waves without free ones (:mod:`sphdvi.wave_second_order`). The waves it
+    makes at a distance x from the paddle are :meth:`elevation`."""
 
     def __init__(self, spec: dict, g: float = 9.81):
         comp = self._set_waves(spec, g)
@@ -884,18 +884,22 @@ class SpectrumPaddle(_Paddle):
         if not self.second_order:
             return x, v
         tau, moving = self._clock(t)
-        if tau == 0.0:
-            return x, v
+        s, ds = self._drift_under_end_ramp(tau)
+        return x + s, (v + ds) if moving else 0.0
+
+    def _drift_under_end_ramp(self, tau: float):
+        """A second-order piston's subharmonic drift D(τ) and its rate, under the end ramp (0 at τ = 0)."""
+        if tau <= 0.0:
+            return 0.0, 0.0
         s, ds = self._drift(tau)
         e, de = self._end_ramp(tau)
-        return x + e * s, (v + e * ds + de * s) if moving else 0.0
+        return e * s, e * ds + de * s
 
     def drift_position(self, t: float) -> float:
-        """A second-order piston's subharmonic stroke at t (its drift from rest, under the end ramp)."""
+        """A second-order piston's subharmonic drift at t."""
         if not self.second_order:
             return 0.0
-        tau, _ = self._clock(t)
-        return self._end_ramp(tau)[0] * self._drift(tau)[0] if tau > 0.0 else 0.0
+        return self._drift_under_end_ramp(self._clock(t)[0])[0]
 
     def _series(self, tau: float):
         x, v = self._series_from_rest(tau)
