@@ -225,6 +225,7 @@ class SubharmonicStroke:
         self.c, self.c_rate = c, c * 1j * b
         self.c_lin, self.c_const = c / (1j * b_safe), c / b_safe ** 2     # ∫ s S ds = τ F1 + F2 − ΣF2(0)
         self.start = self._form(self.c, np.ones_like(omega))             # S(0)
+        self.const_at_start = self._form(self.c_const, np.ones_like(omega))
         if self.ramp_time > 0:
             self.after_ramp = -2.0 / self.ramp_time ** 2 * self._moment(self.ramp_time)
 
@@ -236,8 +237,7 @@ class SubharmonicStroke:
     def _moment(self, tau: float) -> float:
         """∫_0^τ s S(s) ds."""
         u = np.exp(1j * self.omega * tau)
-        return tau * self._form(self.c_lin, u) + self._form(self.c_const, u) - self._form(self.c_const,
-                                                                                            np.ones_like(u))
+        return tau * self._form(self.c_lin, u) + self._form(self.c_const, u) - self.const_at_start
 
     def __call__(self, tau: float):
         """(S_r(τ), its rate)."""
