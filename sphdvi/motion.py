@@ -649,6 +649,12 @@ class _Paddle:
         the distances of ``<savemotion xpos>`` are counted."""
         self.face = float(face)
 
+    def place_on(self, positions: np.ndarray) -> None:
+        """:meth:`place` the face at the largest coordinate along :attr:`heading` of the paddle's
+        particles at rest (``positions``, none: left where it is)."""
+        if len(positions):
+            self.place(float((np.asarray(positions) @ self.heading).max()))
+
     def orbital_velocity(self, x: float, z: float, t):
         """The theory's (u along the heading, w up) at a distance ``x`` in front of the paddle and ``z``
         below the still water (negative), without the ramp and the evanescent modes."""
@@ -1194,9 +1200,13 @@ class MotionSet:
         every paddle its ``<savemotion xpos>``): the largest coordinate along its :attr:`heading` of
         its particles (``labels``: each particle's mkbound, -1 for fluid)."""
         for mkb, paddle in self.paddles.items():
-            mine = labels == mkb
-            if mine.any():
-                paddle.place(float((pos[mine] @ paddle.heading).max()))
+            paddle.place_on(pos[labels == mkb])
+
+    def place_paddles_from_particles(self, p: dict, fluidcount: int) -> None:
+        """:meth:`place_paddles` from a particle set (``pos``, ``type``, ``mk``: GenCase's global mk,
+        the boundary labels mk − fluidcount − 1)."""
+        from .coupling import body_labels
+        self.place_paddles(p["pos"], np.where(p["type"] != 3, body_labels(p["mk"], fluidcount), -1))
 
     def transform(self, mkbound: int, t: float) -> Rigid:
         base = motion_transform(self.motions[mkbound], t, self._walks) if mkbound in self.motions else Rigid()

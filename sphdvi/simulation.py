@@ -732,10 +732,8 @@ class SPHRun:
     def _place_paddles(motions, p: dict, fluidcount: int) -> None:
         """Each wave paddle learns where its front face is at rest (a focused piston counts its focus
         from it, every paddle its ``<savemotion xpos>``); a focus behind the face is an InputError."""
-        from .coupling import body_labels
-        labels = np.where(p["type"] != 3, body_labels(p["mk"], fluidcount), -1)
         try:
-            motions.place_paddles(p["pos"], labels)
+            motions.place_paddles_from_particles(p, fluidcount)
         except ValueError as exc:
             raise InputError(f"<piston_focused>: {exc}") from None
 

@@ -780,9 +780,7 @@ def focused_paddle(wp: dict, pos, ptype, label):
     particles of its mkbound (ValueError: the focus is not in front of it)."""
     from ..motion import FocusedPaddle
     paddle = FocusedPaddle(wp)
-    mine = (ptype != TYPE_FLUID) & (label == wp["mkbound"])
-    if mine.any():
-        paddle.place(float((pos[mine] @ paddle.direction).max()))
+    paddle.place_on(pos[(ptype != TYPE_FLUID) & (label == wp["mkbound"])])
     return paddle
 
 

@@ -22,15 +22,13 @@ WINDOW_PERIODS = 2.0       # the scored window: this many peak periods either si
 
 def focused_paddle(outdir: str):
     """The case's :class:`FocusedPaddle`, placed as the run placed it (its face from the particles)."""
-    from ..coupling import body_labels
     from ..motion import MotionSet
     from .runs import case_data
     data = case_data(outdir)
     js, p = data["json"], data["particles"]
     g = float(np.linalg.norm(data["constants"]["gravity"]))
     motions = MotionSet([], [w for w in js["special"]["wavepaddles"] if w["type"] == "piston_focused"], g)
-    labels = np.where(p["type"] != 3, body_labels(p["mk"], int(js["mkconfig"]["fluidcount"])), -1)
-    motions.place_paddles(p["pos"], labels)
+    motions.place_paddles_from_particles(p, int(js["mkconfig"]["fluidcount"]))
     (paddle,) = motions.paddles.values()
     return paddle
 
