@@ -145,8 +145,21 @@ Redraw (``redraw``, ``redrawbox``, ``redrawnear``, ``redrawnearbox``; see :mod:`
     is refused (its direction rule is not documented). A redraw that changes no node is warned
     about. GenCase v4.0's records of RedrawSimple and RedrawComplex are matched count for count.
 
+Bathymetries (``drawbathymetry``, ``drawfilecsv mode="bathymetry"``; see :mod:`.bathymetry`)
+    A bed z(x, y) drawn as a triangulated surface by the planar-surface rule (fill the void under
+    it to make it solid). ``<zpoints file>`` (XYZ text or VTK points; ``<scale>``, ``<rotate x y
+    z>``, ``<move>`` in that order, then ``<selection>`` in x, y) is triangulated (Delaunay in
+    x, y) and drawn as it is, or with ``<grid dp>`` resampled on a grid of spacing dp over
+    ``<initdomain>`` (else the points' extent) by linear interpolation on the triangulation, the
+    nearest point's height outside it (warned); ``<expands>`` adds ramps at the sides (``size``
+    to height ``z``, then ``size2`` to ``z2``; a missing height keeps the edge's),
+    ``<finalmove>`` moves the bed. ``<grid file>`` gives the grid's points. ``<savepoints>``,
+    ``<savegrid>`` write ``<casename>_Bathymetry_Points.vtk`` and ``..._Grid.vtk``. A CSV table
+    (a label and the x values, then rows of y and heights) draws two triangles a cell.
+    ``<periodicx>``/``<periodicy>`` and sizes <= 0 are refused (not documented).
+
 Not supported (CaseError "not supported by sphdvi"): see ``UNSUPPORTED``
-(bathymetry, waves, clipping, patterns, ...)
+(waves, clipping, patterns, ...)
 and ``<layers>`` of ellipsoids; commands that only tune GenCase's own output or sampling
 (``setdpctes``, ``setshapemode``, ``debugout``, ...) are accepted with no effect.
 """

@@ -16,7 +16,7 @@ from . import raster, shapes
 from . import redraw as redraw_kernels
 from . import transform as tf
 from .lattice import Canvas, Lattice, ceil_idx, floor_idx, round_idx
-from .shapeout import FORMATS, merge_shapes, write_shapes
+from .shapeout import FORMATS, merge_shapes, write_points, write_shapes
 
 MAX_COMMANDS = 1_000_000      # commands executed in all (runlist loops included)
 MAX_LIST_DEPTH = 64
@@ -32,7 +32,7 @@ SKIPPED_ATTRS = {"comment", "units_comment", "comment2", "rem", "active"}
 
 #: commands of GenCase that sphdvi does not implement
 UNSUPPORTED = {
-    "drawbathymetry", "drawwave", "drawfilevtm", "drawfilecsv",
+    "drawwave", "drawfilevtm",
     "clipdomain", "clipplane", "clipbox",
     "clipreset", "setpattern", "patterns", "fillfigure", "fillprism",
     "setmknextfluid", "setmknextbound", "setmknextauto", "setmkbackvoid", "setmkbackfluid",
@@ -139,6 +139,7 @@ class GeometryRunner:
         self.shape_files: list = []
         self.shape_sets: dict = {}
         self.messages: list = []
+        self.bathymetries = 0         # <drawbathymetry> commands run (names their debug files)
         self._empty_warned = None     # element already warned to draw nothing (open shape, solid)
         self.handlers = self._handler_table()
 
@@ -154,7 +155,8 @@ class GeometryRunner:
                  "drawpolygon", "drawtriangles", "drawfigure", "drawbox", "drawsphere",
                  "drawellipsoid", "drawcylinder", "drawprism", "drawpyramid", "drawbeach",
                  "drawextrude", "drawfilestl",
-                 "drawfileply", "drawfilevtk", "fillpoint", "fillvoidpoint", "fillbox", "shapeout",
+                 "drawfileply", "drawfilevtk", "drawfilecsv", "drawbathymetry",
+                 "fillpoint", "fillvoidpoint", "fillbox", "shapeout",
                  "redraw", "redrawbox", "redrawnear", "redrawnearbox"]
         return {n: getattr(self, "cmd_" + n) for n in names}
 
@@ -933,6 +935,28 @@ class GeometryRunner:
             self._record(el, "extrude", params, tris, False, n)
 
     # ------------------------------------------------------------ mesh files
+    def _file_transform(self, el) -> np.ndarray:
+        """The matrix of a file's ``<drawscale>``, ``<drawrotate angx angy angz>`` and
+        ``<drawmove>``, applied in that order (scale first)."""
+        local = tf.identity()
+        mv = self.reader.child(el, "drawmove")
+        rot = self.reader.child(el, "drawrotate")
+        sc = self.reader.child(el, "drawscale")
+        if sc is not None:
+            local = tf.scaling(self._scale_factors(sc)) @ local
+        if rot is not None:
+            ang = [self.reader.num(rot, n, 0.0) for n in ("angx", "angy", "angz")]
+            local = tf.rotation_xyz(ang) @ local
+        if mv is not None:
+            local = tf.translation(self.reader.vec3(mv)) @ local
+        return local
+
+    def _scale_factors(self, sc) -> np.ndarray:
+        s = np.array([self.reader.num(sc, n, 1.0) for n in "xyz"])
+        if np.any(s == 0):
+            raise self.reader.error(sc, "a scale factor is 0", "non-zero x, y, z")
+        return s
+
     def _draw_file(self, el, kind):
         from . import meshfile
         self._need_pen(el)
@@ -947,20 +971,7 @@ class GeometryRunner:
         path = self.reader.resolve_path(el, "file")
         autofill = self.reader.boolean(el, "autofill", False)
         self.reader.boolean(el, "reverse", False)
-        local = tf.identity()
-        mv = self.reader.child(el, "drawmove")
-        rot = self.reader.child(el, "drawrotate")
-        sc = self.reader.child(el, "drawscale")
-        if sc is not None:
-            s = np.array([self.reader.num(sc, n, 1.0) for n in "xyz"])
-            if np.any(s == 0):
-                raise self.reader.error(sc, "a scale factor is 0", "non-zero x, y, z")
-            local = tf.scaling(s) @ local
-        if rot is not None:
-            ang = [self.reader.num(rot, n, 0.0) for n in ("angx", "angy", "angz")]
-            local = tf.rotation_xyz(ang) @ local
-        if mv is not None:
-            local = tf.translation(self.reader.vec3(mv)) @ local
+        local = self._file_transform(el)
         try:
             tris_local = meshfile.read_triangles(path, kind)
         except (meshfile.MeshError, OSError) as exc:
@@ -982,6 +993,176 @@ class GeometryRunner:
 
     def cmd_drawfilevtk(self, el):
         self._draw_file(el, "vtk")
+
+    # ------------------------------------------------------------ bathymetries
+    def _draw_bed(self, el, tris, params) -> None:
+        """Draw a bed's triangles (world coordinates) as a surface and record it."""
+        pieces = raster.triangle_pieces(self.lat, tris, surface=True, solid=False)
+        n = self._paint(el, pieces)
+        params.update({"triangles": int(len(tris)), "min": tris.reshape(-1, 3).min(axis=0).tolist(),
+                       "max": tris.reshape(-1, 3).max(axis=0).tolist()})
+        self._record(el, "bathymetry", params, tris, False, n)
+
+    def cmd_drawfilecsv(self, el):
+        """``<drawfilecsv file mode="bathymetry">``: a table of heights (GenCase_Bathymetry.csv)
+        drawn as a surface, two triangles a cell, after ``<drawscale>``, ``<drawrotate>``,
+        ``<drawmove>``. Other modes are not documented and are refused."""
+        from . import bathymetry
+        self._need_pen(el)
+        self._check(el, {"drawmove", "drawrotate", "drawscale"})
+        mode = self.reader.text_attr(el, "mode", choices={"bathymetry"})
+        path = self.reader.resolve_path(el, "file")
+        xs, ys, z = bathymetry.read_height_table(path)
+        tris = tf.apply(self.state.matrix @ self._file_transform(el), bathymetry.grid_triangles(xs, ys, z))
+        self._draw_bed(el, tris, {"file": path, "mode": mode.lower(), "grid": [len(xs), len(ys)]})
+
+    def _xy(self, el, tag: str, positive: bool = False):
+        c = self.reader.child(el, tag, required=True)
+        return np.array([self.reader.num(c, n, positive=positive) for n in "xy"])
+
+    def _bathymetry_points(self, zp):
+        """The points of ``<zpoints file>`` after its ``<scale>``, ``<rotate x y z>`` (degrees) and
+        ``<move>`` (in that order), and kept inside its ``<selection>`` rectangle in (x, y)."""
+        from . import bathymetry
+        self.reader.check_children(zp, {"move", "rotate", "scale", "selection", "rem"}, "child element")
+        pts = bathymetry.read_points(self.reader.resolve_path(zp, "file"))
+        local = tf.identity()
+        sc, rot, mv = (self.reader.child(zp, t) for t in ("scale", "rotate", "move"))
+        if sc is not None:
+            local = tf.scaling(self._scale_factors(sc)) @ local
+        if rot is not None:
+            local = tf.rotation_xyz([self.reader.num(rot, n, 0.0) for n in "xyz"]) @ local
+        if mv is not None:
+            local = tf.translation(self.reader.vec3(mv, missing=0.0)) @ local
+        pts = tf.apply(local, pts)
+        sel = self.reader.child(zp, "selection")
+        if sel is not None:
+            self.reader.check_children(sel, {"point", "size", "rem"}, "child element")
+            lo, size = self._xy(sel, "point"), self._xy(sel, "size", positive=True)
+            inside = np.all((pts[:, :2] >= lo) & (pts[:, :2] <= lo + size), axis=1)
+            if np.count_nonzero(inside) < 3:
+                raise self.reader.error(sel, f"{np.count_nonzero(inside)} of the {len(pts)} points "
+                                             "lie inside the selection", "a rectangle holding at least 3 points")
+            pts = pts[inside]
+        return pts
+
+    def _bathymetry_expands(self, ex):
+        """``<expands>``: per side (xmin, xmax, ymin, ymax) the ramps (size, z), (size2, z2)."""
+        from . import bathymetry
+        self.reader.check_children(ex, set(bathymetry.SIDES) | {"rem"}, "child element")
+        out = []
+        for side in bathymetry.SIDES:
+            c = self.reader.child(ex, side)
+            if c is None:
+                continue
+            segs = []
+            for k in ("", "2"):
+                if self.reader.has(c, "size" + k):
+                    size = self.reader.num(c, "size" + k)
+                    if not size > 0:
+                        raise self.reader.error(c, f"size{k}={size:g}: sphdvi widens a bed only "
+                                                   "(GenCase's documentation does not say what a "
+                                                   "size <= 0 does)", "a length > 0")
+                    segs.append((size, self.reader.num(c, "z" + k, None)))
+                elif self.reader.has(c, "z" + k):
+                    raise self.reader.error(c, f"z{k} without size{k}", f"size{k} with z{k}")
+            if segs:
+                out.append((side, segs))
+        return out
+
+    def cmd_drawbathymetry(self, el):
+        """``<drawbathymetry>``: a bed from scattered points (see :mod:`.bathymetry`). Without
+        ``<grid>`` the points' Delaunay triangulation is drawn; ``<grid dp>`` resamples it on a
+        regular grid (over ``<initdomain>``, else over the points' extent), widened by
+        ``<expands>`` and moved by ``<finalmove>``; ``<grid file>`` gives the grid's points
+        directly. ``<periodicx>``/``<periodicy>`` are refused (their ramps are not documented)."""
+        from . import bathymetry
+        self._need_pen(el)
+        self._check(el, {"zpoints", "grid", "savepoints", "savegrid"})
+        zp = self.reader.child(el, "zpoints")
+        grid = self.reader.child(el, "grid")
+        params = {}
+        if grid is not None:
+            self.reader.check_children(grid, {"initdomain", "expands", "periodicx", "periodicy",
+                                              "finalmove", "rem"}, "child element")
+            for tag in ("periodicx", "periodicy"):
+                if self.reader.child(grid, tag) is not None:
+                    raise self.reader.error(self.reader.child(grid, tag),
+                                            f"<{tag}> is not supported by sphdvi (GenCase's documentation "
+                                            "does not say how it ramps the bed to make it periodic)",
+                                            "a bed without <periodicx>/<periodicy>")
+        with_dp = grid is not None and self.reader.has(grid, "dp")
+        with_file = grid is not None and self.reader.has(grid, "file")
+        if with_dp and with_file:
+            raise self.reader.error(grid, "both dp and file", "dp (a grid over <zpoints>) or file (the grid's points)")
+        if zp is None and not with_file:
+            raise self.reader.error(el, "no <zpoints file> and no <grid file>", "the bed's points in one of them")
+        if zp is not None and with_file:
+            raise self.reader.error(grid, "<grid file> beside <zpoints>", "one source of points")
+        if grid is not None and not (with_dp or with_file):
+            raise self.reader.error(grid, "neither dp nor file", "dp (a grid spacing) or file (the grid's points)")
+        if with_file and any(self.reader.child(grid, t) is not None for t in ("initdomain", "expands")):
+            raise self.reader.error(grid, "<initdomain> and <expands> need a grid of spacing dp",
+                                    "<grid dp> over <zpoints>")
+        try:
+            if with_file:
+                pts = bathymetry.read_points(self.reader.resolve_path(grid, "file"))
+            else:
+                pts = self._bathymetry_points(zp)
+            tri_idx = bathymetry.delaunay(pts)
+            if with_dp:
+                tris, params = self._bathymetry_grid(grid, pts, tri_idx)
+            else:
+                tris = pts[tri_idx]
+            if grid is not None and self.reader.child(grid, "finalmove") is not None:
+                tris = tris + self.reader.vec3(self.reader.child(grid, "finalmove"), missing=0.0)
+        except bathymetry.BathymetryError as exc:
+            raise self.reader.error(el, str(exc), "a bed of points spanning an area") from None
+        params["points"] = int(len(pts))
+        self._save_bathymetry(el, pts, tris)
+        self._draw_bed(el, tf.apply(self.state.matrix, tris), params)
+
+    def _bathymetry_grid(self, grid, pts, tri_idx):
+        from . import bathymetry
+        dp = self.reader.num(grid, "dp", positive=True)
+        dom = self.reader.child(grid, "initdomain")
+        if dom is not None:
+            self.reader.check_children(dom, {"point", "size", "rem"}, "child element")
+            lo, size = self._xy(dom, "point"), self._xy(dom, "size", positive=True)
+        else:
+            lo = pts[:, :2].min(axis=0)
+            size = pts[:, :2].max(axis=0) - lo
+        nx, ny = (int(np.floor(v / dp * (1 + 1e-12) + 1e-6)) + 1 for v in size)
+        bathymetry.check_grid_size(nx, ny)
+        xs, ys = bathymetry.grid_axis(lo[0], size[0], dp), bathymetry.grid_axis(lo[1], size[1], dp)
+        z, outside = bathymetry.resample(pts, tri_idx, xs, ys)
+        if outside:
+            self.reader.warn(grid, f"{outside} of the {z.size} grid nodes lie outside the points' "
+                                   "convex hull: they take the height of the nearest point")
+        ex = self.reader.child(grid, "expands")
+        if ex is not None:
+            for side, segs in self._bathymetry_expands(ex):
+                xs, ys, z = bathymetry.expand(xs, ys, z, side, segs, dp)
+            bathymetry.check_grid_size(len(xs), len(ys))
+        return bathymetry.grid_triangles(xs, ys, z), {"grid": [len(xs), len(ys)], "dp": dp,
+                                                      "outside": outside}
+
+    def _save_bathymetry(self, el, pts, tris) -> None:
+        """``<savepoints file="true">`` and ``<savegrid file="true">``: the bed's points and its
+        triangles (before the current matrix) as ``<casename>_Bathymetry[N]_Points.vtk`` and
+        ``..._Grid.vtk`` in the output folder (N from the second ``<drawbathymetry>`` on)."""
+        self.bathymetries += 1
+        tag = "" if self.bathymetries == 1 else str(self.bathymetries)
+        for child, suffix in (("savepoints", "Points"), ("savegrid", "Grid")):
+            c = self.reader.child(el, child)
+            if c is None or not self.reader.boolean(c, "file", False) or self.outdir is None:
+                continue
+            path = os.path.join(self.outdir, f"{self.casename}_Bathymetry{tag}_{suffix}.vtk")
+            if suffix == "Points":
+                write_points(path, pts)
+            else:
+                write_shapes(path, [{"triangles": tris, "mk": -1, "fluid": False}], "vtk")
+            self.messages.append(f"bathymetry {suffix.lower()}: {path}")
 
     # ------------------------------------------------------------ fills
     def _fill_modes(self, el):

@@ -257,3 +257,39 @@ def seed_fill(codes, fillable, seed, lo, hi, newcode):
             stack[top, 0], stack[top, 1], stack[top, 2] = a, b, c
             top += 1
     return filled
+
+
+@njit(cache=True)
+def interpolate_on_triangles(px, py, pz, tri, xs, ys, z, found):
+    """Linear (barycentric) interpolation of the heights pz of the points (px, py) over their
+    triangles ``tri`` (T, 3) at the nodes (xs[i], ys[j]) of a grid (xs, ys increasing): z[j, i] and
+    found[j, i] = True for every node inside a triangle or on its edges (1e-9 in barycentric terms);
+    a node on a shared edge takes its first triangle's value (the same, the surface being
+    continuous there)."""
+    eps = 1e-9
+    for t in range(tri.shape[0]):
+        a, b, c = tri[t, 0], tri[t, 1], tri[t, 2]
+        x0, y0, x1, y1, x2, y2 = px[a], py[a], px[b], py[b], px[c], py[c]
+        det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
+        if det == 0.0:
+            continue
+        xmin, xmax = min(x0, x1, x2), max(x0, x1, x2)
+        ymin, ymax = min(y0, y1, y2), max(y0, y1, y2)
+        padx = eps * (xmax - xmin) + 1e-12 * (abs(xmin) + abs(xmax))
+        pady = eps * (ymax - ymin) + 1e-12 * (abs(ymin) + abs(ymax))
+        i0 = np.searchsorted(xs, xmin - padx)
+        i1 = np.searchsorted(xs, xmax + padx, side="right")
+        j0 = np.searchsorted(ys, ymin - pady)
+        j1 = np.searchsorted(ys, ymax + pady, side="right")
+        for j in range(j0, j1):
+            y = ys[j]
+            for i in range(i0, i1):
+                if found[j, i]:
+                    continue
+                x = xs[i]
+                l1 = ((x - x0) * (y2 - y0) - (x2 - x0) * (y - y0)) / det
+                l2 = ((x1 - x0) * (y - y0) - (x - x0) * (y1 - y0)) / det
+                l0 = 1.0 - l1 - l2
+                if l0 >= -eps and l1 >= -eps and l2 >= -eps:
+                    z[j, i] = l0 * pz[a] + l1 * pz[b] + l2 * pz[c]
+                    found[j, i] = True

@@ -31,15 +31,14 @@ def _reader_for(path: str, kind: str):
     raise MeshError(f"unknown VTK file extension '{ext}' (expected .vtk, .vtp or .vtu)")
 
 
-def read_triangles(path: str, kind: str) -> np.ndarray:
-    """All triangles of a mesh file as a (T, 3, 3) float64 array (polygons are triangulated)."""
+def _read_data(path: str, kind: str):
+    """The data set of a mesh file, read by vtk with its messages kept off the terminal."""
     size = os.path.getsize(path)
     if size > MAX_MESH_BYTES:
         raise MeshError(f"file is {size} bytes; at most {MAX_MESH_BYTES}")
     if size == 0:
         raise MeshError("file is empty")
     import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
     vtk.vtkObject.GlobalWarningDisplayOff()
     reader = _reader_for(path, kind)
     reader.SetFileName(path)
@@ -54,6 +53,27 @@ def read_triangles(path: str, kind: str) -> np.ndarray:
     data = reader.GetOutputDataObject(0)
     if data is None:
         raise MeshError("vtk could not read the file")
+    return data
+
+
+def read_points(path: str) -> np.ndarray:
+    """Every point (N, 3) of a VTK file (legacy .vtk, .vtp or .vtu), whatever its cells."""
+    from vtk.util.numpy_support import vtk_to_numpy
+    data = _read_data(path, "vtk")
+    pts = data.GetPoints() if hasattr(data, "GetPoints") else None
+    if pts is None or pts.GetNumberOfPoints() == 0:
+        raise MeshError("no points found (not a VTK data set with points?)")
+    out = vtk_to_numpy(pts.GetData()).astype(np.float64).reshape(-1, 3)
+    if not np.all(np.isfinite(out)):
+        raise MeshError("the file has non-finite coordinates")
+    return out
+
+
+def read_triangles(path: str, kind: str) -> np.ndarray:
+    """All triangles of a mesh file as a (T, 3, 3) float64 array (polygons are triangulated)."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    data = _read_data(path, kind)
     geom = vtk.vtkGeometryFilter()
     geom.SetInputData(data)
     tri = vtk.vtkTriangleFilter()

@@ -84,3 +84,19 @@ def write_shapes(path: str, shapes, fmt: str) -> None:
             fh.write(f'<DataArray type="UInt8" Name="types" format="ascii">\n'
                      f"{_fmt(np.full(n, 5))}\n</DataArray>\n")
         fh.write(f"</{tag}>\n</Piece>\n</{kind}>\n</VTKFile>\n")
+
+
+def write_points(path: str, pts) -> None:
+    """Points (N, 3) as a legacy VTK PolyData of vertices, with their height as ``Z``."""
+    pts = np.asarray(pts, dtype=np.float64).reshape(-1, 3)
+    n = len(pts)
+    with open(path, "w", encoding="ascii") as fh:
+        fh.write("# vtk DataFile Version 3.0\nsphdvi points\nASCII\nDATASET POLYDATA\n")
+        fh.write(f"POINTS {n} double\n")
+        for p in pts:
+            fh.write(_fmt(p) + "\n")
+        fh.write(f"VERTICES {n} {2 * n}\n")
+        for k in range(n):
+            fh.write(f"1 {k}\n")
+        fh.write(f"POINT_DATA {n}\nSCALARS Z double 1\nLOOKUP_TABLE default\n")
+        fh.write("\n".join(repr(float(v)) for v in pts[:, 2]) + "\n")
