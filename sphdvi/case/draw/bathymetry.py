@@ -31,6 +31,10 @@ from ...errors import CaseError
 from .. import datafiles
 
 MAX_GRID_NODES = 20_000_000
+#: share of the points' hull the triangulation may leave uncovered (vtkDelaunay2D drops a few
+#: slivers along the hull of large sets: 3e-7 of it for 200,000 random points); the grid nodes
+#: there take the nearest point's height
+HULL_GAP = 1e-4
 SIDES = ("xmin", "xmax", "ymin", "ymax")
 
 
@@ -175,13 +179,31 @@ def _triangle_areas(xy, tri) -> np.ndarray:
     return 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
 
 
+def morton_order(xy) -> np.ndarray:
+    """The order of points (N, 2) along a Morton (Z-order) curve on a 2^16 grid over their extent."""
+    xy = np.asarray(xy, dtype=np.float64)
+    lo = xy.min(axis=0)
+    span = float((xy.max(axis=0) - lo).max()) or 1.0
+    q = np.clip(((xy - lo) / span * 65535.0).astype(np.int64), 0, 65535).astype(np.uint64)
+
+    def spread(v):
+        for shift, mask in ((8, 0x00FF00FF), (4, 0x0F0F0F0F), (2, 0x33333333), (1, 0x55555555)):
+            v = (v | (v << np.uint64(shift))) & np.uint64(mask)
+        return v
+
+    return np.argsort(spread(q[:, 0]) | (spread(q[:, 1]) << np.uint64(1)), kind="stable")
+
+
 def delaunay(points) -> np.ndarray:
     """The Delaunay triangulation of the points' (x, y) -> vertex indices (T, 3) (vtkDelaunay2D;
     points closer than 1e-9 of the data's extent count as one).
 
     vtkDelaunay2D starts from a bounding triangulation ``Offset`` times the data's size and may
     lose triangles along the convex hull when it is small (with the default 1, 7 % of the area of
-    200 random points in a square); the offset grows until the triangles cover the hull."""
+    200 random points in a square); the offset grows until the triangles cover the hull, or
+    all but ``HULL_GAP`` of it (slivers along the hull of large sets). The
+    points go in along a Morton curve: vtkDelaunay2D walks from the last triangle to the next
+    point, and in the file's order (random here) 200,000 points took 86 s against 0.5 s."""
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
     points = np.asarray(points, dtype=np.float64)
@@ -192,22 +214,27 @@ def delaunay(points) -> np.ndarray:
     target = hull_area(points[:, :2])
     if not target > 0:
         raise BathymetryError("the points lie on one line in (x, y): they span no area")
-    source = _polydata(flat)
-    covered = 0.0
-    for offset in (1e3, 1e4, 1e5, 1e6):
+    order = morton_order(points[:, :2])
+    source = _polydata(flat[order])
+    best, covered = None, -1.0
+    for offset in (1e3, 1e4, 1e5):
         d = vtk.vtkDelaunay2D()
         d.SetInputData(source)
         d.SetTolerance(1e-9)
         d.SetOffset(offset)
         d.Update()
         polys = d.GetOutput().GetPolys()
-        # vtkDelaunay2D keeps the input points in order, so the indices refer to ``points``
-        tri = vtk_to_numpy(polys.GetConnectivityArray()).astype(np.int64).reshape(-1, 3)
-        covered = float(_triangle_areas(points[:, :2], tri).sum())
+        # vtkDelaunay2D keeps the input points in order: back to the indices of ``points``
+        tri = order[vtk_to_numpy(polys.GetConnectivityArray()).astype(np.int64).reshape(-1, 3)]
+        area = float(_triangle_areas(points[:, :2], tri).sum())
+        if area > covered:
+            best, covered = tri, area
         if abs(covered - target) <= 1e-9 * target:
-            return tri
-    raise BathymetryError(f"the Delaunay triangulation covers {covered:.6g} of the points' hull "
-                          f"area {target:.6g} (nearly coincident or collinear points?)")
+            break
+    if covered < (1.0 - HULL_GAP) * target:
+        raise BathymetryError(f"the Delaunay triangulation covers {covered:.6g} of the points' hull "
+                              f"area {target:.6g} (nearly coincident or collinear points?)")
+    return best
 
 
 def resample(points, triangles, xs, ys) -> tuple[np.ndarray, int]:
