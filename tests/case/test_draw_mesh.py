@@ -77,6 +77,28 @@ def test_other_formats(tmp_path, name, writer, tag):
     assert nodes(d) == FULL
 
 
+def test_multiblock_vtm_draws_every_block(tmp_path):
+    """A .vtm of two blocks (the cube and the same cube moved by 6 in x) draws both cubes' surfaces."""
+    import vtk
+    moved = vtk.vtkTransformFilter()
+    t = vtk.vtkTransform()
+    t.Translate(6, 0, 0)
+    moved.SetTransform(t)
+    moved.SetInputData(cube_polydata())
+    moved.Update()
+    mb = vtk.vtkMultiBlockDataSet()
+    mb.SetNumberOfBlocks(2)
+    mb.SetBlock(0, cube_polydata())
+    mb.SetBlock(1, moved.GetOutput())
+    w = vtk.vtkXMLMultiBlockDataWriter()
+    w.SetFileName(str(tmp_path / "two.vtm"))
+    w.SetInputData(mb)
+    w.Write()
+    d = draw(tmp_path, '<setmkbound mk="0"/><drawfilevtm file="two.vtm"/>', pmax=(14, 10, 10))
+    assert nodes(d) == SURFACE | {(x + 6, y, z) for x, y, z in SURFACE}
+    assert d.primitives[0]["params"]["triangles"] == 24
+
+
 def test_drawmove_rotate_scale(tmp_path):
     write_ascii_stl(tmp_path / "unit.stl", lo=0, hi=1)
     body = ('<setmkbound mk="0"/><drawfilestl file="unit.stl" autofill="true">'

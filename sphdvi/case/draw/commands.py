@@ -32,7 +32,7 @@ SKIPPED_ATTRS = {"comment", "units_comment", "comment2", "rem", "active"}
 
 #: commands of GenCase that sphdvi does not implement
 UNSUPPORTED = {
-    "drawwave", "drawfilevtm",
+    "drawwave",
     "clipdomain", "clipplane", "clipbox",
     "clipreset", "setpattern", "patterns", "fillfigure", "fillprism",
     "setmknextfluid", "setmknextbound", "setmknextauto", "setmkbackvoid", "setmkbackfluid",
@@ -155,7 +155,7 @@ class GeometryRunner:
                  "drawpolygon", "drawtriangles", "drawfigure", "drawbox", "drawsphere",
                  "drawellipsoid", "drawcylinder", "drawprism", "drawpyramid", "drawbeach",
                  "drawextrude", "drawfilestl",
-                 "drawfileply", "drawfilevtk", "drawfilecsv", "drawbathymetry",
+                 "drawfileply", "drawfilevtk", "drawfilevtm", "drawfilecsv", "drawbathymetry",
                  "fillpoint", "fillvoidpoint", "fillbox", "shapeout",
                  "redraw", "redrawbox", "redrawnear", "redrawnearbox"]
         return {n: getattr(self, "cmd_" + n) for n in names}
@@ -993,6 +993,10 @@ class GeometryRunner:
 
     def cmd_drawfilevtk(self, el):
         self._draw_file(el, "vtk")
+
+    def cmd_drawfilevtm(self, el):
+        """A VTK multiblock file (.vtm): the triangles of all its blocks, as ``drawfilevtk``."""
+        self._draw_file(el, "vtm")
 
     # ------------------------------------------------------------ bathymetries
     def _draw_bed(self, el, tris, params) -> None:

@@ -1,4 +1,4 @@
-"""Reading triangle meshes (STL, PLY, VTK legacy, VTP, VTU) with the vtk package.
+"""Reading triangle meshes (STL, PLY, VTK legacy, VTP, VTU, VTM multiblock) with the vtk package.
 
 vtk is imported inside :func:`read_triangles` only, so importing sphdvi stays fast.
 """
@@ -22,6 +22,8 @@ def _reader_for(path: str, kind: str):
         return vtk.vtkSTLReader()
     if kind == "ply":
         return vtk.vtkPLYReader()
+    if kind == "vtm":
+        return vtk.vtkXMLMultiBlockDataReader()
     if ext == ".vtp":
         return vtk.vtkXMLPolyDataReader()
     if ext == ".vtu":
@@ -74,7 +76,8 @@ def read_triangles(path: str, kind: str) -> np.ndarray:
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
     data = _read_data(path, kind)
-    geom = vtk.vtkGeometryFilter()
+    # a multiblock file (.vtm): the surfaces of all its blocks together
+    geom = vtk.vtkCompositeDataGeometryFilter() if data.IsA("vtkCompositeDataSet") else vtk.vtkGeometryFilter()
     geom.SetInputData(data)
     tri = vtk.vtkTriangleFilter()
     tri.SetInputConnection(geom.GetOutputPort())
