@@ -19,7 +19,9 @@ How GenCase itself grids the points is not documented: linear interpolation on t
 triangulation is sphdvi's rule (exact for a plane, second order in the point spacing for a smooth
 bed: :mod:`tests.case.test_draw_bathymetry` measures it).
 
-vtk does the triangulation (vtkDelaunay2D) and finds the nearest points (vtkStaticPointLocator): it is imported inside the functions that need it.
+vtk does the triangulation (vtkDelaunay2D) and finds the nearest points (vtkStaticPointLocator);
+it is imported inside the functions that need it. The interpolation is a numba kernel
+(:func:`.kernels.interpolate_on_triangles`): vtkProbeFilter missed nodes on the hull's edges.
 """
 from __future__ import annotations
 

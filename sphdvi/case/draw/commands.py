@@ -1046,7 +1046,8 @@ class GeometryRunner:
             inside = np.all((pts[:, :2] >= lo) & (pts[:, :2] <= lo + size), axis=1)
             if np.count_nonzero(inside) < 3:
                 raise self.reader.error(sel, f"{np.count_nonzero(inside)} of the {len(pts)} points "
-                                             "lie inside the selection", "a rectangle holding at least 3 points")
+                                             "lie inside the selection",
+                                        "a rectangle holding at least 3 points")
             pts = pts[inside]
         return pts
 
@@ -1074,6 +1075,39 @@ class GeometryRunner:
                 out.append((side, segs))
         return out
 
+    def _bathymetry_source(self, el):
+        """(``<zpoints>``, ``<grid>``, grid by dp?) of a ``<drawbathymetry>``, checked: the points
+        come from ``<zpoints file>`` or from ``<grid file>``, never both; ``<grid>`` has dp or
+        file; ``<initdomain>``/``<expands>`` need dp; ``<periodicx>``/``<periodicy>`` are refused."""
+        zp = self.reader.child(el, "zpoints")
+        grid = self.reader.child(el, "grid")
+        if grid is None:
+            if zp is None:
+                raise self.reader.error(el, "no <zpoints file> and no <grid file>",
+                                        "the bed's points in one of them")
+            return zp, None, False
+        self.reader.check_children(grid, {"initdomain", "expands", "periodicx", "periodicy",
+                                          "finalmove", "rem"}, "child element")
+        for tag in ("periodicx", "periodicy"):
+            if self.reader.child(grid, tag) is not None:
+                raise self.reader.error(self.reader.child(grid, tag),
+                                        f"<{tag}> is not supported by sphdvi (GenCase's documentation "
+                                        "does not say how it ramps the bed to make it periodic)",
+                                        "a bed without <periodicx>/<periodicy>")
+        with_dp, with_file = self.reader.has(grid, "dp"), self.reader.has(grid, "file")
+        if with_dp == with_file:
+            raise self.reader.error(grid, "both dp and file" if with_dp else "neither dp nor file",
+                                    "dp (a grid over <zpoints>) or file (the grid's points)")
+        if zp is None and with_dp:
+            raise self.reader.error(el, "no <zpoints file> and no <grid file>",
+                                    "the bed's points in one of them")
+        if zp is not None and with_file:
+            raise self.reader.error(grid, "<grid file> beside <zpoints>", "one source of points")
+        if with_file and any(self.reader.child(grid, t) is not None for t in ("initdomain", "expands")):
+            raise self.reader.error(grid, "<initdomain> and <expands> need a grid of spacing dp",
+                                    "<grid dp> over <zpoints>")
+        return zp, grid, with_dp
+
     def cmd_drawbathymetry(self, el):
         """``<drawbathymetry>``: a bed from scattered points (see :mod:`.bathymetry`). Without
         ``<grid>`` the points' Delaunay triangulation is drawn; ``<grid dp>`` resamples it on a
@@ -1083,33 +1117,10 @@ class GeometryRunner:
         from . import bathymetry
         self._need_pen(el)
         self._check(el, {"zpoints", "grid", "savepoints", "savegrid"})
-        zp = self.reader.child(el, "zpoints")
-        grid = self.reader.child(el, "grid")
+        zp, grid, with_dp = self._bathymetry_source(el)
         params = {}
-        if grid is not None:
-            self.reader.check_children(grid, {"initdomain", "expands", "periodicx", "periodicy",
-                                              "finalmove", "rem"}, "child element")
-            for tag in ("periodicx", "periodicy"):
-                if self.reader.child(grid, tag) is not None:
-                    raise self.reader.error(self.reader.child(grid, tag),
-                                            f"<{tag}> is not supported by sphdvi (GenCase's documentation "
-                                            "does not say how it ramps the bed to make it periodic)",
-                                            "a bed without <periodicx>/<periodicy>")
-        with_dp = grid is not None and self.reader.has(grid, "dp")
-        with_file = grid is not None and self.reader.has(grid, "file")
-        if with_dp and with_file:
-            raise self.reader.error(grid, "both dp and file", "dp (a grid over <zpoints>) or file (the grid's points)")
-        if zp is None and not with_file:
-            raise self.reader.error(el, "no <zpoints file> and no <grid file>", "the bed's points in one of them")
-        if zp is not None and with_file:
-            raise self.reader.error(grid, "<grid file> beside <zpoints>", "one source of points")
-        if grid is not None and not (with_dp or with_file):
-            raise self.reader.error(grid, "neither dp nor file", "dp (a grid spacing) or file (the grid's points)")
-        if with_file and any(self.reader.child(grid, t) is not None for t in ("initdomain", "expands")):
-            raise self.reader.error(grid, "<initdomain> and <expands> need a grid of spacing dp",
-                                    "<grid dp> over <zpoints>")
         try:
-            if with_file:
+            if zp is None:
                 pts = bathymetry.read_points(self.reader.resolve_path(grid, "file"))
             else:
                 pts = self._bathymetry_points(zp)
