@@ -755,3 +755,52 @@ def test_sphere_and_cylinder_layers(tmp_path):
         "</drawcylinder>", '<layers vdp="1"/></drawcylinder>'))
     # radius 2.5, covers at z=1 and z=7: 21 nodes per cover, 12 side nodes per layer
     assert len(d.pos) == 21 + 21 + 5 * 12
+
+
+# ---------------------------------------------------------------- fillbox under a rotation
+def _turned_box_nodes(lat_max, ang, point, size, margin, is2d=False):
+    """Nodes (dp 1 lattice 0..lat_max) whose coordinates, turned back by ``ang`` degrees about
+    y through the origin, lie in [point - margin, point + size + margin] (margin < 0 shrinks)."""
+    from sphdvi.case.draw import transform as tf     # <rotate>'s sense: test_rotation_sense.py
+    back = tf.inverse(tf.rotation_line(ang, np.zeros(3), (0, 1, 0)))
+    out = set()
+    ys = [0] if is2d else range(lat_max + 1)
+    for x in range(lat_max + 1):
+        for y in ys:
+            for z in range(lat_max + 1):
+                q = tf.apply(back, np.array([[x, y, z]], dtype=float))[0]
+                m = np.array([margin, 0.0 if is2d else margin, margin])
+                if np.all(q >= np.array(point) - m - 1e-9) and np.all(q <= np.array(point) + size + m + 1e-9):
+                    out.add((x, y, z))
+    return out
+
+
+@pytest.mark.parametrize("is2d", [False, True])
+def test_fillbox_under_a_rotation_fills_the_turned_box(tmp_path, is2d):
+    """A void lattice filled from a seed inside a box turned 30 degrees: the nodes at least dp/2
+    inside it along its own axes (inner), or those of a solid <drawbox> under the same rotation
+    (setboxlimitmode full)."""
+    kw = dict(pmin=(0, 0, 0), pmax=(12, 0, 12)) if is2d else dict(pmin=(0, 0, 0), pmax=(12, 12, 12))
+    turn = '<rotate ang="30" x="0" y="1" z="0"/>'
+    y0, ysize = (-1, 2) if is2d else (2, 6.5)       # a 2D case: the plane y = 0 inside the box
+    box = f'<point x="4" y="{y0}" z="0.5"/><size x="6" y="{ysize}" z="5"/>'
+    fill = f'<setmkfluid mk="0"/>{turn}<fillbox x="7" y="{0 if is2d else 5}" z="3">{box}</fillbox>'
+    d = draw(tmp_path, fill, **kw)
+    expect = _turned_box_nodes(11, 30, (4, y0, 0.5), np.array([6, ysize, 5]), -0.5, is2d)
+    assert nodes(d) == expect and len(expect) > (15 if is2d else 100)
+    full = draw(tmp_path, '<setboxlimitmode mode="full"/>' + fill, **kw)
+    solid = draw(tmp_path, f'<setmkfluid mk="0"/>{turn}<drawbox><boxfill>solid</boxfill>{box}</drawbox>', **kw)
+    assert nodes(full) == nodes(solid) and nodes(full) > nodes(d)
+
+
+def test_fillbox_under_a_rotation_stops_at_walls(tmp_path):
+    """A tank turned 20 degrees and filled under the same rotation: the water stays inside."""
+    turn = '<rotate ang="20" x="0" y="1" z="0"/>'
+    body = (f'<setmkbound mk="0"/>{turn}<drawbox><boxfill>bottom | left | right</boxfill>'
+            '<point x="4" y="-1" z="1"/><size x="12" y="2" z="8"/></drawbox>'
+            '<setmkfluid mk="0"/><fillbox x="8" y="0" z="3"><modefill>void</modefill>'
+            '<point x="4" y="-1" z="1"/><size x="12" y="2" z="6"/></fillbox>')
+    d = draw(tmp_path, body, pmin=(0, 0, 0), pmax=(22, 0, 22))
+    water = nodes(d, fluid=True)
+    expect = _turned_box_nodes(21, 20, (4, 0, 1), np.array([12, 0, 6]), -0.5, True) - nodes(d, fluid=False)
+    assert water == expect and len(water) > 40

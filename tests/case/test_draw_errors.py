@@ -128,8 +128,9 @@ def test_drawing_without_mk(tmp_path):
     ('<runlist name="nolist"/>', "no <list"),
     ('<setmkfluid mk="0"/><fillpoint x="1" y="1" z="1"><modefill>water</modefill></fillpoint>',
      "invalid modefill"),
-    ('<setmkfluid mk="0"/><rotate ang="30" x="0" y="0" z="1"/><fillbox x="1" y="1" z="1">'
-     '<point x="0" y="0" z="0"/><size x="2" y="2" z="2"/></fillbox>', "rotation"),
+    ('<setmkfluid mk="0"/><rotate ang="30" x="0" y="0" z="1"/><scale x="1" y="2" z="1"/>'
+     '<fillbox x="1" y="1" z="1"><point x="0" y="0" z="0"/><size x="2" y="2" z="2"/></fillbox>',
+     "non-uniform scale"),
     ('<shapeout file="a b"/>', "file name"),
     ('<shapeout file="a" format="obj"/>', "not recognised"),
 ])

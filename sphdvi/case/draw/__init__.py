@@ -94,7 +94,8 @@ Fills (``fillpoint``, ``fillvoidpoint``, ``fillbox``)
     ``mkfluid``/``mkbound`` attributes restrict fluid/bound nodes to that mk;
     ``border`` alone means void, GenCase users see no difference), limited to
     the lattice or to the ``fillbox`` box (the nodes at least dp/2 inside it, as GenCase fills:
-    one layer less than a solid box where a face lies on the lattice). Every reached node
+    one layer less than a solid box where a face lies on the lattice; under a rotation the box's
+    own axes are used, sphdvi's extension of that rule: GenCase's outputs show no turned fill box). Every reached node
     gets the current pen. A seed outside, or on a node of another kind, fills
     nothing (warning).
 

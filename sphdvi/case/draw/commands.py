@@ -1192,7 +1192,7 @@ class GeometryRunner:
             tokens = {"void"}
         return tokens
 
-    def _fill(self, el, seed, modes, lo, hi, shape):
+    def _fill(self, el, seed, modes, lo, hi, shape, allowed=None):
         self._need_pen(el)
         mkfluid = self.reader.integer(el, "mkfluid", None, lo=0)
         mkbound = self.reader.integer(el, "mkbound", None, lo=0)
@@ -1207,15 +1207,25 @@ class GeometryRunner:
                 fillable[c] = "bound" in modes and (mkbound is None or mk == mkbound)
         s = np.array([round_idx(v) for v in self.lat.to_index(seed)], dtype=np.int64)
         r = self.lat.clip_range(lo, hi)
+        if r is not None:
+            r = (np.asarray(r[0], dtype=np.int64), np.asarray(r[1], dtype=np.int64))
+            shape_r = tuple(int(v) for v in r[1] - r[0] + 1)
+            if allowed is None:
+                allowed_r = np.ones(shape_r, dtype=np.bool_)
+            else:   # ``allowed`` covers lo..hi: its part inside the lattice
+                off = r[0] - np.asarray(lo, dtype=np.int64)
+                allowed_r = np.ascontiguousarray(allowed[tuple(slice(int(o), int(o) + n)
+                                                               for o, n in zip(off, shape_r))])
         n = 0
-        if r is None or np.any(s < r[0]) or np.any(s > r[1]):
+        if (r is None or np.any(s < r[0]) or np.any(s > r[1])
+                or not allowed_r[tuple(int(v) for v in s - r[0])]):
             self.reader.warn(el, "the seed point is outside the lattice (or the fill box); "
                                  "nothing filled")
         elif not self.state.draw_points:
             pass
         else:
             from .kernels import seed_fill
-            n = int(seed_fill(self.canvas.codes, fillable, s, r[0], r[1], code))
+            n = int(seed_fill(self.canvas.codes, fillable, s, r[0], r[1], code, allowed_r))
             if n == 0:
                 self.reader.warn(el, "the seed node is not of a kind listed in <modefill>; "
                                      "nothing filled")
@@ -1233,13 +1243,56 @@ class GeometryRunner:
         big = 2**40
         self._fill(el, seed, {"void"}, [-big] * 3, [big] * 3, "fillpoint")
 
+    def _rotated_fill_limit(self, el, point, size):
+        """(lo, hi, allowed) of a ``<fillbox>`` drawn under a rotation: the nodes at least dp/2
+        inside the turned box along its own axes (``setboxlimitmode inner``), or those of a solid
+        ``<drawbox>`` over it, the box widened by dp/2 (``full``); in a 2D case the box's own y
+        extent is widened by dp/2 in both modes (the plane must lie in it, as for drawbox)."""
+        m = self.state.matrix
+        scale = tf.uniform_scale(m)
+        if scale is None:
+            raise self.reader.error(el, "<fillbox> under a non-uniform scale or a shear is not "
+                                        "supported by sphdvi", "a rotation, a move and a uniform scale")
+        margin = 0.5 * self.lat.dp / scale
+        sign = 1.0 if self.state.box_limit == "full" else -1.0
+        grow = np.full(3, sign * margin)
+        if self.lat.is2d:
+            grow[1] = margin
+        qlo, qhi = point - grow, point + size + grow
+        if np.any(qhi < qlo):
+            return None
+        corners = np.array([[x, y, z] for x in (qlo[0], qhi[0]) for y in (qlo[1], qhi[1])
+                            for z in (qlo[2], qhi[2])])
+        r = raster.world_range(self.lat, tf.apply(m, corners), raster.EPS)
+        if r is None:
+            return None
+        lo, hi = (np.asarray(v, dtype=np.int64) for v in r)
+        if self.lat.is2d:
+            lo[1] = hi[1] = 0
+        X, Y, Z = self.lat.axis_coords(lo, hi)
+        if self.lat.is2d:
+            Y = np.full_like(Y, self.lat.pointmin[1])
+        inv = tf.inverse(m)
+        tol = 1e-9 * max(float(np.abs(size).max()), self.lat.dp / scale)
+        allowed = np.ones(tuple(int(v) for v in hi - lo + 1), dtype=np.bool_)
+        for a in range(3):
+            q = inv[a, 0] * X + inv[a, 1] * Y + inv[a, 2] * Z + inv[a, 3]
+            allowed &= (q >= qlo[a] - tol) & (q <= qhi[a] + tol)
+        return lo, hi, allowed
+
     def cmd_fillbox(self, el):
         self._check(el, {"modefill", "point", "size", "endpoint"})
-        if not tf.is_axis_aligned(self.state.matrix):
-            raise self.reader.error(el, "<fillbox> under a rotation is not supported by sphdvi",
-                                    "no rotation (matrixreset) before fillbox")
         seed = self._world(self.reader.vec3(el)[None])[0]
         point, size = self._box_extent(el)
+        if not tf.is_axis_aligned(self.state.matrix):
+            limit = self._rotated_fill_limit(el, point, size)
+            if limit is None:
+                self.reader.warn(el, "the fill box holds no node; nothing filled")
+                self._record(el, "fillbox", {"seed": seed.tolist()}, None, False, 0)
+                return
+            lo, hi, allowed = limit
+            self._fill(el, seed, self._fill_modes(el), lo, hi, "fillbox", allowed)
+            return
         corners = self._world(np.array([point, point + size]))
         a = self.lat.to_index(corners.min(axis=0))
         b = self.lat.to_index(corners.max(axis=0))
