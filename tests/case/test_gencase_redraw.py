@@ -4,6 +4,8 @@ matched count for count in ``test_gencase_outputs_counts.py``; here each rule on
 dp = 1 lattices."""
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from test_draw import box, draw, lattice_box, nodes
@@ -117,8 +119,8 @@ def test_redrawnear_times_zero_and_dirfilter_all(tmp_path):
     ('<redrawnear targettp="water" bordertp="bound"/>', "targettp='water' is not recognised"),
     ('<redrawnear bordertp="bound"/>', "missing attribute 'targettp'"),
     ('<redrawnear targettp="void" bordertp="bound" times="-1"/>', "times='-1' is below 0"),
-    ('<rotate ang="30" x="0" y="0" z="1"/><redrawbox><point x="0" y="0" z="0"/>'
-     '<size x="1" y="1" z="1"/></redrawbox>', "under a rotation"),
+    ('<rotate ang="30" x="0" y="0" z="1"/><scale x="2" y="1" z="1"/><redrawbox><point x="0" y="0" z="0"/>'
+     '<size x="1" y="1" z="1"/></redrawbox>', "under a non-uniform scale"),
     ('<redrawbox><point x="0" y="0" z="0"/></redrawbox>', "<size> or <endpoint>"),
 ])
 def test_bad_redraw_commands_name_the_problem(tmp_path, command, expected):
@@ -186,3 +188,26 @@ def test_a_redraw_that_changes_nodes_is_not_warned(tmp_path):
                            + '<setmkbound mk="1"/><redraw mkbound="0"/><redrawnear times="0" '
                            'targettp="void" bordertp="bound"/>', **CUBE)
     assert not warns
+
+
+def test_redraw_boxes_under_a_rotation_take_the_turned_solid_box(tmp_path):
+    """<redrawbox> and <redrawnearbox> under a rotation change the nodes a solid <drawbox> under
+    that rotation draws, and none outside it."""
+    turn = '<rotate ang="25" x="0" y="0" z="1"/>'
+    box = '<point x="3" y="1" z="2"/><size x="4" y="3" z="4"/>'
+    everything = '<setmkbound mk="0"/><redraw/>'
+    d = draw(tmp_path, everything + f'<setmkbound mk="1"/>{turn}<redrawbox>{box}</redrawbox>', **CUBE)
+    solid = draw(tmp_path, f'<setmkbound mk="1"/>{turn}<drawbox><boxfill>solid</boxfill>{box}</drawbox>', **CUBE)
+    assert mk_nodes(d, 1) == mk_nodes(solid, 1) and len(mk_nodes(d, 1)) > 50
+    # a node near a corner of the turned box grows mk 1 around it, within the box only
+    from sphdvi.case.draw import transform as tf
+    corner = tf.apply(tf.rotation_line(25, np.zeros(3), (0, 0, 1)), np.array([[3.6, 1.6, 2.6]]))[0]
+    near = (everything + '<setmkbound mk="2"/><drawpoint x="{}" y="{}" z="{}"/>'.format(*corner)
+            + f'<setmkbound mk="1"/>{turn}<redrawnearbox times="2" targettp="bound" targetmk="0" '
+            f'bordertp="bound" bordermk="2">{box}</redrawnearbox>')
+    d = draw(tmp_path, near, **CUBE)
+    grown = mk_nodes(d, 1)
+    assert grown and grown <= mk_nodes(solid, 1)
+    seed = next(iter(mk_nodes(d, 2)))
+    ring = {tuple(int(v) for v in np.add(seed, s)) for s in itertools.product((-1, 0, 1), repeat=3)} - {seed}
+    assert grown == ring & mk_nodes(solid, 1) and grown != ring     # the box cuts the ring

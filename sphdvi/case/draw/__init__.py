@@ -138,7 +138,7 @@ Lines (``drawline``, ``drawlines``, ``drawlineto``; the edges in ``wire`` mode)
 Redraw (``redraw``, ``redrawbox``, ``redrawnear``, ``redrawnearbox``; see :mod:`.redraw`)
     They give the current pen (void erases) to nodes chosen by what they hold. ``redraw`` takes
     every node holding ``mkfluid``/``mkbound`` (every node, void included, without either);
-    ``redrawbox`` the same within a box (the nodes of a solid ``<drawbox>``; no rotation).
+    ``redrawbox`` the same within a box (the nodes of a solid ``<drawbox>``, under a rotation too).
     ``redrawnear times targettp targetmk bordertp bordermk`` takes, ``times`` passes over, the
     target nodes (void, fluid or bound, joined by ``|``; of mk ``targetmk`` if given) with a
     border node among their 26 neighbours (8 in 2D); a pen equal to the border grows it a layer

@@ -1243,19 +1243,19 @@ class GeometryRunner:
         big = 2**40
         self._fill(el, seed, {"void"}, [-big] * 3, [big] * 3, "fillpoint")
 
-    def _rotated_fill_limit(self, el, point, size):
-        """(lo, hi, allowed) of a ``<fillbox>`` drawn under a rotation: the nodes at least dp/2
-        inside the turned box along its own axes (``setboxlimitmode inner``), or those of a solid
-        ``<drawbox>`` over it, the box widened by dp/2 (``full``); in a 2D case the box's own y
-        extent is widened by dp/2 in both modes (the plane must lie in it, as for drawbox)."""
+    def _turned_box_nodes(self, el, point, size, inner: bool):
+        """(lo, hi, allowed) of a box command drawn under a rotation (``<fillbox>``,
+        ``<redrawbox>``, ``<redrawnearbox>``): the nodes of a solid ``<drawbox>`` over the turned
+        box (the box widened by dp/2 along its own axes), or with ``inner`` those at least dp/2
+        inside it; in a 2D case the box's own y extent is widened by dp/2 either way (the plane
+        must lie in it, as for drawbox). None when no node is in it."""
         m = self.state.matrix
         scale = tf.uniform_scale(m)
         if scale is None:
-            raise self.reader.error(el, "<fillbox> under a non-uniform scale or a shear is not "
+            raise self.reader.error(el, f"<{el.tag}> under a non-uniform scale or a shear is not "
                                         "supported by sphdvi", "a rotation, a move and a uniform scale")
         margin = 0.5 * self.lat.dp / scale
-        sign = 1.0 if self.state.box_limit == "full" else -1.0
-        grow = np.full(3, sign * margin)
+        grow = np.full(3, -margin if inner else margin)
         if self.lat.is2d:
             grow[1] = margin
         qlo, qhi = point - grow, point + size + grow
@@ -1285,7 +1285,7 @@ class GeometryRunner:
         seed = self._world(self.reader.vec3(el)[None])[0]
         point, size = self._box_extent(el)
         if not tf.is_axis_aligned(self.state.matrix):
-            limit = self._rotated_fill_limit(el, point, size)
+            limit = self._turned_box_nodes(el, point, size, inner=self.state.box_limit != "full")
             if limit is None:
                 self.reader.warn(el, "the fill box holds no node; nothing filled")
                 self._record(el, "fillbox", {"seed": seed.tolist()}, None, False, 0)
@@ -1316,13 +1316,14 @@ class GeometryRunner:
 
     # ------------------------------------------------------------ redraw
     def _redraw_box_range(self, el):
-        """Index range (lo, hi) of the nodes of a redraw command's box (those of a solid
-        ``<drawbox>``: from the node nearest the min corner to the node nearest the max corner),
+        """(lo, hi, within) of the nodes of a redraw command's box (those of a solid
+        ``<drawbox>``: from the node nearest the min corner to the node nearest the max corner;
+        under a rotation ``within`` marks those of the turned box in lo..hi, else it is None),
         or of the whole lattice without a box; None when the box misses the lattice."""
+        if el.tag.endswith("box") and not tf.is_axis_aligned(self.state.matrix):
+            point, size = self._box_extent(el)
+            return self._turned_box_nodes(el, point, size, inner=False)
         if el.tag.endswith("box"):
-            if not tf.is_axis_aligned(self.state.matrix):
-                raise self.reader.error(el, f"<{el.tag}> under a rotation is not supported by sphdvi",
-                                        f"no rotation (matrixreset) before {el.tag}")
             point, size = self._box_extent(el)
             corners = self._world(np.array([point, point + size]))
             lo = [round_idx(v) for v in self.lat.to_index(corners.min(axis=0))]
@@ -1331,7 +1332,8 @@ class GeometryRunner:
             lo, hi = [0, 0, 0], [n - 1 for n in self.lat.shape]
         if self.lat.is2d:
             lo[1] = hi[1] = 0
-        return self.lat.clip_range(lo, hi)
+        r = self.lat.clip_range(lo, hi)
+        return None if r is None else (r[0], r[1], None)
 
     def _redraw_label(self, el, kind_attr: str | None, mk_attr: str | None):
         """(kinds, mk) named by a redraw command: ``mkfluid``/``mkbound`` (redraw, redrawbox;
@@ -1376,7 +1378,7 @@ class GeometryRunner:
             code = self._code()     # first: it may add the pen's label to the table
             n = redraw_kernels.redraw(self.canvas.codes,
                                       redraw_kernels.label_selection(self.canvas.labels, kinds, mk),
-                                      r[0], r[1], code)
+                                      r[0], r[1], code, within=r[2])
         what = ("every node already holds the pen's label" if mk is None else
                 f"no node holds mk{'fluid' if 'fluid' in kinds else 'bound'} {mk} (other than the pen's)")
         self._redraw_record(el, {"kinds": sorted(kinds), "mk": mk}, n, what)
@@ -1406,7 +1408,7 @@ class GeometryRunner:
             n = redraw_kernels.redraw_near(self.canvas.codes,
                                            redraw_kernels.label_selection(labels, tkinds, tmk),
                                            redraw_kernels.label_selection(labels, bkinds, bmk),
-                                           times, r[0], r[1], code)
+                                           times, r[0], r[1], code, within=r[2])
         def named(kinds, mk):
             return " or ".join(sorted(kinds)) + ("" if mk is None else f" mk {mk}")
         self._redraw_record(el, {"times": times, "target": sorted(tkinds), "targetmk": tmk,

@@ -51,21 +51,24 @@ def _touching(mask: np.ndarray) -> np.ndarray:
     return out
 
 
-def redraw(codes: np.ndarray, selected: np.ndarray, lo, hi, code: int) -> int:
+def redraw(codes: np.ndarray, selected: np.ndarray, lo, hi, code: int, within=None) -> int:
     """Write ``code`` on the nodes of the index box lo..hi (inclusive, clipped) whose code is
-    selected; returns the number of nodes changed (those holding ``code`` already are not)."""
+    selected (and that ``within``, shaped as the box, marks, when given); returns the number of
+    nodes changed (those holding ``code`` already are not)."""
     sl = tuple(slice(int(lo[a]), int(hi[a]) + 1) for a in range(3))
     view = codes[sl]
     hit = selected[view] & (view != code)
+    if within is not None:
+        hit &= within
     view[hit] = code
     return int(np.count_nonzero(hit))
 
 
 def redraw_near(codes: np.ndarray, target: np.ndarray, border: np.ndarray, times: int,
-                lo, hi, code: int) -> int:
-    """``times`` passes: write ``code`` on the target nodes of the box lo..hi that touch a border
-    node (inside the box or next to it); returns the number of nodes written in all. Each pass
-    looks at the box and one node around it only."""
+                lo, hi, code: int, within=None) -> int:
+    """``times`` passes: write ``code`` on the target nodes of the box lo..hi (those ``within``
+    marks, when given) that touch a border node (inside the box or next to it); returns the
+    number of nodes written in all. Each pass looks at the box and one node around it only."""
     wlo = [max(int(lo[a]) - 1, 0) for a in range(3)]
     whi = [min(int(hi[a]) + 1, codes.shape[a] - 1) for a in range(3)]
     window = codes[tuple(slice(wlo[a], whi[a] + 1) for a in range(3))]      # a view
@@ -74,6 +77,8 @@ def redraw_near(codes: np.ndarray, target: np.ndarray, border: np.ndarray, times
     written = 0
     for _ in range(times):
         hit = target[view] & (view != code) & _touching(border[window])[inner]
+        if within is not None:
+            hit &= within
         n = int(np.count_nonzero(hit))
         if n == 0:
             break
