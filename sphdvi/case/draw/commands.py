@@ -1210,15 +1210,15 @@ class GeometryRunner:
         if r is not None:
             r = (np.asarray(r[0], dtype=np.int64), np.asarray(r[1], dtype=np.int64))
             shape_r = tuple(int(v) for v in r[1] - r[0] + 1)
-            if allowed is None:
-                allowed_r = np.ones(shape_r, dtype=np.bool_)
+            if allowed is None:    # the whole box (seed_fill's empty mask)
+                allowed_r = np.zeros((0, 0, 0), dtype=np.bool_)
             else:   # ``allowed`` covers lo..hi: its part inside the lattice
                 off = r[0] - np.asarray(lo, dtype=np.int64)
                 allowed_r = np.ascontiguousarray(allowed[tuple(slice(int(o), int(o) + n)
                                                                for o, n in zip(off, shape_r))])
         n = 0
         if (r is None or np.any(s < r[0]) or np.any(s > r[1])
-                or not allowed_r[tuple(int(v) for v in s - r[0])]):
+                or (allowed_r.size and not allowed_r[tuple(int(v) for v in s - r[0])])):
             self.reader.warn(el, "the seed point is outside the lattice (or the fill box); "
                                  "nothing filled")
         elif not self.state.draw_points:

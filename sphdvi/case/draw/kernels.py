@@ -211,14 +211,17 @@ def seed_fill(codes, fillable, seed, lo, hi, newcode, allowed):
     """Flood fill (6-connected) from ``seed`` through nodes whose code is fillable.
 
     Only nodes within the inclusive index box lo..hi where ``allowed`` (shaped as
-    that box) is True are visited. Every reached node gets ``newcode``. Returns
-    the number of nodes filled.
+    that box; empty for all of it) is True are visited. Every reached node gets
+    ``newcode``. Returns the number of nodes filled.
     """
     if not fillable[codes[seed[0], seed[1], seed[2]]]:
         return 0
-    if not allowed[seed[0] - lo[0], seed[1] - lo[1], seed[2] - lo[2]]:
+    if allowed.size == 0:
+        visited = np.zeros((hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1), dtype=np.bool_)
+    elif not allowed[seed[0] - lo[0], seed[1] - lo[1], seed[2] - lo[2]]:
         return 0
-    visited = ~allowed
+    else:
+        visited = ~allowed
     cap = 1024
     stack = np.empty((cap, 3), dtype=np.int64)
     stack[0, 0], stack[0, 1], stack[0, 2] = seed[0], seed[1], seed[2]
