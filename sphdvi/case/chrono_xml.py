@@ -52,8 +52,8 @@ def read_chrono(reader, el) -> dict:
                         "links.csv hold the bodies' and links' data at each output")
     if el.find("schemescale") is not None:
         out["schemescale"] = reader.child_value(el, "schemescale", positive=True)
-    if el.find("ompthreads") is not None:
-        out["ompthreads"] = int(reader.child_value(el, "ompthreads", lo=1))
+    if el.find("ompthreads") is not None:      # Chrono's threads (0 all cores, 1 one): no effect here
+        out["ompthreads"] = int(reader.child_value(el, "ompthreads", lo=0))
     if el.find("solver") is not None:
         out["solver"] = _read_chrono_solver(reader, reader.child(el, "solver"))
     _read_chrono_timestepper(reader, reader.child(el, "timestepper"))
@@ -152,7 +152,11 @@ def _read_chrono_collision(reader, col, default: dict) -> dict:
                            'activate="true" (Chrono collisions) or activate="false"')
     if not reader.boolean(col, "activate"):
         return dict(default)
-    reader.check_children(col, {"distancedp", "contactmethod"})
+    # <ompthreads> sits here in DualSPHysics v5.x's chrono examples (CaseExternalVelocity,
+    # CaseBreakingWall): Chrono's thread count, 0 all cores, 1 one; read, no effect in sphdvi
+    reader.check_children(col, {"distancedp", "contactmethod", "ompthreads"})
+    if col.find("ompthreads") is not None:
+        reader.child_value(col, "ompthreads", lo=0)
     return {"activate": True,
             "distancedp": reader.child_value(col, "distancedp", 0.5, nonnegative=True),
             "contactmethod": int(reader.child_value(col, "contactmethod", 0, lo=0, hi=1))}

@@ -86,3 +86,17 @@ def test_solver_settings_reach_the_system(tmp_path):
     assert mech["system"]["solver"] == "direct" and mech["warnings"] == []
     system, _ = build_system(mech["bodies"], mech["links"], mech["materials"], **mech["system"])
     assert (system.solver, system.max_iter, system.tol) == ("direct", 321, 1e-7)
+
+
+@pytest.mark.parametrize("where", ["collision", "chrono"])
+@pytest.mark.parametrize("threads", ["0", "1"])
+def test_ompthreads_is_read_in_collision_and_at_chrono_level(tmp_path, where, threads):
+    """DualSPHysics v5.x's chrono examples CaseExternalVelocity and CaseBreakingWall put
+    <ompthreads> (Chrono's threads: 0 all cores, 1 one) inside <collision>; it was refused there
+    (exit 2), and 0 was refused at the chrono level. Read silently, no effect."""
+    omp = f'<ompthreads value="{threads}"/>'
+    col = ('<collision activate="true"><distancedp value="0.5"/>'
+           f'{omp if where == "collision" else ""}</collision>')
+    r = build(tmp_path, col + (omp if where == "chrono" else ""))
+    assert r.case.special["chrono"]["collision"]["activate"]
+    assert not [w for w in r.warnings if "ompthreads" in w]
