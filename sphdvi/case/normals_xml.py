@@ -170,6 +170,8 @@ def read_normals(reader, casedef) -> list:
                   "file": reader.text_attr(c, "file"),
                   "distanceh": _scalar_el(reader, el, "distanceh", 2.0, positive=True)}
             ops.append(op)
+        elif c.tag == "svshapes":      # GenCase's debug VTK of the shapes' normals: read, not written
+            _scalar_el(reader, el, "svshapes", False, "bool")
     return ops
 
 

@@ -100,3 +100,4 @@ def test_ompthreads_is_read_in_collision_and_at_chrono_level(tmp_path, where, th
     r = build(tmp_path, col + (omp if where == "chrono" else ""))
     assert r.case.special["chrono"]["collision"]["activate"]
     assert not [w for w in r.warnings if "ompthreads" in w]
+

@@ -221,3 +221,20 @@ def test_shapeout_stays_in_outdir(tmp_path):
 def test_shapeout_without_outdir_writes_nothing(tmp_path):
     d = draw(tmp_path, '<setmkbound mk="0"/><drawpoint x="1" y="1" z="1"/><shapeout file="s"/>')
     assert d.shape_files == [] and os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("fill,faces", [("all", 6), ("solid", 6), ("all ^ top", 5),
+                                         ("bottom | left | right", 3), ("bottom", 1)])
+def test_shapeout_of_a_box_holds_the_faces_drawn(tmp_path, fill, faces):
+    """An open tank's shape has no lid: the norgeometry normals of the particles at its rim were
+    pulled towards the missing face (DualSPHysics's mdbc/04 CaseDamBreak3D chooses each box's
+    faces for its normals geometry: 2,556 rim particles were tilted, 312 on a phantom floor got
+    no normal). A solid box keeps its six faces."""
+    out = tmp_path / "out"
+    out.mkdir()
+    d = draw(tmp_path, f'<setmkbound mk="0"/><drawbox><boxfill>{fill}</boxfill><point x="1" y="1" z="1"/>'
+             '<size x="4" y="4" z="4"/></drawbox><shapeout file="tank"/>', outdir=str(out))
+    tris, _, _ = d.shape_sets["tank"]
+    assert len(tris) == 2 * faces
+    if fill == "all ^ top":
+        assert tris[..., 2].max() == 5.0 and not np.any(np.all(tris[..., 2] == 5.0, axis=1))

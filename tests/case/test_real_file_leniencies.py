@@ -199,3 +199,18 @@ def test_a_gencase_output_file_reads_as_its_case(tmp_path):
     assert r.constants.h == pytest.approx(0.014722431864, rel=1e-10)
     assert r.constants.b == pytest.approx(162005.14286, rel=1e-9)
     assert not [w for w in r.warnings if "unknown" in w]
+
+
+def test_bare_v5_normals_with_svshapes_read_silently(tmp_path):
+    """DualSPHysics v5.0's bare <normals> (<distanceh>, <geometryfile>, <svshapes> directly
+    inside; mdbc/04 CaseDamBreak3D): <svshapes value> got an unknown-attribute warning."""
+    from casetext import TANK_2D
+    hdp = ('<setactive drawpoints="0" drawshapes="1"/><setmkbound mk="0"/><drawbox>'
+           '<boxfill>bottom | left | right</boxfill><point x="0" y="-1" z="0"/><size x="4" y="2" z="3"/>'
+           '<layers vdp="-0.5"/></drawbox><shapeout file="hdp"/><resetdraw/>')
+    normals = ('<normals><distanceh value="2.0"/><geometryfile file="[CaseName]_hdp_Actual.vtk"/>'
+               '<svshapes value="1"/></normals>')
+    text = case_xml(commands=hdp + TANK_2D, casedef_extra=normals, dp="0.05")
+    r = build_case(write_case(tmp_path, text), str(tmp_path / "out"))
+    assert not [w for w in r.warnings if "svshapes" in w]
+    assert r.normals is not None and np.any(r.normals != 0)

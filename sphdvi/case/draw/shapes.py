@@ -183,7 +183,8 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
     v5.4); an ``all^top`` 3D tank (yupengxiang/DualSPHysics F1_DUAL_FINITE_CENTER, GenCase v5.4:
     361,104, walls ending at their layer-0 top). An axis-aligned layer is placed on the lattice
     as a whole number of nodes from the first (:func:`_box_pieces`). The recorded shape
-    (shapeout, ``norgeometry``) is the box widened on every side."""
+    (shapeout, ``norgeometry``) is the box widened on every side, with the faces drawn (all six
+    for a solid box or a wire frame)."""
     full = m @ tf.translation(point)
     if angles is not None and np.any(angles != 0):
         full = full @ tf.rotation_xyz(angles)
@@ -218,7 +219,12 @@ def draw_box(lat: Lattice, m, point, size, angles, *, solid: bool, faces, wire: 
     if params["axis_aligned"]:
         params["min"] = verts.min(axis=0).tolist()
         params["max"] = verts.max(axis=0).tolist()
-    tris = faces_to_triangles(verts, list(BOX_FACES.values()))
+    # the recorded shape (shapeout, norgeometry) holds the faces drawn: an open tank's missing lid
+    # is no wall for the normals of the particles under it (DualSPHysics's mdbc/04 CaseDamBreak3D
+    # picks each box's faces for its normals geometry: all^bottom for the obstacle, all^top^right
+    # for the tank)
+    shown = list(BOX_FACES) if solid or wire or not faces else [f for f in BOX_FACES if f in faces]
+    tris = faces_to_triangles(verts, [BOX_FACES[f] for f in shown])
     return pieces, params, tris
 
 
