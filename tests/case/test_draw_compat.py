@@ -1,5 +1,5 @@
 """GenCase compatibility of the drawing commands found in the DualSPHysics v5.4 examples:
-``mask`` lists the faces left out (and an open shape has no inside), ``<resetdraw>``,
+``mask`` lists the faces left out (an open shape has no inside in full mode), ``<resetdraw>``,
 ``<setboxlimitmode>``, GenCase's own ``<case app date>`` attributes and the no-fluid warning."""
 from __future__ import annotations
 
@@ -149,11 +149,26 @@ def test_pyramid_mask_faces(tmp_path):
         nodes(draw(tmp_path, body.format(mode="face", mask="1 | 3")))
 
 
-def test_open_shape_in_solid_mode_draws_nothing_and_warns(tmp_path):
-    d, w = warnings_of(tmp_path, PRISM.format(mode="solid", mask="2"))
-    assert len(d.pos) == 0 and any("open shape has no inside" in m for m in w)
-    d, w = warnings_of(tmp_path, CYL.format(mode="solid", mask="3"))
-    assert len(d.pos) == 0 and any("faces [3]" in m for m in w)
+@pytest.mark.parametrize("shape,mask", [(PRISM, "2"), (CYL, "3"), (CYL, "1")])
+def test_masked_shape_in_solid_mode_draws_its_volume(tmp_path, shape, mask):
+    """solid mode draws no surface, so the mask changes nothing: the closed shape's volume
+    (GenCase v4.0.053's record of DualSPHysics's motion/Motion08: three short cylinders with
+    mask="1" in solid mode are whole disks, 110, 311 and 312 particles; sphdvi said "an open
+    shape has no inside" and drew nothing, so their motion found no particles)."""
+    d, w = warnings_of(tmp_path, shape.format(mode="solid", mask=mask))
+    ref = draw(tmp_path, shape.format(mode="solid", mask="0"))
+    assert nodes(d) == nodes(ref) and len(ref.pos) > 0 and not w
+
+
+def test_short_masked_cylinder_in_solid_mode_is_a_disk(tmp_path):
+    """Motion08's mkbound 151 at dp 1: a cylinder of radius 10 and length 1/2 along y, mask="1",
+    in solid mode: the disk of nodes within the radius in the x-z plane (GenCase: 311-312;
+    here 317, the 12 nodes at exactly the radius included)."""
+    body = ('<setdrawmode mode="solid"/><setmkbound mk="0"/><drawcylinder radius="10" mask="1">'
+            '<point x="15" y="5.5" z="15"/><point x="15" y="5" z="15"/></drawcylinder>')
+    got = nodes(draw(tmp_path, body, pmax=(30, 10, 30)))
+    disk = {(x, 5, z) for x in range(31) for z in range(31) if (x - 15) ** 2 + (z - 15) ** 2 <= 100}
+    assert got == disk and len(disk) == 317
 
 
 @pytest.mark.parametrize("mask", ["top", "-1", "1.5", "1 | x"])
@@ -230,16 +245,14 @@ def test_shape_outside_the_domain_is_warned(tmp_path):
 
 
 def test_commands_that_may_draw_nothing_are_not_warned(tmp_path):
-    """Void drawing, fills into a filled region (already warned by the fill itself), hidden
-    points (setactive) and an open shape in solid mode (its own warning) are not warned twice."""
+    """Void drawing, fills into a filled region (already warned by the fill itself) and hidden
+    points (setactive) are not warned twice."""
     body = (WALL_2D + '<setmkvoid/><drawpoint x="0.5" y="0.3" z="0.5"/><setmkbound mk="3"/>'
             '<setactive drawpoints="false"/><drawpoint x="0.5" y="0.3" z="0.5"/>'
             '<setactive drawpoints="true"/><setmkfluid mk="0"/><fillbox x="0.2" y="0" z="0.2">'
             '<modefill>void</modefill><point x="0" y="0" z="0"/><size x="1" y="0" z="1"/></fillbox>')
     d, w = warnings_of(tmp_path, body, **KW_2D)
     assert len(w) == 1 and "<fillbox>: the seed node is not of a kind listed in <modefill>" in w[0]
-    d, w = warnings_of(tmp_path, PRISM.format(mode="solid", mask="2"))
-    assert len(w) == 1 and "open shape has no inside" in w[0]
 
 
 def test_false_printf_and_abort_read_their_text(tmp_path):

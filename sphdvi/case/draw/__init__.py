@@ -59,14 +59,18 @@ Masks (``drawprism``, ``drawbeach``, ``drawpyramid``, ``drawcylinder``)
     (side k joins points k-2 and k-1 of each polygon, the last one closes it).
     Pyramid (apex, then base points): 1 = base, 2, 3, ... = sides apex-P1P2,
     apex-P2P3, ... Cylinder: 1 = cover at the first point, 2 = cover at the
-    second point, 3 = tube. A shape with a face left out is open and has no
-    inside: ``full`` draws its remaining faces only, ``solid`` draws nothing
-    (warning), ``wire`` the edges of the remaining faces.
+    second point, 3 = tube. A shape with a face left out is open: ``full``
+    draws its remaining faces only (no inside), ``wire`` the edges of the
+    remaining faces, ``solid`` (no surface) the closed shape's volume as
+    without the mask. The recorded shape (``shapeout``, ``norgeometry``) holds
+    the remaining faces.
     Evidence: the DualSPHysics v5.4 examples CaseWavemaker, CasePointAbsorber
     and CaseFloatingWavesVal only make sense with faces listed (as bits their
     masks would draw a lid, a diagonal through the water or a wall over the
     piston), and their fillbox seeds (or the fluid drawn before) lie inside
-    the masked prism drawn in full mode, so GenCase leaves it hollow. The
+    the masked prism drawn in full mode, so GenCase leaves it hollow; GenCase
+    v4.0.053's record of motion/Motion08 has three short cylinders with
+    mask="1" drawn in solid mode as whole disks (110, 311, 312 particles). The
     cylinder and pyramid numbering is inferred (caps first, like prisms).
 
 Beach (``drawbeach``, 2D cases only)

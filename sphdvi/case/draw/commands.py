@@ -140,7 +140,6 @@ class GeometryRunner:
         self.shape_sets: dict = {}
         self.messages: list = []
         self.bathymetries = 0         # <drawbathymetry> commands run (names their debug files)
-        self._empty_warned = None     # element already warned to draw nothing (open shape, solid)
         self.handlers = self._handler_table()
 
     # ------------------------------------------------------------ dispatch
@@ -253,8 +252,6 @@ class GeometryRunner:
         the domain, or in 2D the plane y = posy, or lies between the lattice nodes) is warned
         about: its wall or fluid silently vanished before (warn_no_fluid caught only a case with
         no fluid at all). Fills and void drawing are left out: they may rightly change nothing."""
-        if self._empty_warned is el:
-            return
         s, lat = self.state, self.lat
         msg = f"this <{el.tag}> (mk{s.kind} {s.mk}) creates no particles: "
         pts = tris if tris is not None and len(tris) else params.get("points", params.get("point"))
@@ -312,15 +309,15 @@ class GeometryRunner:
     def _open_shape_flags(self, el, hidden: frozenset, nfaces: int):
         """(solid, faces, wire) of a shape with ``nfaces`` faces of which ``hidden`` are left out.
 
-        Only a closed shape has an inside: with a face left out, ``full`` draws the remaining
-        faces alone and ``solid`` draws nothing (warning).
+        With a face left out, ``full`` draws the remaining faces alone (an open shape: the fluid
+        drawn before or filled after stays inside, DualSPHysics v5.4's CaseWavemaker,
+        CasePointAbsorber, CaseFloatingWavesVal); ``solid`` draws no surface, so the mask changes
+        nothing there: the closed shape's volume is drawn (GenCase v4.0.053's record of
+        DualSPHysics's motion/Motion08: three cylinders with mask="1" in solid mode, 110, 311 and
+        312 particles, the whole disks).
         """
         solid, surface, wire = self._mode_flags()
-        if any(1 <= f <= nfaces for f in hidden):
-            if self.state.mode == "solid":
-                self.reader.warn(el, f"mask leaves faces {sorted(f for f in hidden if f <= nfaces)} "
-                                     "out: an open shape has no inside, nothing drawn in solid mode")
-                self._empty_warned = el
+        if any(1 <= f <= nfaces for f in hidden) and self.state.mode != "solid":
             solid = False
         return solid, surface, wire
 

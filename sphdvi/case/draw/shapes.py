@@ -341,12 +341,13 @@ def draw_cylinder(lat: Lattice, m, p1, p2, radius, *, solid: bool, shell: bool, 
                                     solid=solid, shell_faces=shell_faces)
     ang = np.linspace(0, 2 * math.pi, NSIDES + 1)
     ring = np.stack([np.zeros_like(ang), radius * np.cos(ang), radius * np.sin(ang)], axis=1)
-    tris = []
+    tris = []          # the recorded shape: the faces not hidden (cover 1, cover 2, tube)
     for i in range(NSIDES):
         a0, a1 = ring[i], ring[i + 1]
         b0, b1 = a0 + [L, 0, 0], a1 + [L, 0, 0]
-        tris += [[a0, b0, b1], [a0, b1, a1], [[0, 0, 0], a1, a0], [[L, 0, 0], b0, b1]]
-    tris = tf.apply(full, np.array(tris))
+        tris += ([[a0, b0, b1], [a0, b1, a1]] if drawn[2] else []) + \
+            ([[[0, 0, 0], a1, a0]] if drawn[0] else []) + ([[[L, 0, 0], b0, b1]] if drawn[1] else [])
+    tris = tf.apply(full, np.array(tris).reshape(-1, 3, 3))
     s = tf.uniform_scale(m)
     w1, w2 = tf.apply(m, p1), tf.apply(m, p2)
     params = {"p1": w1.tolist(), "p2": w2.tolist(), "point1": w1.tolist(), "point2": w2.tolist(),
@@ -380,7 +381,8 @@ def draw_polyhedron(lat: Lattice, m, verts, faces, *, solid: bool, surface: bool
     """A polyhedron: inside by parity, faces by triangles, edges by segments.
 
     Face ``i`` (0-based) is hidden when ``i + 1`` is listed in ``mask``; the wire edges are those
-    of the faces drawn. The caller decides whether the inside is drawn (only closed shapes have one).
+    of the faces drawn. The caller decides whether the inside is drawn (the closed shape's, the
+    hidden faces included). The recorded triangles are those of the faces not hidden.
     """
     w = tf.apply(m, verts)
     drawn = drawn_faces(mask, len(faces))
@@ -396,7 +398,9 @@ def draw_polyhedron(lat: Lattice, m, verts, faces, *, solid: bool, surface: bool
         shown = [f for f, d in zip(faces, drawn) if d]
         pieces += raster.segment_pieces(lat, [w[[a, b]] for a, b in face_edges(shown)])
     params = {"vertices": w.tolist(), "faces": [list(f) for f in faces]}
-    return pieces, params, all_tris
+    # the recorded shape (shapeout, norgeometry) holds the faces not hidden
+    shown = [f for f, d in zip(faces, drawn) if d]
+    return pieces, params, all_tris if len(shown) == len(faces) else faces_to_triangles(w, shown)
 
 
 # ---------------------------------------------------------------- extrusions and beaches
