@@ -36,7 +36,7 @@ SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", 
                      "savedt", "outputparts"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
     "mlayerpistons", "relaxationzones", "flexstrucs", "boundextrap", "boundcorr",
-    "moorings", "forcepoints", "inout", "vres", "nnphases"}
+    "moorings", "forcepoints", "inout", "vres", "nnphases", "temperature"}
 
 
 def case_name_from_path(path: str) -> str:

@@ -23,6 +23,7 @@ from click.testing import CliRunner
 
 from sphdvi.case.gencase import build_case
 from sphdvi.cli import main
+from sphdvi.errors import CaseError
 
 DESIGNSPHYSICS_HEAD = '<!-- Case name: MyCase -->\n'
 
@@ -214,3 +215,11 @@ def test_bare_v5_normals_with_svshapes_read_silently(tmp_path):
     r = build_case(write_case(tmp_path, text), str(tmp_path / "out"))
     assert not [w for w in r.warnings if "svshapes" in w]
     assert r.normals is not None and np.any(r.normals != 0)
+
+
+def test_temperature_special_is_a_named_refusal(tmp_path):
+    """DualSPHysics's examples/main/99_Temperature has <special><temperature> (heat transfer):
+    "unknown special section" before, now refused by name."""
+    text = case_xml(special='<temperature><tempdef value="20"/></temperature>')
+    with pytest.raises(CaseError, match=r"<special><temperature> is not supported by sphdvi"):
+        build_case(write_case(tmp_path, text), str(tmp_path / "out"))
