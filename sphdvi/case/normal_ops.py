@@ -75,8 +75,10 @@ def _write(normals, sel, reached, vectors, clear: bool) -> None:
 
 
 def _reach(maxdisth: float, h: float) -> float:
-    """``maxdisth`` h; no limit for maxdisth <= 0 (DualSPHysics)."""
-    return maxdisth * h if maxdisth > 0 else np.inf
+    """``maxdisth`` h, a particle at that distance included (with 1e-9 of it for round-off: two
+    mirror walls reached the same rows only on one side); no limit for maxdisth <= 0
+    (DualSPHysics)."""
+    return maxdisth * h * (1.0 + 1e-9) if maxdisth > 0 else np.inf
 
 
 def plane_point_auto(normal: np.ndarray, shown: np.ndarray, whole: np.ndarray, limit: float) -> np.ndarray:
@@ -112,7 +114,7 @@ def apply_plane(normals, op, pos, ptype, sel, mkbound, dp, h) -> None:
                 groups.append((group, plane_point_auto(n, pos[group], whole, op["limitdist"] * dp)))
     for group, point in groups:
         depth = (pos[group] - point) @ n
-        _write(normals, group, np.abs(depth) < reach, -depth[:, None] * n[None, :], op["clear"])
+        _write(normals, group, np.abs(depth) <= reach, -depth[:, None] * n[None, :], op["clear"])
 
 
 def apply_sphere(normals, op, pos, sel, h) -> None:

@@ -301,3 +301,28 @@ def test_geometry_through_the_particles_gives_them_no_normal():
     behind = ~inner & (np.linalg.norm(np.clip(pos, 0, [0.4, 0.3, 0.5]) - pos, axis=1) < 1.01 * DP)
     assert behind.sum() > 100
     assert np.allclose(np.linalg.norm(normals[behind], axis=1), DP)
+
+
+def test_plane_reach_is_the_same_for_mirror_walls():
+    """Two mirror walls on a 0.1 lattice (z = k 0.1), planes at z = 0.3 (normal +z, rows 0 to 3
+    under it) and z = 0.7 (normal -z, rows 7 to 10 over it), reach exactly 0.3: both take their
+    4 rows. With a strict < on the float depth (DualSPHysics's mdbc/02 CasePoiseuilleLR: 2 rows
+    against 3) the first lost its far row (0.3 - 0.0 = 0.3) and the second kept it
+    (1.0 - 0.7000000000000001)."""
+    xs = np.arange(0, 1 + DP / 2, DP)
+    rows = [k * 0.1 for k in (0, 1, 2, 3, 7, 8, 9, 10)]
+    pos = np.array([[x, 0, z] for z in rows for x in xs], float)
+    mk = np.repeat([0, 0, 0, 0, 1, 1, 1, 1], len(xs))
+    ptype = np.zeros(len(pos), int)
+    maxdisth = 0.3 / H
+    ops = [op("plane", mkbound="0", point=[0, 0, 3 * 0.1], normal=[0, 0, 1], limitdist=0.5, maxdisth=maxdisth),
+           op("plane", mkbound="1", point=[0, 0, 7 * 0.1], normal=[0, 0, -1], limitdist=0.5, maxdisth=maxdisth)]
+    start = np.full_like(pos, 7.0)
+    start[:, 1] = 0.0
+    n, _ = run_ops(ops, pos, ptype, mk, start=start)
+    reached = ~np.all(n == [7, 0, 7], axis=1)           # clear: a row out of reach keeps no value
+    cleared = np.all(n == 0, axis=1) & ~np.isclose(pos[:, 2], 0.3) & ~np.isclose(pos[:, 2], 0.7)
+    assert not cleared.any()
+    assert reached[mk == 0].sum() == reached[mk == 1].sum() == 4 * len(xs)
+    far = np.isclose(pos[:, 2], 0.0) | np.isclose(pos[:, 2], 1.0)
+    assert np.allclose(np.abs(n[far, 2]), 0.3)
