@@ -346,3 +346,31 @@ def test_body_only_case_is_silent(tmp_path):
     res = build_case(write_case(tmp_path, case_xml(commands=BODY_ONLY)), str(tmp_path / "out"))
     assert not [w for w in res.warnings if "fluid" in w]
     assert res.particles["pos"].shape[0] > 0
+
+
+def test_setmknextbound_numbers_the_blocks_of_a_list(tmp_path):
+    """DualSPHysics's chrono/03 CaseFlexibleGate: a list draws a gate segment, moves up and ends
+    with <setmknextbound next="true"/>; run five times from <setmkbound mk="1"/> it draws the
+    segments mkbound 1 to 5 (its <floating mkbound="1-5">). The same for fluid."""
+    lists = ('<list name="Block"><drawbox><boxfill>solid</boxfill><point x="1" y="1" z="0"/>'
+             '<size x="1" y="1" z="1"/></drawbox><move x="0" y="0" z="2"/>'
+             '<setmknextbound next="true"/></list>')
+    d = draw(tmp_path, '<setmkbound mk="1"/><runlist name="Block" times="5"/>', lists=lists)
+    zs = {int(m): sorted({int(round(p[2])) for p, k in zip(d.pos, d.mk) if k == m}) for m in set(d.mk)}
+    assert sorted(zs) == [1, 2, 3, 4, 5]
+    assert [zs[m] for m in sorted(zs)] == [[2 * i, 2 * i + 1] for i in range(5)]
+    f = draw(tmp_path, '<setmkfluid mk="3"/><drawpoint x="1" y="1" z="1"/><setmknextfluid/>'
+             '<drawpoint x="2" y="2" z="2"/>')
+    assert sorted(f.mk.tolist()) == [3, 4] and f.is_fluid.all()
+
+
+@pytest.mark.parametrize("body,expected", [
+    ('<setmknextbound next="true"/>', "no mkbound set before it"),
+    ('<setmkfluid mk="0"/><setmknextbound/>', "no mkbound set before it"),
+    ('<setmkbound mk="2"/><setmknextbound next="false"/>', 'next="false" is not supported'),
+    ('<setmkbound mk="65535"/><setmknextbound/>', "has no next"),
+])
+def test_setmknext_errors(tmp_path, body, expected):
+    with pytest.raises(CaseError) as e:
+        draw(tmp_path, body)
+    assert expected in str(e.value)

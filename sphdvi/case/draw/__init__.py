@@ -13,7 +13,8 @@ Lattice
 
 Pen
     ``setmkfluid``/``setmkbound``/``setmkvoid`` choose what is written (drawing
-    before any of them is an error). Transforms (``move``, ``rotate``,
+    before any of them is an error); ``setmknextbound``/``setmknextfluid``
+    (``next="true"``) take the last mk of that kind plus one. Transforms (``move``, ``rotate``,
     ``rotateline``, ``scale``) multiply the current matrix on the right
     (OpenGL order); ``matrixsave/load`` and ``statesave/load`` are stacks.
 

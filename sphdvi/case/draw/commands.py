@@ -35,7 +35,7 @@ UNSUPPORTED = {
     "drawwave",
     "clipdomain", "clipplane", "clipbox",
     "clipreset", "setpattern", "patterns", "fillfigure", "fillprism",
-    "setmknextfluid", "setmknextbound", "setmknextauto", "setmkbackvoid", "setmkbackfluid",
+    "setmknextauto", "setmkbackvoid", "setmkbackfluid",
     "setmkbackbound", "setmkbackclear", "setfrdrawmode", "rotateadv",
 }
 BOX_LIMIT_MODES = {"full", "inner"}
@@ -127,6 +127,7 @@ class GeometryRunner:
         self.saved_matrices: list[np.ndarray] = []
         self.saved_states: list[DrawState] = []
         self.saved_mk: tuple | None = None
+        self.last_mk: dict = {"fluid": None, "bound": None}   # the last mk of each kind (setmknext*)
         self.saved_vars: list = []
         self.lists: dict = {}
         self.call_stack: list[str] = []
@@ -146,7 +147,8 @@ class GeometryRunner:
     def _handler_table(self):
         names = ["newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",
                  "delvar", "varssave", "varsload", "printf", "abort", "runlist",
-                 "setmkfluid", "setmkbound", "setmkvoid", "mksave", "mkload", "setdrawmode",
+                 "setmkfluid", "setmkbound", "setmkvoid", "setmknextbound", "setmknextfluid",
+                 "mksave", "mkload", "setdrawmode",
                  "setactive", "resetdraw", "setboxlimitmode", "move", "scale", "rotate", "rotateline", "matrixreset",
                  "matrixsave", "matrixload", "statesave", "stateload",
                  "drawpoint", "drawpoints", "drawline", "drawlines", "setlinebegin", "drawlineto",
@@ -426,14 +428,40 @@ class GeometryRunner:
             self.call_stack.pop()
 
     # ------------------------------------------------------------ pen state
+    def _set_pen(self, kind: str, mk: int) -> None:
+        self.state.kind, self.state.mk = kind, mk
+        if kind in self.last_mk:
+            self.last_mk[kind] = mk
+
     def cmd_setmkfluid(self, el):
-        self.state.kind, self.state.mk = "fluid", self.reader.integer(el, "mk", lo=0, hi=65535)
+        self._set_pen("fluid", self.reader.integer(el, "mk", lo=0, hi=65535))
 
     def cmd_setmkbound(self, el):
-        self.state.kind, self.state.mk = "bound", self.reader.integer(el, "mk", lo=0, hi=65535)
+        self._set_pen("bound", self.reader.integer(el, "mk", lo=0, hi=65535))
 
     def cmd_setmkvoid(self, el):
         self.state.kind, self.state.mk = "void", 0
+
+    def _next_mk(self, el, kind: str) -> None:
+        """``<setmknextbound next="true"/>`` / ``<setmknextfluid next="true"/>``: the pen takes the
+        next mk of that kind (the last one set, plus one). DualSPHysics's chrono examples
+        CaseFlexibleGate (gate segments mkbound 1-5 from a list ending in it) and CaseBreakingWall
+        (blocks 51-77) use it so; ``next="false"`` is not documented and is refused."""
+        if not self.reader.boolean(el, "next", True):
+            raise self.reader.error(el, 'next="false" is not supported by sphdvi (GenCase\'s documentation '
+                                        "does not say what it does)", 'next="true": the next mk')
+        last = self.last_mk[kind]
+        if last is None:
+            raise self.reader.error(el, f"no mk{kind} set before it", f"a <setmk{kind}> first")
+        if last >= 65535:
+            raise self.reader.error(el, f"mk{kind} {last} has no next", "an mk below 65535")
+        self._set_pen(kind, last + 1)
+
+    def cmd_setmknextbound(self, el):
+        self._next_mk(el, "bound")
+
+    def cmd_setmknextfluid(self, el):
+        self._next_mk(el, "fluid")
 
     def cmd_mksave(self, el):
         self.saved_mk = (self.state.kind, self.state.mk)
@@ -441,7 +469,7 @@ class GeometryRunner:
     def cmd_mkload(self, el):
         if self.saved_mk is None:
             raise self.reader.error(el, "no mk saved", "a <mksave> before <mkload>")
-        self.state.kind, self.state.mk = self.saved_mk
+        self._set_pen(*self.saved_mk)
 
     def cmd_setdrawmode(self, el):
         self.state.mode = self.reader.text_attr(el, "mode", choices=DRAW_MODES).lower()
