@@ -459,10 +459,14 @@ def rotate_about_axis(points: np.ndarray, p1, p2, angle: float) -> np.ndarray:
 # floating bodies
 # ---------------------------------------------------------------------------
 def particle_inertia(pos: np.ndarray, center: np.ndarray, mpart: float) -> np.ndarray:
-    """Inertia tensor of point masses about ``center``: Σ m [(r·r) I − r rᵀ]."""
+    """Inertia tensor of point masses about ``center``: Σ m [(r·r) I − r rᵀ], its diagonal
+    summed as Σ m (y² + z²) ... so that it is never negative (Σ r·r − Σ x² left −3e-17 for a
+    row of particles along x: DualSPHysics's chrono/01 CaseDemolisher, mkbound 3)."""
     r = pos - center
-    rr = np.einsum("ij,ij->i", r, r)
-    return mpart * (np.eye(3) * rr.sum() - r.T @ r)
+    out = -(r.T @ r)
+    sq = np.einsum("ij,ij->j", r, r)             # Σ x², Σ y², Σ z²
+    out[np.diag_indices(3)] = [sq[1] + sq[2], sq[0] + sq[2], sq[0] + sq[1]]
+    return mpart * out
 
 
 def _mk_list(values) -> str:

@@ -598,3 +598,21 @@ def test_a_wave_paddles_depth_unlike_the_water_drawn_is_warned(tmp_path):
         assert bool(found) == warned, list(r.warnings)
         if warned:
             assert "<depth> 3 m of the wave paddle" in found[0] and "0.3 m deep" in found[0]
+
+
+def test_particle_inertia_of_a_row_is_never_negative():
+    """A row of particles along x (DualSPHysics's chrono/01 CaseDemolisher, mkbound 3: 20
+    particles) has I_xx = 0; Σ r·r − Σ x² left −3.3e-17. The tensor against the direct sums."""
+    from sphdvi.case.gencase import particle_inertia
+    x = 8.0 + 0.05 * np.arange(20)
+    pos = np.column_stack([x, np.full(20, 5.0), np.full(20, 5.2)])
+    c = pos.mean(axis=0)
+    I = particle_inertia(pos, c, 0.15)
+    assert I[0, 0] >= 0.0 and abs(I[0, 0]) < 1e-12
+    assert I[1, 1] == pytest.approx(0.15 * np.sum((x - c[0]) ** 2)) == I[2, 2]
+    rng = np.random.default_rng(2)
+    p = rng.normal(size=(50, 3))
+    c = p.mean(axis=0)
+    r = p - c
+    ref = 2.0 * sum(np.dot(v, v) * np.eye(3) - np.outer(v, v) for v in r)
+    assert np.allclose(particle_inertia(p, c, 2.0), ref, rtol=1e-13, atol=1e-13)
