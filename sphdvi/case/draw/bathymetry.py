@@ -139,20 +139,14 @@ def grid_triangles(xs, ys, z) -> np.ndarray:
     return np.concatenate([t1, t2])
 
 
-def _polydata(points, triangles=None):
+def _polydata(points):
+    """A vtkPolyData of the points (no cells)."""
     import vtk
-    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtk.util.numpy_support import numpy_to_vtk
     pts = vtk.vtkPoints()
     pts.SetData(numpy_to_vtk(np.ascontiguousarray(points, dtype=np.float64), deep=True))
     pd = vtk.vtkPolyData()
     pd.SetPoints(pts)
-    if triangles is not None:
-        tri = np.ascontiguousarray(triangles, dtype=np.int64)
-        cells = vtk.vtkCellArray()
-        offsets = numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(tri) + 1, 3, dtype=np.int64), deep=True)
-        conn = numpy_to_vtkIdTypeArray(tri.ravel(), deep=True)
-        cells.SetData(offsets, conn)
-        pd.SetPolys(cells)
     return pd
 
 
@@ -270,6 +264,7 @@ def grid_axis(lo: float, size: float, dp: float) -> np.ndarray:
     if not dp > 0:
         raise BathymetryError(f"grid dp = {dp:g}: expected a spacing > 0")
     n = int(np.floor(size / dp * (1 + 1e-12) + 1e-6)) + 1
+    check_grid_size(n, 1)
     return lo + dp * np.arange(max(n, 1))
 
 

@@ -960,27 +960,32 @@ class GeometryRunner:
             self._record(el, "extrude", params, tris, False, n)
 
     # ------------------------------------------------------------ mesh files
-    def _file_transform(self, el) -> np.ndarray:
-        """The matrix of a file's ``<drawscale>``, ``<drawrotate angx angy angz>`` and
-        ``<drawmove>``, applied in that order (scale first)."""
+    def _file_transform(self, el, tags=("drawscale", "drawrotate", "drawmove"),
+                        angles=("angx", "angy", "angz")) -> np.ndarray:
+        """The matrix of a file's scale, rotation (degrees about x, y, z) and move children
+        (``<drawscale>``, ``<drawrotate angx angy angz>``, ``<drawmove>``; a bathymetry's
+        ``<scale>``, ``<rotate x y z>``, ``<move>``), applied in that order (scale first)."""
         local = tf.identity()
-        mv = self.reader.child(el, "drawmove")
-        rot = self.reader.child(el, "drawrotate")
-        sc = self.reader.child(el, "drawscale")
+        sc, rot, mv = (self.reader.child(el, t) for t in tags)
         if sc is not None:
-            local = tf.scaling(self._scale_factors(sc)) @ local
+            s = np.array([self.reader.num(sc, n, 1.0) for n in "xyz"])
+            if np.any(s == 0):
+                raise self.reader.error(sc, "a scale factor is 0", "non-zero x, y, z")
+            local = tf.scaling(s) @ local
         if rot is not None:
-            ang = [self.reader.num(rot, n, 0.0) for n in ("angx", "angy", "angz")]
-            local = tf.rotation_xyz(ang) @ local
+            local = tf.rotation_xyz([self.reader.num(rot, n, 0.0) for n in angles]) @ local
         if mv is not None:
             local = tf.translation(self.reader.vec3(mv)) @ local
         return local
 
-    def _scale_factors(self, sc) -> np.ndarray:
-        s = np.array([self.reader.num(sc, n, 1.0) for n in "xyz"])
-        if np.any(s == 0):
-            raise self.reader.error(sc, "a scale factor is 0", "non-zero x, y, z")
-        return s
+    def _draw_mesh(self, el, tris, shape: str, params: dict, solid: bool = False) -> None:
+        """Draw world triangles as a surface (and with ``solid`` their inside, by parity) and
+        record them: mesh files and bathymetries."""
+        pieces = raster.triangle_pieces(self.lat, tris, surface=True, solid=solid)
+        n = self._paint(el, pieces)
+        params.update({"triangles": int(len(tris)), "min": tris.reshape(-1, 3).min(axis=0).tolist(),
+                       "max": tris.reshape(-1, 3).max(axis=0).tolist()})
+        self._record(el, shape, params, tris, solid, n)
 
     def _draw_file(self, el, kind):
         from . import meshfile
@@ -1003,12 +1008,7 @@ class GeometryRunner:
             raise self.reader.error(el, f"cannot read '{os.path.basename(path)}': {exc}",
                                     f"a valid {kind.upper()} triangle mesh") from None
         tris = tf.apply(self.state.matrix @ local, tris_local)
-        pieces = raster.triangle_pieces(self.lat, tris, surface=True, solid=autofill)
-        n = self._paint(el, pieces)
-        params = {"file": path, "triangles": int(len(tris)),
-                  "min": tris.reshape(-1, 3).min(axis=0).tolist(),
-                  "max": tris.reshape(-1, 3).max(axis=0).tolist(), "autofill": autofill}
-        self._record(el, "mesh", params, tris, autofill, n)
+        self._draw_mesh(el, tris, "mesh", {"file": path, "autofill": autofill}, solid=autofill)
 
     def cmd_drawfilestl(self, el):
         self._draw_file(el, "stl")
@@ -1024,14 +1024,6 @@ class GeometryRunner:
         self._draw_file(el, "vtm")
 
     # ------------------------------------------------------------ bathymetries
-    def _draw_bed(self, el, tris, params) -> None:
-        """Draw a bed's triangles (world coordinates) as a surface and record it."""
-        pieces = raster.triangle_pieces(self.lat, tris, surface=True, solid=False)
-        n = self._paint(el, pieces)
-        params.update({"triangles": int(len(tris)), "min": tris.reshape(-1, 3).min(axis=0).tolist(),
-                       "max": tris.reshape(-1, 3).max(axis=0).tolist()})
-        self._record(el, "bathymetry", params, tris, False, n)
-
     def cmd_drawfilecsv(self, el):
         """``<drawfilecsv file mode="bathymetry">``: a table of heights (GenCase_Bathymetry.csv)
         drawn as a surface, two triangles a cell, after ``<drawscale>``, ``<drawrotate>``,
@@ -1043,7 +1035,7 @@ class GeometryRunner:
         path = self.reader.resolve_path(el, "file")
         xs, ys, z = bathymetry.read_height_table(path)
         tris = tf.apply(self.state.matrix @ self._file_transform(el), bathymetry.grid_triangles(xs, ys, z))
-        self._draw_bed(el, tris, {"file": path, "mode": mode.lower(), "grid": [len(xs), len(ys)]})
+        self._draw_mesh(el, tris, "bathymetry", {"file": path, "mode": mode.lower(), "grid": [len(xs), len(ys)]})
 
     def _xy(self, el, tag: str, positive: bool = False):
         c = self.reader.child(el, tag, required=True)
@@ -1055,15 +1047,7 @@ class GeometryRunner:
         from . import bathymetry
         self.reader.check_children(zp, {"move", "rotate", "scale", "selection", "rem"}, "child element")
         pts = bathymetry.read_points(self.reader.resolve_path(zp, "file"))
-        local = tf.identity()
-        sc, rot, mv = (self.reader.child(zp, t) for t in ("scale", "rotate", "move"))
-        if sc is not None:
-            local = tf.scaling(self._scale_factors(sc)) @ local
-        if rot is not None:
-            local = tf.rotation_xyz([self.reader.num(rot, n, 0.0) for n in "xyz"]) @ local
-        if mv is not None:
-            local = tf.translation(self.reader.vec3(mv, missing=0.0)) @ local
-        pts = tf.apply(local, pts)
+        pts = tf.apply(self._file_transform(zp, ("scale", "rotate", "move"), "xyz"), pts)
         sel = self.reader.child(zp, "selection")
         if sel is not None:
             self.reader.check_children(sel, {"point", "size", "rem"}, "child element")
@@ -1155,12 +1139,12 @@ class GeometryRunner:
             else:
                 tris = pts[tri_idx]
             if grid is not None and self.reader.child(grid, "finalmove") is not None:
-                tris = tris + self.reader.vec3(self.reader.child(grid, "finalmove"), missing=0.0)
+                tris = tris + self.reader.vec3(self.reader.child(grid, "finalmove"))
         except bathymetry.BathymetryError as exc:
             raise self.reader.error(el, str(exc), "a bed of points spanning an area") from None
         params["points"] = int(len(pts))
         self._save_bathymetry(el, pts, tris)
-        self._draw_bed(el, tf.apply(self.state.matrix, tris), params)
+        self._draw_mesh(el, tf.apply(self.state.matrix, tris), "bathymetry", params)
 
     def _bathymetry_grid(self, grid, pts, tri_idx):
         from . import bathymetry
@@ -1172,9 +1156,8 @@ class GeometryRunner:
         else:
             lo = pts[:, :2].min(axis=0)
             size = pts[:, :2].max(axis=0) - lo
-        nx, ny = (int(np.floor(v / dp * (1 + 1e-12) + 1e-6)) + 1 for v in size)
-        bathymetry.check_grid_size(nx, ny)
         xs, ys = bathymetry.grid_axis(lo[0], size[0], dp), bathymetry.grid_axis(lo[1], size[1], dp)
+        bathymetry.check_grid_size(len(xs), len(ys))
         z, outside = bathymetry.resample(pts, tri_idx, xs, ys)
         if outside:
             self.reader.warn(grid, f"{outside} of the {z.size} grid nodes lie outside the points' "
@@ -1283,26 +1266,21 @@ class GeometryRunner:
         grow = np.full(3, -margin if inner else margin)
         if self.lat.is2d:
             grow[1] = margin
-        qlo, qhi = point - grow, point + size + grow
+        tol = 1e-9 * max(float(np.abs(size).max()), self.lat.dp / scale)
+        qlo, qhi = point - grow - tol, point + size + grow + tol
         if np.any(qhi < qlo):
             return None
-        corners = np.array([[x, y, z] for x in (qlo[0], qhi[0]) for y in (qlo[1], qhi[1])
-                            for z in (qlo[2], qhi[2])])
-        r = raster.world_range(self.lat, tf.apply(m, corners), raster.EPS)
-        if r is None:
+
+        def inside(qx, qy, qz):
+            return [(q >= qlo[a]) & (q <= qhi[a]) for a, q in enumerate((qx, qy, qz))]
+        pieces = raster.analytic_pieces(self.lat, m, qlo, qhi, inside, solid=True, shell_faces=())
+        if not pieces:
             return None
-        lo, hi = (np.asarray(v, dtype=np.int64) for v in r)
-        if self.lat.is2d:
-            lo[1] = hi[1] = 0
-        X, Y, Z = self.lat.axis_coords(lo, hi)
-        if self.lat.is2d:
-            Y = np.full_like(Y, self.lat.pointmin[1])
-        inv = tf.inverse(m)
-        tol = 1e-9 * max(float(np.abs(size).max()), self.lat.dp / scale)
-        allowed = np.ones(tuple(int(v) for v in hi - lo + 1), dtype=np.bool_)
-        for a in range(3):
-            q = inv[a, 0] * X + inv[a, 1] * Y + inv[a, 2] * Z + inv[a, 3]
-            allowed &= (q >= qlo[a] - tol) & (q <= qhi[a] + tol)
+        lo = np.min([p.lo for p in pieces], axis=0)
+        hi = np.max([p.lo + np.array(p.mask.shape) - 1 for p in pieces], axis=0)
+        allowed = np.zeros(tuple(int(v) for v in hi - lo + 1), dtype=np.bool_)
+        for p in pieces:
+            allowed[tuple(slice(int(a), int(a) + n) for a, n in zip(p.lo - lo, p.mask.shape))] |= p.mask
         return lo, hi, allowed
 
     def cmd_fillbox(self, el):
