@@ -780,6 +780,9 @@ class SPHRun:
             except ValueError as exc:
                 raise InputError(str(exc)) from None
         check_boundary_in_domain(p, domain, fluidcount)
+        self.inout = None
+        if js.get("special", {}).get("inout"):
+            p, state = self._place_inout_buffers(js["special"]["inout"], data, c, domain, periodic)
         normals0 = None
         if int(params.get("Boundary", 1)) == 2:
             from .case.normals import boundary_normals
@@ -838,7 +841,7 @@ class SPHRun:
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table,
                                 acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")),
-                                shift_zones=shift_zones(data))
+                                shift_zones=shift_zones(data), inout=self.inout)
         if self.floating is not None:       # Symplectic: the bodies at the half step for the corrector
             self.solver.half_step_hook = self.floating.predict
         for absorber in self.absorbers:
@@ -858,6 +861,29 @@ class SPHRun:
         self.dtmin_warn_at = 1          # the next count of DtMin steps warned about (1, 10, 100, ...)
         self.step_warnings = []         # lines for run.log (and stderr) found by check()
         self.out_faces = set()          # faces of the domain that fluid excluded for its position crossed
+
+    def _place_inout_buffers(self, spec: dict, data: dict, c: dict, domain, periodic):
+        """``<special><inout>``: the buffers of the inlet/outlet zones put in place of the fluid in
+        them (sphdvi.sph.inout.place_buffers); ``data["particles"]`` (and the case's normals) become
+        the run's initial particles.  Returns (particles, state)."""
+        from .sph.inout import InOutError, place_buffers
+        from .sph.state import FluidState
+        if periodic:
+            raise InputError("<special><inout> with periodic boundaries is not supported by sphdvi "
+                             "(expected a case without the *Periodic* parameters)")
+        try:
+            p, extra, self.inout, notes = place_buffers(spec, data["particles"], c, domain,
+                                                        {"normals": data.get("normals")})
+        except InOutError as exc:
+            raise InputError(f"<special><inout>: {exc}") from None
+        self.inout.add_gauges(float(c["h"]), int(self.params.get("Kernel", 2)), float(domain[1][2]))
+        data["particles"] = p
+        if extra.get("normals") is not None:
+            data["normals"] = extra["normals"]
+        self.inout_notes = notes
+        state = FluidState(p["pos"], p["vel"], p["rhop"], p["mass"], p["type"], p["idp"], p["mk"],
+                           rhop0=c["rhop0"])
+        return p, state
 
     @staticmethod
     def _mdbc_only_on(normals, p, fluidcount: int, mkbound_list: str):
@@ -1423,7 +1449,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                   f"{dt_lo if dt_lo < math.inf else 0:.6g},{dt_hi:.6g},{wall:.3f}")
         files.log(f"Part {k:04d}  t={sol.time:.6f} s  steps={sol.nstep}  particles={sol.state.n}  "
                   f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s"
-                  + written)
+                  + written + (inout_text(sol.inout) if sol.inout is not None else ""))
         for line in excl_lines:
             files.log("WARNING: " + line)
             warnings.warn(line)
@@ -1537,11 +1563,20 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     files.write_json(status=status, message=message, steps=int(sol.nstep), physical_time=float(sol.time),
                      runtime_s=runtime, excluded=dict(sol.n_excluded), dtmin_steps=int(sol.n_dtmin),
                      particles_final=int(sol.state.n), threads_used=sol.threads_in_use(),
+                     **({"inout": dict(sol.inout.counts)} if sol.inout is not None else {}),
                      **({"dtfixedfile_max_excess_s": float(sol.dt_error)}
                         if sol.dt_table is not None and np.isfinite(sol.dt_error) else {}),
                      us_per_particle_step=(1e6 * (runtime - wall_prev) / (sol.nstep - steps_at_start)
                                            / max(1, sol.state.n) if sol.nstep > steps_at_start else None))
     return RunResult(status, message, code, int(sol.nstep), float(sol.time), runtime)
+
+
+def inout_text(io) -> str:
+    """The inlet/outlet counts of run.log's output lines: particles created in and removed from
+    the buffers, and those that crossed between buffers and fluid, since the start."""
+    n = io.counts
+    return (f"  inout: created={n['created']} removed={n['removed']} to_fluid={n['to_fluid']} "
+            f"to_buffer={n['to_buffer']}")
 
 
 def _resumed_dtlog(outdir, spec, tout, saved, sol, files) -> DtLog:

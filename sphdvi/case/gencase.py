@@ -115,6 +115,8 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     check_particle_values(particles, reader)
     domain = resolve_domain(case, particles, consts, reader)
     check_case(case, particles, bodies, mkinfo, domain, reader)
+    if case.special.get("inout"):
+        check_inout(case.special["inout"], particles, consts.is2d, reader)
     warn_gauges_outside(case.special.get("gauges"), domain, consts.is2d, reader)
     reader.warn_unread_attributes(root)
     return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
@@ -670,6 +672,22 @@ def resolve_domain(case: Case, particles: dict, consts: Constants, reader) -> di
                         file=reader.file, line=reader.line_of("execution/parameters/simulationdomain"),
                         element="simulationdomain", expected="posmin <= posmax")
     return {"posmin": posmin.tolist(), "posmax": posmax.tolist()}
+
+
+def check_inout(spec: dict, particles, is2d: bool, reader) -> None:
+    """The inlet/outlet zones against the case: <zone2d> in 2D, <zone3d> in 3D, and a
+    <particles mkfluid> zone's particles drawn (one plane of them: checked when the run builds it)."""
+    fluid_labels = set(np.unique(particles["label"][particles["type"] == TYPE_FLUID]).tolist())
+    for z in spec["zones"]:
+        want = 2 if is2d else 3
+        if z["dim"] != want:
+            raise CaseError(f"inout zone {z['index']} is a <zone{z['dim']}d> in a {want}D case", file=reader.file,
+                            line=z["line"], element="inoutzone", expected=f"<zone{want}d>")
+        shape = z["shape"]
+        if shape["kind"] == "particles" and shape["mkfluid"] not in fluid_labels:
+            raise CaseError(f"inout zone {z['index']}: <particles mkfluid=\"{shape['mkfluid']}\">, which has no "
+                            "particles", file=reader.file, line=shape["line"], element="particles",
+                            expected="an mkfluid drawn by the geometry (a layer of fluid particles)")
 
 
 def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:

@@ -147,6 +147,12 @@ class SPHSolver:
         ViscoBoundFactor) is interpolated linearly at the start of each step
         (end values outside), as DualSPHysics's JDsViscoInput.
 
+    inout : sphdvi.sph.inout.InOut or None
+        Inlet/outlet zones (``<special><inout>``): their buffer particles' velocity and density
+        are imposed before each interaction, their rates zeroed after it, and at the end of each
+        step particles cross between buffers and fluid, new ones are created and others removed
+        (:mod:`sphdvi.sph.inout`); ``N`` changes from step to step.
+
     After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
     accelerations, density rates and pressures of the last interaction, in
     the current particle order (``state.idp`` identifies the particles).
@@ -157,10 +163,12 @@ class SPHSolver:
     def __init__(self, state, constants, params=None, *, domain=None, motion_hook=None,
                  parallel_threshold=PARALLEL_THRESHOLD, light_threshold=LIGHT_THRESHOLD,
                  periodic=None, normals=None,
-                 cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None, shift_zones=None):
+                 cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None, shift_zones=None,
+                 inout=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.acc_inputs = list(acc_inputs or [])     # imposed accelerations (sphdvi.sph.accinput)
+        self.inout = inout                            # inlet/outlet zones (sphdvi.sph.inout.InOut) or None
         self.dt_table = None if dt_table is None else np.asarray(dt_table, float).reshape(-1, 2)
         self.dt_error = -np.inf
         self.visco_table = None if visco_table is None else np.asarray(visco_table, float).reshape(-1, 2)
@@ -186,6 +194,8 @@ class SPHSolver:
         if domain is not None:
             self._domain = (np.array(domain[0], float), np.array(domain[1], float))
         self.periodicity = self._setup_periodic(periodic)
+        if self.inout is not None and self.periodicity is not None:
+            raise ValueError("inlet/outlet zones (<inout>) with periodic boundaries are not supported by sphdvi")
         self.shift_zones = None
         if shift_zones and self.rates_shift:
             self.shift_zones = _shift_zones.zone_arrays(shift_zones)
@@ -656,6 +666,8 @@ class SPHSolver:
             _shift_zones.unshift_outside(self.state.pos, self.state.ptype, self.shiftpos, *self.shift_zones)
         if self.acc_inputs:
             self._add_acc_inputs()
+        if self.inout is not None:
+            self._inout_zero_rates()
 
     def _add_acc_inputs(self):
         """``<accinputs>`` at the time the step started; the force term of dt then sees
@@ -680,6 +692,8 @@ class SPHSolver:
         k = self._kernels(par)
         s = self.state
         ptype_rows, oi, _ = self._rows
+        if self.inout is not None and not self._in_corrector:
+            self._inout_impose(ptype_rows, oi)
         if self._mdbc_now():
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
@@ -960,6 +974,8 @@ class SPHSolver:
                 moving_wall_ace(self.state.ptype, self.state.vel, v0, dt, self.wall_ace)
             else:
                 self.motion_hook(self, self.time, dt)
+        if self.inout is not None:
+            self._inout_update()
         return dt
 
     def _step_verlet(self):
@@ -1043,6 +1059,136 @@ class SPHSolver:
             n += 1
         return n
 
+    # ------------------------------------------------------------------ inlet/outlet
+    def _inout_impose(self, ptype_rows, oi):
+        """The buffer particles' imposed or extrapolated velocity and density, into the state
+        and the packed rows, before the interaction (sphdvi.sph.inout.impose_kernel)."""
+        from .inout import impose_kernel
+        io = self.inout
+        s = self.state
+        io.update_time(self.time, s)
+        verlet = self.step_algorithm == 1
+        ncx, ncy, ncz = self.cells.shape
+        impose_kernel(self.kernel, self.is2d, self.nb, ptype_rows, oi, s.pos, s.vel, s.rhop, s.mass, s.idp,
+                      io.zone_of_idp, self.cells.cell_start, self.cells.pmin, 1.0 / self.cells.cellsize,
+                      ncx, ncy, ncz, self.cst, io.geo, io.cfg, io.coef, io.zsurf, io.determlimit, io.coef_hydro,
+                      self.vel_m1 if verlet else self._no_m1[0], self.rhop_m1 if verlet else self._no_m1[1],
+                      self.dp)
+
+    _no_m1 = (np.zeros((0, 3)), np.zeros(0))
+
+    def _inout_zero_rates(self):
+        """Buffer particles take no acceleration, density rate or shift; the force term of dt is
+        taken again without them (as after the imposed accelerations)."""
+        from .inout import zero_rates
+        s = self.state
+        zero_rates(s.ptype, s.idp, self.inout.zone_of_idp, self.ace, self.ar, self.shiftpos)
+        self.dtmax[:, 0] = 0.0
+        self.dtmax[0, 0] = fluid_ace_max2(self.ace, s.ptype, *self.gravity)
+
+    def _inout_update(self):
+        """End of step: buffer particles that crossed their plane become fluid (a new one taking
+        each one's place behind), those that left the buffer's back are removed, fluid entering a
+        zone is converted or removed (sphdvi.sph.inout.classify_kernel); advanced refilling fills
+        the columns the flow emptied."""
+        from .inout import (REMOVE, TO_BUFFER, TO_FLUID, TO_FLUID_REFILL, G_N, G_W, classify_kernel,
+                            refill_columns)
+        io = self.inout
+        s = self.state
+        self._check_state_arrays()
+        action = np.empty(s.n, np.int8)
+        classify_kernel(s.pos, s.ptype, s.idp, io.zone_of_idp, io.geo, io.cfg, io.zsurf, self.dp, action)
+        moved = np.flatnonzero(action != 0)
+        new_pos = new_src = new_zone = None
+        if moved.size:
+            act = action[moved]
+            ids = s.idp[moved]
+            crossing = moved[(act == TO_FLUID) | (act == TO_FLUID_REFILL)]
+            refill = moved[act == TO_FLUID_REFILL]
+            if refill.size:
+                zr = io.zone_of_idp[s.idp[refill]].astype(np.int64)
+                new_pos = s.pos[refill] - io.geo[zr, G_W][:, None] * io.geo[zr, G_N:G_N + 3]
+                new_src, new_zone = refill, zr
+            io.mark(s.idp[crossing], -1)
+            io.counts["to_fluid"] += int(crossing.size)
+            conv = act >= TO_BUFFER
+            if conv.any():
+                io.mark(ids[conv], (act[conv] - TO_BUFFER).astype(np.int8))
+                io.counts["to_buffer"] += int(np.count_nonzero(conv))
+        if io.pts_all.shape[0]:
+            depth = np.empty(io.pts_all.shape[0])
+            refill_columns(io.pts_all, io.pts_zone, io.geo, io.zsurf, s.pos, s.ptype, s.idp, io.zone_of_idp,
+                           self.dp, depth)
+            ok = np.flatnonzero(depth >= 0)
+            if ok.size:
+                zr = io.pts_zone[ok]
+                fill = io.pts_all[ok] - depth[ok][:, None] * io.geo[zr, G_N:G_N + 3]
+                src = self._buffer_row_of_zone(zr)
+                keep = src >= 0
+                if keep.any():
+                    fill, zr, src = fill[keep], zr[keep], src[keep]
+                    new_pos = fill if new_pos is None else np.concatenate([new_pos, fill])
+                    new_src = src if new_src is None else np.concatenate([new_src, src])
+                    new_zone = zr if new_zone is None else np.concatenate([new_zone, zr])
+        if new_pos is not None and len(new_pos):
+            self._append_buffer_particles(new_pos, new_src, new_zone)
+            action = np.concatenate([action, np.zeros(len(new_pos), np.int8)])
+        gone = action == REMOVE
+        if gone.any():
+            io.counts["removed"] += int(np.count_nonzero(gone))
+            self._remove_rows(gone.astype(np.int8))
+
+    def _buffer_row_of_zone(self, zones):
+        """A particle row to copy mass, mk and density from for new particles of each zone: one of
+        its buffer particles (-1 for a zone with none)."""
+        s = self.state
+        zrow = self.inout.zone_of_idp[s.idp]
+        out = np.full(len(zones), -1, np.int64)
+        for z in np.unique(zones):
+            rows = np.flatnonzero((zrow == z) & (s.ptype == FLUID))
+            if rows.size:
+                out[zones == z] = rows[0]
+        return out
+
+    def _append_buffer_particles(self, pos, src, zones):
+        """Add buffer particles at ``pos`` of ``zones``, with the mass, mk, density and velocity
+        of rows ``src``; every per-particle work array gains zero rows (the Verlet previous-step
+        values copy the source's)."""
+        s = self.state
+        io = self.inout
+        m = len(pos)
+        ids = io.take_ids(m)
+        io.mark(ids, np.asarray(zones, np.int8))
+        io.counts["created"] += m
+        new = {"pos": np.asarray(pos, float), "vel": s.vel[src], "rhop": s.rhop[src], "mass": s.mass[src],
+               "ptype": np.full(m, FLUID, np.int8), "idp": ids, "mk": s.mk[src]}
+        n = s.n
+        for name in self._aux_names():
+            a = getattr(self, name)
+            if a.shape[0] != n:
+                continue
+            if name in ("vel_m1", "rhop_m1"):
+                extra = a[src]
+            else:
+                extra = np.zeros((m,) + a.shape[1:], a.dtype)
+            setattr(self, name, np.concatenate([a, extra]))
+        for f in FluidState.FIELDS:
+            setattr(s, f, np.concatenate([getattr(s, f), new[f]]))
+        self._alloc()
+
+    def _remove_rows(self, codes):
+        """Drop the rows where ``codes`` is not 0 from the state and the per-particle arrays
+        (what :meth:`_exclude` does, without recording them as excluded)."""
+        s = self.state
+        n = codes.shape[0]
+        for f in FluidState.FIELDS:
+            setattr(s, f, _compacted(getattr(s, f), codes))
+        for name in self._aux_names():
+            a = getattr(self, name)
+            if a.shape[0] == n:
+                setattr(self, name, _compacted(a, codes))
+        self._alloc(reuse=True)
+
     # ------------------------------------------------------------------ exclusion
     def _exclude(self, t_end: float, carry=()):
         """Remove the flagged fluid particles from the state and work arrays, and keep an
@@ -1086,8 +1232,11 @@ class SPHSolver:
         """What a resumed run needs to go on bitwise: the particle state, the integrator's
         work arrays (previous-step values, SPS stresses, mDBC normals…), the clock and
         step counters, and the exclusion counts.  The arrays are the solver's own, not copies."""
+        aux = {name: getattr(self, name) for name in self._aux_names()}
+        if self.inout is not None:
+            aux.update(self.inout.get_state())
         return {"state": {name: getattr(self.state, name) for name in self.state.FIELDS},
-                "aux": {name: getattr(self, name) for name in self._aux_names()},
+                "aux": aux,
                 "scalars": {name: getattr(self, name) for name in self.CHECKPOINT_SCALARS},
                 "n_excluded": dict(self.n_excluded)}
 
@@ -1111,6 +1260,10 @@ class SPHSolver:
             if value is None:
                 raise KeyError(name)
             setattr(self, name, value.item() if isinstance(value, np.generic) else value)
+        if self.inout is not None:
+            if "inout_zone_of_idp" not in ck["aux"]:
+                raise KeyError("inout_zone_of_idp")
+            self.inout.set_state(ck["aux"])
         # a reason added since the checkpoint was written ("movement") starts from 0
         self.n_excluded = {**{name: 0 for name in REASON_NAMES.values()}, **dict(ck["n_excluded"])}
         return missing
