@@ -89,6 +89,15 @@ class RunOutput:
                           + (f" (outputs 0, {every}, {2 * every}, ... whole)" if every > 0 else "")
                           + ": what is measured from it sees those alone")
 
+    def _masses(self, idp: np.ndarray) -> np.ndarray:
+        """The masses of the particles ``idp``: those of the case's, and for the ids a run created
+        past them (the buffers of inlet/outlet zones, fluid) the fluid mass rho0 dp^d."""
+        if idp.size and int(idp.max()) >= self.mass_by_idp.size:
+            grown = np.full(int(idp.max()) + 1, float(self.data["constants"]["massfluid"]))
+            grown[:self.mass_by_idp.size] = self.mass_by_idp
+            self.mass_by_idp = grown
+        return self.mass_by_idp[idp]
+
     def _run_masses(self, p) -> np.ndarray:
         """The particle masses the run used: the case's, but rho0 dp^d for the floating
         particles mDBC corrects (:func:`sphdvi.case.normals.mdbc_floating_mask`: of the case's
@@ -148,7 +157,7 @@ class RunOutput:
                     rhop=read("Rhop") if "Rhop" in arrays else None,
                     press=read("Press") if "Press" in arrays else None,
                     ptype=read("Type"), idp=idp, mk=read("Mk") if "Mk" in arrays else None,
-                    mass=self.mass_by_idp[idp])
+                    mass=self._masses(idp))
 
     def fluid_grid(self, snap: Snapshot) -> core.ParticleGrid:
         press = snap.press if snap.press is not None else self.spec.tait_pressure(snap.rhop)

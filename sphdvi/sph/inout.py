@@ -29,6 +29,10 @@ and the right-hand sides (sum m w, sum m grad w) for the density and (sum V w u,
 for each velocity component u, the first-order value f_b = f_g + (r_b - g).grad f where
 |det A| >= ``determlimit``, else the Shepard value (sum m w / sum V w; sum V w u / sum V w) when
 sum V w > 0 (DualSPHysics's default determlimit 1e+3 is zeroth order everywhere; 1e-3 first order).
+A fluid particle on the ghost node counts with W(0) (its gradient term zero), as in sphdvi's mDBC;
+DualSPHysics leaves it out (``rr2 >= ALMOSTZERO``), which on a regular lattice, where the plane lies
+half-way between rows and every ghost node falls on a fluid particle, drops the nearest neighbour of
+every buffer particle from its Shepard average.
 
 At the end of each step (:func:`classify_kernel`, JSphInOut::ComputeStepCpu):
 
@@ -219,11 +223,13 @@ def _extrapolate(kern, is2d, nb, ptype_s, oi, idp, zone_of_idp, cell_start, pmin
                     vj = mj * nb[j, 9]
                     u0, u1, u2 = nb[j, 3], nb[j, 4], nb[j, 5]
                 r2 = dx * dx + dy * dy + dz * dz
-                if r2 >= r2max or r2 < 1e-18:
+                if r2 >= r2max:
                     continue
                 q = math.sqrt(r2) / h
                 wk = kernel_w(kern, q, alpha)
-                fac = kernel_fac(kern, q, alpha_h2)
+                # a particle on the ghost node counts with W(0) and no gradient (DualSPHysics leaves it
+                # out, and on a lattice every ghost node of a buffer falls on a fluid particle)
+                fac = kernel_fac(kern, q, alpha_h2) if r2 > 1e-18 else 0.0
                 # rows: the value and its gradient (d/dx, [d/dy], d/dz); columns (g - r_j) as DualSPHysics
                 g0 = fac * dx
                 g1 = fac * dy
@@ -546,6 +552,25 @@ class InOut:
             self.gauges[k] = (VerticalSurfaceGauge(zmin, zmax, self.dp, 0.4 if self.is2d else 0.5, kernel, h,
                                                    self.is2d), float(centre[0]), float(centre[1]))
 
+    def initial_values(self, pos: np.ndarray, zone: np.ndarray, rhop0: float, inv_gamma: float):
+        """The imposed velocity and density of buffer particles at ``pos`` of ``zone`` now (those to
+        be extrapolated: at rest, rho0), for the outputs before the first step."""
+        vel = np.zeros((len(pos), 3))
+        rho = np.full(len(pos), rhop0)
+        for k in np.unique(zone):
+            sel = zone == k
+            w = pos[sel, 2]
+            if self.cfg[k, C_VEL] != 2:
+                c = self.coef[k]
+                v = (c[0] * w + c[1]) * w + c[2]
+                if self.cfg[k, C_REFILL] != 0:
+                    v = np.where(w <= self.zsurf[k], v, 0.0)
+                vel[sel] = v[:, None] * self.geo[k, G_N:G_N + 3]
+            if self.cfg[k, C_RHOP] == 1:
+                base = np.maximum(1.0 + self.coef_hydro * (self.zsurf[k] - w), 0.0)
+                rho[sel] = rhop0 * np.maximum(base ** inv_gamma, 1.0)
+        return vel, rho
+
     # -- ids ---------------------------------------------------------------------------------------
     def mark(self, idp: np.ndarray, zone) -> None:
         """Set the zone (-1: none) of the particle ids ``idp``, growing the table as needed."""
@@ -648,8 +673,9 @@ def place_buffers(spec: dict, particles: dict, constants: dict, domain, extra: d
     keep = ~drop
     out = {k: np.asarray(v)[keep] if np.ndim(v) and np.shape(v)[0] == n else v for k, v in particles.items()}
     idmax = int(np.max(particles["idp"])) + 1 if n else 0
-    rho0 = float(constants["rhop0"])
-    add = {"pos": add_pos, "vel": np.zeros((m, 3)), "rhop": np.full(m, rho0),
+    vel, rho = io.initial_values(add_pos, np.concatenate(new_zone).astype(np.int64), float(constants["rhop0"]),
+                                 1.0 / float(constants["gamma"]))
+    add = {"pos": add_pos, "vel": vel, "rhop": rho,
            "mass": np.full(m, float(constants["massfluid"])), "type": np.full(m, 3),
            "mk": np.concatenate(new_mk), "idp": np.arange(idmax, idmax + m)}
     for k, v in add.items():

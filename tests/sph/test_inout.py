@@ -1,6 +1,7 @@
 """Inlet/outlet zones (``<special><inout>``, :mod:`sphdvi.sph.inout`): exact solutions, the
 extrapolation's order, the buffers' bookkeeping, resume."""
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -66,7 +67,7 @@ def slab_case(tmp_path, *, u=1.0, rin=0, rout=2, refill=0, inout=None, tmax=0.2,
               '</simulationdomain>')
     text = case_xml(dp="0.02", pointmin=("-0.2", "0", "-0.1"), pointmax=("0.8", "0", "0.3"), constants=NO_GRAVITY,
                     commands=commands, special=special, parameters=params)
-    return write_case(tmp_path, text, f"{name}_Def.xml")
+    return pathlib.Path(write_case(tmp_path, text, f"{name}_Def.xml"))
 
 
 def run(case, out, *args):
@@ -104,3 +105,207 @@ def test_a_slab_moves_exactly_through_an_inlet_and_an_outlet(tmp_path):
     # the lattice stays a lattice: x of every fluid particle a multiple of dp from x(t) = U t
     x = last["points"][fluid, 0] - t
     assert np.abs(x / 0.02 - np.round(x / 0.02)).max() < 1e-6
+
+
+def solver_of(tmp_path, case, sets=()):
+    """gencase + the run's set-up (SPHRun) without stepping."""
+    from sphdvi.run_options import apply_overrides
+    from sphdvi.simulation import SPHRun, find_case_file, special_parameters
+    g = tmp_path / "g"
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(g)])
+    assert r.exit_code == 0, r.output
+    data = read_case_h5(find_case_file(str(g)))
+    params = apply_overrides(special_parameters(data), list(sets))
+    return SPHRun(data, params, str(tmp_path))
+
+
+def _linear_fields(sol):
+    """Fluid at rest but for a linear density and velocity field; returns the field functions."""
+    s = sol.state
+    rho = lambda p: 1000.0 + 20.0 * p[:, 0] - 15.0 * p[:, 2]        # noqa: E731
+    u = lambda p: 0.5 + 0.3 * p[:, 0] + 0.2 * p[:, 2]              # noqa: E731
+    fl = s.ptype == 3
+    s.rhop[fl] = rho(s.pos[fl])
+    s.vel[fl] = 0.0
+    s.vel[fl, 0] = u(s.pos[fl])
+    return rho, u
+
+
+@pytest.mark.parametrize("order", ["first", "zeroth"])
+def test_extrapolation_from_the_ghost_node(tmp_path, order):
+    """The outlet's buffer takes the fluid's density and velocity mirrored through the plane: with
+    determlimit 1e-3 (first order) a linear field is carried to the buffer particle exactly (the
+    kernel-corrected value and gradient at the ghost node, then the Taylor step back); with the
+    default 1e+3 it takes the Shepard average at the ghost node."""
+    limit = "1e-3" if order == "first" else "1e+3"
+    zones = INLET.format(u=1.0, rin=0, refill=0) + OUTLET.format(rout=2)
+    case = slab_case(tmp_path, inout=zones)
+    text = case.read_text().replace("<inout>", f'<inout><determlimit value="{limit}" />')
+    case.write_text(text)
+    sph = solver_of(tmp_path, case)
+    sol = sph.solver
+    rho, u = _linear_fields(sol)
+    sol.compute_rates()
+    s = sol.state
+    io = sol.inout
+    buf = (s.ptype == 3) & (io.zone_of_idp[s.idp] == 1)
+    assert buf.sum() == 4 * 11
+    p = s.pos[buf]
+    if order == "first":
+        assert np.abs(s.rhop[buf] - rho(p)).max() < 1e-8
+        assert np.abs(s.vel[buf, 0] - u(p)).max() < 1e-10
+    else:
+        g = p.copy()
+        plane = io.geo[1, IO.G_D0] * io.geo[1, 0]       # the plane's x (direction -x)
+        g[:, 0] = 2 * plane - p[:, 0]
+        # the Shepard average at the ghost node over the fluid (buffers left out), summed here
+        h = sol.h
+        src = (s.ptype == 3) & (io.zone_of_idp[s.idp] < 0)
+        r = np.linalg.norm(g[:, None, [0, 2]] - s.pos[None, src][:, :, [0, 2]], axis=2) / h
+        w = np.where(r < 2, (1 - r / 2) ** 4 * (2 * r + 1), 0.0)
+        m = s.mass[src]
+        shepard = (w * m).sum(1) / (w * m / s.rhop[src]).sum(1)
+        assert np.abs(s.rhop[buf] - shepard).max() < 1e-9
+        assert np.abs(s.rhop[buf] - rho(g)).max() < 0.6          # the ghost node's value, to O(h)
+        assert np.abs(s.rhop[buf] - rho(p)).max() > 1.0          # not the buffer's own value
+    # the inlet's buffer is imposed: U and rho0, and never seen by the extrapolation
+    inlet = (s.ptype == 3) & (io.zone_of_idp[s.idp] == 0)
+    assert np.all(s.vel[inlet, 0] == 1.0) and np.all(s.rhop[inlet] == 1000.0)
+
+
+def test_buffers_take_no_acceleration(tmp_path):
+    sph = solver_of(tmp_path, slab_case(tmp_path))
+    sol = sph.solver
+    _linear_fields(sol)
+    sol.compute_rates()
+    s = sol.state
+    buf = sol.inout.zone_of_idp[s.idp] >= 0
+    assert not sol.ace[buf].any() and not sol.ar[buf].any()
+    assert np.abs(sol.ace[~buf]).max() > 0
+
+
+def test_hydrostatic_buffer_density_and_zsurf_velocity(tmp_path):
+    """imposerhop 1: rho0 (1 + rho0 g (zsurf - z)/B)^(1/gamma), rho0 above zsurf; refilling 1: the
+    velocity is zero above zsurf and the buffer starts below it."""
+    zones = """
+                <inoutzone>
+                    <refilling value="1" /><inputtreatment value="2" /><layers value="3" />
+                    <zone2d><particles mkfluid="1" direction="right" /></zone2d>
+                    <imposevelocity mode="0"><velocity v="0.5" /></imposevelocity>
+                    <imposerhop mode="1" />
+                    <imposezsurf mode="0"><zsurf value="0.11" /></imposezsurf>
+                </inoutzone>"""
+    case = slab_case(tmp_path, inout=zones)
+    case.write_text(case.read_text().replace('<gravity x="0" y="0" z="0" />', '<gravity x="0" y="0" z="-9.81" />'))
+    sph = solver_of(tmp_path, case)
+    sol = sph.solver
+    sol.compute_rates()
+    s = sol.state
+    buf = sol.inout.zone_of_idp[s.idp] == 0
+    z = s.pos[buf, 2]
+    assert z.max() <= 0.11 and buf.sum() == 3 * 6          # rows z = 0 ... 0.1
+    b = sol.b
+    want = 1000.0 * (1 + 1000.0 * 9.81 * (0.11 - z) / b) ** (1 / 7)
+    assert np.allclose(s.rhop[buf], want, rtol=1e-12)
+    assert np.all(s.vel[buf, 0] == 0.5)
+
+
+def test_velocity_profiles_and_time_tables():
+    """velocity2 is the line through (z, v), (z2, v2); velocity3 the parabola through its three
+    points; a variable velocity interpolates those profiles linearly in time."""
+    lin = IO._coefficient_table({"mode": 0, "profile": "linear", "rows": [[0.0, 1.0, 3.0, 2.0, 3.0]]})
+    a, b, c = lin[0, 1:]
+    assert a == 0 and math.isclose(b * 2 + c, 1.0) and math.isclose(b * 3 + c, 3.0)
+    par = IO._coefficient_table({"mode": 0, "profile": "parabolic",
+                                 "rows": [[0.0, 0.0, 0.608, 3.0, 4.0, 4.5, 5.0]]})
+    f = lambda z: np.polyval(par[0, 1:], z)                              # noqa: E731
+    assert np.allclose([f(4.0), f(4.5), f(5.0)], [0.0, 0.608, 3.0])
+    spec = {"zones": [{"velocity": {"mode": 1, "profile": "uniform", "rows": [[0.0, 2.0], [2.0, 0.0], [4.5, 2.0]]},
+                       "zsurf": {"mode": None}, "refilling": 0, "inputtreatment": 2, "rhop": {"mode": 0},
+                       "layers": 2, "shape": {"kind": "line"}}]}
+    pts = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.1]])
+    io = IO.InOut(spec, {"gravity": [0, 0, -9.81], "cs0": 10.0, "rhop0": 1000.0, "gamma": 7.0}, 0.1, True,
+                  [(pts, np.array([1.0, 0.0, 0.0]))])
+    for t, v in ((0.0, 2.0), (1.0, 1.0), (3.25, 1.0), (9.0, 2.0)):
+        io.update_time(t)
+        assert math.isclose(IO.profile_velocity(io.coef, 0, 0.3), v)
+
+
+def test_zone_points_follow_dualsphysics():
+    """A <line> 0.9 m long at dp 0.2: 4 gaps of 0.2 m and 0.1 left (< 0.95 dp): 5 points 0.2 apart;
+    1.0 m: 6 points; a <box> 0.4 x 0.2 at dp 0.1: 5 x 3; a circle of radius 0.2 at dp 0.1: rings of
+    1, 6 and 13 points; the plane dp/2 in front of the points."""
+    line = {"kind": "line", "point": [0, 0, 0], "point2": [0, 0, 0.9], "direction": [1.0, 0, 0]}
+    pts, n = IO.zone_points(line, 0.2, None)
+    assert len(pts) == 5 and np.allclose(np.diff(pts[:, 2]), 0.2) and np.allclose(n, [1, 0, 0])
+    line["point2"] = [0, 0, 1.0]
+    assert len(IO.zone_points(line, 0.2, None)[0]) == 6
+    box = {"kind": "box", "point": [0, 0, 0], "size": [0.4, 0, 0.2], "direction": [0, 1.0, 0]}
+    assert len(IO.zone_points(box, 0.1, None)[0]) == 15
+    circ = {"kind": "circle", "point": [0, 0, 0], "radius": 0.2, "direction": [0, 0, 1.0]}
+    pts, n = IO.zone_points(circ, 0.1, None)
+    assert len(pts) == 1 + 6 + 13 and np.allclose(pts[:, 2], 0.0)
+    rot = dict(line, rotation={"angle": math.radians(90), "p1": [0, 0, 0], "p2": [0, 1, 0]})
+    pts, n = IO.zone_points(rot, 0.2, None)
+    assert np.allclose(n, [0, 0, -1], atol=1e-12) and np.allclose(pts[:, 2], 0.0, atol=1e-12)
+
+
+def test_advanced_refilling_fills_an_emptied_buffer(tmp_path):
+    """refilling 2: the columns of a buffer the flow leaves (velocity out of the fluid at an inlet-
+    outlet, here an outlet pulled backwards) are refilled from the back, each to L deep."""
+    zones = """
+                <inoutzone>
+                    <refilling value="2" /><inputtreatment value="1" /><layers value="4" />
+                    <zone2d><particles mkfluid="1" direction="right" /></zone2d>
+                    <imposevelocity mode="0"><velocity v="1.0" /></imposevelocity>
+                    <imposerhop mode="0" />
+                </inoutzone>""" + OUTLET.format(rout=2)
+    case = slab_case(tmp_path, inout=zones, tmax=0.1)
+    out = tmp_path / "out"
+    r = run(case, out)
+    assert r.exit_code == 0, r.output
+    last = last_step(out)
+    fluid = last["Type"] == 3
+    x = last["points"][fluid, 0]
+    # the inlet buffer still holds its 4 layers behind the plane at x = dp/2 (a refilled one each
+    # time the flow empties a column's back)
+    behind = x < 0.01
+    assert 4 * 11 - 11 <= int(behind.sum()) <= 4 * 11 + 11
+    assert np.abs(last["Vel"][fluid, 0] - 1.0).max() < 1e-6
+
+
+def test_resume_is_bitwise_with_inout(tmp_path):
+    """A run stopped at an output and resumed ends where the uninterrupted run ends (1 thread): the
+    buffers' ids, the next id and the counts are in restart.h5."""
+    case = slab_case(tmp_path, tmax=0.1)
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert run(case, a).exit_code == 0
+    assert run(case, b, "--tmax", "0.05").exit_code == 0
+    r = run(b, b, "--resume", "--tmax", "0.1")
+    assert r.exit_code == 0, r.output
+    la, lb = last_step(a), last_step(b)
+    order_a, order_b = np.argsort(la["Idp"]), np.argsort(lb["Idp"])
+    assert np.array_equal(la["Idp"][order_a], lb["Idp"][order_b])
+    assert np.array_equal(la["points"][order_a], lb["points"][order_b])
+    assert np.array_equal(la["Vel"][order_a], lb["Vel"][order_b])
+    import json
+    ia, ib = (json.loads((d / "run.json").read_text())["inout"] for d in (a, b))
+    assert ia == ib
+
+
+def test_measure_reads_the_particles_a_run_created(tmp_path):
+    """`sphdvi measure points` on a run whose inlet created particles (ids past the case's): they
+    take the fluid mass, and the gauge in the slab reads U and rho0."""
+    case = slab_case(tmp_path, tmax=0.1)
+    out = tmp_path / "out"
+    assert run(case, out).exit_code == 0
+    csv = tmp_path / "p.csv"
+    r = CliRunner().invoke(main, ["measure", "points", str(out), "--points", "0.05,0,0.1",
+                                  "--vars", "vel,rhop", "--csv", str(csv)])
+    assert r.exit_code == 0, r.output
+    rows = [ln.split(",") for ln in csv.read_text().splitlines() if ln and not ln.startswith("#")]
+    head, last = rows[0], rows[-1]
+    vals = dict(zip(head, last))
+    ux = next(v for k, v in vals.items() if "vel" in k.lower() and "x" in k.lower())
+    rho = next(v for k, v in vals.items() if "rho" in k.lower())
+    assert abs(float(ux) - 1.0) < 1e-6 and abs(float(rho) - 1000.0) < 1e-3
