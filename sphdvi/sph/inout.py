@@ -86,6 +86,9 @@ C_RHOP = 2
 C_VEL = 3
 C_REMOVE = 4
 NCFG = 5
+# a height within ZTOL dp above zsurf counts as below it: GenCase's lattice puts a row meant to be at
+# zsurf 4e-17 m above it, which DualSPHysics's float comparison (float(z) <= zsurf) rounds away
+ZTOL = 1e-6
 # actions of classify_kernel
 KEEP, TO_FLUID, TO_FLUID_REFILL, REMOVE = 0, 1, 2, 3
 TO_BUFFER = 4        # + zone index
@@ -135,7 +138,7 @@ def classify_kernel(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
         z = zone_of_idp[idp[i]]
         if z >= 0:
             d = plane_depth(geo, z, x, y, w)
-            above = w > zsurf[z]
+            above = w > zsurf[z] + ZTOL * dp
             if d < -geo[z, G_W] or (cfg[z, C_REMOVE] != 0 and above):
                 action[i] = REMOVE
             elif d >= 0.0:
@@ -146,7 +149,7 @@ def classify_kernel(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
             if cfg[k, C_INPUT] == 0 and cfg[k, C_REMOVE] == 0:
                 continue
             if in_zone(geo, k, x, y, w, dp):
-                if cfg[k, C_INPUT] == 2 or (cfg[k, C_REMOVE] != 0 and w > zsurf[k]):
+                if cfg[k, C_INPUT] == 2 or (cfg[k, C_REMOVE] != 0 and w > zsurf[k] + ZTOL * dp):
                     action[i] = REMOVE
                 elif cfg[k, C_INPUT] == 1:
                     action[i] = TO_BUFFER + k
@@ -296,7 +299,7 @@ def impose_kernel(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_o
             rho = hydrostatic_density(zsurf[z], w, rhop0, coef_hydro, inv_gamma)
         if vmode != 2:
             v = 0.0
-            if cfg[z, C_REFILL] == 0 or w <= zsurf[z]:
+            if cfg[z, C_REFILL] == 0 or w <= zsurf[z] + ZTOL * dp:
                 v = profile_velocity(coef, z, w)
             vel[o, 0] = v * geo[z, 0]
             vel[o, 1] = v * geo[z, 1]
@@ -341,7 +344,7 @@ def refill_columns(pts, ptzone, geo, zsurf, pos, ptype, idp, zone_of_idp, dp, de
     dp2 = dp * dp
     for k in range(npt):
         z = ptzone[k]
-        if pts[k, 2] > zsurf[z]:
+        if pts[k, 2] > zsurf[z] + ZTOL * dp:
             continue
         dmax = 0.0
         for i in range(pos.shape[0]):
@@ -564,7 +567,7 @@ class InOut:
                 c = self.coef[k]
                 v = (c[0] * w + c[1]) * w + c[2]
                 if self.cfg[k, C_REFILL] != 0:
-                    v = np.where(w <= self.zsurf[k], v, 0.0)
+                    v = np.where(w <= self.zsurf[k] + ZTOL * self.dp, v, 0.0)
                 vel[sel] = v[:, None] * self.geo[k, G_N:G_N + 3]
             if self.cfg[k, C_RHOP] == 1:
                 base = np.maximum(1.0 + self.coef_hydro * (self.zsurf[k] - w), 0.0)
@@ -655,7 +658,7 @@ def place_buffers(spec: dict, particles: dict, constants: dict, domain, extra: d
     for k, (z, (pts, nvec)) in enumerate(zip(zones, geom)):
         keep = np.ones(len(pts), bool)
         if z["refilling"] != 0 and z["zsurf"]["mode"] is not None:
-            keep = pts[:, 2] <= io.zsurf[k]
+            keep = pts[:, 2] <= io.zsurf[k] + ZTOL * dp
         rows = np.concatenate([pts[keep] - c * dp * nvec for c in range(z["layers"])])
         lo, hi = domain
         bad = np.any((rows < lo) | (rows > hi), axis=1)
