@@ -10,7 +10,7 @@ plus dp/2 (a circle's radius plus dp/2); with ``useboxlimit`` the zone is that p
 
 Buffer particles are fluid particles (ptype 3) marked by their id (:attr:`InOut.zone_of_idp`).  The
 fluid sees them as fluid; their own velocity and density are imposed at the start of each step
-(:func:`impose_kernel`), their accelerations and density rates are zeroed (:func:`zero_rates`), so
+(:func:`impose_serial`), their accelerations and density rates are zeroed (:func:`zero_rates_serial`), so
 they move r += v dt with the imposed velocity:
 
 * velocity along n: fixed (uniform, linear v = m z + b, parabolic a z^2 + b z + c through three
@@ -34,7 +34,7 @@ DualSPHysics leaves it out (``rr2 >= ALMOSTZERO``), which on a regular lattice, 
 half-way between rows and every ghost node falls on a fluid particle, drops the nearest neighbour of
 every buffer particle from its Shepard average.
 
-At the end of each step (:func:`classify_kernel`, JSphInOut::ComputeStepCpu):
+At the end of each step (:func:`classify_serial`, JSphInOut::ComputeStepCpu):
 
 * a buffer particle that crossed the plane (d >= 0) becomes ordinary fluid; with refilling 0, or
   1 and z <= zsurf, a new buffer particle takes its place at r - L n (refilling 2, DualSPHysics's
@@ -61,6 +61,7 @@ import math
 import numpy as np
 
 from . import _env  # noqa: F401
+from ._env import CHUNK
 from numba import njit, prange
 
 from .interaction import _pack_row
@@ -89,7 +90,7 @@ NCFG = 5
 # a height within ZTOL dp above zsurf counts as below it: GenCase's lattice puts a row meant to be at
 # zsurf 4e-17 m above it, which DualSPHysics's float comparison (float(z) <= zsurf) rounds away
 ZTOL = 1e-6
-# actions of classify_kernel
+# actions of classify_serial
 KEEP, TO_FLUID, TO_FLUID_REFILL, REMOVE = 0, 1, 2, 3
 TO_BUFFER = 4        # + zone index
 
@@ -126,11 +127,10 @@ def in_zone(geo, z, x, y, w, dp):
     return d >= -(geo[z, G_W] + 0.5 * dp) and in_lateral(geo, z, x, y, w)
 
 
-@njit(cache=True, parallel=True)
-def classify_kernel(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
-    """The end-of-step actions (module docstring) of every particle into ``action``."""
+@njit(cache=True)
+def _classify_range(i0, i1, pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
     nz = geo.shape[0]
-    for i in prange(pos.shape[0]):
+    for i in range(i0, i1):
         action[i] = KEEP
         if ptype[i] != 3:
             continue
@@ -156,12 +156,25 @@ def classify_kernel(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
                 break
 
 
+@njit(cache=True)
+def classify_serial(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
+    """The end-of-step actions (module docstring) of every particle into ``action``."""
+    _classify_range(0, pos.shape[0], pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action)
+
+
 @njit(cache=True, parallel=True)
-def zero_rates(ptype, idp, zone_of_idp, ace, ar, shiftpos):
-    """Buffer particles take no acceleration, density rate or shift: they move with the velocity
-    imposed on them (``shiftpos`` of one row: no shifting in the run)."""
+def classify_parallel(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
+    """Threaded :func:`classify_serial`."""
+    n = pos.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _classify_range(c * CHUNK, min(n, (c + 1) * CHUNK), pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp,
+                        action)
+
+
+@njit(cache=True)
+def _zero_rates_range(i0, i1, ptype, idp, zone_of_idp, ace, ar, shiftpos):
     shift = shiftpos.shape[0] == ptype.shape[0]
-    for i in prange(ptype.shape[0]):
+    for i in range(i0, i1):
         if ptype[i] == 3 and zone_of_idp[idp[i]] >= 0:
             ace[i, 0] = 0.0
             ace[i, 1] = 0.0
@@ -171,6 +184,21 @@ def zero_rates(ptype, idp, zone_of_idp, ace, ar, shiftpos):
                 shiftpos[i, 0] = 0.0
                 shiftpos[i, 1] = 0.0
                 shiftpos[i, 2] = 0.0
+
+
+@njit(cache=True)
+def zero_rates_serial(ptype, idp, zone_of_idp, ace, ar, shiftpos):
+    """Buffer particles take no acceleration, density rate or shift: they move with the velocity
+    imposed on them (``shiftpos`` of one row: no shifting in the run)."""
+    _zero_rates_range(0, ptype.shape[0], ptype, idp, zone_of_idp, ace, ar, shiftpos)
+
+
+@njit(cache=True, parallel=True)
+def zero_rates_parallel(ptype, idp, zone_of_idp, ace, ar, shiftpos):
+    """Threaded :func:`zero_rates_serial`."""
+    n = ptype.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _zero_rates_range(c * CHUNK, min(n, (c + 1) * CHUNK), ptype, idp, zone_of_idp, ace, ar, shiftpos)
 
 
 @njit(cache=True)
@@ -271,18 +299,18 @@ def _extrapolate(kern, is2d, nb, ptype_s, oi, idp, zone_of_idp, cell_start, pmin
     return True
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def impose_kernel(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
-                  inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro,
-                  vel_m1, rhop_m1, dp):
-    """Impose the velocity and density of every buffer particle (packed row k, particle oi[k]):
-    the state rows, the packed rows (so the coming interaction sees them) and, for Verlet,
-    the previous-step values ``vel_m1``/``rhop_m1`` (zero rows: Symplectic)."""
-    n = nb.shape[0]
+@njit(cache=True, error_model="numpy")
+def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
+                  inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro, vel_m1, rhop_m1,
+                  dp):
+    """:func:`impose_serial` over the packed rows k0 <= k < k1 (work arrays once per range)."""
     verlet = vel_m1.shape[0] == pos.shape[0]
     rhop0 = cst[10]
     inv_gamma = cst[11]
-    for k in prange(n):
+    a = np.empty((4, 4))
+    b = np.empty((4, 4))
+    out = np.empty(4)
+    for k in range(k0, k1):
         if ptype_s[k] != 3:
             continue
         o = oi[k]
@@ -305,9 +333,6 @@ def impose_kernel(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_o
             vel[o, 1] = v * geo[z, 1]
             vel[o, 2] = v * geo[z, 2]
         if rmode == 2 or vmode == 2:
-            a = np.empty((4, 4))
-            b = np.empty((4, 4))
-            out = np.empty(4)
             d = -plane_depth(geo, z, x, y, w)        # > 0 behind the plane
             if d < 0.0:
                 d = 0.0
@@ -329,6 +354,29 @@ def impose_kernel(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_o
             vel_m1[o, 2] = vel[o, 2]
             rhop_m1[o] = rho
         _pack_row(k, o, is2d, pos, vel, rhop, mass, cst, nb)
+
+
+@njit(cache=True, error_model="numpy")
+def impose_serial(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
+                  inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro, vel_m1, rhop_m1, dp):
+    """Impose the velocity and density of every buffer particle (packed row k, particle oi[k]):
+    the state rows, the packed rows (so the coming interaction sees them) and, for Verlet,
+    the previous-step values ``vel_m1``/``rhop_m1`` (zero rows: Symplectic)."""
+    _impose_range(0, nb.shape[0], kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp,
+                  cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro,
+                  vel_m1, rhop_m1, dp)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def impose_parallel(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
+                    inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro, vel_m1, rhop_m1,
+                    dp):
+    """Threaded :func:`impose_serial` (``CHUNK`` rows a work item)."""
+    n = nb.shape[0]
+    for c in prange((n + CHUNK - 1) // CHUNK):
+        _impose_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp,
+                      zone_of_idp, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf,
+                      determlimit, coef_hydro, vel_m1, rhop_m1, dp)
 
 
 @njit(cache=True)

@@ -1062,26 +1062,28 @@ class SPHSolver:
     # ------------------------------------------------------------------ inlet/outlet
     def _inout_impose(self, ptype_rows, oi):
         """The buffer particles' imposed or extrapolated velocity and density, into the state
-        and the packed rows, before the interaction (sphdvi.sph.inout.impose_kernel)."""
-        from .inout import impose_kernel
+        and the packed rows, before the interaction (sphdvi.sph.inout.impose_serial)."""
+        from .inout import impose_parallel, impose_serial
         io = self.inout
         s = self.state
         io.update_time(self.time, s)
         verlet = self.step_algorithm == 1
         ncx, ncy, ncz = self.cells.shape
-        impose_kernel(self.kernel, self.is2d, self.nb, ptype_rows, oi, s.pos, s.vel, s.rhop, s.mass, s.idp,
-                      io.zone_of_idp, self.cells.cell_start, self.cells.pmin, 1.0 / self.cells.cellsize,
-                      ncx, ncy, ncz, self.cst, io.geo, io.cfg, io.coef, io.zsurf, io.determlimit, io.coef_hydro,
-                      self.vel_m1 if verlet else self._no_m1[0], self.rhop_m1 if verlet else self._no_m1[1],
-                      self.dp)
+        # not a light kernel: the extrapolation sums a kernel's worth of fluid per buffer particle
+        fn = impose_parallel if self._use_parallel() else impose_serial
+        fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, s.pos, s.vel, s.rhop, s.mass, s.idp, io.zone_of_idp,
+           self.cells.cell_start, self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, io.geo,
+           io.cfg, io.coef, io.zsurf, io.determlimit, io.coef_hydro,
+           self.vel_m1 if verlet else self._no_m1[0], self.rhop_m1 if verlet else self._no_m1[1], self.dp)
 
     _no_m1 = (np.zeros((0, 3)), np.zeros(0))
 
     def _inout_zero_rates(self):
         """Buffer particles take no acceleration, density rate or shift; the force term of dt is
         taken again without them (as after the imposed accelerations)."""
-        from .inout import zero_rates
+        from .inout import zero_rates_parallel, zero_rates_serial
         s = self.state
+        zero_rates = zero_rates_parallel if self._use_parallel(light=True) else zero_rates_serial
         zero_rates(s.ptype, s.idp, self.inout.zone_of_idp, self.ace, self.ar, self.shiftpos)
         self.dtmax[:, 0] = 0.0
         self.dtmax[0, 0] = fluid_ace_max2(self.ace, s.ptype, *self.gravity)
@@ -1089,15 +1091,16 @@ class SPHSolver:
     def _inout_update(self):
         """End of step: buffer particles that crossed their plane become fluid (a new one taking
         each one's place behind), those that left the buffer's back are removed, fluid entering a
-        zone is converted or removed (sphdvi.sph.inout.classify_kernel); advanced refilling fills
+        zone is converted or removed (sphdvi.sph.inout.classify_serial); advanced refilling fills
         the columns the flow emptied."""
-        from .inout import (REMOVE, TO_BUFFER, TO_FLUID, TO_FLUID_REFILL, G_N, G_W, classify_kernel,
+        from .inout import (REMOVE, TO_BUFFER, TO_FLUID, TO_FLUID_REFILL, G_N, G_W, classify_parallel, classify_serial,
                             refill_columns)
         io = self.inout
         s = self.state
         self._check_state_arrays()
         action = np.empty(s.n, np.int8)
-        classify_kernel(s.pos, s.ptype, s.idp, io.zone_of_idp, io.geo, io.cfg, io.zsurf, self.dp, action)
+        classify = classify_parallel if self._use_parallel() else classify_serial
+        classify(s.pos, s.ptype, s.idp, io.zone_of_idp, io.geo, io.cfg, io.zsurf, self.dp, action)
         moved = np.flatnonzero(action != 0)
         new_pos = new_src = new_zone = None
         if moved.size:
