@@ -380,33 +380,66 @@ def impose_parallel(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone
 
 
 @njit(cache=True)
-def refill_columns(pts, ptzone, geo, zsurf, pos, ptype, idp, zone_of_idp, dp, depth_out):
+def _lateral_bin(geo, z, x, y, w, dp):
+    """The (i1, i2) cell of dp x dp of a point's lateral coordinates in zone z's frame."""
+    dx = x - geo[z, G_C]
+    dy = y - geo[z, G_C + 1]
+    dz = w - geo[z, G_C + 2]
+    a1 = dx * geo[z, G_T1] + dy * geo[z, G_T1 + 1] + dz * geo[z, G_T1 + 2]
+    a2 = dx * geo[z, G_T2] + dy * geo[z, G_T2 + 1] + dz * geo[z, G_T2 + 2]
+    return int(math.floor(a1 / dp)), int(math.floor(a2 / dp))
+
+
+@njit(cache=True)
+def refill_columns(pts, ptzone, geo, zsurf, pos, rows, rowzone, dp, depth_out):
     """Advanced refilling (refilling 2, JSphInOut::ComputeStepFillingCpu): for each lattice point
     of the plane below zsurf, the depth behind the plane where its column of buffer particles
-    ends: the deepest buffer particle whose projection lies within dp of the point, plus the
-    rest of dp along n (sqrt(dp^2 - s^2), s its lateral distance); dp without one.  A new buffer
-    particle goes there when it is less than L deep (``depth_out`` -1 otherwise)."""
+    ends: the deepest buffer particle (``rows`` of zones ``rowzone``) whose projection lies within
+    dp of the point, plus the rest of dp along n (sqrt(dp^2 - s^2), s its lateral distance); dp
+    without one.  A new buffer particle goes there when it is less than L deep (``depth_out`` -1
+    otherwise).  The buffer particles are binned by their lateral position (cells of dp), so each
+    point looks at the 3 x 3 cells around its own."""
     npt = pts.shape[0]
+    m = rows.shape[0]
     for k in range(npt):
         depth_out[k] = -1.0
+    # bin the buffer particles: key (zone, i1, i2) sorted
+    key1 = np.empty(m, np.int64)
+    key2 = np.empty(m, np.int64)
+    for r in range(m):
+        i = rows[r]
+        b1, b2 = _lateral_bin(geo, rowzone[r], pos[i, 0], pos[i, 1], pos[i, 2], dp)
+        key1[r] = b1
+        key2[r] = b2
+    order = np.argsort(rowzone * 4000000000 + (key1 + 1000000) * 2000000 + (key2 + 1000000)) if m else \
+        np.empty(0, np.int64)
+    skey = np.empty(m, np.int64)
+    for r in range(m):
+        o = order[r]
+        skey[r] = rowzone[o] * 4000000000 + (key1[o] + 1000000) * 2000000 + (key2[o] + 1000000)
     dp2 = dp * dp
     for k in range(npt):
         z = ptzone[k]
         if pts[k, 2] > zsurf[z] + ZTOL * dp:
             continue
+        p1, p2 = _lateral_bin(geo, z, pts[k, 0], pts[k, 1], pts[k, 2], dp)
         dmax = 0.0
-        for i in range(pos.shape[0]):
-            if ptype[i] != 3 or zone_of_idp[idp[i]] != z:
-                continue
-            d = -plane_depth(geo, z, pos[i, 0], pos[i, 1], pos[i, 2])
-            sx = pos[i, 0] + d * geo[z, 0] - pts[k, 0]
-            sy = pos[i, 1] + d * geo[z, 1] - pts[k, 1]
-            sz = pos[i, 2] + d * geo[z, 2] - pts[k, 2]
-            s2 = sx * sx + sy * sy + sz * sz
-            if s2 < dp2:
-                e = d + math.sqrt(dp2 - s2)
-                if e > dmax:
-                    dmax = e
+        for c1 in range(p1 - 1, p1 + 2):
+            for c2 in range(p2 - 1, p2 + 2):
+                want = z * 4000000000 + (c1 + 1000000) * 2000000 + (c2 + 1000000)
+                r = np.searchsorted(skey, want)
+                while r < m and skey[r] == want:
+                    i = rows[order[r]]
+                    d = -plane_depth(geo, z, pos[i, 0], pos[i, 1], pos[i, 2])
+                    sx = pos[i, 0] + d * geo[z, 0] - pts[k, 0]
+                    sy = pos[i, 1] + d * geo[z, 1] - pts[k, 1]
+                    sz = pos[i, 2] + d * geo[z, 2] - pts[k, 2]
+                    s2 = sx * sx + sy * sy + sz * sz
+                    if s2 < dp2:
+                        e = d + math.sqrt(dp2 - s2)
+                        if e > dmax:
+                            dmax = e
+                    r += 1
         if dmax == 0.0:
             dmax = dp
         if dmax < geo[z, G_W]:
@@ -518,6 +551,7 @@ class InOut:
                                       or [np.zeros((0, 3))])
         self.pts_zone = np.concatenate([np.full(len(p), k, np.int64) for k, p in enumerate(self.points)
                                         if self.cfg[k, C_REFILL] == 2] or [np.zeros(0, np.int64)])
+        self.refill2 = self.cfg[:, C_REFILL] == 2
         self.zone_of_idp = np.zeros(0, np.int8)
         self.next_idp = 0
         self.counts = {"created": 0, "removed": 0, "to_fluid": 0, "to_buffer": 0}

@@ -1120,7 +1120,9 @@ class SPHSolver:
                 io.counts["to_buffer"] += int(np.count_nonzero(conv))
         if io.pts_all.shape[0]:
             depth = np.empty(io.pts_all.shape[0])
-            refill_columns(io.pts_all, io.pts_zone, io.geo, io.zsurf, s.pos, s.ptype, s.idp, io.zone_of_idp,
+            zrow = io.zone_of_idp[s.idp]
+            rows = np.flatnonzero((s.ptype == FLUID) & (zrow >= 0) & io.refill2[np.maximum(zrow, 0)])
+            refill_columns(io.pts_all, io.pts_zone, io.geo, io.zsurf, s.pos, rows, zrow[rows].astype(np.int64),
                            self.dp, depth)
             ok = np.flatnonzero(depth >= 0)
             if ok.size:

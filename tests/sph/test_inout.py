@@ -357,3 +357,27 @@ def test_a_3d_block_moves_exactly_through_its_zones(tmp_path, inlet):
     info = json.loads((out / "run.json").read_text())
     cols = math.floor(info["physical_time"] / 0.02 + 1e-9)
     assert info["inout"]["created"] == info["inout"]["removed"] == 36 * cols      # 6 x 6 per column
+
+
+def test_refill_columns_fills_each_column_from_its_back():
+    """JSphInOut::ComputeStepFillingCpu's rule: a point's column ends at its deepest buffer particle
+    within dp (laterally) plus sqrt(dp^2 - s^2); a new particle goes there while that is less than
+    L deep; an empty column gets one at dp; a point above zsurf gets none."""
+    dp, layers = 0.1, 4
+    spec = {"zones": [{"velocity": {"mode": 2}, "zsurf": {"mode": 0, "rows": [[0.0, 0.55]]}, "refilling": 2,
+                       "inputtreatment": 1, "rhop": {"mode": 0}, "layers": layers, "shape": {"kind": "line"}}]}
+    pts = np.array([[0.0, 0.0, 0.1 * k] for k in range(7)])          # x = 0, z = 0 ... 0.6
+    io = IO.InOut(spec, {"gravity": [0, 0, -9.81], "cs0": 10.0, "rhop0": 1000.0, "gamma": 7.0}, dp, True,
+                  [(pts, np.array([1.0, 0.0, 0.0]))])
+    io.update_time(0.0)
+    # the plane is at x = dp/2, so rows at x = 0, -0.1, -0.2, -0.3 are 0.05, 0.15, 0.25, 0.35 deep.
+    # column z=0: full; z=0.2: two rows and a third 0.06 off to the side; z=0.4: empty
+    pos = [[-0.1 * c, 0, 0.0] for c in range(4)] + [[-0.1 * c, 0, 0.2] for c in range(2)] + [[-0.2, 0, 0.26]]
+    pos = np.array(pos, float)
+    depth = np.empty(len(io.pts_all))
+    IO.refill_columns(io.pts_all, io.pts_zone, io.geo, io.zsurf, pos, np.arange(len(pos)),
+                      np.zeros(len(pos), np.int64), dp, depth)
+    assert depth[0] == -1.0                                   # full: 0.35 + 0.1 = 0.45 > L = 0.4
+    assert math.isclose(depth[2], 0.25 + math.sqrt(0.01 - 0.06 ** 2))
+    assert math.isclose(depth[4], 0.1)                         # empty: dp
+    assert depth[6] == -1.0                                   # above zsurf 0.55
