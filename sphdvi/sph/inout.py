@@ -46,7 +46,7 @@ At the end of each step (:func:`classify_serial`, JSphInOut::ComputeStepCpu):
   particle (an outlet), 2 removes it (an inlet); with ``remove`` one above zsurf is removed.
 
 zsurf: fixed, variable (rows in time), or calculated (mode 2): the free surface measured on the
-vertical line through the zone's centre 2h in front of the plane (the ``swl`` gauge's kernel-sum
+vertical line through the centre of the zone's points, 2h in front of them (the ``swl`` gauge's kernel-sum
 rule, :class:`sphdvi.sph.surface_gauge.VerticalSurfaceGauge`), from ``zsurfmin`` up, plus the fit
 (-dp/2 by default), as JSphInOutZsurf's gauge.
 
@@ -619,14 +619,15 @@ class InOut:
         return level + shift if math.isfinite(level) else self.zsurf[k]
 
     def add_gauges(self, h: float, kernel: int, top: float) -> None:
-        """zsurf mode 2: a vertical gauge 2h in front of each such zone's centre."""
+        """zsurf mode 2: a vertical gauge 2h in front of the centre of each such zone's points
+        (JSphInOutZsurf::ComputeZsurfLine: from ``zsurfmin`` (the points' lowest) to the top)."""
         from .surface_gauge import VerticalSurfaceGauge
         for k, zone in enumerate(self.spec["zones"]):
             zs = zone["zsurf"]
             if zs["mode"] != 2:
                 continue
             geo = self.geo[k]
-            pts = self.points[k]
+            pts = self.points[k] - 0.5 * self.dp * geo[G_N:G_N + 3]       # the zone's points (its first row)
             n = geo[G_N:G_N + 3]
             if abs(n[2]) > 1e-4:
                 raise InOutError(f"inout zone {k}: a calculated zsurf (<imposezsurf mode=\"2\">) needs a horizontal "

@@ -381,3 +381,27 @@ def test_refill_columns_fills_each_column_from_its_back():
     assert math.isclose(depth[2], 0.25 + math.sqrt(0.01 - 0.06 ** 2))
     assert math.isclose(depth[4], 0.1)                         # empty: dp
     assert depth[6] == -1.0                                   # above zsurf 0.55
+
+
+def test_calculated_zsurf_follows_the_water(tmp_path):
+    """imposezsurf mode 2: the level measured 2h in front of the zone's centre by the swl rule, less
+    dp/2 (the default zsurffit), or less a given zsurffit value."""
+    import os
+    tank = os.path.join(os.path.dirname(__file__), "..", "..", "cases", "inout2d", "CaseFlowTank2D_Def.xml")
+    text = open(tank).read()
+    i = text.index('<particles mkfluid="2"')
+    j = text.index("</inoutzone>", i)
+    outlet = text[i:j].replace('<imposezsurf mode="0"><zsurf value="0.31" /></imposezsurf>',
+                               '<imposezsurf mode="2"><zsurffit value="0.004" /></imposezsurf>')
+    text = text[:i] + outlet + text[j:]
+    case = tmp_path / "CaseTank_Def.xml"
+    case.write_text(text)
+    sph = solver_of(tmp_path, case)
+    sol = sph.solver
+    sol.compute_rates()
+    io = sol.inout
+    g, x, y = io.gauges[1]
+    assert math.isclose(x, 1.0 - 2 * sol.h, abs_tol=1e-9)        # 2h in front of the outlet's points (x = 1.0)
+    level = g.level(sol.state, x, y)
+    assert 0.30 < level < 0.32                                   # the top row at 0.30 (the swl rule: ~0.31)
+    assert math.isclose(io.zsurf[1], level - 0.004, rel_tol=1e-12)
