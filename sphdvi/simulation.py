@@ -306,7 +306,9 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
     out_times = output_schedule(data, params, tout)
     threads = _usable_threads(threads)
     nfluid = int(np.count_nonzero(data["particles"]["type"] == 3))
-    if nfluid:
+    # inlet/outlet zones bring fluid of their own: such a case is an SPH run even with none drawn
+    sph_run = nfluid > 0 or bool((data["json"].get("special") or {}).get("inout"))
+    if sph_run:
         _check_dtfixed(float(params.get("DtFixed") or 0.0), params)
     if not resume:
         check_new_run_folder(outdir, overwrite)
@@ -320,14 +322,14 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
         files.on_start = set_aside.discard     # the new run's start-up passed its checks
     base_meta = {
         "version": __version__, "case": data["casename"], "case_file": os.path.abspath(case_h5),
-        **resolved_parameters(params, data["constants"], nfluid > 0),
+        **resolved_parameters(params, data["constants"], sph_run),
         "overrides": {"tmax": tmax, "tout": tout, "set": list(sets or ())},
         "threads": threads, "particles": int(data["particles"]["type"].size),
         "fluid_particles": nfluid, "python": sys.version.split()[0], "numpy": np.__version__,
     }
     with restored_on_bad_input(set_aside), \
             (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
-        if nfluid == 0:
+        if not sph_run:
             return _run_bodies_only(data, params, out_times, outdir, files, base_meta, t_start, quiet, resume, stop)
         return _run_sph(data, params, out_times, outdir, files, base_meta, threads, resume, quiet, t_start, stop)
 
@@ -873,10 +875,10 @@ class SPHRun:
                              "(expected a case without the *Periodic* parameters)")
         try:
             p, extra, self.inout, notes = place_buffers(spec, data["particles"], c, domain,
-                                                        {"normals": data.get("normals")})
+                                                        {"normals": data.get("normals")},
+                                                        kernel=int(self.params.get("Kernel", 2)))
         except InOutError as exc:
             raise InputError(f"<special><inout>: {exc}") from None
-        self.inout.add_gauges(float(c["h"]), int(self.params.get("Kernel", 2)), float(domain[1][2]))
         data["particles"] = p
         if extra.get("normals") is not None:
             data["normals"] = extra["normals"]

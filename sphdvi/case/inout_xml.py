@@ -231,7 +231,13 @@ def _read_velocity(reader, el) -> dict:
             raise reader.error(flow, "<flowvelocity active=\"true\"> (a flow rate instead of a velocity) is not "
                                      "supported by sphdvi", "a velocity in m/s")
     if mode == 2:
-        reader.check_children(el, {"flowvelocity"})
+        for c in reader.children(el):
+            if c.tag != "flowvelocity" and not c.tag.startswith("_"):
+                # DualSPHysics v5 reads no child in mode 2 and ignores any (examples/inletoutlet/03_ReverseFlow
+                # keeps a <velocity> there)
+                reader.warn(c, f"<{c.tag}> is ignored: <imposevelocity mode=\"2\"> extrapolates the velocity")
+                for a in c.keys():
+                    reader.mark(c, a)
         return {"mode": 2}
     if mode == 0:
         reader.check_children(el, {"velocity", "velocity2", "velocity3", "jetcircle", "flowvelocity"})

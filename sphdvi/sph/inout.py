@@ -616,7 +616,10 @@ class InOut:
         level = g.level(state, x, y)
         fit = zs["fit"]
         shift = -float(fit["value"]) if "value" in fit else -float(fit["valuedp"]) * self.dp
-        return level + shift if math.isfinite(level) else self.zsurf[k]
+        if math.isfinite(level):
+            return level + shift
+        # no water at the gauge: the level stays; before any measurement, the gauge's bottom
+        return self.zsurf[k] if math.isfinite(self.zsurf[k]) else g.zmin
 
     def add_gauges(self, h: float, kernel: int, top: float) -> None:
         """zsurf mode 2: a vertical gauge 2h in front of the centre of each such zone's points
@@ -711,7 +714,8 @@ def _coefficient_table(vel: dict):
     return np.asarray(out, float)
 
 
-def place_buffers(spec: dict, particles: dict, constants: dict, domain, extra: dict | None = None):
+def place_buffers(spec: dict, particles: dict, constants: dict, domain, extra: dict | None = None, *,
+                  kernel: int = 2):
     """The run's initial particles with the inlet/outlet buffers in place (module docstring) and
     the :class:`InOut` that follows them.  ``particles``: the case's arrays (pos, vel, rhop, mass,
     type, mk, idp); ``extra``: other per-particle arrays to keep aligned (new rows zero).
@@ -721,7 +725,10 @@ def place_buffers(spec: dict, particles: dict, constants: dict, domain, extra: d
     zones = spec["zones"]
     geom = [zone_points(z["shape"], dp, particles) for z in zones]
     io = InOut(spec, constants, dp, is2d, geom)
-    io.update_time(0.0)
+    io.add_gauges(float(constants["h"]), kernel, float(domain[1][2]))
+    # a calculated zsurf starts from the level the case's water has at its gauge (JSphInOutZsurf: the
+    # gauge's first measurement, before the zones' particles are placed)
+    io.update_time(0.0, _ParticleView(particles))
     n = particles["pos"].shape[0]
     pos = np.asarray(particles["pos"], float)
     ptype = np.asarray(particles["type"])
@@ -778,6 +785,16 @@ def place_buffers(spec: dict, particles: dict, constants: dict, domain, extra: d
     notes = [f"inout: {len(zones)} zone(s), {m} buffer particles placed"
              + (f", {int(drop.sum())} fluid particles replaced or removed from the zones" if drop.any() else "")]
     return out, ext, io, notes
+
+
+class _ParticleView:
+    """The case's particle arrays as the surface gauge reads a state (pos, mass, rhop, ptype)."""
+
+    def __init__(self, p: dict):
+        self.pos = np.ascontiguousarray(p["pos"], float)
+        self.mass = np.ascontiguousarray(p["mass"], float)
+        self.rhop = np.ascontiguousarray(p["rhop"], float)
+        self.ptype = np.ascontiguousarray(p["type"], np.int8)
 
 
 def _in_zone_rows(geo, k, pos, dp):

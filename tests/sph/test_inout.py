@@ -405,3 +405,55 @@ def test_calculated_zsurf_follows_the_water(tmp_path):
     level = g.level(sol.state, x, y)
     assert 0.30 < level < 0.32                                   # the top row at 0.30 (the swl rule: ~0.31)
     assert math.isclose(io.zsurf[1], level - 0.004, rel_tol=1e-12)
+
+
+def test_a_case_whose_only_water_comes_from_an_inlet_runs(tmp_path):
+    """No fluid drawn (DualSPHysics's examples/inletoutlet/05_ShapesInlet3D): the zones make the
+    run an SPH run, and the inlet fills the domain."""
+    zones = INLET.format(u=1.0, rin=0, refill=0).replace(
+        '<particles mkfluid="1" direction="right" />',
+        '<line><point x="0" z="0.2" /><point2 x="0" z="0" /></line>')
+    case = slab_case(tmp_path, inout=zones, tmax=0.06, commands="""
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="-0.1" y="-1" z="-0.06" /><size x="0.8" y="2" z="0.04" />
+                    </drawbox>""")
+    out = tmp_path / "out"
+    r = run(case, out)
+    assert r.exit_code == 0, r.output
+    last = last_step(out)
+    fl = last["Type"] == 3
+    import json
+    info = json.loads((out / "run.json").read_text())
+    assert info["inout"]["created"] >= 11 * 2 and int(fl.sum()) == 4 * 11 + info["inout"]["created"]
+    assert np.all(last["points"][fl, 0] < 0.06 + 1.0 * 0.06)
+
+
+def test_imposevelocity_mode_2_ignores_a_velocity_child(tmp_path):
+    """DualSPHysics reads no child of an extrapolated velocity (examples/inletoutlet/03_ReverseFlow
+    keeps a <velocity v> there): read, warned as ignored."""
+    zones = INLET.format(u=1.0, rin=0, refill=0) + OUTLET.format(rout=2).replace(
+        '<imposevelocity mode="2" />', '<imposevelocity mode="2"><velocity v="0.5" /></imposevelocity>')
+    case = slab_case(tmp_path, inout=zones)
+    r = CliRunner().invoke(main, ["gencase", str(case), "-o", str(tmp_path / "g")])
+    assert r.exit_code == 0, r.output
+    assert "<velocity> is ignored" in r.output
+
+
+def test_calculated_zsurf_is_measured_before_the_first_output(tmp_path):
+    """A hydrostatic buffer under a calculated zsurf starts from the level measured in the case's
+    water (it was infinite until the first step); its layers only below it."""
+    import os
+    tank = os.path.join(os.path.dirname(__file__), "..", "..", "cases", "inout2d", "CaseFlowTank2D_Def.xml")
+    text = open(tank).read()
+    i = text.index('<particles mkfluid="2"')
+    j = text.index("</inoutzone>", i)
+    outlet = text[i:j].replace('<imposezsurf mode="0"><zsurf value="0.31" /></imposezsurf>',
+                               '<imposezsurf mode="2" />')
+    case = tmp_path / "CaseTank_Def.xml"
+    case.write_text(text[:i] + outlet + text[j:])
+    sph = solver_of(tmp_path, case)
+    io = sph.inout
+    assert 0.29 < io.zsurf[1] < 0.32
+    s = sph.solver.state
+    buf = io.zone_of_idp[s.idp] == 1
+    assert np.isfinite(s.rhop[buf]).all() and s.pos[buf, 2].max() <= io.zsurf[1]
