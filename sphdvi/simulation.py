@@ -840,10 +840,11 @@ class SPHRun:
             from .case.datafiles import read_visco_table
             visco_table = read_visco_table(str(params["ViscoTime"]))
         from .sph.accinput import acc_inputs
+        bound_corr = self._bound_corr(js.get("special", {}).get("boundcorr"), p, c, fluidcount)
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table,
                                 acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")),
-                                shift_zones=shift_zones(data), inout=self.inout)
+                                shift_zones=shift_zones(data), inout=self.inout, bound_corr=bound_corr)
         if self.floating is not None:       # Symplectic: the bodies at the half step for the corrector
             self.solver.half_step_hook = self.floating.predict
         for absorber in self.absorbers:
@@ -863,6 +864,21 @@ class SPHRun:
         self.dtmin_warn_at = 1          # the next count of DtMin steps warned about (1, 10, 100, ...)
         self.step_warnings = []         # lines for run.log (and stderr) found by check()
         self.out_faces = set()          # faces of the domain that fluid excluded for its position crossed
+
+    def _bound_corr(self, spec, p: dict, c: dict, fluidcount: int):
+        """``<special><boundcorr>``: (normals, determlimit) for the solver (sphdvi.sph.inout.boundcorr_normals),
+        or None.  With mDBC (Boundary=2) every wall is corrected already: warned and left out."""
+        if not spec:
+            return None
+        if int(self.params.get("Boundary", 1)) == 2:
+            warnings.warn("<special><boundcorr> is ignored: Boundary=2 (mDBC) corrects the density of every wall "
+                          "with a normal")
+            return None
+        from .coupling import body_labels
+        from .sph.inout import boundcorr_normals
+        labels = body_labels(np.asarray(p["mk"]), fluidcount)
+        normals = boundcorr_normals(spec, np.asarray(p["pos"], float), np.asarray(p["type"]), labels, float(c["dp"]))
+        return normals, float(spec.get("determlimit", 1e3))
 
     def _place_inout_buffers(self, spec: dict, data: dict, c: dict, domain, periodic):
         """``<special><inout>``: the buffers of the inlet/outlet zones put in place of the fluid in
@@ -991,6 +1007,31 @@ class SPHRun:
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: time step {sol.last_dt} is not valid")
         # the floating bodies' states were checked where they changed (FloatingBodies.step / predict:
         # bodychecks.BodyWatch), before their particles reached the fluid
+
+    def wall_density_warning(self) -> str:
+        """Once a run: a line when a fixed or moving boundary particle's density has passed RhopOutMax
+        (DualSPHysics excludes fluid there, never walls, so nothing else says it): the DBC wall past an
+        outlet's buffer, which compresses without end (``<boundcorr>`` or Boundary=2 correct it)."""
+        if getattr(self, "_wall_warned", False):
+            return ""
+        s = self.solver.state
+        limit = float(self.params.get("RhopOutMax", 1300.0))
+        walls = np.flatnonzero(s.ptype < 2)
+        if walls.size == 0:
+            return ""
+        k = walls[int(np.argmax(s.rhop[walls]))]
+        if not s.rhop[k] > limit:
+            return ""
+        self._wall_warned = True
+        from .coupling import body_labels
+        mkb = int(body_labels(s.mk[k:k + 1], int(self.data["json"]["mkconfig"]["fluidcount"]))[0])
+        n = int(np.count_nonzero(s.rhop[walls] > limit))
+        hint = ("walls behind an outlet's buffer see buffer particles approach and vanish: give them <boundcorr> "
+                "(as DualSPHysics's inlet/outlet examples do) or use Boundary=2" if self.inout is not None else
+                "check the time step and the flow against that wall, or use Boundary=2 (mDBC)")
+        return (f"t={self.solver.time:.6g} s: {n} boundary particle{'s' if n > 1 else ''} past RhopOutMax "
+                f"({limit:g} kg/m3), the densest mkbound {mkb} particle {int(s.idp[k])} at {fmt_vec(s.pos[k])} "
+                f"with {float(s.rhop[k]):.6g} kg/m3; {hint}")
 
     @staticmethod
     def _last_excluded(events: list) -> str:
@@ -1452,7 +1493,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         files.log(f"Part {k:04d}  t={sol.time:.6f} s  steps={sol.nstep}  particles={sol.state.n}  "
                   f"excluded={excl}  dt=[{dt_lo if dt_lo < math.inf else 0:.3g}, {dt_hi:.3g}] s  wall={wall:.2f} s"
                   + written + (inout_text(sol.inout) if sol.inout is not None else ""))
-        for line in excl_lines:
+        wall_line = sph.wall_density_warning()
+        for line in excl_lines + ([wall_line] if wall_line else []):
             files.log("WARNING: " + line)
             warnings.warn(line)
         for line in step_lines:

@@ -117,6 +117,8 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     check_case(case, particles, bodies, mkinfo, domain, reader)
     if case.special.get("inout"):
         check_inout(case.special["inout"], particles, consts.is2d, reader)
+    if case.special.get("boundcorr"):
+        check_boundcorr(case.special["boundcorr"], particles, reader)
     warn_gauges_outside(case.special.get("gauges"), domain, consts.is2d, reader)
     reader.warn_unread_attributes(root)
     return GenCaseResult(case=case, constants=consts, particles=particles, bodies=bodies, domain=domain,
@@ -688,6 +690,19 @@ def check_inout(spec: dict, particles, is2d: bool, reader) -> None:
             raise CaseError(f"inout zone {z['index']}: <particles mkfluid=\"{shape['mkfluid']}\">, which has no "
                             "particles", file=reader.file, line=shape["line"], element="particles",
                             expected="an mkfluid drawn by the geometry (a layer of fluid particles)")
+
+
+def check_boundcorr(spec: dict, particles, reader) -> None:
+    """Each <boundcorr> mkbound a fixed or moving boundary with particles (JSphBoundCorr::UpdateMkCode:
+    "MkBound value is not a Mk fixed boundary valid")."""
+    ptype, label = particles["type"], particles["label"]
+    for z in spec["zones"]:
+        for mk in z["mkbound"]:
+            sel = (ptype != TYPE_FLUID) & (label == mk)
+            if not sel.any() or np.any(ptype[sel] == 2):
+                what = "has no particles" if not sel.any() else "is a floating body"
+                raise CaseError(f"<boundcorr> mkzone mkbound {mk} {what}", file=reader.file, line=z["line"],
+                                element="mkzone", expected="the mkbound of a fixed or moving boundary")
 
 
 def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:

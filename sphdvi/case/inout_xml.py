@@ -359,3 +359,55 @@ def velocity_behaviour(vel: dict) -> str:
     if lo <= 0 and hi <= 0:
         return "outlet"
     return "reverse"
+
+
+BOUNDCORR_DIRECTIONS = DIRECTIONS
+
+
+def read_boundcorr(reader, el) -> dict:
+    """``<special><boundcorr>`` (DualSPHysics's JSphBoundCorr, "used in combination with InOut"):
+    the density of the listed fixed or moving walls extrapolated from the fluid at each particle's
+    ghost node mirrored through a limit plane (:func:`sphdvi.sph.inout.boundcorr_normals`).
+    ``<determlimit value>`` (1e+3, as JSphBoundCorr::ReadXml's default: zeroth order; 1e-3 first
+    order), ``<extrapolatemode>`` accepted, no effect; each ``<mkzone mkbound>`` (a list of values
+    and ranges) with ``<autoconfig direction>`` (the plane dp/2 beyond the mk's particles on that
+    side), ``<limitpoint>`` + ``<direction>``, or ``<autolimitpoint dpfactor>`` + ``<direction>`` (the
+    plane dpfactor dp beyond the particle furthest along the direction)."""
+    from .mkrange import parse_mk_range
+    reader.check_children(el, {"determlimit", "extrapolatemode", "mkzone"})
+    mode = reader.child(el, "extrapolatemode")
+    if mode is not None:
+        reader.integer(mode, "value", lo=1, hi=3)
+    out = {"determlimit": reader.child_value(el, "determlimit", 1e3, nonnegative=True), "zones": []}
+    seen = set()
+    for z in reader.children(el, "mkzone"):
+        reader.check_children(z, {"autoconfig", "limitpoint", "direction", "autolimitpoint"})
+        text = reader.text_attr(z, "mkbound")
+        try:
+            mks = parse_mk_range(text)
+        except ValueError as exc:
+            raise reader.error(z, f"mkbound=\"{text}\": {exc}", "mkbound values and ranges such as 2,4-6") from None
+        again = sorted(seen & set(mks))
+        if again:
+            raise reader.error(z, f"mkbound {again[0]} is in two <mkzone> (DualSPHysics: \"An input already exists "
+                                  "for the same mkbound.\")", "each mkbound in one <mkzone>")
+        seen |= set(mks)
+        zone = {"mkbound": mks, "line": z.sourceline}
+        auto = reader.child(z, "autoconfig")
+        if auto is not None:
+            name = reader.text_attr(auto, "direction", choices=set(BOUNDCORR_DIRECTIONS)).lower()
+            zone["auto"] = name
+        else:
+            d = reader.vec3(reader.child(z, "direction", True))
+            if not np.any(d):
+                raise reader.error(reader.child(z, "direction"), "the direction is zero", "a vector to the fluid")
+            zone["direction"] = (d / np.linalg.norm(d)).tolist()
+            lim = reader.child(z, "autolimitpoint")
+            if lim is not None:
+                zone["dpfactor"] = reader.num(lim, "dpfactor", 0.5)
+            else:
+                zone["limitpoint"] = reader.vec3(reader.child(z, "limitpoint", True)).tolist()
+        out["zones"].append(zone)
+    if not out["zones"]:
+        raise reader.error(el, "<boundcorr> has no <mkzone>", "one or more <mkzone mkbound> elements")
+    return out

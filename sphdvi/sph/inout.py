@@ -807,3 +807,37 @@ def _in_zone_rows(geo, k, pos, dp):
 def _in_zone_many(geo, k, pos, dp, out):
     for i in range(pos.shape[0]):
         out[i] = in_zone(geo, k, pos[i, 0], pos[i, 1], pos[i, 2], dp)
+
+
+def boundcorr_normals(spec: dict, pos: np.ndarray, ptype: np.ndarray, label: np.ndarray, dp: float) -> np.ndarray:
+    """``<boundcorr>`` as mDBC normals (JSphBoundCorr): for the particles of each zone's mkbounds the
+    vector to their limit plane along its direction, N = -((r - L).d) d (ghost node r + 2N, the mirror
+    image through the plane); zero rows elsewhere.  The plane: ``autoconfig`` dp/2 beyond the
+    particles' extreme on that side (through the middle of their extent, JSphBoundCorrZone::
+    ConfigAutoLimit), ``autolimitpoint`` dpfactor dp beyond the particle furthest along the direction,
+    or ``limitpoint``."""
+    normals = np.zeros((pos.shape[0], 3))
+    for z in spec["zones"]:
+        sel = np.flatnonzero((ptype != 3) & np.isin(label, z["mkbound"]))
+        if sel.size == 0:
+            continue
+        p = pos[sel]
+        if "auto" in z:
+            d = np.asarray(DIRECTIONS_XYZ[z["auto"]], float)
+            limit = 0.5 * (p.min(axis=0) + p.max(axis=0))
+            a = int(np.argmax(np.abs(d)))
+            limit[a] = (p[:, a].max() if d[a] > 0 else p[:, a].min()) + 0.5 * dp * d[a]
+        else:
+            d = np.asarray(z["direction"], float)
+            if "dpfactor" in z:
+                k = int(np.argmax(p @ d))
+                limit = p[k] + float(z["dpfactor"]) * dp * d
+            else:
+                limit = np.asarray(z["limitpoint"], float)
+        depth = (limit - p) @ d
+        normals[sel] = np.maximum(depth, 0.0)[:, None] * d[None, :]
+    return normals
+
+
+DIRECTIONS_XYZ = {"top": (0, 0, 1), "bottom": (0, 0, -1), "right": (1, 0, 0), "left": (-1, 0, 0),
+                  "back": (0, 1, 0), "front": (0, -1, 0)}

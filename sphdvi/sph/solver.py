@@ -164,11 +164,13 @@ class SPHSolver:
                  parallel_threshold=PARALLEL_THRESHOLD, light_threshold=LIGHT_THRESHOLD,
                  periodic=None, normals=None,
                  cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None, shift_zones=None,
-                 inout=None):
+                 inout=None, bound_corr=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.acc_inputs = list(acc_inputs or [])     # imposed accelerations (sphdvi.sph.accinput)
         self.inout = inout                            # inlet/outlet zones (sphdvi.sph.inout.InOut) or None
+        # <boundcorr>: mDBC's density extrapolation on the DBC walls it lists (normals, determlimit)
+        self.bc_determlimit = float(bound_corr[1]) if bound_corr is not None else 0.0
         self.dt_table = None if dt_table is None else np.asarray(dt_table, float).reshape(-1, 2)
         self.dt_error = -np.inf
         self.visco_table = None if visco_table is None else np.asarray(visco_table, float).reshape(-1, 2)
@@ -196,6 +198,11 @@ class SPHSolver:
         self.periodicity = self._setup_periodic(periodic)
         if self.inout is not None and self.periodicity is not None:
             raise ValueError("inlet/outlet zones (<inout>) with periodic boundaries are not supported by sphdvi")
+        self.bc_normals = None
+        if bound_corr is not None and self.boundary == 1:
+            if self.periodicity is not None:
+                raise ValueError("<boundcorr> with periodic boundaries is not supported by sphdvi")
+            self.bc_normals = np.ascontiguousarray(bound_corr[0], dtype=np.float64).reshape(state.n, 3).copy()
         self.shift_zones = None
         if shift_zones and self.rates_shift:
             self.shift_zones = _shift_zones.zone_arrays(shift_zones)
@@ -445,6 +452,8 @@ class SPHSolver:
             names += ["normals"]
             if self._wall_ace_on:
                 names += ["wall_ace"]
+        if getattr(self, "bc_normals", None) is not None:
+            names += ["bc_normals"]
         return names
 
     def _alloc(self, reuse=False, keep=()):
@@ -705,6 +714,14 @@ class SPHSolver:
             if self.nopen and self._need_nopen:
                 self._nopen_detect(par, self.nb, ptype_rows, self.cell_sorted, oi, self.normals,
                                    s.vel, s.pos, self.npshift)
+        elif self.bc_normals is not None and not self._in_corrector:
+            # <boundcorr> (JSphBoundCorr): once a step, mDBC's SlipMode 1 density on the walls it lists
+            from . import mdbc
+            fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
+            ncx, ncy, ncz = self.cells.shape
+            fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.bc_normals, self.cells.cell_start,
+               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, self.bc_determlimit,
+               0.0, s.rhop, 1, 1, self.dp, self._no_tvel, self._no_wall_ace)
         if self.shift == 4 and self._need_shift_adv:
             # before the interaction, which reads the shift with ShiftAdvALE / NCPress
             self._advanced_shift(par, self.nb, ptype_rows, self.cell_sorted, oi, self.shiftpos, self.fstype,

@@ -109,3 +109,48 @@ def test_a_buffer_outside_the_domain_stops_the_run(tmp_path):
     r = CliRunner().invoke(main, ["run", case, "-o", str(tmp_path / "o"), "--quiet"])
     assert r.exit_code == 2, r.output
     assert "inout zone 0" in r.output and "outside the simulation domain" in r.output
+
+
+WALLS = SLAB + """
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="-0.1" y="-1" z="-0.05" /><size x="0.8" y="2" z="0.04" />
+                    </drawbox>
+                    <setmkbound mk="1" />
+                    <drawbox><boxfill>solid</boxfill><point x="-0.1" y="-1" z="0.25" /><size x="0.8" y="2" z="0.04" />
+                    </drawbox>"""
+
+
+def _gencase_bc(tmp_path, boundcorr):
+    text = case_xml(dp="0.02", pointmin=("-0.2", "0", "-0.1"), pointmax=("0.8", "0", "0.4"), commands=WALLS,
+                    special=f"<inout>{GOOD}</inout>{boundcorr}",
+                    parameters='<parameter key="TimeMax" value="0.1" /><parameter key="TimeOut" value="0.1" />')
+    case = write_case(tmp_path, text, "CaseIO_Def.xml")
+    out = tmp_path / "g"
+    return CliRunner().invoke(main, ["gencase", case, "-o", str(out)]), out
+
+
+def test_boundcorr_is_read(tmp_path):
+    r, out = _gencase_bc(tmp_path, """<boundcorr><determlimit value="1e-3" /><extrapolatemode value="2" />
+        <mkzone mkbound="0"><autoconfig direction="top" /></mkzone>
+        <mkzone mkbound="1"><autolimitpoint dpfactor="0.5" /><direction x="0" y="0" z="-1" /></mkzone>
+        </boundcorr>""")
+    assert r.exit_code == 0, r.output
+    bc = read_case_h5(find_case_file(str(out)))["json"]["special"]["boundcorr"]
+    assert bc["determlimit"] == 1e-3
+    assert bc["zones"][0]["mkbound"] == [0] and bc["zones"][0]["auto"] == "top"
+    assert bc["zones"][1]["dpfactor"] == 0.5 and bc["zones"][1]["direction"] == [0.0, 0.0, -1.0]
+
+
+@pytest.mark.parametrize("boundcorr, message", [
+    ('<boundcorr><mkzone mkbound="0"><autoconfig direction="up" /></mkzone></boundcorr>', "is not recognised"),
+    ('<boundcorr><mkzone mkbound="0,0-1"><autoconfig direction="top" /></mkzone>'
+     '<mkzone mkbound="1"><autoconfig direction="top" /></mkzone></boundcorr>', "in two <mkzone>"),
+    ('<boundcorr><mkzone mkbound="7"><autoconfig direction="top" /></mkzone></boundcorr>', "has no particles"),
+    ('<boundcorr><mkzone mkbound="0"><direction x="0" y="0" z="1" /></mkzone></boundcorr>',
+     "missing child element <limitpoint>"),
+    ('<boundcorr><determlimit value="1e-3" /></boundcorr>', "has no <mkzone>"),
+])
+def test_boundcorr_refusals(tmp_path, boundcorr, message):
+    r, _ = _gencase_bc(tmp_path, boundcorr)
+    assert r.exit_code == 2, r.output
+    assert message in r.output and "Traceback" not in r.output

@@ -457,3 +457,51 @@ def test_calculated_zsurf_is_measured_before_the_first_output(tmp_path):
     s = sph.solver.state
     buf = io.zone_of_idp[s.idp] == 1
     assert np.isfinite(s.rhop[buf]).all() and s.pos[buf, 2].max() <= io.zsurf[1]
+
+
+def test_boundcorr_normals_reach_the_limit_plane():
+    """Each listed wall particle's normal points along the zone's direction to its limit plane:
+    autoconfig dp/2 beyond the particles' top, autolimitpoint dpfactor dp beyond the particle furthest
+    along the direction, limitpoint as given; other particles keep no normal."""
+    dp = 0.1
+    x, z = np.meshgrid(np.arange(5) * dp, np.arange(3) * dp - 0.3)
+    bottom = np.column_stack([x.ravel(), np.zeros(x.size), z.ravel()])          # z = -0.3, -0.2, -0.1
+    top = bottom + [0, 0, 1.3]                                                     # z = 1.0, 1.1, 1.2
+    pos = np.vstack([bottom, top, [[0.2, 0.0, 0.5]]])
+    ptype = np.r_[np.zeros(30, np.int8), np.int8(3)]
+    label = np.r_[np.zeros(15, int), np.ones(15, int), 5]
+    for spec, want_top in (({"zones": [{"mkbound": [0], "auto": "top"},
+                                        {"mkbound": [1], "direction": [0, 0, -1.0], "dpfactor": 0.5}]}, 0.95),
+                           ({"zones": [{"mkbound": [0], "auto": "top"},
+                                        {"mkbound": [1], "direction": [0, 0, -1.0], "limitpoint": [0, 0, 0.9]}]}, 0.9)):
+        n = IO.boundcorr_normals(spec, pos, ptype, label, dp)
+        assert np.allclose(n[:15, :2], 0) and np.allclose(n[:15, 2], -0.05 - pos[:15, 2])     # plane z = -0.05
+        assert np.allclose(n[15:30, 2], want_top - pos[15:30, 2])
+        assert not n[30].any()
+
+
+def test_a_wall_past_an_outlet_warns_and_boundcorr_holds_it(tmp_path):
+    """A DBC wall behind an outlet's buffer compresses without end; the run warns once it passes
+    RhopOutMax (naming the particle), and <boundcorr> keeps it near rho0."""
+    walls = SLAB + """
+                    <setmkbound mk="0" />
+                    <drawbox><boxfill>solid</boxfill><point x="-0.15" y="-1" z="-0.05" /><size x="0.9" y="2" z="0.04" />
+                    </drawbox>"""
+    for bc in ("", '<boundcorr><mkzone mkbound="0"><autoconfig direction="top" /></mkzone></boundcorr>'):
+        sub = tmp_path / ("bc" if bc else "dbc")
+        sub.mkdir()
+        case = slab_case(sub, tmax=0.3, commands=walls, special_extra=bc)
+        out = sub / "out"
+        if bc:
+            r = run(case, out)
+        else:
+            with pytest.warns(UserWarning, match="past RhopOutMax"):
+                r = run(case, out)
+        assert r.exit_code == 0, r.output
+        last = last_step(out)
+        wall = last["Rhop"][last["Type"] == 0]
+        log = (out / "run.log").read_text()
+        if bc:
+            assert wall.max() < 1010.0 and "past RhopOutMax" not in log
+        else:
+            assert wall.max() > 1300.0 and "past RhopOutMax" in log and "<boundcorr>" in log
