@@ -1009,14 +1009,20 @@ class SPHRun:
         # bodychecks.BodyWatch), before their particles reached the fluid
 
     def wall_density_warning(self) -> str:
-        """Once a run: a line when a fixed or moving boundary particle's density has passed RhopOutMax
-        (DualSPHysics excludes fluid there, never walls, so nothing else says it): the DBC wall past an
-        outlet's buffer, which compresses without end (``<boundcorr>`` or Boundary=2 correct it)."""
-        if getattr(self, "_wall_warned", False):
+        """Once a run with inlet/outlet zones: a line when a DBC wall particle (fixed or moving, not
+        corrected by ``<boundcorr>``) has passed RhopOutMax.  DualSPHysics excludes fluid there, never
+        walls, so nothing else says it: the wall past an outlet's buffer sees buffer particles approach
+        and vanish and compresses without end (``<boundcorr>`` or Boundary=2 correct it).  (mDBC walls,
+        and DBC walls in runs without zones, reach such densities in impacts: not warned.)"""
+        sol = self.solver
+        if getattr(self, "_wall_warned", False) or self.inout is None or sol.boundary != 1:
             return ""
-        s = self.solver.state
+        s = sol.state
         limit = float(self.params.get("RhopOutMax", 1300.0))
-        walls = np.flatnonzero(s.ptype < 2)
+        dbc = s.ptype < 2
+        if sol.bc_normals is not None:
+            dbc &= ~sol.bc_normals.any(axis=1)
+        walls = np.flatnonzero(dbc)
         if walls.size == 0:
             return ""
         k = walls[int(np.argmax(s.rhop[walls]))]
@@ -1027,8 +1033,7 @@ class SPHRun:
         mkb = int(body_labels(s.mk[k:k + 1], int(self.data["json"]["mkconfig"]["fluidcount"]))[0])
         n = int(np.count_nonzero(s.rhop[walls] > limit))
         hint = ("walls behind an outlet's buffer see buffer particles approach and vanish: give them <boundcorr> "
-                "(as DualSPHysics's inlet/outlet examples do) or use Boundary=2" if self.inout is not None else
-                "check the time step and the flow against that wall, or use Boundary=2 (mDBC)")
+                "(as DualSPHysics's inlet/outlet examples do) or use Boundary=2")
         return (f"t={self.solver.time:.6g} s: {n} boundary particle{'s' if n > 1 else ''} past RhopOutMax "
                 f"({limit:g} kg/m3), the densest mkbound {mkb} particle {int(s.idp[k])} at {fmt_vec(s.pos[k])} "
                 f"with {float(s.rhop[k]):.6g} kg/m3; {hint}")

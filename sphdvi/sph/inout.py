@@ -65,8 +65,8 @@ from ._env import CHUNK
 from numba import njit, prange
 
 from .interaction import _pack_row
-from .kernels import kernel_fac, kernel_w
 from .linalg import solve_pivoted
+from .mdbc import _ghost_sums
 
 # columns of the zone geometry array
 G_N = 0          # 0:3 the unit direction n into the fluid
@@ -216,86 +216,28 @@ def hydrostatic_density(zsurf, w, rhop0, coef_hydro, inv_gamma):
 
 @njit(cache=True, error_model="numpy")
 def _extrapolate(kern, is2d, nb, ptype_s, oi, idp, zone_of_idp, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                 cst, gx, gy, gz, ex, ey, ez, a, b, determlimit, want_vel, out):
-    """Density and velocity at the buffer particle extrapolated from the ghost node (gx, gy, gz),
-    (ex, ey, ez) = g - r_b (module docstring), into out[0:4] (rho, vx, vy, vz); False with no
-    fluid in reach (out untouched)."""
-    h = cst[0]
-    r2max = cst[1]
-    alpha = cst[3]
-    alpha_h2 = cst[4]
+                 cst, k, nx, ny, nz, a, b, vsum, determlimit, want_vel, out):
+    """Density and velocity at the buffer particle of packed row k extrapolated from its ghost node
+    r + 2N, N = (nx, ny, nz) (module docstring; the sums are mDBC's, buffers left out), into
+    out[0:4] (rho, vx, vy, vz); False with no fluid in reach (out untouched)."""
     n = 3 if is2d else 4
-    for r in range(4):
-        for c in range(4):
-            a[r, c] = 0.0
-            b[r, c] = 0.0
-    cx = min(max(int((gx - pmin[0]) * inv_cell), 0), ncx - 1)
-    cy = min(max(int((gy - pmin[1]) * inv_cell), 0), ncy - 1) if not is2d else 0
-    cz = min(max(int((gz - pmin[2]) * inv_cell), 0), ncz - 1)
-    rs = int(cst[18])
-    for zc in range(max(cz - rs, 0), min(cz + rs, ncz - 1) + 1):
-        for yc in range(max(cy - rs, 0), min(cy + rs, ncy - 1) + 1):
-            row = (zc * ncy + yc) * ncx
-            for j in range(cell_start[row + max(cx - rs, 0)], cell_start[row + min(cx + rs, ncx - 1) + 1]):
-                if ptype_s[j] != 3 or zone_of_idp[idp[oi[j]]] >= 0:
-                    continue
-                if is2d:
-                    dx = gx - nb[j, 0]
-                    dy = 0.0
-                    dz = gz - nb[j, 1]
-                    mj = nb[j, 6]
-                    vj = mj * nb[j, 7]
-                    u0, u1, u2 = nb[j, 2], 0.0, nb[j, 3]
-                else:
-                    dx = gx - nb[j, 0]
-                    dy = gy - nb[j, 1]
-                    dz = gz - nb[j, 2]
-                    mj = nb[j, 8]
-                    vj = mj * nb[j, 9]
-                    u0, u1, u2 = nb[j, 3], nb[j, 4], nb[j, 5]
-                r2 = dx * dx + dy * dy + dz * dz
-                if r2 >= r2max:
-                    continue
-                q = math.sqrt(r2) / h
-                wk = kernel_w(kern, q, alpha)
-                # a particle on the ghost node counts with W(0) and no gradient (DualSPHysics leaves it
-                # out, and on a lattice every ghost node of a buffer falls on a fluid particle)
-                fac = kernel_fac(kern, q, alpha_h2) if r2 > 1e-18 else 0.0
-                # rows: the value and its gradient (d/dx, [d/dy], d/dz); columns (g - r_j) as DualSPHysics
-                g0 = fac * dx
-                g1 = fac * dy
-                g2 = fac * dz
-                if is2d:
-                    wr = (wk, g0, g2, 0.0)
-                    dr = (dx, dz, 0.0)
-                else:
-                    wr = (wk, g0, g1, g2)
-                    dr = (dx, dy, dz)
-                for rr in range(n):
-                    k = wr[rr] * vj
-                    a[rr, 0] += k
-                    for cc in range(n - 1):
-                        a[rr, 1 + cc] += k * dr[cc]
-                    b[rr, 0] += wr[rr] * mj
-                    if want_vel:
-                        b[rr, 1] += k * u0
-                        b[rr, 2] += k * u1
-                        b[rr, 3] += k * u2
+    _ghost_sums(kern, is2d, nb, ptype_s, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, k, nx, ny, nz, a, b,
+                vsum, zone_of_idp, idp, oi)
     if a[0, 0] <= 0.0:
         return False
     shep = 1.0 / a[0, 0]
-    for c in range(4):
-        out[c] = b[0, c] * shep
+    out[0] = b[0, 0] * shep
+    for c in range(3):
+        out[1 + c] = vsum[c] * shep
     m = 4 if want_vel else 1
     det = solve_pivoted(a, b, n, m, 0.0)
     if det > 0.0 and det >= determlimit:
-        # columns (g - r_j): the unknowns are f_g and -grad f, so f_b = f_g + (r_b - g).grad f
-        # = f_g + (g - r_b).(-grad f)
+        # the unknowns are f_g and grad f (columns r_j - g): f_b = f_g + (r_b - g).grad f = f_g - 2 N.grad f
         for c in range(m):
             if is2d:
-                out[c] = b[0, c] + ex * b[1, c] + ez * b[2, c]
+                out[c] = b[0, c] - 2.0 * (nx * b[1, c] + nz * b[2, c])
             else:
-                out[c] = b[0, c] + ex * b[1, c] + ey * b[2, c] + ez * b[3, c]
+                out[c] = b[0, c] - 2.0 * (nx * b[1, c] + ny * b[2, c] + nz * b[3, c])
     return True
 
 
@@ -309,6 +251,7 @@ def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp
     inv_gamma = cst[11]
     a = np.empty((4, 4))
     b = np.empty((4, 4))
+    vsum = np.empty(4)
     out = np.empty(4)
     for k in range(k0, k1):
         if ptype_s[k] != 3:
@@ -333,14 +276,12 @@ def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp
             vel[o, 1] = v * geo[z, 1]
             vel[o, 2] = v * geo[z, 2]
         if rmode == 2 or vmode == 2:
-            d = -plane_depth(geo, z, x, y, w)        # > 0 behind the plane
+            d = -plane_depth(geo, z, x, y, w)        # > 0 behind the plane: N = d n reaches it
             if d < 0.0:
                 d = 0.0
-            gx = x + 2.0 * d * geo[z, 0]
-            gy = y + 2.0 * d * geo[z, 1] if not is2d else y
-            gz = w + 2.0 * d * geo[z, 2]
             if _extrapolate(kern, is2d, nb, ptype_s, oi, idp, zone_of_idp, cell_start, pmin, inv_cell, ncx, ncy,
-                            ncz, cst, gx, gy, gz, gx - x, gy - y, gz - w, a, b, determlimit, vmode == 2, out):
+                            ncz, cst, k, d * geo[z, 0], 0.0 if is2d else d * geo[z, 1], d * geo[z, 2], a, b, vsum,
+                            determlimit, vmode == 2, out):
                 if rmode == 2:
                     rho = out[0]
                 if vmode == 2:

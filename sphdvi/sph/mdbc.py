@@ -142,6 +142,9 @@ from .interaction import tait_pressure
 from .kernels import kernel_fac, kernel_w
 from .linalg import solve_pivoted
 
+_NO_SKIP = np.zeros(0, np.int8)      # _ghost_sums leaves out no fluid particle
+_NO_IDP = np.zeros(0, np.int64)
+
 # mDBC2 (SlipMode 2, 3) limits, DualSPHysics v5.4 (JSphCpu_mdbc.cpp, JSphGpu_mdbc_iker.cu)
 MDBC2_KSUM_MIN = 0.1      # kernel sum at the ghost node below which the Shepard density is used
 MDBC2_DET_MIN = 1e-3      # |det A| below which the Shepard density is used
@@ -150,14 +153,16 @@ MDBC2_COND_MAX = 50.0     # scaled condition number dp^2 |A|_inf |A^-1|_inf abov
 
 @njit(cache=True, error_model="numpy")
 def _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst,
-                i, nx, ny, nz, a, b, vsum):
+                i, nx, ny, nz, a, b, vsum, skip_of_idp=_NO_SKIP, idp=_NO_IDP, oi=_NO_IDP):
     """Sums over the fluid particles j near the ghost node g = r_i + 2 N of
     packed boundary row i with normal N = (nx, ny, nz):
     the moment matrix a (see the module docstring), the right-hand side
     b[:, 0] = (sum m w, sum m grad w), and, when ``vsum`` has 4 entries (mDBC2),
     sum V w v_j in vsum[0:3], the submersion measure -sum V (g - r_j).grad w
     in vsum[3] and the velocity right-hand sides b[:, 1:4] = (sum V w v_j,
-    sum V grad w v_j) of the corrected ghost velocity."""
+    sum V grad w v_j) of the corrected ghost velocity.  ``skip_of_idp`` (by particle id,
+    packed row j's particle oi[j]): fluid particles with a value >= 0 left out (the buffers
+    of inlet/outlet zones, :mod:`sphdvi.sph.inout`); empty: none."""
     if is2d:
         gx = nb[i, 0] + 2.0 * nx
         gy = 0.0
@@ -189,6 +194,8 @@ def _ghost_sums(kern, is2d, nb, ptype, cell_start, pmin, inv_cell, ncx, ncy, ncz
             for j in range(cell_start[row + max(cx - rs, 0)],
                            cell_start[row + min(cx + rs, ncx - 1) + 1]):
                 if ptype[j] != 3:
+                    continue
+                if skip_of_idp.shape[0] and skip_of_idp[idp[oi[j]]] >= 0:
                     continue
                 if is2d:
                     dx = gx - nb[j, 0]

@@ -1198,37 +1198,14 @@ class SPHSolver:
             setattr(s, f, np.concatenate([getattr(s, f), new[f]]))
         self._alloc()
 
-    def _remove_rows(self, codes):
-        """Drop the rows where ``codes`` is not 0 from the state and the per-particle arrays
-        (what :meth:`_exclude` does, without recording them as excluded)."""
+    def _remove_rows(self, codes, carry=()):
+        """Drop the rows where ``codes`` is not 0 from the state and the per-particle arrays.
+        ``carry``: per-particle work arrays (attribute names) kept, less those rows, rather than
+        zeroed.  The kept rows move down in place (:func:`_compact_rows`) and every array becomes a
+        view of its first rows: nothing is allocated (DualSPHysics moves the excluded particles to
+        the end of its arrays and shrinks Np, JCellDivCpu)."""
         s = self.state
         n = codes.shape[0]
-        for f in FluidState.FIELDS:
-            setattr(s, f, _compacted(getattr(s, f), codes))
-        for name in self._aux_names():
-            a = getattr(self, name)
-            if a.shape[0] == n:
-                setattr(self, name, _compacted(a, codes))
-        self._alloc(reuse=True)
-
-    # ------------------------------------------------------------------ exclusion
-    def _exclude(self, t_end: float, carry=()):
-        """Remove the flagged fluid particles from the state and work arrays, and keep an
-        event of them (what they were when the step ending at ``t_end`` removed them).
-        ``carry``: per-particle work arrays (attribute names) kept, less those rows, rather
-        than zeroed.  The kept rows move down in place (:func:`_compact_rows`) and every array
-        becomes a view of its first rows: nothing is allocated (DualSPHysics moves the excluded
-        particles to the end of its arrays and shrinks Np, JCellDivCpu)."""
-        s = self.state
-        codes = self.out.copy()
-        n = codes.shape[0]
-        bad = codes != 0
-        for code, name in REASON_NAMES.items():
-            self.n_excluded[name] += int(np.count_nonzero(codes == code))
-        self.excluded.append({
-            "time": t_end, "idp": s.idp[bad].copy(), "pos": s.pos[bad].copy(),
-            "vel": s.vel[bad].copy(), "rhop": s.rhop[bad].copy(),
-            "reason": [REASON_NAMES[int(c)] for c in codes[bad]]})
         for f in FluidState.FIELDS:
             setattr(s, f, _compacted(getattr(s, f), codes))
         for name in self._aux_names():
@@ -1239,6 +1216,22 @@ class SPHSolver:
         for name in kept:
             setattr(self, name, _compacted(getattr(self, name), codes))
         self._alloc(reuse=True, keep=kept)
+
+    # ------------------------------------------------------------------ exclusion
+    def _exclude(self, t_end: float, carry=()):
+        """Remove the flagged fluid particles from the state and work arrays
+        (:meth:`_remove_rows`, ``carry`` as there), and keep an event of them (what they were
+        when the step ending at ``t_end`` removed them)."""
+        s = self.state
+        codes = self.out.copy()
+        bad = codes != 0
+        for code, name in REASON_NAMES.items():
+            self.n_excluded[name] += int(np.count_nonzero(codes == code))
+        self.excluded.append({
+            "time": t_end, "idp": s.idp[bad].copy(), "pos": s.pos[bad].copy(),
+            "vel": s.vel[bad].copy(), "rhop": s.rhop[bad].copy(),
+            "reason": [REASON_NAMES[int(c)] for c in codes[bad]]})
+        self._remove_rows(codes, carry)
 
     def take_excluded(self) -> list:
         """The exclusion events since the last call (oldest first); the list starts anew."""
