@@ -886,9 +886,6 @@ class SPHRun:
         the run's initial particles.  Returns (particles, state)."""
         from .sph.inout import InOutError, place_buffers
         from .sph.state import FluidState
-        if periodic:
-            raise InputError("<special><inout> with periodic boundaries is not supported by sphdvi "
-                             "(expected a case without the *Periodic* parameters)")
         try:
             p, extra, self.inout, notes = place_buffers(spec, data["particles"], c, domain,
                                                         {"normals": data.get("normals")},

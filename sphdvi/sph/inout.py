@@ -50,6 +50,11 @@ vertical line through the centre of the zone's points, 2h in front of them (the 
 rule, :class:`sphdvi.sph.surface_gauge.VerticalSurfaceGauge`), from ``zsurfmin`` up, plus the fit
 (-dp/2 by default), as JSphInOutZsurf's gauge.
 
+Periodic boundaries: the extrapolation runs on the extended set (the copies across the periodic
+boundary are neighbours), the copies of buffer particles take their particles' imposed values
+(:func:`refresh_buffer_copies`), and a buffer particle the wrap took to the other end is classified
+at its image nearest the zone (:func:`nearest_image`).
+
 At the start (:func:`place_buffers`, JSphCpuSingle::InOutInit): the particles of ``<particles
 mkfluid>`` zones are replaced by the buffer's rows, and ordinary fluid inside a zone's box is
 removed (DualSPHysics excludes fluid "too close to inout particles").
@@ -66,7 +71,7 @@ from numba import njit, prange
 
 from .interaction import _pack_row
 from .linalg import solve_pivoted
-from .mdbc import _ghost_sums
+from .mdbc import _ghost_sums, _set_packed
 
 # columns of the zone geometry array
 G_N = 0          # 0:3 the unit direction n into the fluid
@@ -128,7 +133,26 @@ def in_zone(geo, z, x, y, w, dp):
 
 
 @njit(cache=True)
-def _classify_range(i0, i1, pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
+def nearest_image(geo, z, x, y, w, paxes, pshift):
+    """The periodic image of (x, y, w) nearest zone z's centre (along each periodic axis a: the point,
+    or it plus or minus the period vector pshift[a]); the point itself without periodic axes."""
+    for m in range(paxes.shape[0]):
+        a = paxes[m]
+        best = (x - geo[z, G_C]) ** 2 + (y - geo[z, G_C + 1]) ** 2 + (w - geo[z, G_C + 2]) ** 2
+        bx, by, bw = x, y, w
+        for sgn in (-1.0, 1.0):
+            cx = x + sgn * pshift[a, 0]
+            cy = y + sgn * pshift[a, 1]
+            cw = w + sgn * pshift[a, 2]
+            d2 = (cx - geo[z, G_C]) ** 2 + (cy - geo[z, G_C + 1]) ** 2 + (cw - geo[z, G_C + 2]) ** 2
+            if d2 < best:
+                best, bx, by, bw = d2, cx, cy, cw
+        x, y, w = bx, by, bw
+    return x, y, w
+
+
+@njit(cache=True)
+def _classify_range(i0, i1, pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action, paxes, pshift):
     nz = geo.shape[0]
     for i in range(i0, i1):
         action[i] = KEEP
@@ -137,6 +161,8 @@ def _classify_range(i0, i1, pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, a
         x, y, w = pos[i, 0], pos[i, 1], pos[i, 2]
         z = zone_of_idp[idp[i]]
         if z >= 0:
+            # a buffer particle the periodic wrap took to the other end is judged where it was
+            x, y, w = nearest_image(geo, z, x, y, w, paxes, pshift)
             d = plane_depth(geo, z, x, y, w)
             above = w > zsurf[z] + ZTOL * dp
             if d < -geo[z, G_W] or (cfg[z, C_REMOVE] != 0 and above):
@@ -157,18 +183,19 @@ def _classify_range(i0, i1, pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, a
 
 
 @njit(cache=True)
-def classify_serial(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
-    """The end-of-step actions (module docstring) of every particle into ``action``."""
-    _classify_range(0, pos.shape[0], pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action)
+def classify_serial(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action, paxes, pshift):
+    """The end-of-step actions (module docstring) of every particle into ``action``; ``paxes`` and
+    ``pshift``: the periodic axes and period vectors (none: empty)."""
+    _classify_range(0, pos.shape[0], pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action, paxes, pshift)
 
 
 @njit(cache=True, parallel=True)
-def classify_parallel(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action):
+def classify_parallel(pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp, action, paxes, pshift):
     """Threaded :func:`classify_serial`."""
     n = pos.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
         _classify_range(c * CHUNK, min(n, (c + 1) * CHUNK), pos, ptype, idp, zone_of_idp, geo, cfg, zsurf, dp,
-                        action)
+                        action, paxes, pshift)
 
 
 @njit(cache=True)
@@ -242,9 +269,9 @@ def _extrapolate(kern, is2d, nb, ptype_s, oi, idp, zone_of_idp, cell_start, pmin
 
 
 @njit(cache=True, error_model="numpy")
-def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
-                  inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro, vel_m1, rhop_m1,
-                  dp):
+def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, prow, pos, vel, rhop, mass, idp, zone_of_idp, cell_start,
+                  pmin, inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro, vel_m1,
+                  rhop_m1, dp):
     """:func:`impose_serial` over the packed rows k0 <= k < k1 (work arrays once per range)."""
     verlet = vel_m1.shape[0] == pos.shape[0]
     rhop0 = cst[10]
@@ -257,6 +284,8 @@ def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp
         if ptype_s[k] != 3:
             continue
         o = oi[k]
+        if o < 0:           # a periodic copy: refresh_buffer_copies gives it its particle's values
+            continue
         z = zone_of_idp[idp[o]]
         if z < 0:
             continue
@@ -279,7 +308,7 @@ def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp
             d = -plane_depth(geo, z, x, y, w)        # > 0 behind the plane: N = d n reaches it
             if d < 0.0:
                 d = 0.0
-            if _extrapolate(kern, is2d, nb, ptype_s, oi, idp, zone_of_idp, cell_start, pmin, inv_cell, ncx, ncy,
+            if _extrapolate(kern, is2d, nb, ptype_s, prow, idp, zone_of_idp, cell_start, pmin, inv_cell, ncx, ncy,
                             ncz, cst, k, d * geo[z, 0], 0.0 if is2d else d * geo[z, 1], d * geo[z, 2], a, b, vsum,
                             determlimit, vmode == 2, out):
                 if rmode == 2:
@@ -298,26 +327,49 @@ def _impose_range(k0, k1, kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp
 
 
 @njit(cache=True, error_model="numpy")
-def impose_serial(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
+def impose_serial(kern, is2d, nb, ptype_s, oi, prow, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
                   inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro, vel_m1, rhop_m1, dp):
-    """Impose the velocity and density of every buffer particle (packed row k, particle oi[k]):
-    the state rows, the packed rows (so the coming interaction sees them) and, for Verlet,
-    the previous-step values ``vel_m1``/``rhop_m1`` (zero rows: Symplectic)."""
-    _impose_range(0, nb.shape[0], kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp,
+    """Impose the velocity and density of every buffer particle (packed row k, particle oi[k]; oi[k] < 0
+    for a periodic copy, left to :func:`refresh_buffer_copies`): the state rows, the packed rows (so the
+    coming interaction sees them) and, for Verlet, the previous-step values ``vel_m1``/``rhop_m1``
+    (zero rows: Symplectic).  ``prow``: every packed row's particle (copies too), for the buffers the
+    extrapolation leaves out."""
+    _impose_range(0, nb.shape[0], kern, is2d, nb, ptype_s, oi, prow, pos, vel, rhop, mass, idp, zone_of_idp,
                   cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro,
                   vel_m1, rhop_m1, dp)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def impose_parallel(kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
+def impose_parallel(kern, is2d, nb, ptype_s, oi, prow, pos, vel, rhop, mass, idp, zone_of_idp, cell_start, pmin,
                     inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf, determlimit, coef_hydro, vel_m1, rhop_m1,
                     dp):
     """Threaded :func:`impose_serial` (``CHUNK`` rows a work item)."""
     n = nb.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
-        _impose_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype_s, oi, pos, vel, rhop, mass, idp,
-                      zone_of_idp, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf,
+        _impose_range(c * CHUNK, min(n, (c + 1) * CHUNK), kern, is2d, nb, ptype_s, oi, prow, pos, vel, rhop, mass,
+                      idp, zone_of_idp, cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, geo, cfg, coef, zsurf,
                       determlimit, coef_hydro, vel_m1, rhop_m1, dp)
+
+
+@njit(cache=True, error_model="numpy")
+def refresh_buffer_copies(nb, ptype_s, oi, prow, idp, zone_of_idp, vel, rhop, is2d, cst):
+    """Periodic runs: the packed velocity, density, pressure and 1/rho of the copies of buffer particles
+    from their particles (imposed by :func:`impose_serial`); positions stay the copies'."""
+    for k in range(nb.shape[0]):
+        if oi[k] >= 0 or ptype_s[k] != 3:
+            continue
+        i = prow[k]
+        if zone_of_idp[idp[i]] < 0:
+            continue
+        rho = rhop[i]
+        if is2d:
+            nb[k, 2] = vel[i, 0]
+            nb[k, 3] = vel[i, 2]
+        else:
+            nb[k, 3] = vel[i, 0]
+            nb[k, 4] = vel[i, 1]
+            nb[k, 5] = vel[i, 2]
+        _set_packed(nb, k, is2d, rho, cst, False)
 
 
 @njit(cache=True)

@@ -152,6 +152,10 @@ class SPHSolver:
         are imposed before each interaction, their rates zeroed after it, and at the end of each
         step particles cross between buffers and fluid, new ones are created and others removed
         (:mod:`sphdvi.sph.inout`); ``N`` changes from step to step.
+    bound_corr : (normals, determlimit) or None
+        ``<special><boundcorr>`` with DBC (Boundary=1): once a step (the predictor's interaction), mDBC's
+        SlipMode 1 density extrapolation on the particles with a non-zero normal (the vector to their
+        limit plane; :func:`sphdvi.sph.inout.boundcorr_normals`), first order where |det A| >= determlimit.
 
     After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
     accelerations, density rates and pressures of the last interaction, in
@@ -196,12 +200,8 @@ class SPHSolver:
         if domain is not None:
             self._domain = (np.array(domain[0], float), np.array(domain[1], float))
         self.periodicity = self._setup_periodic(periodic)
-        if self.inout is not None and self.periodicity is not None:
-            raise ValueError("inlet/outlet zones (<inout>) with periodic boundaries are not supported by sphdvi")
         self.bc_normals = None
         if bound_corr is not None and self.boundary == 1:
-            if self.periodicity is not None:
-                raise ValueError("<boundcorr> with periodic boundaries is not supported by sphdvi")
             self.bc_normals = np.ascontiguousarray(bound_corr[0], dtype=np.float64).reshape(state.n, 3).copy()
         self.shift_zones = None
         if shift_zones and self.rates_shift:
@@ -858,17 +858,26 @@ class SPHSolver:
         par = self._use_parallel()
         k = self._kernels(par)
         ncx, ncy, ncz = self.cells.shape
-        if self._mdbc_now():
-            # mDBC on the extended set: ghost copies see the fluid across the
+        if self.inout is not None and not self._in_corrector:
+            self._inout_impose(ptype_e, oi, nb=nb, prow=idx)
+        mdbc_now = self._mdbc_now()
+        boundcorr_now = not mdbc_now and self.bc_normals is not None and not self._in_corrector
+        if mdbc_now or boundcorr_now:
+            # mDBC (or <boundcorr>) on the extended set: ghost copies see the fluid across the
             # periodic boundary; the real boundary particles keep their density
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             rhop_e = np.take(s.rhop, idx, out=w("rhop", ne, zero=False), mode="clip")
-            normals_e = np.ascontiguousarray(self.normals[idx])
+            normals_e = np.ascontiguousarray((self.normals if mdbc_now else self.bc_normals)[idx])
             wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
-            fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
-               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
+            if mdbc_now:
+                fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
+                   self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
+                   self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
+            else:
+                fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
+                   self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, self.bc_determlimit,
+                   0.0, rhop_e, 1, 1, self.dp, self._no_tvel, self._no_wall_ace)
             # a copy's ghost node sees a truncated extended set: it takes its real particle's result
             real_e = order < n
             row_of = np.empty(n, np.int64)
@@ -876,7 +885,7 @@ class SPHSolver:
             mdbc.copy_to_periodic_rows(self.is2d, nb, ptype_e, row_of[idx], self._tvel(ne))
             bound = real_e & (ptype_e != 3)
             s.rhop[order[bound]] = rhop_e[bound]
-            if self.nopen and self._need_nopen:
+            if mdbc_now and self.nopen and self._need_nopen:
                 npshift = w("npshift", ne, self.npshift.shape[1:])
                 pos_e = np.take(unsorted, order, axis=0, out=w("pos", ne, (3,), zero=False), mode="clip")
                 vel_e = np.take(s.vel, idx, axis=0, out=w("vel", ne, (3,), zero=False), mode="clip")
@@ -1077,10 +1086,14 @@ class SPHSolver:
         return n
 
     # ------------------------------------------------------------------ inlet/outlet
-    def _inout_impose(self, ptype_rows, oi):
+    def _inout_impose(self, ptype_rows, oi, nb=None, prow=None):
         """The buffer particles' imposed or extrapolated velocity and density, into the state
-        and the packed rows, before the interaction (sphdvi.sph.inout.impose_serial)."""
-        from .inout import impose_parallel, impose_serial
+        and the packed rows, before the interaction (sphdvi.sph.inout.impose_serial).  Periodic runs
+        pass the extended set's packed array ``nb``, ``oi`` (-1 - particle for a copy) and ``prow``
+        (every row's particle); the copies of buffers then take their particles' values."""
+        from .inout import impose_parallel, impose_serial, refresh_buffer_copies
+        nb = self.nb if nb is None else nb
+        prow = oi if prow is None else prow
         io = self.inout
         s = self.state
         io.update_time(self.time, s)
@@ -1088,12 +1101,17 @@ class SPHSolver:
         ncx, ncy, ncz = self.cells.shape
         # not a light kernel: the extrapolation sums a kernel's worth of fluid per buffer particle
         fn = impose_parallel if self._use_parallel() else impose_serial
-        fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, s.pos, s.vel, s.rhop, s.mass, s.idp, io.zone_of_idp,
+        fn(self.kernel, self.is2d, nb, ptype_rows, oi, prow, s.pos, s.vel, s.rhop, s.mass, s.idp, io.zone_of_idp,
            self.cells.cell_start, self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, io.geo,
            io.cfg, io.coef, io.zsurf, io.determlimit, io.coef_hydro,
            self.vel_m1 if verlet else self._no_m1[0], self.rhop_m1 if verlet else self._no_m1[1], self.dp)
+        if prow is not oi:
+            refresh_buffer_copies(nb, ptype_rows, oi, prow, s.idp, io.zone_of_idp, s.vel, s.rhop, self.is2d,
+                                  self.cst)
 
     _no_m1 = (np.zeros((0, 3)), np.zeros(0))
+    _no_axes = np.zeros(0, np.int64)
+    _no_shift = np.zeros((3, 3))
 
     def _inout_zero_rates(self):
         """Buffer particles take no acceleration, density rate or shift; the force term of dt is
@@ -1117,7 +1135,10 @@ class SPHSolver:
         self._check_state_arrays()
         action = np.empty(s.n, np.int8)
         classify = classify_parallel if self._use_parallel() else classify_serial
-        classify(s.pos, s.ptype, s.idp, io.zone_of_idp, io.geo, io.cfg, io.zsurf, self.dp, action)
+        per = self.periodicity
+        paxes = np.asarray(per.axes, np.int64) if per is not None else self._no_axes
+        pshift = per.shift if per is not None else self._no_shift
+        classify(s.pos, s.ptype, s.idp, io.zone_of_idp, io.geo, io.cfg, io.zsurf, self.dp, action, paxes, pshift)
         moved = np.flatnonzero(action != 0)
         new_pos = new_src = new_zone = None
         if moved.size:

@@ -505,3 +505,18 @@ def test_a_wall_past_an_outlet_warns_and_boundcorr_holds_it(tmp_path):
             assert wall.max() < 1010.0 and "past RhopOutMax" not in log
         else:
             assert wall.max() > 1300.0 and "past RhopOutMax" in log and "<boundcorr>" in log
+
+
+def test_a_slab_periodic_across_the_flow_moves_exactly(tmp_path):
+    """Inlet and outlet with a periodic axis across the flow (z, ZPeriodicIncX): the buffers' copies
+    across the periodic boundary take their particles' imposed and extrapolated values, and the
+    translation stays exact (no free surface at all now)."""
+    case = slab_case(tmp_path, extra_params='<parameter key="ZPeriodicIncX" value="0" />')
+    out = tmp_path / "out"
+    r = run(case, out)
+    assert r.exit_code == 0, r.output
+    first, last = read_step(str(out / "particles.vtkhdf"), 0), last_step(out)
+    fluid = last["Type"] == 3
+    assert int(fluid.sum()) == int((first["Type"] == 3).sum())
+    assert np.abs(last["Vel"][fluid] - [1.0, 0.0, 0.0]).max() < 1e-9
+    assert np.abs(last["Rhop"][fluid] - 1000.0).max() < 1e-6
