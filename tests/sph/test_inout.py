@@ -5,7 +5,7 @@ import pathlib
 
 import numpy as np
 import pytest
-from case.casetext import case_xml, write_case      # tests/case (tests/ is on the path: conftest)
+from case.casetext import CONSTANTS, case_xml, write_case      # tests/case (tests/ is on the path: conftest)
 from click.testing import CliRunner
 
 from sphdvi.cli import main
@@ -13,18 +13,10 @@ from sphdvi.io.casefile import read_case_h5
 from sphdvi.io.vtkhdf import read_step, step_times
 from sphdvi.sph import inout as IO
 
-NO_GRAVITY = """
-        <constantsdef>
-            <gravity x="0" y="0" z="0" />
-            <rhop0 value="1000" />
-            <hswl value="0" auto="true" />
-            <gamma value="7" />
-            <speedsystem value="0" auto="true" />
-            <coefsound value="20" />
-            <speedsound value="15" auto="false" />
-            <coefh value="1.2" />
-            <cflnumber value="0.2" />
-        </constantsdef>"""
+# casetext's constants without gravity, with c0 = 15 m/s and coefh 1.2
+NO_GRAVITY = (CONSTANTS.replace('<gravity x="0" y="0" z="-9.81" />', '<gravity x="0" y="0" z="0" />')
+              .replace('<speedsound value="0" auto="true" />', '<speedsound value="15" auto="false" />')
+              .replace('<coefh value="1.0" />', '<coefh value="1.2" />'))
 
 SLAB = """
                     <setmkfluid mk="0" />
