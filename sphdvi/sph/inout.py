@@ -22,10 +22,10 @@ Extrapolation (JSphCpu::InteractionInOutExtrap): the ghost node g = r + 2|d| n m
 particle (d its signed distance to the plane) into the fluid; over the fluid particles j near g
 (buffer particles excluded), with V = m/rho,
 
-  A = [[sum V w,        sum V w (g - r_j)^T     ],
-       [sum V grad w,   sum V grad w (g - r_j)^T]]
+  A = [[sum V w,        sum V w (r_j - g)^T     ],
+       [sum V grad w,   sum V grad w (r_j - g)^T]]
 
-and the right-hand sides (sum m w, sum m grad w) for the density and (sum V w u, sum V grad w u)
+(mDBC's moment matrix, :func:`sphdvi.sph.mdbc._ghost_sums`) and the right-hand sides (sum m w, sum m grad w) for the density and (sum V w u, sum V grad w u)
 for each velocity component u, the first-order value f_b = f_g + (r_b - g).grad f where
 |det A| >= ``determlimit``, else the Shepard value (sum m w / sum V w; sum V w u / sum V w) when
 sum V w > 0 (DualSPHysics's default determlimit 1e+3 is zeroth order everywhere; 1e-3 first order).
