@@ -987,17 +987,24 @@ class SPHRun:
             self.dtmin_run = 0
         excluded = sum(sol.n_excluded.values())
         new, self.excluded_seen = excluded - self.excluded_seen, excluded
-        if new > self.excluded_step_limit:
+        step_limit, base = self.excluded_step_limit, self.n0_fluid
+        if self.inout is not None:
+            # inlets create fluid: the limits count every fluid particle the run has had
+            base = self.n0_fluid + self.inout.counts["created"]
+            step_limit = max(step_limit, int(MAX_EXCLUDED_PER_STEP * sol.n_fluid))
+        if new > step_limit:
             raise DivergenceError(
-                f"t={sol.time:.6g} s, step {sol.nstep}: {new} of {self.n0_fluid} fluid particles excluded in one "
+                f"t={sol.time:.6g} s, step {sol.nstep}: {new} of {base} fluid particles excluded in one "
                 f"step (more than {MAX_EXCLUDED_PER_STEP:.0%} at once; dt {sol.last_dt:.3g} s); "
                 + self._last_excluded(events) + "; "
                 + self._exclusion_cause("the time step is far too large for the flow (DtFixed?) or the "
                                         "solution blew up"))
         limit = self.excluded_limit
+        if self.inout is not None:
+            limit = int(self.excluded_limit * base / max(1, self.n0_fluid))
         if excluded > limit:
             raise DivergenceError(
-                f"t={sol.time:.6g} s, step {sol.nstep}: {excluded} of {self.n0_fluid} fluid particles excluded "
+                f"t={sol.time:.6g} s, step {sol.nstep}: {excluded} of {base} fluid particles excluded "
                 f"(limit {limit}); " + self._last_excluded(events) + "; excluded so far: "
                 + self._excluded_by_reason() + "; " + self._exclusion_cause(self._divergence_hint()))
         if not np.isfinite(sol.last_dt) or sol.last_dt <= 0:

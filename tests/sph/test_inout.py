@@ -530,3 +530,19 @@ def test_a_slab_moves_exactly_under_verlet(tmp_path):
     assert int(fluid.sum()) == int((first["Type"] == 3).sum())
     assert np.abs(last["Vel"][fluid] - [1.0, 0.0, 0.0]).max() < 1e-9
     assert np.abs(last["Rhop"][fluid] - 1000.0).max() < 1e-6
+
+
+def test_the_exclusion_limit_counts_the_fluid_an_inlet_brings(tmp_path):
+    """An inlet with no outlet: the water leaves the domain at the far end, excluded for its position,
+    more than half the fluid the run started with; the run goes on, since the limit counts every
+    fluid particle the run has had (the initial ones and those the inlet created)."""
+    case = slab_case(tmp_path, inout=INLET.format(u=1.0, rin=0, refill=0), tmax=0.8,
+                     extra_params='<parameter key="WrnPartsOut" value="0" />')
+    out = tmp_path / "out"
+    r = run(case, out)
+    assert r.exit_code == 0, r.output
+    import json
+    info = json.loads((out / "run.json").read_text())
+    first = read_step(str(out / "particles.vtkhdf"), 0)
+    n0 = int((first["Type"] == 3).sum())
+    assert info["excluded"]["position"] > 0.5 * n0 and info["status"] == "completed"
