@@ -730,6 +730,8 @@ class ExclusionWarnings:
 class SPHRun:
     """One SPH run: the solver, its motion/body hook, the output schedule and the checks."""
 
+    inout = None            # the run's inlet/outlet zones (sphdvi.sph.inout.InOut), when the case has them
+
     @staticmethod
     def _place_paddles(motions, p: dict, fluidcount: int) -> None:
         """Each wave paddle learns where its front face is at rest (a focused piston counts its focus
