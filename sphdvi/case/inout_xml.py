@@ -361,8 +361,6 @@ def velocity_behaviour(vel: dict) -> str:
     return "reverse"
 
 
-BOUNDCORR_DIRECTIONS = DIRECTIONS
-
 
 def read_boundcorr(reader, el) -> dict:
     """``<special><boundcorr>`` (DualSPHysics's JSphBoundCorr, "used in combination with InOut"):
@@ -395,8 +393,9 @@ def read_boundcorr(reader, el) -> dict:
         zone = {"mkbound": mks, "line": z.sourceline}
         auto = reader.child(z, "autoconfig")
         if auto is not None:
-            name = reader.text_attr(auto, "direction", choices=set(BOUNDCORR_DIRECTIONS)).lower()
+            name = reader.text_attr(auto, "direction", choices=set(DIRECTIONS)).lower()
             zone["auto"] = name
+            zone["direction"] = list(map(float, DIRECTIONS[name]))
         else:
             d = reader.vec3(reader.child(z, "direction", True))
             if not np.any(d):

@@ -540,6 +540,9 @@ class InOut:
                            1 if zone["zsurf"].get("remove") else 0)
             self.points.append(pts + 0.5 * self.dp * n)
         self._coef_tables = [_coefficient_table(z["velocity"]) for z in zones]
+        # fixed or variable zsurf: (t, zsurf) rows, read once
+        self._zsurf_tables = [np.asarray(z["zsurf"]["rows"], float) if z["zsurf"]["mode"] in (0, 1) else None
+                              for z in zones]
         self.pts_all = np.concatenate([p for k, p in enumerate(self.points) if self.cfg[k, C_REFILL] == 2]
                                       or [np.zeros((0, 3))])
         self.pts_zone = np.concatenate([np.full(len(p), k, np.int64) for k, p in enumerate(self.points)
@@ -587,16 +590,17 @@ class InOut:
         geo[G_BOX] = 1.0 if box else 0.0
 
     # -- values in time ----------------------------------------------------------------------------
-    def update_time(self, t: float, state=None, gauge_args=None) -> None:
-        """The velocity profiles' coefficients and zsurf at time ``t``."""
+    def update_time(self, t: float, state=None) -> None:
+        """The velocity profiles' coefficients and zsurf at time ``t`` (a calculated zsurf measured in
+        ``state``)."""
         for k, zone in enumerate(self.spec["zones"]):
             tab = self._coef_tables[k]
             if tab is not None:
                 for c in range(3):
                     self.coef[k, c] = np.interp(t, tab[:, 0], tab[:, 1 + c])
             zs = zone["zsurf"]
-            if zs["mode"] in (0, 1):
-                rows = np.asarray(zs["rows"], float)
+            rows = self._zsurf_tables[k]
+            if rows is not None:
                 self.zsurf[k] = float(np.interp(t, rows[:, 0], rows[:, 1]))
             elif zs["mode"] == 2 and state is not None:
                 self.zsurf[k] = self._measured_zsurf(k, zs, state)
@@ -815,22 +819,17 @@ def boundcorr_normals(spec: dict, pos: np.ndarray, ptype: np.ndarray, label: np.
         if sel.size == 0:
             continue
         p = pos[sel]
+        d = np.asarray(z["direction"], float)
         if "auto" in z:
-            d = np.asarray(DIRECTIONS_XYZ[z["auto"]], float)
             limit = 0.5 * (p.min(axis=0) + p.max(axis=0))
             a = int(np.argmax(np.abs(d)))
             limit[a] = (p[:, a].max() if d[a] > 0 else p[:, a].min()) + 0.5 * dp * d[a]
+        elif "dpfactor" in z:
+            k = int(np.argmax(p @ d))
+            limit = p[k] + float(z["dpfactor"]) * dp * d
         else:
-            d = np.asarray(z["direction"], float)
-            if "dpfactor" in z:
-                k = int(np.argmax(p @ d))
-                limit = p[k] + float(z["dpfactor"]) * dp * d
-            else:
-                limit = np.asarray(z["limitpoint"], float)
+            limit = np.asarray(z["limitpoint"], float)
         depth = (limit - p) @ d
         normals[sel] = np.maximum(depth, 0.0)[:, None] * d[None, :]
     return normals
 
-
-DIRECTIONS_XYZ = {"top": (0, 0, 1), "bottom": (0, 0, -1), "right": (1, 0, 0), "left": (-1, 0, 0),
-                  "back": (0, 1, 0), "front": (0, -1, 0)}

@@ -703,25 +703,19 @@ class SPHSolver:
         ptype_rows, oi, _ = self._rows
         if self.inout is not None and not self._in_corrector:
             self._inout_impose(ptype_rows, oi)
-        if self._mdbc_now():
+        corr = self._wall_correction()
+        if corr is not None:
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             ncx, ncy, ncz = self.cells.shape
-            fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.normals, self.cells.cell_start,
-               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-               self.mdbc_ksum, s.rhop, self.slip, self.ghostvel, self.dp, self._tvel(s.n),
+            normals, threshold, ksum_min, slip, ghostvel = corr
+            fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, normals, self.cells.cell_start,
+               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, threshold,
+               ksum_min, s.rhop, slip, ghostvel, self.dp, self._tvel(s.n),
                self.wall_ace if self._wall_ace_on else self._no_wall_ace)
             if self.nopen and self._need_nopen:
                 self._nopen_detect(par, self.nb, ptype_rows, self.cell_sorted, oi, self.normals,
                                    s.vel, s.pos, self.npshift)
-        elif self.bc_normals is not None and not self._in_corrector:
-            # <boundcorr> (JSphBoundCorr): once a step, mDBC's SlipMode 1 density on the walls it lists
-            from . import mdbc
-            fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
-            ncx, ncy, ncz = self.cells.shape
-            fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, self.bc_normals, self.cells.cell_start,
-               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, self.bc_determlimit,
-               0.0, s.rhop, 1, 1, self.dp, self._no_tvel, self._no_wall_ace)
         if self.shift == 4 and self._need_shift_adv:
             # before the interaction, which reads the shift with ShiftAdvALE / NCPress
             self._advanced_shift(par, self.nb, ptype_rows, self.cell_sorted, oi, self.shiftpos, self.fstype,
@@ -786,6 +780,17 @@ class SPHSolver:
         Boundary=2, except in the Symplectic corrector without MDBCCorrector, where the
         walls keep the densities the predictor gave them (DualSPHysics's runmdbc)."""
         return self.boundary == 2 and (self.mdbc_corrector or not self._in_corrector)
+
+    def _wall_correction(self):
+        """The wall density correction this evaluation of the rates runs, as the arguments of
+        sphdvi.sph.mdbc.mdbc_serial (normals, threshold, ksum_min, slip, ghostvel): mDBC's
+        (:meth:`_mdbc_now`), or ``<boundcorr>``'s under DBC (SlipMode 1 with its determlimit, in
+        the predictor only: once a step, as JSphBoundCorr); None for neither."""
+        if self._mdbc_now():
+            return self.normals, 1e-3, self.mdbc_ksum, self.slip, self.ghostvel
+        if self.bc_normals is not None and not self._in_corrector:
+            return self.bc_normals, self.bc_determlimit, 0.0, 1, 1
+        return None
 
     @property
     def _mdbc2_flag(self):
@@ -860,24 +865,19 @@ class SPHSolver:
         ncx, ncy, ncz = self.cells.shape
         if self.inout is not None and not self._in_corrector:
             self._inout_impose(ptype_e, oi, nb=nb, prow=idx)
-        mdbc_now = self._mdbc_now()
-        boundcorr_now = not mdbc_now and self.bc_normals is not None and not self._in_corrector
-        if mdbc_now or boundcorr_now:
+        corr = self._wall_correction()
+        if corr is not None:
             # mDBC (or <boundcorr>) on the extended set: ghost copies see the fluid across the
             # periodic boundary; the real boundary particles keep their density
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
+            normals, threshold, ksum_min, slip, ghostvel = corr
             rhop_e = np.take(s.rhop, idx, out=w("rhop", ne, zero=False), mode="clip")
-            normals_e = np.ascontiguousarray((self.normals if mdbc_now else self.bc_normals)[idx])
+            normals_e = np.ascontiguousarray(normals[idx])
             wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
-            if mdbc_now:
-                fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
-                   self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, 1e-3,
-                   self.mdbc_ksum, rhop_e, self.slip, self.ghostvel, self.dp, self._tvel(ne), wace_e)
-            else:
-                fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
-                   self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, self.bc_determlimit,
-                   0.0, rhop_e, 1, 1, self.dp, self._no_tvel, self._no_wall_ace)
+            fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
+               self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, threshold,
+               ksum_min, rhop_e, slip, ghostvel, self.dp, self._tvel(ne), wace_e)
             # a copy's ghost node sees a truncated extended set: it takes its real particle's result
             real_e = order < n
             row_of = np.empty(n, np.int64)
@@ -885,7 +885,7 @@ class SPHSolver:
             mdbc.copy_to_periodic_rows(self.is2d, nb, ptype_e, row_of[idx], self._tvel(ne))
             bound = real_e & (ptype_e != 3)
             s.rhop[order[bound]] = rhop_e[bound]
-            if mdbc_now and self.nopen and self._need_nopen:
+            if self.nopen and self._need_nopen:
                 npshift = w("npshift", ne, self.npshift.shape[1:])
                 pos_e = np.take(unsorted, order, axis=0, out=w("pos", ne, (3,), zero=False), mode="clip")
                 vel_e = np.take(s.vel, idx, axis=0, out=w("vel", ne, (3,), zero=False), mode="clip")

@@ -138,6 +138,7 @@ def test_boundcorr_is_read(tmp_path):
     bc = read_case_h5(find_case_file(str(out)))["json"]["special"]["boundcorr"]
     assert bc["determlimit"] == 1e-3
     assert bc["zones"][0]["mkbound"] == [0] and bc["zones"][0]["auto"] == "top"
+    assert bc["zones"][0]["direction"] == [0.0, 0.0, 1.0]
     assert bc["zones"][1]["dpfactor"] == 0.5 and bc["zones"][1]["direction"] == [0.0, 0.0, -1.0]
 
 

@@ -464,9 +464,9 @@ def test_boundcorr_normals_reach_the_limit_plane():
     pos = np.vstack([bottom, top, [[0.2, 0.0, 0.5]]])
     ptype = np.r_[np.zeros(30, np.int8), np.int8(3)]
     label = np.r_[np.zeros(15, int), np.ones(15, int), 5]
-    for spec, want_top in (({"zones": [{"mkbound": [0], "auto": "top"},
+    for spec, want_top in (({"zones": [{"mkbound": [0], "auto": "top", "direction": [0, 0, 1.0]},
                                         {"mkbound": [1], "direction": [0, 0, -1.0], "dpfactor": 0.5}]}, 0.95),
-                           ({"zones": [{"mkbound": [0], "auto": "top"},
+                           ({"zones": [{"mkbound": [0], "auto": "top", "direction": [0, 0, 1.0]},
                                         {"mkbound": [1], "direction": [0, 0, -1.0], "limitpoint": [0, 0, 0.9]}]}, 0.9)):
         n = IO.boundcorr_normals(spec, pos, ptype, label, dp)
         assert np.allclose(n[:15, :2], 0) and np.allclose(n[:15, 2], -0.05 - pos[:15, 2])     # plane z = -0.05
