@@ -731,6 +731,7 @@ class SPHRun:
     """One SPH run: the solver, its motion/body hook, the output schedule and the checks."""
 
     inout = None            # the run's inlet/outlet zones (sphdvi.sph.inout.InOut), when the case has them
+    relax = ()              # the run's relaxation zones (sphdvi.sph.relaxzones), when the case has them
 
     @staticmethod
     def _place_paddles(motions, p: dict, fluidcount: int) -> None:
@@ -830,9 +831,11 @@ class SPHRun:
             self.bodies.defer_warnings = True        # its lines come through take_step_warnings
         self.body_names = self.floating.names if self.floating is not None else None
         self.damping = damping_zones(js.get("special", {}).get("damping", []))
+        self.relax = self._relaxation_zones(js.get("special", {}).get("relaxationzones"), state, c, params)
         from .wave_absorption import piston_absorbers
         self.absorbers = piston_absorbers(motions, data, params) if self.moving is not None else []
-        hook = self._hook if (self.moving is not None or self.floating is not None or self.damping) else None
+        hook = (self._hook if (self.moving is not None or self.floating is not None or self.damping or self.relax)
+                else None)
         dt_table = None
         if str(params.get("DtFixedFile", "NONE")).upper() != "NONE":
             from .case.datafiles import read_dt_table
@@ -866,6 +869,22 @@ class SPHRun:
         self.dtmin_warn_at = 1          # the next count of DtMin steps warned about (1, 10, 100, ...)
         self.step_warnings = []         # lines for run.log (and stderr) found by check()
         self.out_faces = set()          # faces of the domain that fluid excluded for its position crossed
+
+    def _relaxation_zones(self, specs, state, c: dict, params: dict) -> list:
+        """``<special><relaxationzones>`` (sphdvi.sph.relaxzones): the zones, their ``<savemotion>`` files
+        written; a zone that holds no fluid at the start is warned about (it would make no waves)."""
+        if not specs:
+            return []
+        from .sph.relaxzones import relaxation_zones
+        zones = relaxation_zones(specs, g=float(np.linalg.norm(c["gravity"])))
+        for zone in zones:
+            if zone.count_inside(state) == 0:
+                warnings.warn(f"<relaxationzones> {zone.name}: the zone holds no fluid particle at the start, so it "
+                              "relaxes nothing (expected a <center> and <width>, or a <domainbox>, over the water)")
+        if any(z.spec.get(k) for z in zones for k in ("savemotion", "saveserie", "saveseriewaves")):
+            from .io.paddle_motion import write_relaxzone_motions
+            write_relaxzone_motions(self.outdir, zones, float(params["TimeMax"]), float(params["TimeOut"]))
+        return zones
 
     def _bound_corr(self, spec, p: dict, c: dict, fluidcount: int):
         """``<special><boundcorr>``: (normals, determlimit) for the solver (sphdvi.sph.inout.boundcorr_normals),
@@ -922,7 +941,7 @@ class SPHRun:
 
     def _hook(self, solver, t, dt):
         """The end of each step: absorbing pistons' corrections, imposed motions, floating bodies,
-        damping zones."""
+        damping zones, relaxation zones (at the step's end time t)."""
         for absorber in self.absorbers:      # the gauge in front of the piston where it stands
             absorber.update(t, dt, absorber.measure(solver.state, t - dt) if absorber.absorbs(t, dt) else math.nan)
         if self.moving is not None:
@@ -932,6 +951,8 @@ class SPHRun:
             self.floating.step(solver, dt)
         for zone in self.damping:
             zone.apply(solver.state, dt)
+        for zone in self.relax:
+            zone.apply(solver.state, t, dt)
 
     def _check_moving_in_domain(self, solver) -> None:
         """Stop the run (DivergenceError, exit 3) when a moving boundary particle has left the

@@ -155,7 +155,7 @@ def _read_shape(reader, el, dim: int) -> dict:
         shape["direction"] = _direction(reader, reader.child(c, "direction", True), 3)
     rot = reader.child(c, "rotate") if dim == 2 else reader.child(c, "rotateaxis")
     if rot is not None:
-        shape["rotation"] = _read_rotation(reader, rot, dim, shape)
+        shape["rotation"] = read_rotation(reader, rot, dim, shape)
     return shape
 
 
@@ -173,7 +173,7 @@ def _angle(reader, rot) -> float:
     return a if units == "radians" else math.radians(a)
 
 
-def _read_rotation(reader, rot, dim: int, shape: dict) -> dict:
+def read_rotation(reader, rot, dim: int, shape: dict) -> dict:
     """2D ``<rotate angle [centerx centerz] anglesunits>`` (about y through the centre, the first
     point by default; the particles' origin for ``<particles>``), 3D ``<rotateaxis angle
     anglesunits>`` with ``<point1>``, ``<point2>`` (JSphInOutPoints::ReadRotate2D/3D)."""
@@ -192,7 +192,7 @@ def _read_rotation(reader, rot, dim: int, shape: dict) -> dict:
     return {"angle": angle, "p1": p1, "p2": p2}
 
 
-def _table_rows(reader, lis, cols: tuple) -> list:
+def table_rows(reader, lis, cols: tuple) -> list:
     rows = []
     for t in reader.children(lis, "timevalue"):
         rows.append([reader.num(t, "time")] + [reader.num(t, k) for k in cols])
@@ -263,7 +263,7 @@ def _read_velocity(reader, el) -> dict:
         kind, suffix = found[0]
         c = reader.child(el, "velocity" + kind + suffix)
         cols = PROFILES[suffix]
-        rows = (_table_rows(reader, c, cols) if kind == "times"
+        rows = (table_rows(reader, c, cols) if kind == "times"
                 else _file_rows(reader, c, len(cols), f"<velocityfile{suffix}>"))
     prof = {"mode": mode, "profile": PROFILE_NAMES[suffix], "rows": rows}
     for r in rows:
@@ -307,7 +307,7 @@ def _read_zsurf(reader, el) -> dict:
         if (lis is None) == (f is None):
             raise reader.error(el, "no variable zsurf definition" if lis is None else "several zsurf definitions",
                                "one of <zsurftimes> or <zsurffile>")
-        out["rows"] = _table_rows(reader, lis, ("zsurf",)) if lis is not None else _file_rows(reader, f, 1,
+        out["rows"] = table_rows(reader, lis, ("zsurf",)) if lis is not None else _file_rows(reader, f, 1,
                                                                                                 "<zsurffile>")
     else:
         reader.check_children(el, {"remove", "savevtk", "zsurfmin", "zsurffit", "zsurf", "zbottom"})

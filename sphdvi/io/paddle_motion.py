@@ -15,7 +15,10 @@ period (one per TimeOut by default); an irregular or focused one's ``time`` (Tim
 
 An irregular paddle's ``<saveserie timemin timemax timedt xpos>`` writes the same columns over that window
 to ``PaddleSerie_mkbound<mk>.csv``; its ``<saveseriewaves timemin timemax xpos>`` the waves of the theory's
-elevation there by zero up-crossing (start, period, height) to ``PaddleSerieWaves_mkbound<mk>.csv``."""
+elevation there by zero up-crossing (start, period, height) to ``PaddleSerieWaves_mkbound<mk>.csv``.
+
+A wave relaxation zone's lines (``<rzwaves_regular>``, ``<rzwaves_spectrum>``) write the same files
+without the stroke's columns, named ``RelaxZone...`` (:func:`write_relaxzone_motions`)."""
 from __future__ import annotations
 
 import math
@@ -62,11 +65,14 @@ def theory_elevation(paddle, distance: float, t: np.ndarray) -> np.ndarray:
 def theory_table(paddle, t: np.ndarray, entry: dict) -> tuple[list, np.ndarray]:
     """(column names, rows) of the paddle's theory at the times ``t``: displacement, rate, a flap's
     angle, the elevation at ``entry["xpos"]`` and with ``entry["zpos"]`` the velocity there."""
-    x, v = np.array([paddle.theory_position(ti) for ti in t]).T.reshape(2, -1)
-    names, cols = ["time [s]", "stroke [m]", "stroke_vel [m/s]"], [t, x, v]
-    if paddle.kind == "flap":
-        names.append("angle [deg]")
-        cols.append(np.degrees(np.arctan2(x, paddle.hinge_depth)))
+    names, cols = ["time [s]"], [t]
+    if getattr(paddle, "has_stroke", True):     # a relaxation zone has none
+        x, v = np.array([paddle.theory_position(ti) for ti in t]).T.reshape(2, -1)
+        names += ["stroke [m]", "stroke_vel [m/s]"]
+        cols += [x, v]
+        if paddle.kind == "flap":
+            names.append("angle [deg]")
+            cols.append(np.degrees(np.arctan2(x, paddle.hinge_depth)))
     distance = entry.get("xpos", 0.0) - paddle.face
     names.append("eta [m]")
     cols.append(theory_elevation(paddle, distance, t))
@@ -102,21 +108,47 @@ def _write(outdir: str, name: str, names: list, rows: np.ndarray) -> None:
     write_text_atomic(os.path.join(outdir, name), "\n".join(lines) + "\n")
 
 
+def _write_theory_files(outdir: str, maker, names: tuple, tmax: float, tout: float) -> list[str]:
+    """The ``<savemotion>`` files, ``<saveserie>`` and ``<saveseriewaves>`` of one wave maker (a paddle or
+    a relaxation zone); ``names``: (the n-th savemotion file's name as a function of n, the serie's file,
+    the serie waves' file)."""
+    motion_name, serie_name, waves_name = names
+    written, spec = [], maker.spec
+    for n, entry in enumerate(spec.get("savemotion") or [], start=1):
+        written.append(motion_name(n))
+        _write(outdir, written[-1], *motion_table(maker, entry, float(tmax), float(tout)))
+    if spec.get("saveserie"):
+        e = spec["saveserie"]
+        t = time_grid(e["timemin"], e["timemax"], e["timedt"])
+        written.append(serie_name)
+        _write(outdir, written[-1], *theory_table(maker, t, e))
+    if spec.get("saveseriewaves"):
+        written.append(waves_name)
+        _write(outdir, written[-1], *serie_waves_table(maker, spec["saveseriewaves"]))
+    return written
+
+
 def write_paddle_motions(outdir: str, motions, tmax: float, tout: float) -> list[str]:
     """Write the files of every paddle's ``<savemotion>`` lines, ``<saveserie>`` and ``<saveseriewaves>``
     (``motions``: a :class:`sphdvi.motion.MotionSet`, its paddles placed); the names written."""
     written = []
     for mkb, paddle in sorted(motions.paddles.items()):
-        spec = paddle.spec
-        for n, entry in enumerate(spec.get("savemotion") or [], start=1):
-            written.append(file_name(mkb, n))
-            _write(outdir, written[-1], *motion_table(paddle, entry, float(tmax), float(tout)))
-        if spec.get("saveserie"):
-            e = spec["saveserie"]
-            t = time_grid(e["timemin"], e["timemax"], e["timedt"])
-            written.append(f"PaddleSerie_mkbound{mkb}.csv")
-            _write(outdir, written[-1], *theory_table(paddle, t, e))
-        if spec.get("saveseriewaves"):
-            written.append(f"PaddleSerieWaves_mkbound{mkb}.csv")
-            _write(outdir, written[-1], *serie_waves_table(paddle, spec["saveseriewaves"]))
+        written += _write_theory_files(outdir, paddle, (lambda n, mkb=mkb: file_name(mkb, n),
+                                                        f"PaddleSerie_mkbound{mkb}.csv",
+                                                        f"PaddleSerieWaves_mkbound{mkb}.csv"), tmax, tout)
+    return written
+
+
+def write_relaxzone_motions(outdir: str, zones, tmax: float, tout: float) -> list[str]:
+    """The same files of the wave relaxation zones (:class:`sphdvi.sph.relaxzones.WaveZone`, numbered from 1
+    in the case's order): ``RelaxZoneMotion_<zone>_<n>.csv`` (time, the theory's elevation at ``xpos``
+    and with ``zpos`` its velocity there, ``xpos`` a coordinate whose distance from the zone's centre
+    counts), ``RelaxZoneSerie_<zone>.csv`` and ``RelaxZoneSerieWaves_<zone>.csv``."""
+    written = []
+    for zone in zones:
+        if hasattr(zone, "theory"):
+            z = zone.number
+            written += _write_theory_files(outdir, zone, (lambda n, z=z: f"RelaxZoneMotion_{z}_{n}.csv",
+                                                          f"RelaxZoneSerie_{z}.csv", f"RelaxZoneSerieWaves_{z}.csv"),
+                                           tmax, tout)
     return written

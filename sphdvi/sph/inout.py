@@ -439,7 +439,7 @@ def refill_columns(pts, ptzone, geo, zsurf, pos, rows, rowzone, dp, depth_out):
             depth_out[k] = dmax
 
 
-def _rotation_matrix(axis_p1, axis_p2, angle):
+def rotation_matrix(axis_p1, axis_p2, angle):
     """Rotation by ``angle`` (radians) about the axis through p1 and p2 (right hand): (R, t) with
     x' = R x + t."""
     p1 = np.asarray(axis_p1, float)
@@ -484,7 +484,7 @@ def zone_points(shape: dict, dp: float, particles: dict | None) -> tuple[np.ndar
         pts = np.concatenate(rows)
     rot = shape.get("rotation")
     if rot is not None and rot["angle"] != 0.0:
-        r, t = _rotation_matrix(rot["p1"], rot["p2"], rot["angle"])
+        r, t = rotation_matrix(rot["p1"], rot["p2"], rot["angle"])
         p0 = pts[0].copy() if len(pts) else np.zeros(3)
         pts = pts @ r.T + t
         d = (r @ (p0 + d) + t) - (r @ p0 + t)
