@@ -8,7 +8,7 @@ stepping (``runtime_s`` of run.json: without start-up and JIT), µs per particle
 and whether they meet the target; after each case the observed order of its headline error
 between successive resolutions, log(e1/e2)/log(dp1/dp2).
 
-    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3, W5, W6, W7, W8, C3)
+    python tools/validate.py                 # the fast cases (S1/S2, S3, S3M, S5, S5M, S7, S9, S10, S11, S12, S13, A1, W1, W2, W3, W5, W6, W7, W8, W10, W11, C3)
     python tools/validate.py S3 S7 --threads 2
     python tools/validate.py --all           # with the slow S4 (Lobovsky; dp 2.5 mm takes ~12 min on 2 threads), S8 (sloshing)
                                              # and S16 (floating box in waves; dp 0.02 ~2 min, dp 0.005 took 1 h 52 min on 2 threads);
@@ -17,7 +17,8 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
                                              # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
                                              # W9: W4's sea generated to second order (the same times)
-    python tools/validate.py W3 --fine       # also the resolutions run only on request (W3 depth/dp 40, dp 0.01: ~15 min on 2 threads)
+    python tools/validate.py W3 --fine       # also the resolutions run only on request (W3 depth/dp 40, dp 0.01: ~15 min on 2 threads;
+                                             # W10 H/dp 6, dp 0.005)
     python tools/validate.py S9 --csv s9.csv --keep runs/
     python tools/validate.py S16M --dp 0.02 --dp 0.01 --threads 2     # some of a case's resolutions
     python tools/validate.py S3 S7 --constant coefh=1.2                # the case files with another constant
@@ -385,6 +386,23 @@ def cases() -> list:
              and abs(e["H_incident"]) <= 0.10,
              "the paddle reflects what linear theory says its absorber should (within 0.1; a still piston: 1), "
              "and the wave leaving it stays within 10 % of H (judgement)"),
+        Case("W10", "wave flume: relaxation zone (<relaxationzones><rzwaves_regular>, Altomare et al. 2018) on "
+             "the closed end, W1's waves", case_path("waveflume2d", "CaseWaveRelaxZone2D_Def.xml"),
+             [Resolution("H/dp 1.5", 0.02), Resolution("H/dp 3", 0.01), Resolution("H/dp 6", 0.005, on_request=True)],
+             score_wave_flume, [("H inc err %", "H_incident", PCT), ("refl %", "reflection", "{:.1f} %"),
+                                ("H WG1 %", "H_WG1", PCT), ("H WG3 %", "H_WG3", PCT),
+                                ("celerity %", "celerity", PCT), ("vs still depth %", "celerity_still_depth", PCT)],
+             "H_incident", lambda e: abs(e["H_incident"]) <= 0.10,
+             "incident wave height within 10 % of the target (judgement, as W1)"),
+        Case("W11", "relaxation zone in the W5 flume closed by a wall: the zone takes out the wave coming back",
+             case_path("waveflume2d", "CaseWaveRelaxZoneWall2D_Def.xml"),
+             [Resolution("H/dp 1.5", 0.02), Resolution("H/dp 3", 0.01)],
+             score_absorption, [("R zone", "reflection", "{:.3f}"), ("R spread", "reflection_spread", "{:.3f}"),
+                                ("H inc err %", "H_incident", PCT), ("H before %", "H_before", PCT),
+                                ("H back/H", "H_returning", "{:.2f}")],
+             "reflection", lambda e: e["reflection"] <= 0.1 and abs(e["H_incident"]) <= 0.10,
+             "the zone reflects at most 10 % of the wave coming back (a still wall: 1), and the wave leaving it "
+             "stays within 10 % of H (judgement)"),
         Case("W6", "solitary wave from a piston (<piston_solitary>, Goring 1978: H = 0.02 m in h = 0.1 m)",
              case_path("waveflume2d", "CaseWaveSolitary2D_Def.xml"),
              [Resolution("h/dp 10", 0.01), Resolution("h/dp 20", 0.005)],
