@@ -23,8 +23,7 @@ Refused: ``<rzwaves_external_1d>`` (velocities from another model's files, whose
 does not document).
 """
 from .inout_xml import read_rotation, table_rows
-from .wavepaddles_xml import (_read_savemotion, _read_serie_window, _read_spectrum_options, _value_children,
-                              wave_validity_warnings)
+from .wavepaddles_xml import _read_spectrum_options, _value_children, read_theory_outputs, wave_validity_warnings
 
 COMMON = {"start": "num", "duration": "num", "coefdt": "num", "function": "raw"}
 WAVES = {**COMMON, "waveorder": "int", "waveheight": "num", "waveperiod": "num", "depth": "num", "swl": "num",
@@ -112,16 +111,7 @@ def _read_waves(reader, c, d: dict) -> None:
     for k in ("ramp", "ramptime"):
         if d.get(k, 0.0) < 0:
             raise reader.error(reader.child(c, k), f"<{k}> value={d[k]:g} is negative", f"{k} >= 0")
-    if "savemotion" in d:
-        d["savemotion"] = _read_savemotion(reader, c, d, spectral)
-    if "calcserielength" in d:
-        el = reader.child(c, "calcserielength")
-        reader.mark(el, "comment")
-        d["calcserielength"] = reader.num(el, "timemax", positive=True)
-    for k, attrs in (("saveserie", ("timemin", "timemax", "timedt", "xpos")),
-                     ("saveseriewaves", ("timemin", "timemax", "xpos"))):
-        if k in d:
-            d[k] = _read_serie_window(reader, reader.child(c, k), attrs)
+    read_theory_outputs(reader, c, d, spectral)
     try:
         from ..sph.relaxzones import wave_theory
         wave_theory(d)

@@ -111,16 +111,7 @@ def read_wavepaddles(reader, el) -> list:
         if "usefiledata" in d:
             reader.warn(reader.child(c, "usefiledata"), "<usefiledata> is not implemented by sphdvi: the paddle "
                         "follows the regular-wave theory; <usefiledata> is ignored")
-        if "savemotion" in d:
-            d["savemotion"] = _read_savemotion(reader, c, d, spectral)
-        if "calcserielength" in d:
-            el = reader.child(c, "calcserielength")
-            reader.mark(el, "comment")
-            d["calcserielength"] = reader.num(el, "timemax", positive=True)
-        for k, attrs in (("saveserie", ("timemin", "timemax", "timedt", "xpos")),
-                         ("saveseriewaves", ("timemin", "timemax", "xpos"))):
-            if k in d:
-                d[k] = _read_serie_window(reader, reader.child(c, k), attrs)
+        read_theory_outputs(reader, c, d, spectral)
         if d.get("fixeddepth", 0.0):
             reader.warn(reader.child(c, "fixeddepth"), "<fixeddepth> (the fluid depth without the paddle) is not "
                         "implemented by sphdvi: the stroke follows <depth>; <fixeddepth> is ignored")
@@ -321,6 +312,22 @@ def _read_savemotion(reader, c, d: dict, spectral: bool) -> list:
                     raise reader.error(el, f"{k}={e[k]:g}", f"{k} > 0")
         out.append(e)
     return out
+
+
+def read_theory_outputs(reader, c, d: dict, spectral: bool) -> None:
+    """A wave maker's outputs of its theory (in place): ``<savemotion>`` lines, and an irregular one's
+    ``<calcserielength timemax>``, ``<saveserie>`` and ``<saveseriewaves>`` (a paddle's or a
+    relaxation zone's)."""
+    if "savemotion" in d:
+        d["savemotion"] = _read_savemotion(reader, c, d, spectral)
+    if "calcserielength" in d:
+        el = reader.child(c, "calcserielength")
+        reader.mark(el, "comment")
+        d["calcserielength"] = reader.num(el, "timemax", positive=True)
+    for k, attrs in (("saveserie", ("timemin", "timemax", "timedt", "xpos")),
+                     ("saveseriewaves", ("timemin", "timemax", "xpos"))):
+        if k in d:
+            d[k] = _read_serie_window(reader, reader.child(c, k), attrs)
 
 
 def _read_serie_window(reader, el, attrs) -> dict:
