@@ -153,8 +153,3 @@ def _read_uniform(reader, c, d: dict) -> None:
     elif "velocity" not in d:
         raise reader.error(c, "missing <velocity> or <velocitytimes>", "<velocity value=\"0.3\"/> or a "
                            "<velocitytimes> table of <timevalue time v/> rows")
-
-
-def zone_name(spec: dict, n: int) -> str:
-    """How messages name the n-th zone (from 1): ``<rzwaves_regular> 1``."""
-    return f"<{spec['type']}> {n}"
