@@ -195,12 +195,30 @@ class WaveZone(_Zone):
             self.amp = np.array([0.5 * th.height])
             self.omega, self.k = np.array([th.omega]), np.array([th.k])
             self.phase, self.t0 = np.array([th.phase]), 0.0
-            self.order2 = spec.get("waveorder", 1) == 2
         else:
             self.ramp_time = float(spec.get("ramptime", 0.0))
             self.amp, self.omega, self.k = th.amp, th.omega, th.k
             self.phase, self.t0 = th.phase, th.t0
-            self.order2 = False
+        self._set_components(spec.get("waveorder", 1) == 2 and spec["type"] == "rzwaves_regular")
+
+    def _set_components(self, bound_harmonic: bool) -> None:
+        """The kernel's terms, fixed but for the ramp and the phase: a ω, k, the frequency and the phase of
+        each wave (and of Stokes's bound harmonic of a second-order regular wave, as
+        WavePaddle.orbital_velocity: (3/16) H² ω k cosh 2k(z+d)/sinh⁴ kd = a2 cosh K(z+d)/sinh Kd with K = 2k,
+        a2 = (3/16) H² ω k · 2 cosh kd/sinh³ kd, at twice the wave's frequency and phase); the drift's
+        c_d a² ω k and 2k."""
+        amp_w, wk, freq, phase = self.amp * self.omega, self.k, self.omega, self.phase
+        if bound_harmonic:
+            from ..motion import _coth_over_sinh2
+            th = self.theory
+            a2 = 0.1875 * th.height ** 2 * th.omega * th.k * 2.0 * _coth_over_sinh2(th.k * th.depth)
+            amp_w, wk = np.append(amp_w, a2), np.append(wk, 2.0 * th.k)
+            freq, phase = np.append(freq, 2.0 * th.omega), np.append(phase, 2.0 * th.phase)
+        self._amp_w, self._wk, self._freq, self._phase = amp_w, wk, freq, phase
+        if self.drift > 0:
+            self._drift_c, self._drift_k = self.drift * self.amp ** 2 * self.omega * self.k, 2.0 * self.k
+        else:
+            self._drift_c, self._drift_k = np.zeros(0), np.zeros(0)
 
     # what sphdvi.io.paddle_motion reads of a wave maker
     kind = "relaxzone"
@@ -216,24 +234,11 @@ class WaveZone(_Zone):
         return 1.0 if self.ramp_time <= 0 or tau >= self.ramp_time else tau / self.ramp_time
 
     def components(self, tau: float):
-        """(a ω, k, θ at the centre, drift coefficients, drift wave numbers) at τ, under the ramp."""
+        """(a ω, k, θ at the centre, drift coefficients, drift wave numbers) at τ, under the ramp (the
+        drift, of the waves' height squared, under its square)."""
         r = self.ramp(tau)
-        theta0 = self.omega * (tau + self.t0) + self.phase
-        amp_w, wk = r * self.amp * self.omega, self.k
-        if self.order2:                     # Stokes's bound harmonic (as WavePaddle.orbital_velocity)
-            from ..motion import _coth_over_sinh2
-            th = self.theory
-            kd = th.k * th.depth
-            # (3/16) H² ω k cosh 2k(z+d)/sinh⁴ kd = a2 cosh K(z+d)/sinh Kd, K = 2k: a2 = (3/16) H² ω k 2 cosh kd/sinh³ kd
-            a2 = 0.1875 * th.height ** 2 * th.omega * th.k * 2.0 * _coth_over_sinh2(kd)
-            amp_w = np.append(amp_w, r * a2)
-            wk = np.append(wk, 2.0 * th.k)
-            theta0 = np.append(theta0, 2.0 * theta0[0])
-        if self.drift > 0:
-            drift_c, drift_k = self.drift * r * r * self.amp ** 2 * self.omega * self.k, 2.0 * self.k
-        else:
-            drift_c, drift_k = np.zeros(0), np.zeros(0)
-        return amp_w, wk, theta0, drift_c, drift_k
+        return (r * self._amp_w, self._wk, self._freq * (tau + self.t0) + self._phase, r * r * self._drift_c,
+                self._drift_k)
 
     def _apply(self, state, tau: float, factor: float) -> None:
         amp_w, wk, theta0, drift_c, drift_k = self.components(tau)
@@ -243,22 +248,6 @@ class WaveZone(_Zone):
 
     def inside(self, pos: np.ndarray) -> np.ndarray:
         return np.abs(np.asarray(pos)[:, 0] - self.centre[0]) <= self.halfw
-
-    def target_velocity(self, pos: np.ndarray, t: float) -> np.ndarray:
-        """v_T at ``pos`` (numpy; the tests' reference): (u, 0, w), the drift subtracted."""
-        tau = self.clock(t) or 0.0
-        amp_w, wk, theta0, drift_c, drift_k = self.components(tau)
-        x = np.asarray(pos)[:, 0] - self.centre[0]
-        z = np.asarray(pos)[:, 2] - self.swl
-        out = np.zeros((len(x), 3))
-        for a, k, t0 in zip(amp_w, wk, theta0):
-            ch = np.cosh(k * (z + self.depth)) / np.sinh(k * self.depth)
-            sh = np.sinh(k * (z + self.depth)) / np.sinh(k * self.depth)
-            out[:, 0] += a * ch * np.cos(t0 - k * x)
-            out[:, 2] -= a * sh * np.sin(t0 - k * x)
-        for c, kk in zip(drift_c, drift_k):
-            out[:, 0] -= c * np.cosh(kk * (z + self.depth)) / (2.0 * np.sinh(0.5 * kk * self.depth) ** 2)
-        return out
 
 
 class UniformZone(_Zone):

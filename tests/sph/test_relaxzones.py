@@ -36,6 +36,20 @@ def column(x, zs, vel=None, ptype=FLUID):
     return FluidState(pos, v, mass=1.0, ptype=np.full(len(zs), ptype))
 
 
+def target_velocity(zone, pos, t):
+    """v_T of a wave zone at ``pos`` in numpy, with cosh and sinh (the kernel uses exponentials):
+    (u, 0, w), the drift c cosh K(z+d)/(2 sinh² (K d/2)) subtracted."""
+    amp_w, wk, theta0, drift_c, drift_k = zone.components(zone.clock(t) or 0.0)
+    x, z, d = pos[:, 0] - zone.centre[0], pos[:, 2] - zone.swl, zone.depth
+    out = np.zeros((len(x), 3))
+    for a, k, t0 in zip(amp_w, wk, theta0):
+        out[:, 0] += a * np.cosh(k * (z + d)) / np.sinh(k * d) * np.cos(t0 - k * x)
+        out[:, 2] -= a * np.sinh(k * (z + d)) / np.sinh(k * d) * np.sin(t0 - k * x)
+    for c, kk in zip(drift_c, drift_k):
+        out[:, 0] -= c * np.cosh(kk * (z + d)) / (2.0 * np.sinh(0.5 * kk * d) ** 2)
+    return out
+
+
 ZS = np.linspace(0.005, 0.33, 12)       # through the depth, and above the still water (a crest)
 
 
@@ -85,7 +99,7 @@ def test_across_the_zone_the_weight_blends_target_and_own_velocity():
     v0 = np.array([0.2, 0.0, -0.1])
     for x in (0.55, 0.8, 1.25, 1.5):
         st = column(x, ZS, vel=v0)
-        target = zone.target_velocity(st.pos, 0.9)
+        target = target_velocity(zone, st.pos, 0.9)
         zone.apply(st, 0.9, 1e-4)
         f = weight((x - 1.0) / 0.5)
         assert np.allclose(st.vel[:, 0], f * target[:, 0] + (1 - f) * v0[0], rtol=1e-12, atol=1e-15)
@@ -104,7 +118,7 @@ def test_the_step_factor_is_coefdt_dt_held_at_one_and_scaled_by_coefdir():
     for coefdt, dt, factor in ((1000.0, 1e-4, 0.1), (1000.0, 5e-3, 1.0), (0.0, 1e-4, 1.0)):
         zone = WaveZone(regular(coefdt=coefdt, coefdir=[0.5, 0.0, 0.25]), 1)
         st = column(1.0, ZS, vel=v0)
-        target = zone.target_velocity(st.pos, 0.9)
+        target = target_velocity(zone, st.pos, 0.9)
         zone.apply(st, 0.9, dt)
         assert np.allclose(st.vel[:, 0], 0.5 * factor * target[:, 0] + (1 - 0.5 * factor) * v0[0], rtol=1e-12)
         assert np.allclose(st.vel[:, 2], 0.25 * factor * target[:, 2] + (1 - 0.25 * factor) * v0[2], rtol=1e-12)
