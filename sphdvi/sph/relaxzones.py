@@ -85,11 +85,14 @@ def _zone_weight(s, psi, beta, fsub, fdiv):
 
 @njit(cache=True, parallel=True)
 def _relax_waves(pos, vel, ptype, xc, halfw, psi, beta, fsub, fdiv, cx, cz, swl, depth,
-                 amp_w, wk, theta0, drift_c, drift_k):
+                 amp_w, wk, theta0, qd, inv_den, drift_c):
     """The wave zones' relaxation (module docstring) over every fluid particle with |x − x_c| ≤ halfw:
-    components i of amplitude·ω ``amp_w``, wave number ``wk`` and phase at x_c ``theta0``; drift terms
-    c_j (e^{K z} + e^{−K(2d + z)})/(1 − e^{−K d})², K = 2k ``drift_k``; cx, cz already times the step's
-    factor."""
+    components c of amplitude·ω ``amp_w``, wave number k ``wk`` and phase at x_c ``theta0``, with
+    q = e^{−2kd} ``qd`` and 1/(1 − q) ``inv_den``: cosh k(z+d)/sinh kd = (e^{kz} + q e^{−kz})/(1 − q), one
+    exponential a component.  The drift of the first len(drift_c) components, c_j cosh 2k(z+d)/(2 sinh² kd)
+    = c_j (e^{2kz} + q² e^{−2kz})/(1 − q)², from the same exponential.  cx, cz already times the step's factor.
+    Where e^{kz} underflows (k z < −745, deep below a short wave) both terms are below e^{−kd}: left out."""
+    ndrift = drift_c.shape[0]
     for i in prange(pos.shape[0]):
         if ptype[i] != FLUID:
             continue
@@ -104,15 +107,15 @@ def _relax_waves(pos, vel, ptype, xc, halfw, psi, beta, fsub, fdiv, cx, cz, swl,
         for c in range(wk.shape[0]):
             k = wk[c]
             ez = math.exp(k * z)
-            em = math.exp(-k * (2.0 * depth + z))
-            den = -math.expm1(-2.0 * k * depth)
+            if ez == 0.0:
+                continue
+            em = qd[c] / ez
             th = theta0[c] - k * x
-            u += amp_w[c] * (ez + em) / den * math.cos(th)
-            w -= amp_w[c] * (ez - em) / den * math.sin(th)
-        for c in range(drift_k.shape[0]):
-            kk = drift_k[c]
-            den = -math.expm1(-kk * depth)
-            u -= drift_c[c] * (math.exp(kk * z) + math.exp(-kk * (2.0 * depth + z))) / (den * den)
+            a = amp_w[c] * inv_den[c]
+            u += a * (ez + em) * math.cos(th)
+            w -= a * (ez - em) * math.sin(th)
+            if c < ndrift:
+                u -= drift_c[c] * (ez * ez + em * em) * inv_den[c] * inv_den[c]
         fx = f * cx
         fz = f * cz
         vel[i, 0] = fx * u + (1.0 - fx) * vel[i, 0]
@@ -215,6 +218,8 @@ class WaveZone(_Zone):
             amp_w, wk = np.append(amp_w, a2), np.append(wk, 2.0 * th.k)
             freq, phase = np.append(freq, 2.0 * th.omega), np.append(phase, 2.0 * th.phase)
         self._amp_w, self._wk, self._freq, self._phase = amp_w, wk, freq, phase
+        self._qd = np.exp(-2.0 * wk * self.depth)
+        self._inv_den = 1.0 / -np.expm1(-2.0 * wk * self.depth)
         if self.drift > 0:
             self._drift_c, self._drift_k = self.drift * self.amp ** 2 * self.omega * self.k, 2.0 * self.k
         else:
@@ -241,10 +246,10 @@ class WaveZone(_Zone):
                 self._drift_k)
 
     def _apply(self, state, tau: float, factor: float) -> None:
-        amp_w, wk, theta0, drift_c, drift_k = self.components(tau)
+        amp_w, wk, theta0, drift_c, _ = self.components(tau)
         _relax_waves(state.pos, state.vel, state.ptype, float(self.centre[0]), self.halfw, self.psi, self.beta,
                      self.fsub, self.fdiv, float(self.coefdir[0] * factor), float(self.coefdir[2] * factor),
-                     self.swl, self.depth, amp_w, wk, theta0, drift_c, drift_k)
+                     self.swl, self.depth, amp_w, wk, theta0, self._qd, self._inv_den, drift_c)
 
     def inside(self, pos: np.ndarray) -> np.ndarray:
         return np.abs(np.asarray(pos)[:, 0] - self.centre[0]) <= self.halfw

@@ -192,3 +192,15 @@ def test_a_uniform_zone_relaxes_its_turned_box_towards_its_velocity():
     f = weight((local[:, 0] - 0.5) / 0.5)[:, None]
     expect = np.where(inside[:, None], f * 0.25 * d + (1 - f) * v0, v0)
     assert np.allclose(st.vel, expect, rtol=1e-12, atol=1e-14)
+
+
+def test_deep_below_a_short_wave_the_target_is_still_water_not_nan():
+    """k z < −745: e^{kz} underflows; the kernel leaves the component out (both its terms are below
+    e^{−kd}) instead of dividing by zero."""
+    zone = WaveZone(regular(waveheight=0.01, waveperiod=0.2, depth=10.0, swl=10.0, driftcorrection=1.0), 1)
+    assert zone.k[0] * 9.0 > 745
+    st = column(1.0, np.array([0.5, 5.0, 9.99]), vel=[0.1, 0.0, 0.1])
+    zone.apply(st, 0.3, 1e-4)
+    assert np.all(np.isfinite(st.vel))
+    assert np.all(st.vel[0] == 0.0)                 # 9.5 m below the surface: still water, fully imposed
+    assert abs(st.vel[2, 0]) > 1e-3                 # at the surface the wave moves the water
