@@ -15,6 +15,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S16M: S16 with mDBC on the box (dp 0.02, 0.01 and 0.005: 2, 25 and 107 min on 2 threads)
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
                                              # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
+                                             # S19: flexible plate hit by a dam break (dp 0.002: 9 min on 2 threads; dp 0.001 on request, ~1 h)
                                              # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
                                              # W9: W4's sea generated to second order (the same times)
     python tools/validate.py W3 --fine       # also the resolutions run only on request (W3 depth/dp 40, dp 0.01: ~15 min on 2 threads;
@@ -260,6 +261,11 @@ def score_hinged_flap(outdir):
     return case_errors(outdir)
 
 
+def score_flex_obstacle(outdir):
+    from sphdvi.validation.flexobstacle import case_errors
+    return case_errors(outdir, REFERENCE)
+
+
 def score_cylinder(outdir):
     from sphdvi.validation.cylinder import case_errors
     return case_errors(outdir, REFERENCE)
@@ -362,6 +368,18 @@ def cases() -> list:
                                  ("horizontal %", "reaction_x", PCT), ("torque %", "torque_error", PCT)],
              "tilt_error", lambda e: abs(e["tilt_error"]) <= 1.0,
              "settled tilt within 1° of F r_c sin φ = K (φ0 − φ)", slow=True),
+        Case("S19", "dam break through a lifted gate against a flexible plate (Liao et al. 2015): ten trunks on "
+             "link_hinge springs EI/dz, Marker 1's displacement",
+             case_path("flexobstacle2d", "CaseFlexibleObstacle2D_Def.xml"),
+             [Resolution("dp 0.002", 0.002, ["--tmax", "0.8"]),
+              Resolution("dp 0.001", 0.001, ["--tmax", "0.8"], on_request=True)],
+             score_flex_obstacle, [("plateau %", "plateau", PCT), ("peak %", "peak", PCT),
+                                   ("arrival s", "arrival", "{:+.3f}"), ("rms %peak", "rms", "{:.1f} %"),
+                                   ("corr", "corr", "{:.3f}"), ("vs DSPH plateau %", "dsph_plateau", PCT)],
+             "plateau", lambda e: abs(e["plateau"]) <= 0.20 and abs(e["arrival"]) <= 0.02,
+             "the plate's deflection under the running water (t = 0.35-0.70 s) within 20 % of the experiment's and "
+             "its arrival within 0.02 s (judgement: DualSPHysics's run of this model is 14 % low, Sun et al.'s SPH "
+             "17 %)", slow=True),
         Case("A1", "tank under an imposed acceleration a_x = 0.1 g (<accinputs>): free-surface slope",
              case_path("acceltank2d", "CaseAccelTank2D_Def.xml"),
              [Resolution("depth/dp 15", 0.02), Resolution("depth/dp 30", 0.01)],
