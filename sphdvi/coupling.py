@@ -325,6 +325,36 @@ class FloatingBodies:
         self._saved = None          # the multibody state the Symplectic predictor puts back (kept arrays)
         self._sel = np.empty(p["idp"].size, np.int64)     # rows and bodies of the floating particles,
         self._body = np.empty(p["idp"].size, np.int64)    # refilled each call (the solver reorders)
+        self.moorings = self._moorings(data)
+
+    def _moorings(self, data: dict):
+        """``<special><moorings>`` (sphdvi.moorings): the lines on the moored floating bodies, or None."""
+        spec = (data["json"].get("special") or {}).get("moorings")
+        if not spec:
+            return None
+        from .moorings.system import Moorings
+        index = {mkb: i for i, mkb in enumerate(self.mkbounds)}
+        missing = [m for m in spec["floatings"] if int(m) not in index]
+        if missing:
+            raise InputError(f"<moorings><mooredfloatings>: mkbound {missing[0]} is not a floating body of the case "
+                             "(expected the mkbound of a <floating>)")
+        g = float(np.linalg.norm(np.asarray(data["constants"]["gravity"], float)))
+        return Moorings(spec, g, index, self.system.pos.copy(), self.system.quat.copy())
+
+    def _with_moorings(self, F: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The fluid's loads plus the mooring lines' (held from the last step; in 2D in the x-z plane)."""
+        if self.moorings is None:
+            return F, T
+        mF, mT = self.moorings.loads()
+        F, T = F + mF, T + mT
+        if self.is2d:
+            F[:, 1] = 0.0
+            T[:, 0] = T[:, 2] = 0.0
+        return F, T
+
+    def _step_moorings(self, t0: float, dt: float) -> None:
+        if self.moorings is not None:
+            self.moorings.step(t0, dt, self.system.pos, self.system.quat)
 
     def rows(self, solver):
         """(rows of the floating particles in the solver's order, their body): views of work
@@ -379,12 +409,14 @@ class FloatingBodies:
         if self.paused(solver.time - dt):
             self.system.time = solver.time     # frozen bodies (FtPause): the clock still runs
             self._held = solver
+            self._step_moorings(solver.time - dt, dt)      # the lines settle on the held bodies
             return
         self._held = None
         sel, body = self.rows(solver)
         F, T = self.loads(solver, sel, body)
         self.system.fluid_force, self.system.fluid_torque = F, T    # bodies.csv ffx.. ftz (fresh arrays)
-        self.system.advance(dt, F, T)
+        self.system.advance(dt, *self._with_moorings(F, T))
+        self._step_moorings(solver.time - dt, dt)
         self.watch.after_step(getattr(solver, "nstep", 0))     # a NaN body: stopped before the fluid sees it
         self.carry_particles(solver, sel, body)
         self.wrap_centres(solver)
@@ -401,7 +433,7 @@ class FloatingBodies:
         sel, body = self.rows(solver)
         F, T = self.loads(solver, sel, body)
         self._saved = saved = self.system.get_state(self._saved)    # into the last step's copy
-        self.system.advance(dt_half, F, T)
+        self.system.advance(dt_half, *self._with_moorings(F, T))
         self.watch.check_finite(getattr(solver, "nstep", 0) + 1)     # the step under way
         self.carry_particles(solver, sel, body)
         self.system.set_state(saved)

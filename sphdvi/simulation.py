@@ -1223,9 +1223,11 @@ class SPHRun:
     def save_checkpoint(self, path: str, extra: dict) -> None:
         if self.absorbers:
             extra = dict(extra, awas=json.dumps([a.get_state() for a in self.absorbers]))
+        moorings = self.floating.moorings if self.floating is not None else None
         save_sph_checkpoint(path, self.solver.get_checkpoint(),
                             dict(extra, dtmin_run=self.dtmin_run, dtmin_seen=self.dtmin_seen, **self.case_id),
-                            self.bodies.get_state() if self.bodies is not None else None)
+                            self.bodies.get_state() if self.bodies is not None else None,
+                            arrays={"moorings": moorings.get_state()} if moorings is not None else None)
 
     def load_checkpoint(self, path: str) -> dict:
         extra = load_sph_checkpoint(path, self.solver, self.bodies, self.case_id, self.data["particles"])
@@ -1241,6 +1243,12 @@ class SPHRun:
                                  "it was written by a run without them: start the run again without --resume")
             for absorber, state in zip(self.absorbers, json.loads(extra["awas"])):
                 absorber.set_state(state)
+        moorings = self.floating.moorings if self.floating is not None else None
+        if moorings is not None:
+            if "moorings" not in extra.get("arrays", {}):
+                raise InputError(f"{path}: the restart file has no state of the mooring lines (<moorings>); it was "
+                                 "written by a run without them: start the run again without --resume")
+            moorings.set_state(extra["arrays"]["moorings"])
         return extra
 
 
@@ -1535,6 +1543,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         excluded_log.record(sol.take_excluded())
         if body_log is not None:
             body_log.record()
+        if mooring_log is not None:
+            mooring_log.record_part(k, float(sol.time))
         saved = {"part": k, "runtime_s": wall, "excl_part_pct": excl_warn.part_pct,
                  "excl_total_pct": excl_warn.total_pct}
         if dtlog is not None:
@@ -1554,6 +1564,14 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     body_log = (BodyLog(outdir, sph.bodies, sph.body_names, float(sol.time) if resume else None,
                         prepare=sph.floating.held_loads)
                 if sph.bodies is not None else None)
+    moorings = sph.floating.moorings if sph.floating is not None else None
+    mooring_log = None
+    if moorings is not None:
+        from .io.moorings_out import MooringLog
+        mooring_log = MooringLog(outdir, moorings, moorings.spec["floatings"], float(params["TimeOut"]), tmax,
+                                 float(sol.time) if resume else None)
+        if not resume:
+            mooring_log.after_step(float(sol.time), moorings.dtm)
     status, code, message = "completed", 0, ""
     with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
         try:
@@ -1580,6 +1598,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                     note_step_warnings()
                 if gauges is not None:
                     gauges.after_step(sol)
+                if mooring_log is not None:
+                    mooring_log.after_step(float(sol.time), moorings.dtm)
                 # MinFluidStop: that instant is written and the run ends normally (DualSPHysics)
                 min_fluid = sph.min_fluid_reached() if sph.npf_minimum else ""
                 if min_fluid:

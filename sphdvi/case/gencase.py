@@ -705,6 +705,32 @@ def check_boundcorr(spec: dict, particles, reader) -> None:
                                 element="mkzone", expected="the mkbound of a fixed or moving boundary")
 
 
+def _check_moored_floatings(case: Case, floating_labels: set, reader) -> None:
+    """Every ``<moorings><mooredfloatings><floating mkbound>`` is a floating body of the case
+    (JDsMooredFloatings: "Floating body used in mooring not found."), and gravity is along z
+    (MoorDynPlus uses |g_z| only; DualSPHysics refuses g_z = 0 with moorings)."""
+    moor = case.special["moorings"]
+    for mkb in moor["floatings"]:
+        if mkb not in floating_labels:
+            el = next((f for f in reader.root.iterfind("execution/special/moorings/mooredfloatings/floating")
+                       if reader.integer(f, "mkbound", lo=0) == mkb), None)
+            raise CaseError(f"moored floating mkbound {mkb} is not a floating body (<mooredfloatings><floating "
+                            f"mkbound=\"{mkb}\">)", file=reader.file,
+                            line=el.sourceline if el is not None else moor["line"], element="floating",
+                            expected=f'<floating mkbound="{mkb}" ...> in <casedef><floatings>, of a drawn mkbound'
+                            + (" (floating mkbounds: " + ", ".join(map(str, sorted(floating_labels))) + ")"
+                               if floating_labels else ""))
+    gx, gy, gz = (float(g) for g in case.constantsdef.gravity)
+    where = reader.root.find("casedef/constantsdef/gravity")
+    if gz == 0:
+        raise CaseError("gravity z is 0: the mooring lines' weight acts along z", file=reader.file,
+                        line=getattr(where, "sourceline", None), element="gravity",
+                        expected="a gravity with a z component (DualSPHysics refuses moorings without one)")
+    if gx or gy:
+        reader.warn(where, f"the mooring lines feel gravity |g_z| = {abs(gz):g} along -z only (MoorDynPlus ignores "
+                    "gravity x and y)")
+
+
 def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
     """Semantic checks that need the particles (the reader already checked each element)."""
     pos, ptype, label = particles["pos"], particles["type"], particles["label"]
@@ -743,6 +769,8 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
                                     file=reader.file, line=wp.get("line"), element="xf")
     chrono = case.special.get("chrono")
     floating_labels = {b.mkbound for b in bodies}
+    if case.special.get("moorings"):
+        _check_moored_floatings(case, floating_labels, reader)
     if chrono:
         for b in chrono["bodies"]:
             if b["mkbound"] not in bound_labels:

@@ -27,6 +27,7 @@ from .parameters import (NNEWTONIAN_TEXT, NOT_SUPPORTED, PARAMETERS, apply_delta
                          domain_from_deprecated, other_build_hint, parameter_warnings)
 from .schema import validate_structure
 from .inout_xml import read_boundcorr, read_inout
+from .moorings_xml import read_moorings
 from .relaxzones_xml import read_relaxationzones
 from .wavepaddles_xml import read_wavepaddles
 from .xmldoc import CaseReader, load_xml, strip_disabled
@@ -35,10 +36,11 @@ CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initia
                     "properties", "normals", "patterns", "vres"}
 EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres", "uservars", "vtkout"}
 SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout", "initialize",
-                     "savedt", "outputparts", "inout", "boundcorr", "relaxationzones"}
+                     "savedt", "outputparts", "inout", "boundcorr", "relaxationzones",
+                     "moorings"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
     "mlayerpistons", "flexstrucs", "boundextrap",
-    "moorings", "forcepoints", "vres", "nnphases", "temperature"}
+    "forcepoints", "vres", "nnphases", "temperature"}
 
 
 def case_name_from_path(path: str) -> str:
@@ -1376,4 +1378,4 @@ SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges":
                    "wavepaddles": read_wavepaddles, "damping": read_damping, "shifting": read_shifting,
                    "timeout": read_timeout, "initialize": read_initialize, "savedt": read_savedt,
                    "outputparts": read_outputparts, "inout": read_inout, "boundcorr": read_boundcorr,
-                   "relaxationzones": read_relaxationzones}
+                   "relaxationzones": read_relaxationzones, "moorings": read_moorings}

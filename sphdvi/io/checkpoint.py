@@ -30,9 +30,11 @@ def _plain(value):
     return value.item() if isinstance(value, np.generic) else value
 
 
-def save_sph_checkpoint(path: str, solver_state: dict, extra: dict, body_state: dict | None = None) -> None:
-    """Write ``solver_state`` (``SPHSolver.get_checkpoint()``), the loop's scalars ``extra``
-    and the floating bodies' ``System.get_state()`` to ``path``, atomically."""
+def save_sph_checkpoint(path: str, solver_state: dict, extra: dict, body_state: dict | None = None,
+                        arrays: dict | None = None) -> None:
+    """Write ``solver_state`` (``SPHSolver.get_checkpoint()``), the loop's scalars ``extra``,
+    the floating bodies' ``System.get_state()`` and ``arrays`` ({group: {name: array}}, e.g. the
+    mooring lines' nodes) to ``path``, atomically."""
     import h5py
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as f:
@@ -48,6 +50,10 @@ def save_sph_checkpoint(path: str, solver_state: dict, extra: dict, body_state: 
                 sc.attrs[k] = v
             if body_state is not None:
                 write_body_state(f.create_group("bodies"), body_state)
+            for group, items in (arrays or {}).items():
+                g = f.create_group(f"arrays/{group}")
+                for name, a in items.items():
+                    g.create_dataset(name, data=np.asarray(a))
 
 
 def _unreadable(path: str, exc: BaseException, what: str = "checkpoint") -> InputError:
@@ -140,6 +146,8 @@ def load_sph_checkpoint(path: str, solver, system=None, case_id: dict | None = N
             aux = {name: f["aux"][name][...] for name in f["aux"]}
             n_excluded = json.loads(sc["n_excluded"])
             has_bodies = "bodies" in f
+            sc["arrays"] = {group: {name: f["arrays"][group][name][()] for name in f["arrays"][group]}
+                            for group in (f["arrays"] if "arrays" in f else ())}
             bodies = None
             if system is not None and has_bodies:
                 bodies = body_state(f["bodies"])

@@ -1,0 +1,155 @@
+"""The mooring lines' output files (DualSPHysics's names and columns, ``;``-separated as its):
+
+* ``moordynplus_data/MoorDynPlus_tension.csv``, ``_force.csv``, ``_velocity.csv``,
+  ``_position.csv`` (MoorDynPlus's ``<savedata>``: ``<tension>``, ``<force>``, ``<velocity>``,
+  ``<position>``): ``time [s];dt [s]`` then, per line with ``savedata``, its anchor's and fairlead's
+  value (``Anchor_L0 [N];Fairlead_L0 [N]``; vectors ``Anchor.x_L0 [N]`` ...), at ``<time starTime
+  endTime dtOut>`` (dtOut: TimeOut);
+* ``moordynplus_data/Line_<id>_pos.csv``, ``_vel.csv``, ``_tension.csv``, ``_strain.csv`` (a line's
+  ``outputFlags`` p, v, t, s: its nodes' positions and velocities, its segments' tensions and
+  strains), at the same times;
+* ``FtForcePoints_ft<ffff>_pt<pp>.csv`` (``<savecsv_points>``): per moored floating (its order in
+  ``<mooredfloatings>``) and fairlead on it, ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...``
+  at every output (the force as the body feels it, after the start ramp).
+
+Numbers are written with 9 significant digits (MoorDynPlus writes six decimals). A resume cuts
+each file back to the restart time, atomically; rows are appended at each output.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .atomic import append_text, write_text_atomic
+
+FOLDER = "moordynplus_data"
+KINDS = ("tension", "force", "velocity", "position")
+UNITS = {"tension": "N", "force": "N", "velocity": "m/s", "position": "m"}
+LINE_FLAGS = {"p": ("pos", "pos_{i}.{a} [m]", 3), "v": ("vel", "vel_{i}.{a} [m/s]", 3),
+              "t": ("tension", "tension_{i} [N]", 1), "s": ("strain", "St_{i} [-]", 1)}
+POINTS_HEADER = ("Part;Time [s];PosX [m];PosY [m];PosZ [m];ForceX [N];ForceY [N];ForceZ [N];"
+                 "VelX [m/s];VelY [m/s];VelZ [m/s]")
+
+
+def _fmt(values) -> str:
+    return ";".join(f"{v:.9g}" for v in np.ravel(values))
+
+
+def _rows_until(path: str, t: float | None, column: int) -> list:
+    """The data rows of ``path`` whose time (in ``column``) is at most ``t`` (all when t is None)."""
+    if not os.path.exists(path):
+        return []
+    with open(path) as fh:
+        lines = fh.readlines()[1:]
+    if t is None:
+        return lines
+    keep = []
+    for line in lines:
+        try:
+            if float(line.split(";")[column]) <= t * (1 + 1e-12) + 1e-12:
+                keep.append(line)
+        except (ValueError, IndexError):
+            break
+    return keep
+
+
+class MooringLog:
+    """Writes :mod:`module <sphdvi.io.moorings_out>`'s files for a :class:`~sphdvi.moorings.system.Moorings`."""
+
+    def __init__(self, outdir: str, moorings, floatings: list, tout: float, tmax: float,
+                 resume_time: float | None = None):
+        self.m = moorings
+        self.folder = os.path.join(outdir, FOLDER)
+        spec = moorings.spec
+        self.files = {}          # path -> (header, column of the time, rows pending)
+        save = spec.get("savedata")
+        self.kinds = [k for k in KINDS if save and save.get(k)]
+        self.lines = [k for k, ln in enumerate(spec["lines"]) if ln.get("savedata", True)]
+        self.flags = {k: [f for f in ln.get("outputflags", "-") if f in LINE_FLAGS]
+                      for k, ln in enumerate(spec["lines"])} if save else {}
+        if save:
+            self.t_start = float(save.get("start") or 0.0)
+            end = save.get("end")
+            self.t_end = float(end) if end else float("inf")
+            self.dtout = float(save.get("dtout") or tout)
+            self.next = self.t_start
+            for kind in self.kinds:
+                head = ["time [s]", "dt [s]"]
+                for k in self.lines:
+                    for where in ("Anchor", "Fairlead"):
+                        head += ([f"{where}_L{k} [{UNITS[kind]}]"] if kind == "tension" else
+                                 [f"{where}.{a}_L{k} [{UNITS[kind]}]" for a in "xyz"])
+                self._open(os.path.join(outdir, FOLDER, f"MoorDynPlus_{kind}.csv"), ";".join(head), 0, resume_time)
+            for k, flags in self.flags.items():
+                n = int(spec["lines"][k]["segments"])
+                for f in flags:
+                    name, col, dim = LINE_FLAGS[f]
+                    count = n + 1 if f in "pv" else n
+                    cols = [col.format(i=i, a=a) for i in range(count) for a in ("xyz" if dim == 3 else "-")]
+                    self._open(os.path.join(outdir, FOLDER, f"Line_{spec['lines'][k]['id']}_{name}.csv"),
+                               "time [s];" + ";".join(c.replace(".-", "") for c in cols), 0, resume_time)
+        self.points = []         # (path, line, end) of each fairlead, per moored floating
+        if spec.get("savecsv_points", True):
+            order = {int(mkb): i for i, mkb in enumerate(floatings)}
+            count = {}
+            for k, ln in enumerate(spec["lines"]):
+                for e, end in enumerate(ln["ends"]):
+                    if end["kind"] != "vessel":
+                        continue
+                    ft = order[int(end["body"])]
+                    pt = count.get(ft, 0)
+                    count[ft] = pt + 1
+                    path = os.path.join(outdir, f"FtForcePoints_ft{ft:04d}_pt{pt:02d}.csv")
+                    self._open(path, POINTS_HEADER, 1, resume_time)
+                    self.points.append((path, k, e))
+        if save and resume_time is not None:
+            # the next row after the restart time
+            while self.next <= resume_time * (1 + 1e-12) + 1e-12:
+                self.next += self.dtout
+
+    def _open(self, path: str, header: str, column: int, resume_time: float | None) -> None:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        rows = _rows_until(path, resume_time, column) if resume_time is not None else []
+        write_text_atomic(path, header + "\n" + "".join(rows))
+        self.files[path] = []
+
+    def after_step(self, t: float, dt_m: float) -> None:
+        """The MoorDynPlus rows due at ``t`` (``<savedata>``'s times), kept until :meth:`flush`."""
+        if not self.kinds and not any(self.flags.values()):
+            return
+        if not (self.t_start <= t <= self.t_end) or t < self.next * (1 - 1e-12) - 1e-12:
+            return
+        self.next += self.dtout
+        m = self.m
+        ends = (m.first, m.last)
+        values = {"tension": m.end_tensions(), "force": m.fairlead_forces(),
+                  "velocity": np.stack([m.vel[e] for e in ends], axis=1),
+                  "position": np.stack([m.pos[e] for e in ends], axis=1)}
+        head = f"{t:.9g};{dt_m:.9g};"
+        for kind in self.kinds:
+            path = os.path.join(self.folder, f"MoorDynPlus_{kind}.csv")
+            self.files[path].append(head + _fmt(values[kind][self.lines]) + "\n")
+        for k, flags in self.flags.items():
+            a, b = m.first[k], m.last[k]
+            seg_len = m.work["seg_len"][a:b]
+            data = {"pos": m.pos[a:b + 1], "vel": m.vel[a:b + 1], "tension": m.work["seg_t"][a:b],
+                    "strain": seg_len / m.prm[k, 0] - 1.0}
+            for f in flags:
+                name = LINE_FLAGS[f][0]
+                path = os.path.join(self.folder, f"Line_{m.lines[k]['id']}_{name}.csv")
+                self.files[path].append(f"{t:.9g};" + _fmt(data[name]) + "\n")
+
+    def record_part(self, part: int, t: float) -> None:
+        """The FtForcePoints rows of output ``part`` at ``t``; then every pending row to its file."""
+        if self.points:
+            from ..moorings.system import start_ramp
+            m = self.m
+            force = m.fairlead_forces() * start_ramp(t, m.start, m.ramptime)
+            for path, k, e in self.points:
+                node = m.first[k] if e == 0 else m.last[k]
+                self.files[path].append(f"{part};{t:.9g};{_fmt(m.pos[node])};{_fmt(force[k, e])};{_fmt(m.vel[node])}\n")
+        for path, rows in self.files.items():
+            if rows:
+                append_text(path, "".join(rows))
+                rows.clear()

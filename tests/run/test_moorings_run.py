@@ -1,0 +1,93 @@
+"""Mooring lines in a run (``<special><moorings>``, cases/mooredbox2d): the output files with
+DualSPHysics's names and columns, a resumed run that ends bitwise as an uninterrupted one (the
+lines' nodes are in restart.h5), and (slow) C4: the box held down by its taut lines sinks by
+what they pull, and the lines at rest are their elastic catenaries."""
+import re
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+
+REPO = Path(__file__).resolve().parents[2]
+CASE = REPO / "cases" / "mooredbox2d" / "CaseMooredBox2D_Def.xml"
+
+
+def run(out, *extra, case=CASE):
+    r = CliRunner().invoke(main, ["run", str(case), "-o", str(out), "--threads", "1", "-q", *extra])
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def final_state(outdir):
+    with h5py.File(outdir / "restart.h5", "r") as f:
+        o = np.argsort(f["state/idp"][...])
+        state = {k: f["state"][k][...][o] for k in ("pos", "vel", "rhop")}
+        state.update({f"line_{k}": f["arrays/moorings"][k][()] for k in ("pos", "vel", "F")})
+        state.update({f"body_{k}": f["bodies"][k][...] for k in ("pos", "vel")})
+        return state, dict(f["scalars"].attrs)
+
+
+def test_the_mooring_files_have_dualsphysics_names_and_columns(tmp_path):
+    """MoorDynPlus_tension.csv / _force.csv (the case's <savedata>: every 0.01 s from 0) and one
+    FtForcePoints file per fairlead (every output): their headers, a row per time, and the
+    fairlead's force in both (the lines start taut: stretched 2.85 %, 80 N)."""
+    out = run(tmp_path / "a", "--tmax", "0.05", "--set", "FtPause=0")
+    data = out / "moordynplus_data"
+    head = (data / "MoorDynPlus_tension.csv").read_text().splitlines()
+    assert head[0] == "time [s];dt [s];Anchor_L0 [N];Fairlead_L0 [N];Anchor_L1 [N];Fairlead_L1 [N]"
+    rows = np.loadtxt(data / "MoorDynPlus_tension.csv", delimiter=";", skiprows=1)
+    assert rows.shape[1] == 6 and rows[0, 0] == 0.0 and rows.shape[0] == 6           # t = 0, 0.01 ... 0.05
+    assert rows[0, 3] == pytest.approx(2.9e3 * (0.32 ** 0.5 / 0.55 - 1), rel=0.02)
+    force = (data / "MoorDynPlus_force.csv").read_text().splitlines()[0].split(";")
+    assert force[2:5] == ["Anchor.x_L0 [N]", "Anchor.y_L0 [N]", "Anchor.z_L0 [N]"] and len(force) == 14
+    pts = sorted(out.glob("FtForcePoints_ft*_pt*.csv"))
+    assert [p.name for p in pts] == ["FtForcePoints_ft0000_pt00.csv", "FtForcePoints_ft0000_pt01.csv"]
+    assert pts[0].read_text().splitlines()[0] == ("Part;Time [s];PosX [m];PosY [m];PosZ [m];ForceX [N];ForceY [N];"
+                                                  "ForceZ [N];VelX [m/s];VelY [m/s];VelZ [m/s]")
+    a = np.loadtxt(pts[0], delimiter=";", skiprows=1)
+    assert a[:, 0].tolist() == [0, 1]                       # TimeOut 0.05: parts 0 and 1
+    # the left line pulls its fairlead (x 1.35) down and to the left, towards its anchor (x 0.95)
+    assert a[0, 5] < 0 and a[0, 7] < 0 and a[0, 2] == pytest.approx(1.35)
+
+
+def test_a_resumed_run_ends_bitwise_as_an_uninterrupted_one(tmp_path):
+    """1 thread, FtPause 0 so the box moves: the fluid, the body and the lines' nodes and loads."""
+    a = run(tmp_path / "a", "--tmax", "0.1", "--tout", "0.05", "--set", "FtPause=0")
+    b = run(tmp_path / "b", "--tmax", "0.05", "--tout", "0.05", "--set", "FtPause=0")
+    r = CliRunner().invoke(main, ["run", str(b), "--resume", "--tmax", "0.1", "--tout", "0.05", "--threads", "1",
+                                  "-q", "--set", "FtPause=0"])
+    assert r.exit_code == 0, r.output
+    (sa, ka), (sb, kb) = final_state(a), final_state(b)
+    assert ka["nstep"] == kb["nstep"]
+    for k in sa:
+        assert np.array_equal(sa[k], sb[k]), k
+    for name in ("moordynplus_data/MoorDynPlus_tension.csv", "FtForcePoints_ft0000_pt01.csv"):
+        assert (a / name).read_text() == (b / name).read_text(), name
+
+
+@pytest.mark.slow
+def test_c4_the_moored_box_sinks_by_what_its_lines_pull(tmp_path):
+    """C4 (sphdvi.validation.mooredbox): the box (0.3 x 0.2 m, half as dense as water) on two lines
+    0.55 m long between its bottom corners and anchors 0.4 m to each side (0.566 m apart: taut),
+    4 s at dp 0.02 (about 50 s per run on 1 thread), against the same box free. Over the last
+    second it floats δ deeper: within 0.5 dp of the lines' pull over ρ g b (S12's mark for a draft;
+    measured δ 16.5 mm against 21.2 mm, −0.24 dp: the boundary's gap makes SPH's box buoyancy grow
+    29 % faster with depth at this dp), and the fluid's extra lift on it balances the lines' pull
+    within 2 % (measured +0.3 %); each line's mean force is its elastic catenary's at its
+    fairlead's mean position within 2 % (measured 0.03 %). Figures in README (C4)."""
+    from sphdvi.validation.mooredbox import equilibrium_errors
+    free_case = tmp_path / "CaseFreeBox2D_Def.xml"
+    free_case.write_text(re.sub(r"\n\s*<moorings>.*</moorings>", "", CASE.read_text(), flags=re.S))
+    moored = run(tmp_path / "moored", "--tmax", "4")
+    free = run(tmp_path / "free", "--tmax", "4", case=free_case)
+    e = equilibrium_errors(str(moored), str(free))
+    print({k: round(v, 5) for k, v in e.items()})
+    assert e["sink"] > 0.5 * e["dp"]            # the lines do hold it down, by more than half a particle
+    assert abs(e["sink_dp"]) <= 0.5
+    assert abs(e["lift_error"]) <= 0.02
+    assert e["catenary_error"] <= 0.02
+    assert abs(e["drift"]) < 0.1 * e["dp"]
