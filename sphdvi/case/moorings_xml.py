@@ -84,6 +84,7 @@ LINE_PARAMS = {
 LINE_KEYS = ("ea", "diameter", "mass", "ba", "can", "cat", "cdn", "cdt", "breaktension", "length", "segments",
              "depth", "outputflags")
 OUTPUT_FLAGS = "-pvUDtcbs"
+UNWRITTEN_FLAGS = "UDcb"       # accepted, warned: sphdvi.io.moorings_out writes p, v, t, s
 SAVEDATA_CHILDREN = {"time", "tension", "force", "velocity", "position"}
 NO_CONNECTS = "free connection nodes (<connects>) are not supported by sphdvi"
 
@@ -229,6 +230,11 @@ def _value(reader, c, name: str, check):
             if bad:
                 raise reader.error(c, f"<{name} value=\"{text}\">: '{bad[0]}' is not an output flag",
                                    f"characters of \"{OUTPUT_FLAGS}\" (\"-\": no node output)")
+            unwritten = sorted({ch for ch in text if ch in UNWRITTEN_FLAGS})
+            if unwritten:
+                reader.warn(c, f"<{name} value=\"{text}\">: sphdvi writes the node outputs p, v, t and s only, not "
+                            + ", ".join(unwritten) + " (wave velocities, hydrodynamic forces, damping, seabed "
+                            "contact)")
             return text or "-"
         return text
     value = reader.num(c, "value")
