@@ -429,6 +429,9 @@ def _run_bodies_only(data, params, out_times, outdir, files, meta, t_start, quie
     mech = mechanism_from_case(data, motions)
     if not mech["bodies"]:
         raise InputError("the case has neither fluid nor bodies: nothing to simulate")
+    if js.get("special", {}).get("moorings"):
+        raise InputError("<special><moorings>: mooring lines in a body-only run (no fluid) are not supported by "
+                         "sphdvi (expected a case with fluid, whose floating bodies the lines hold)")
     dt = params["DtFixed"] if params["DtFixed"] > 0 else 1e-3
     _check_dtfixed(dt, params, "DtFixed" if params["DtFixed"] > 0 else "the default step of a body-only run")
     tout = out_times.rows[0][1] if out_times.uniform else float(params["TimeOut"])

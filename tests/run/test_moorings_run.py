@@ -91,3 +91,15 @@ def test_c4_the_moored_box_sinks_by_what_its_lines_pull(tmp_path):
     assert abs(e["lift_error"]) <= 0.02
     assert e["catenary_error"] <= 0.02
     assert abs(e["drift"]) < 0.1 * e["dp"]
+
+
+def test_moorings_in_a_body_only_run_are_refused(tmp_path):
+    """Without fluid the case runs on the multibody engine alone, which does not carry the lines:
+    exit 2 naming <moorings> rather than a run that leaves them out."""
+    text = CASE.read_text()
+    text = re.sub(r"<setmkfluid mk=\"0\" />\s*<drawbox>.*?</drawbox>", "", text, count=1, flags=re.S)
+    case = tmp_path / "CaseDry_Def.xml"
+    case.write_text(text)
+    r = CliRunner().invoke(main, ["run", str(case), "-o", str(tmp_path / "o"), "-q", "--tmax", "0.01"])
+    assert r.exit_code == 2, r.output
+    assert "<special><moorings>: mooring lines in a body-only run" in r.output and "Traceback" not in r.output
