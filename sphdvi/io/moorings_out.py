@@ -55,10 +55,9 @@ def _rows_until(path: str, t: float | None, column: int) -> list:
 
 
 class MooringLog:
-    """Writes :mod:`module <sphdvi.io.moorings_out>`'s files for a :class:`~sphdvi.moorings.system.Moorings`."""
+    """The files of this module (its docstring) for the lines of a :class:`~sphdvi.moorings.system.Moorings`."""
 
-    def __init__(self, outdir: str, moorings, floatings: list, tout: float, tmax: float,
-                 resume_time: float | None = None):
+    def __init__(self, outdir: str, moorings, floatings: list, tout: float, resume_time: float | None = None):
         self.m = moorings
         self.folder = os.path.join(outdir, FOLDER)
         spec = moorings.spec
