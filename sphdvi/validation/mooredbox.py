@@ -3,13 +3,14 @@
 
 At rest the lines pull the box down by ΣF_z and it floats deeper than without them by
 
-    δ = −ΣF_z / (ρ_w g b)                                                                  (1)
+    δ = −ΣF_z (L − b) / (ρ_w g b L)                                                        (1)
 
-(b the box's width, the buoyancy per metre of depth; 2D, per metre of width). The same case
-without its ``<moorings>`` gives the free box's level. SPH's boundary particles keep the water about
-a particle's width off the box, so its buoyancy grows faster with depth than ρ g b (at dp 0.02 as
-if the box were 29 % wider): δ is scored in dp, as the drafts of S12, and the fluid's extra lift on
-the moored box (bodies.csv ffz) against the lines' pull. And each line, at rest, is the elastic catenary between its anchor and where its fairlead
+(2D, per metre of width: b the box's width, L the tank's; the water the box displaces raises the
+level of the tank by b δ/(L − b), and the buoyancy grows by ρ_w g b times the box's sinking below
+that level). The same case without its ``<moorings>`` gives the free box's level. SPH's boundary
+particles keep the water about a particle's width off the box, so its buoyancy grows faster with
+depth than eq. (1) says (at dp 0.02 by 16 %): δ is scored in dp, as the drafts of S12, and the
+fluid's extra lift on the moored box (bodies.csv ffz) against the lines' pull. And each line, at rest, is the elastic catenary between its anchor and where its fairlead
 settled: the force on the fairlead is (−HF cos φ, −HF sin φ, −VF) of
 :func:`sphdvi.moorings.catenary.elastic_catenary` (the lumped line's end node carries half a
 segment's weight, which the catenary's VF at the fairlead includes).
@@ -54,6 +55,7 @@ def equilibrium_errors(moored: str, free: str, since: float = SETTLED_FROM) -> d
     fluidcount = int(case["json"]["mkconfig"]["fluidcount"])
     box = (p["mk"].astype(int) - fluidcount - 1 == mkb) & (p["type"] != 3)
     width = float(np.ptp(p["pos"][box, 0])) + dp
+    tank = float(np.ptp(p["pos"][p["type"] == 3, 0])) + dp
     rows_m, rows_f = body_log(moored), body_log(free)
     z_m = _late_mean(np.asarray(rows_m["time"], float), np.asarray(rows_m["z"], float), since)
     z_f = _late_mean(np.asarray(rows_f["time"], float), np.asarray(rows_f["z"], float), since)
@@ -62,7 +64,7 @@ def equilibrium_errors(moored: str, free: str, since: float = SETTLED_FROM) -> d
                  - _late_mean(np.asarray(rows_f["time"], float), np.asarray(rows_f["ffz"], float), since))
     points = force_points(moored)
     fz = sum(float(_late_mean(a[:, 1], a[:, 7], since)) for a in points)
-    expected = -fz / (rho * g * width)
+    expected = -fz * (tank - width) / (rho * g * width * tank)
     from ..moorings.catenary import elastic_catenary
     worst = 0.0
     for a, line in zip(points, spec["lines"]):
