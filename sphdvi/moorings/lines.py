@@ -235,8 +235,9 @@ def advance_lines(t0, dt, nsub, pos, vel, first, last, end_kind, end_p0, end_v, 
 
 def auto_time_step(length: float, segments: int, ea: float, rho: float, rho_w: float, area: float) -> float:
     """MoorDynPlus's ``dtM auto``: 2π/(100 ω) with ω = (2N/L) √(EA / (|ρ − ρ_w| A)), a hundredth of
-    the period of the line's highest axial mode taken with its wet mass."""
-    mw = abs(rho - rho_w) * area
+    the period of the line's highest axial mode taken with its wet mass (its mass ρ A for a line as
+    dense as the water, where MoorDynPlus's ω is infinite)."""
+    mw = abs(rho - rho_w) * area or rho * area
     omega = (2.0 * segments / length) * math.sqrt(ea / mw)
     return 2.0 * math.pi / (100.0 * omega)
 

@@ -144,7 +144,8 @@ class Moorings:
         self._evaluate(0.0)
         self.relax_spans = 0
         if float(sol.get("tmaxic", 0.0)) > 0:
-            self.relax_spans = self.relax(float(sol["tmaxic"]), float(sol["dtic"]), float(sol["cdscaleic"]), float(sol["threshic"]))
+            self.relax_spans = self.relax(float(sol["tmaxic"]), float(sol["dtic"]), float(sol["cdscaleic"]),
+                                          float(sol["threshic"]))
         self.F, self.T = self._body_loads(centre, ramp=start_ramp(0.0, self.start, self.ramptime))
 
     # ---- the kernels' calls ----

@@ -10,10 +10,11 @@ level of the tank by b δ/(L − b), and the buoyancy grows by ρ_w g b times th
 that level). The same case without its ``<moorings>`` gives the free box's level. SPH's boundary
 particles keep the water about a particle's width off the box, so its buoyancy grows faster with
 depth than eq. (1) says (at dp 0.02 by 16 %): δ is scored in dp, as the drafts of S12, and the
-fluid's extra lift on the moored box (bodies.csv ffz) against the lines' pull. And each line, at rest, is the elastic catenary between its anchor and where its fairlead
-settled: the force on the fairlead is (−HF cos φ, −HF sin φ, −VF) of
-:func:`sphdvi.moorings.catenary.elastic_catenary` (the lumped line's end node carries half a
-segment's weight, which the catenary's VF at the fairlead includes).
+fluid's extra lift on the moored box (bodies.csv ffz) against the lines' pull. And each line, at
+rest, is the elastic catenary between its anchor and where its fairlead settled: the force on the
+fairlead is (−HF cos φ, −HF sin φ, −VF) of :func:`sphdvi.moorings.catenary.elastic_catenary` (the
+lumped line's end node carries half a segment's weight, which the catenary's VF at the fairlead
+includes).
 """
 from __future__ import annotations
 
