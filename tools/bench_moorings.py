@@ -79,7 +79,8 @@ def main_() -> None:
         nsub = max(1, math.ceil(dt / moor.dtm - 1e-9))
         nodes = int(moor.pos.shape[0])
         print(f"C4 moored box dp={a.dp:g}: {n:,} particles, {len(moor.lines)} lines, {nodes} nodes, "
-              f"dtM {moor.dtm:.3g} s, {nsub} sub-steps per step (dt {dt:.3g} s), {numba.get_num_threads()} threads, {a.steps} steps")
+              f"dtM {moor.dtm:.3g} s, {nsub} sub-steps per step (dt {dt:.3g} s), {numba.get_num_threads()} threads, "
+              f"{a.steps} steps")
         print(f"  step: {1e3 * wall / a.steps:.3f} ms, {1e6 * wall / a.steps / n:.3f} us per particle-step")
         print(f"  lines: {1e3 * lines_time / a.steps:.3f} ms a step ({100 * lines_time / wall:.1f} %), "
               f"{1e6 * lines_time / a.steps / (2 * nsub * nodes):.3f} us per node and evaluation "
