@@ -10,7 +10,10 @@
   strains), at the same times;
 * ``FtForcePoints_ft<ffff>_pt<pp>.csv`` (``<savecsv_points>``): per moored floating (its order in
   ``<mooredfloatings>``) and fairlead on it, ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...``
-  at every output (the force as the body feels it, after the start ramp).
+  at every output (the force as the body feels it, after the start ramp);
+* ``MooringsVtk/MooringsLines_<nnnn>.vtk`` (``<savevtk_lines>``): at every output, a legacy VTK polydata
+  (written by vtk) with one polyline per line through its nodes and the cell array ``Line`` (the line's
+  id), as DualSPHysics writes it.
 
 Numbers are written with 9 significant digits (MoorDynPlus writes six decimals). A resume cuts
 each file back to the restart time, atomically; rows are appended at each output.
@@ -88,6 +91,9 @@ class MooringLog:
                     cols = [col.format(i=i, a=a) for i in range(count) for a in ("xyz" if dim == 3 else "-")]
                     self._open(os.path.join(outdir, FOLDER, f"Line_{spec['lines'][k]['id']}_{name}.csv"),
                                "time [s];" + ";".join(c.replace(".-", "") for c in cols), 0, resume_time)
+        self.vtk_folder = os.path.join(outdir, "MooringsVtk") if spec.get("savevtk_lines", True) else None
+        if self.vtk_folder is not None:
+            os.makedirs(self.vtk_folder, exist_ok=True)
         self.points = []         # (path, line, end) of each fairlead, per moored floating
         if spec.get("savecsv_points", True):
             order = {int(mkb): i for i, mkb in enumerate(floatings)}
@@ -140,7 +146,10 @@ class MooringLog:
                 self.files[path].append(f"{t:.9g};" + _fmt(data[name]) + "\n")
 
     def record_part(self, part: int, t: float) -> None:
-        """The FtForcePoints rows of output ``part`` at ``t``; then every pending row to its file."""
+        """The FtForcePoints rows and the lines' VTK file of output ``part`` at ``t``; then every
+        pending row to its file."""
+        if self.vtk_folder is not None:
+            write_lines_vtk(os.path.join(self.vtk_folder, f"MooringsLines_{part:04d}.vtk"), self.m)
         if self.points:
             from ..moorings.system import start_ramp
             m = self.m
@@ -152,3 +161,37 @@ class MooringLog:
             if rows:
                 append_text(path, "".join(rows))
                 rows.clear()
+
+
+def write_lines_vtk(path: str, moorings) -> None:
+    """One polyline per mooring line through its nodes, cell array ``Line`` (the line's id), as a
+    legacy VTK polydata file written by vtk (atomically)."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonCore import vtkIntArray, vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData, vtkPolyLine
+    from vtkmodules.vtkIOLegacy import vtkPolyDataWriter
+    from .atomic import atomic_path
+    points = vtkPoints()
+    points.SetData(numpy_to_vtk(np.ascontiguousarray(moorings.pos, dtype=np.float32), deep=True))
+    cells = vtkCellArray()
+    ids = vtkIntArray()
+    ids.SetName("Line")
+    for k, line in enumerate(moorings.lines):
+        a, b = int(moorings.first[k]), int(moorings.last[k])
+        poly = vtkPolyLine()
+        poly.GetPointIds().SetNumberOfIds(b - a + 1)
+        for i, j in enumerate(range(a, b + 1)):
+            poly.GetPointIds().SetId(i, j)
+        cells.InsertNextCell(poly)
+        ids.InsertNextValue(int(line["id"]))
+    data = vtkPolyData()
+    data.SetPoints(points)
+    data.SetLines(cells)
+    data.GetCellData().AddArray(ids)
+    with atomic_path(path) as tmp:
+        w = vtkPolyDataWriter()
+        w.SetFileName(tmp)
+        w.SetInputData(data)
+        w.SetFileTypeToBinary()
+        if not w.Write():
+            raise OSError(f"cannot write {path}")

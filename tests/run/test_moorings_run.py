@@ -52,6 +52,19 @@ def test_the_mooring_files_have_dualsphysics_names_and_columns(tmp_path):
     assert a[:, 0].tolist() == [0, 1]                       # TimeOut 0.05: parts 0 and 1
     # the left line pulls its fairlead (x 1.35) down and to the left, towards its anchor (x 0.95)
     assert a[0, 5] < 0 and a[0, 7] < 0 and a[0, 2] == pytest.approx(1.35)
+    # <savevtk_lines> (on by default): a polyline per line at each output, cell array Line
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOLegacy import vtkPolyDataReader
+    names = sorted(p.name for p in (out / "MooringsVtk").iterdir())
+    assert names == ["MooringsLines_0000.vtk", "MooringsLines_0001.vtk"]
+    reader = vtkPolyDataReader()
+    reader.SetFileName(str(out / "MooringsVtk" / "MooringsLines_0001.vtk"))
+    reader.Update()
+    poly = reader.GetOutput()
+    assert (poly.GetNumberOfPoints(), poly.GetNumberOfCells()) == (42, 2)
+    assert vtk_to_numpy(poly.GetCellData().GetArray("Line")).tolist() == [0, 1]
+    ends = vtk_to_numpy(poly.GetPoints().GetData())[[0, 21]]
+    assert ends[:, 0] == pytest.approx([0.95, 2.05]) and ends[:, 2] == pytest.approx([0.0, 0.0])
 
 
 def test_a_resumed_run_ends_bitwise_as_an_uninterrupted_one(tmp_path):
