@@ -338,7 +338,7 @@ class FloatingBodies:
         if missing:
             raise InputError(f"<moorings><mooredfloatings>: mkbound {missing[0]} is not a floating body of the case "
                              "(expected the mkbound of a <floating>)")
-        g = float(np.linalg.norm(np.asarray(data["constants"]["gravity"], float)))
+        g = abs(float(np.asarray(data["constants"]["gravity"], float)[2]))    # |g_z|, as DualSPHysics
         return Moorings(spec, g, index, self.system.pos.copy(), self.system.quat.copy())
 
     def _with_moorings(self, F: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -825,6 +825,10 @@ class SPHRun:
                        if (p["type"] == 1).any() else None)
         self.floating = (FloatingBodies(data, motions, fluidcount, normals0, float(params.get("FtPause", 0.0)))
                          if (p["type"] == 2).any() else None)
+        if self.floating is not None and self.floating.moorings is not None and periodic:
+            raise InputError("<special><moorings> with periodic boundaries is not supported by sphdvi: a moored body "
+                             "crossing a periodic end would drag its lines across the domain (expected a case "
+                             "without the *Periodic* parameters)")
         if self.floating is not None and periodic and not resume:   # DualSPHysics: not on a restart either
             from .sph.periodic import Periodicity
             self.floating.check_radius(Periodicity(periodic, p["pos"], float(c["dp"]), params),
@@ -1574,7 +1578,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         mooring_log = MooringLog(outdir, moorings, moorings.spec["floatings"], float(params["TimeOut"]),
                                  float(sol.time) if resume else None)
         if not resume:
-            mooring_log.after_step(float(sol.time), moorings.dtm)
+            mooring_log.after_step(float(sol.time))
     status, code, message = "completed", 0, ""
     with (contextlib.nullcontext(stop) if stop is not None else _Stop()) as stop:
         try:
@@ -1602,7 +1606,7 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
                 if gauges is not None:
                     gauges.after_step(sol)
                 if mooring_log is not None:
-                    mooring_log.after_step(float(sol.time), moorings.dtm)
+                    mooring_log.after_step(float(sol.time))
                 # MinFluidStop: that instant is written and the run ends normally (DualSPHysics)
                 min_fluid = sph.min_fluid_reached() if sph.npf_minimum else ""
                 if min_fluid:

@@ -97,6 +97,9 @@ def read_moorings(reader, el) -> dict:
     for tag, default in SAVE_FLAGS:
         c = reader.child(el, tag)
         out[tag] = reader.boolean(c, "value", default) if c is not None else default
+        if c is not None and out[tag] and tag in ("savevtk_moorings", "savevtk_points"):
+            reader.warn(c, f"<{tag}> is not written by sphdvi (MooringsVtk/MooringsLines_*.vtk of <savevtk_lines> "
+                        "and FtForcePoints_*.csv hold the lines and their fairleads)")
     start = reader.child(el, "start")
     out["start"] = reader.num(start, "value", 0.0, nonnegative=True) if start is not None else 0.0
     out["ramptime"] = reader.num(start, "ramptime", 0.0, nonnegative=True) if start is not None else 0.0
@@ -407,6 +410,9 @@ def _read_lines(reader, el, solver: dict, bodies: list) -> list:
                                f"the anchor at or above the seabed z = freesurface - depth = {bed:g} (or a larger "
                                "depth: <line><depth>, <body><depth> or waterDepth)")
         span = float(np.linalg.norm(np.subtract(ends[1]["pos"], ends[0]["pos"])))
+        if span == 0.0:
+            raise reader.error(line_el, f"line {k}'s two ends are the same point {tuple(ends[0]['pos'])}",
+                               "two connections at different points (the line's nodes start between them)")
         if d["length"] < span:
             reader.warn(line_el, f"line {k}'s length {d['length']:g} m is shorter than the distance between its ends "
                         f"({span:.6g} m): it starts taut, stretched by {100.0 * (span / d['length'] - 1.0):.3g} %")

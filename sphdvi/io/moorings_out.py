@@ -6,11 +6,11 @@
   value (``Anchor_L0 [N];Fairlead_L0 [N]``; vectors ``Anchor.x_L0 [N]`` ...), at ``<time starTime
   endTime dtOut>`` (dtOut: TimeOut);
 * ``moordynplus_data/Line_<id>_pos.csv``, ``_vel.csv``, ``_tension.csv``, ``_strain.csv`` (a line's
-  ``outputFlags`` p, v, t, s: its nodes' positions and velocities, its segments' tensions and
-  strains), at the same times;
+  ``outputFlags`` p, v, t, s: its nodes' positions and velocities, its segments' tensions EA·strain
+  (no compression) and strains), at the same times;
 * ``FtForcePoints_ft<ffff>_pt<pp>.csv`` (``<savecsv_points>``): per moored floating (its order in
   ``<mooredfloatings>``) and fairlead on it, ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...``
-  at every output (the force as the body feels it, after the start ramp);
+  at every output (the force as the body feels it through the next step, after the start ramp);
 * ``MooringsVtk/MooringsLines_<nnnn>.vtk`` (``<savevtk_lines>``): at every output, a legacy VTK polydata
   (written by vtk) with one polyline per line through its nodes and the cell array ``Line`` (the line's
   id), as DualSPHysics writes it.
@@ -108,10 +108,8 @@ class MooringLog:
                     path = os.path.join(outdir, f"FtForcePoints_ft{ft:04d}_pt{pt:02d}.csv")
                     self._open(path, POINTS_HEADER, 1, resume_time)
                     self.points.append((path, k, e))
-        if save and resume_time is not None:
-            # the next row after the restart time
-            while self.next <= resume_time * (1 + 1e-12) + 1e-12:
-                self.next += self.dtout
+        if save and resume_time is not None and moorings.log_next is not None:
+            self.next = moorings.log_next        # the schedule of the run that wrote the checkpoint
 
     def _open(self, path: str, header: str, column: int, resume_time: float | None) -> None:
         os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -119,14 +117,17 @@ class MooringLog:
         write_text_atomic(path, header + "\n" + "".join(rows))
         self.files[path] = []
 
-    def after_step(self, t: float, dt_m: float) -> None:
-        """The MoorDynPlus rows due at ``t`` (``<savedata>``'s times), kept until :meth:`flush`."""
+    def after_step(self, t: float) -> None:
+        """The MoorDynPlus rows due at ``t`` (``<savedata>``'s times: one ``dtOut`` further after each
+        row, as MoorDynPlus), kept until the next output; the ``dt`` column is the lines' sub-step."""
         if not self.kinds and not any(self.flags.values()):
             return
         if not (self.t_start <= t <= self.t_end) or t < self.next * (1 - 1e-12) - 1e-12:
             return
         self.next += self.dtout
         m = self.m
+        m.log_next = self.next
+        dt_m = m.substep
         ends = (m.first, m.last)
         values = {"tension": m.end_tensions(), "force": m.fairlead_forces(),
                   "velocity": np.stack([m.vel[e] for e in ends], axis=1),
@@ -138,8 +139,9 @@ class MooringLog:
         for k, flags in self.flags.items():
             a, b = m.first[k], m.last[k]
             seg_len = m.work["seg_len"][a:b]
-            data = {"pos": m.pos[a:b + 1], "vel": m.vel[a:b + 1], "tension": m.work["seg_t"][a:b],
-                    "strain": seg_len / m.prm[k, 0] - 1.0}
+            strain = seg_len / m.prm[k, 0] - 1.0
+            data = {"pos": m.pos[a:b + 1], "vel": m.vel[a:b + 1], "strain": strain,
+                    "tension": m.prm[k, 1] * np.maximum(strain, 0.0)}       # |T_i| = EA strain, as MoorDynPlus
             for f in flags:
                 name = LINE_FLAGS[f][0]
                 path = os.path.join(self.folder, f"Line_{m.lines[k]['id']}_{name}.csv")
@@ -151,9 +153,8 @@ class MooringLog:
         if self.vtk_folder is not None:
             write_lines_vtk(os.path.join(self.vtk_folder, f"MooringsLines_{part:04d}.vtk"), self.m)
         if self.points:
-            from ..moorings.system import start_ramp
             m = self.m
-            force = m.fairlead_forces() * start_ramp(t, m.start, m.ramptime)
+            force = m.fairlead_forces() * m.ramp          # as the body feels it (the ramp of the step)
             for path, k, e in self.points:
                 node = m.first[k] if e == 0 else m.last[k]
                 self.files[path].append(f"{part};{t:.9g};{_fmt(m.pos[node])};{_fmt(force[k, e])};{_fmt(m.vel[node])}\n")

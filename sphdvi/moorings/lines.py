@@ -17,7 +17,8 @@ submergence of an adjacent segment (1 both nodes below the free surface, 0 both 
     Dp = ½ ρ_w Cdn D (Σ_s ½ F_s l) |v_p| v_p                   transverse drag
     Dq = ½ ρ_w Cdt π D (Σ_s ½ F_s l) |v_q| v_q                 tangential drag
     B_z = [kBot (z_bed − z) − cBot ż] S,  S = Σ_s ½ D l,  for z < z_bed    seabed
-    B_xy = −min(μ fricDamp |u|, s_μ μ |B_z|) u/|u|,  u = (ẋ, ẏ)        seabed friction
+    B_xy = −F_fr u/|u|,  u = (ẋ, ẏ),  F_fr = μ fricDamp |u|, or μ |B_z| once
+           that exceeds s_μ μ |B_z| (MoorDynPlus's rule)                seabed friction
     F_i = T_i − T_{i−1} + Td_i − Td_{i−1} + W + Dp + Dq + B                                      (3)
 
 (the sums over the node's one or two segments). Its mass matrix is
@@ -69,10 +70,12 @@ def _submerged(za, zb, zfs):
 
 
 @njit(cache=True)
-def _set_ends(t, t0, first, last, end_kind, end_p0, end_v, pos, vel):
-    """The end nodes of every line at time t: a fixed end where it was, a vessel end at
-    p0 + v (t − t0) with velocity v."""
+def _set_ends(t, t0, first, last, end_kind, end_p0, end_v, broken, pos, vel):
+    """The end nodes of every unbroken line at time t: a fixed end where it was, a vessel end at
+    p0 + v (t − t0) with velocity v (a broken line's nodes stay where it broke)."""
     for k in range(first.shape[0]):
+        if broken[k]:
+            continue
         for e in range(2):
             j = first[k] if e == 0 else last[k]
             if end_kind[k, e] == VESSEL:
@@ -205,7 +208,7 @@ def advance_lines(t0, dt, nsub, pos, vel, first, last, end_kind, end_p0, end_v, 
     nbroke = 0
     for s in range(nsub):
         t = t0 + s * h
-        _set_ends(t, t0, first, last, end_kind, end_p0, end_v, pos, vel)
+        _set_ends(t, t0, first, last, end_kind, end_p0, end_v, broken, pos, vel)
         line_forces(pos, vel, first, last, prm, glob, broken, fnet, acc, seg_t, seg_len)
         nbroke += _check_breaks(first, last, prm, broken, seg_t)
         for k in range(first.shape[0]):
@@ -217,7 +220,7 @@ def advance_lines(t0, dt, nsub, pos, vel, first, last, end_kind, end_p0, end_v, 
                     else:
                         pos_h[j, d] = pos[j, d]
                         vel_h[j, d] = vel[j, d]
-        _set_ends(t + 0.5 * h, t0, first, last, end_kind, end_p0, end_v, pos_h, vel_h)
+        _set_ends(t + 0.5 * h, t0, first, last, end_kind, end_p0, end_v, broken, pos_h, vel_h)
         line_forces(pos_h, vel_h, first, last, prm, glob, broken, fnet, acc, seg_t, seg_len)
         nbroke += _check_breaks(first, last, prm, broken, seg_t)
         for k in range(first.shape[0]):
@@ -227,7 +230,7 @@ def advance_lines(t0, dt, nsub, pos, vel, first, last, end_kind, end_p0, end_v, 
                 for d in range(3):
                     pos[j, d] += h * vel_h[j, d]
                     vel[j, d] += h * acc[j, d]
-    _set_ends(t0 + dt, t0, first, last, end_kind, end_p0, end_v, pos, vel)
+    _set_ends(t0 + dt, t0, first, last, end_kind, end_p0, end_v, broken, pos, vel)
     line_forces(pos, vel, first, last, prm, glob, broken, fnet, acc, seg_t, seg_len)
     nbroke += _check_breaks(first, last, prm, broken, seg_t)
     return nbroke

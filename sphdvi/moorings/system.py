@@ -45,10 +45,12 @@ def start_ramp(t: float, start: float, ramptime: float) -> float:
     return ((t - start) / ramptime) ** 2
 
 
-def initial_nodes(anchor, fairlead, length: float, segments: int, ea: float, w: float, seabed: bool) -> np.ndarray:
+def initial_nodes(anchor, fairlead, length: float, segments: int, ea: float, w: float) -> np.ndarray:
     """The nodes 0..N of a line at rest on its elastic catenary (MoorDynPlus's initial shape), in the
-    vertical plane through its ends; on the straight segment between them when the catenary has no
-    solution (a line too long for its seabed, or ``w`` ≤ 0: a line that floats)."""
+    vertical plane through its ends, with a frictionless seabed at the anchor's height whatever the
+    bed's own height (as MoorDynPlus places them); on the straight segment between them when the
+    catenary has no solution (a line too long for that bed, a fairlead below its anchor, or ``w`` ≤ 0:
+    a line that floats)."""
     from .catenary import elastic_catenary
     anchor, fairlead = np.asarray(anchor, float), np.asarray(fairlead, float)
     s = np.linspace(0.0, length, segments + 1)
@@ -58,8 +60,8 @@ def initial_nodes(anchor, fairlead, length: float, segments: int, ea: float, w: 
     if w <= 0:
         return straight
     try:
-        sol = elastic_catenary(xf, d[2], length, ea, w, seabed=seabed, s=s)
-    except (ValueError, ZeroDivisionError, FloatingPointError):
+        sol = elastic_catenary(xf, d[2], length, ea, w, seabed=True, s=s)
+    except (ValueError, RuntimeError, ZeroDivisionError, FloatingPointError):
         return straight
     x, z = np.asarray(sol["x"], float), np.asarray(sol["z"], float)
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(z))):
@@ -125,8 +127,7 @@ class Moorings:
                     self.end_local[k, e] = _rotation(quat[b]).T @ (p - centre[b])
             anchor, fairlead = self.end_p0[k, 0], self.end_p0[k, 1]
             w = (mass / area - self.rho_w) * area * self.g
-            nodes = initial_nodes(anchor, fairlead, float(ln["length"]), int(ln["segments"]), ea, w,
-                                  seabed=anchor[2] <= zbed + 1e-9 * max(1.0, abs(zbed)))
+            nodes = initial_nodes(anchor, fairlead, float(ln["length"]), int(ln["segments"]), ea, w)
             self.pos[self.first[k]:self.last[k] + 1] = nodes
         self.dtm = dtm
         ves = np.nonzero(self.end_kind == L.VESSEL)
@@ -140,23 +141,44 @@ class Moorings:
         self.F = np.zeros((self.nbodies, 3))        # the loads on the bodies through the next step
         self.T = np.zeros((self.nbodies, 3))
         self.time = 0.0
+        self.ramp = start_ramp(0.0, self.start, self.ramptime)    # the factor of the loads held (F, T)
+        self.substep = self.dtm                 # the last coupling step's sub-step (MoorDynPlus's dt column)
+        self.log_next = None                    # the next MoorDynPlus row time (sphdvi.io.moorings_out)
         self.broke_warned = np.zeros(nl, np.bool_)
         self._evaluate(0.0)
+        self._warn_breaks(0.0)
+        self._check_finite(0.0)
         self.relax_spans = 0
         if float(sol.get("tmaxic", 0.0)) > 0:
             self.relax_spans = self.relax(float(sol["tmaxic"]), float(sol["dtic"]), float(sol["cdscaleic"]),
                                           float(sol["threshic"]))
-        self.F, self.T = self._body_loads(centre, ramp=start_ramp(0.0, self.start, self.ramptime))
+        self.F, self.T = self._body_loads(centre, ramp=self.ramp)
 
     # ---- the kernels' calls ----
 
     def _advance(self, t0: float, dt: float) -> None:
         nsub = max(1, int(math.ceil(dt / self.dtm - 1e-9)))
+        self.substep = dt / nsub
         w = self.work
         L.advance_lines(t0, dt, nsub, self.pos, self.vel, self.first, self.last, self.end_kind, self.end_p0,
                         self.end_v, self.prm, self.glob, self.broken, w["fnet"], w["acc"], w["seg_t"], w["seg_len"],
                         w["pos_h"], w["vel_h"])
         self._warn_breaks(t0 + dt)
+        self._check_finite(t0 + dt)
+
+    def _check_finite(self, t: float) -> None:
+        """A node or force that is not finite stops the run (exit 3), naming the line (MoorDynPlus
+        stops on a NaN in its state too)."""
+        bad = ~(np.isfinite(self.pos).all(axis=1) & np.isfinite(self.vel).all(axis=1)
+                & np.isfinite(self.work["fnet"]).all(axis=1))
+        if not bad.any():
+            return
+        from ..errors import DivergenceError
+        j = int(np.flatnonzero(bad)[0])
+        k = int(np.searchsorted(self.last, j))
+        raise DivergenceError(f"<moorings> line {self.lines[k]['id']}: node {j - int(self.first[k])} is not finite "
+                              f"at t = {t:.6g} s (sub-step {self.substep:.3g} s; a smaller dtM, or dtM auto, may "
+                              "hold it)")
 
     def _evaluate(self, t: float) -> None:
         """Eq. (3) at the nodes as they are (the ends where ``end_p0`` says)."""
@@ -218,7 +240,8 @@ class Moorings:
         self.end_p0[:] = target
         self.end_v[:] = 0.0
         self.time = t0 + dt
-        self.F, self.T = self._body_loads(centre, ramp=start_ramp(t0, self.start, self.ramptime))
+        self.ramp = start_ramp(t0, self.start, self.ramptime)     # MoorDynPlus's framp(t_n)
+        self.F, self.T = self._body_loads(centre, ramp=self.ramp)
 
     def loads(self) -> tuple[np.ndarray, np.ndarray]:
         """The force and moment (about each body's centre) the lines put on the bodies this step."""
@@ -246,13 +269,26 @@ class Moorings:
 
     # ---- restart ----
 
+    STATE_ARRAYS = ("pos", "vel", "broken", "end_p0", "F", "T", "broke_warned")
+    STATE_WORK = ("fnet", "seg_t", "seg_len")           # the forces of the last evaluation, for outputs
+    STATE_SCALARS = ("time", "ramp", "substep")
+
     def get_state(self) -> dict:
-        return {"pos": self.pos.copy(), "vel": self.vel.copy(), "broken": self.broken.copy(),
-                "end_p0": self.end_p0.copy(), "F": self.F.copy(), "T": self.T.copy(), "time": self.time,
-                "broke_warned": self.broke_warned.copy()}
+        """Everything that evolves (copies): nodes, broken lines, fairleads, held loads, the last
+        evaluation's forces, and the next MoorDynPlus row time (NaN: none yet)."""
+        st = {key: getattr(self, key).copy() for key in self.STATE_ARRAYS}
+        st.update({key: self.work[key].copy() for key in self.STATE_WORK})
+        st.update({key: float(getattr(self, key)) for key in self.STATE_SCALARS})
+        st["log_next"] = math.nan if self.log_next is None else float(self.log_next)
+        return st
 
     def set_state(self, st: dict) -> None:
-        for key in ("pos", "vel", "broken", "end_p0", "F", "T", "broke_warned"):
+        """Restore a :meth:`get_state` (copied in)."""
+        for key in self.STATE_ARRAYS:
             getattr(self, key)[...] = np.asarray(st[key])
-        self.time = float(st["time"])
-        self._evaluate(self.time)
+        for key in self.STATE_WORK:
+            self.work[key][...] = np.asarray(st[key])
+        for key in self.STATE_SCALARS:
+            setattr(self, key, float(st[key]))
+        nxt = float(st["log_next"])
+        self.log_next = None if math.isnan(nxt) else nxt

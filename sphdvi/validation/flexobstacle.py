@@ -59,7 +59,7 @@ def plate_geometry(outdir: str) -> dict:
     dp = float(case["constants"]["dp"])
     bodies = case["bodies"]
     mkb = [int(m) for m in bodies["mkbound"]]
-    top = int(np.argmax(mkb))
+    top = int(np.argmax(np.asarray(bodies["center"], dtype=float)[:, 2]))     # the highest trunk carries it
     c0 = np.asarray(bodies["center"][top], dtype=float)
     p = case["particles"]
     fluidcount = int(case["json"]["mkconfig"]["fluidcount"])
@@ -68,14 +68,17 @@ def plate_geometry(outdir: str) -> dict:
     top_z = float(pts[:, 2].max()) + 0.5 * dp
     bottom_z = float(pts[:, 2].min()) - 0.5 * dp
     p0 = np.array([0.5 * (pts[:, 0].min() + pts[:, 0].max()), c0[1], top_z - MARKER_BELOW_TOP])
-    return {"c0": c0, "p0": p0, "height": top_z - bottom_z, "trunks": len(mkb), "dp": dp}
+    names = {int(b["mkbound"]): b["id"] for b in case["json"]["chrono"]["bodies"]} if case["json"].get("chrono") \
+        else {}
+    return {"c0": c0, "p0": p0, "height": top_z - bottom_z, "trunks": len(mkb), "dp": dp,
+            "top_body": names.get(mkb[top], TOP_BODY)}
 
 
 def marker_displacement(outdir: str, geo: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(t, d) of eq. (1) from bodies.csv."""
     geo = geo or plate_geometry(outdir)
     rows = body_log(outdir)
-    mine = rows[rows["body"] == TOP_BODY]
+    mine = rows[rows["body"] == geo["top_body"]]
     t = np.asarray(mine["time"], dtype=float)
     c = np.column_stack([mine["x"], mine["y"], mine["z"]]).astype(float)
     q = np.column_stack([mine["qw"], mine["qx"], mine["qy"], mine["qz"]]).astype(float)
@@ -95,21 +98,24 @@ def arrival_time(t: np.ndarray, d: np.ndarray, level: float = ARRIVAL_DISPLACEME
     return float(t[k - 1] + (level - d[k - 1]) * (t[k] - t[k - 1]) / (d[k] - d[k - 1]))
 
 
+GRID = 1e-3                      # s: the uniform time grid the records are compared on
+
+
+def _on_grid(t: np.ndarray, d: np.ndarray, span: tuple) -> np.ndarray:
+    """d(t) interpolated on the uniform GRID over ``span`` (the records' samples are uneven: the
+    experiment's every 0.4-14 ms, Sun et al.'s 0.5-32 ms)."""
+    return np.interp(np.arange(span[0], span[1] + 0.5 * GRID, GRID), t, d)
+
+
 def compare(t: np.ndarray, d: np.ndarray, t_ref: np.ndarray, d_ref: np.ndarray) -> dict:
-    """A run's d(t) against a reference's over WINDOW and PLATEAU: ``plateau`` (the mean over
-    PLATEAU, relative to the reference's), ``peak`` (the largest d in WINDOW, relative),
-    ``rms`` (the rms difference over WINDOW, on the reference's samples, over the reference's
-    peak), ``corr`` (their correlation there) and ``arrival`` (the run's arrival time minus the
-    reference's, s)."""
-    def mean_over(tt, dd, span):
-        m = (tt >= span[0]) & (tt <= span[1])
-        return float(np.mean(dd[m]))
-    inside = (t_ref >= WINDOW[0]) & (t_ref <= WINDOW[1])
-    ours = np.interp(t_ref[inside], t, d)
-    ref = d_ref[inside]
+    """A run's d(t) against a reference's, both on a uniform 1 ms grid: ``plateau`` (the mean over
+    PLATEAU, relative to the reference's), ``peak`` (the largest d in WINDOW, relative), ``rms``
+    (the rms difference over WINDOW over the reference's peak there), ``corr`` (their correlation
+    there) and ``arrival`` (the run's arrival time minus the reference's, s)."""
+    ours, ref = _on_grid(t, d, WINDOW), _on_grid(t_ref, d_ref, WINDOW)
     win = (t >= WINDOW[0]) & (t <= WINDOW[1])
-    peak_ref = float(ref.max())
-    return {"plateau": mean_over(t, d, PLATEAU) / mean_over(t_ref, d_ref, PLATEAU) - 1,
+    peak_ref = float(d_ref[(t_ref >= WINDOW[0]) & (t_ref <= WINDOW[1])].max())
+    return {"plateau": float(np.mean(_on_grid(t, d, PLATEAU)) / np.mean(_on_grid(t_ref, d_ref, PLATEAU)) - 1),
             "peak": float(d[win].max()) / peak_ref - 1,
             "rms": float(np.sqrt(np.mean((ours - ref) ** 2))) / peak_ref,
             "corr": float(np.corrcoef(ours, ref)[0, 1]),
@@ -126,7 +132,8 @@ def chain_model(mechanism: dict, axis: int = 1) -> dict:
     for ln in mechanism["links"]:
         if ln["kind"] != "hinge":
             continue
-        upper = ln["body2"] if ln.get("body2") else ln["body1"]
+        pair = [n for n in (ln["body1"], ln.get("body2")) if n]
+        upper = max(pair, key=lambda n: float(by_name[n]["pos"][2]))      # the hinge is below its upper trunk
         below[upper] = (float(ln["point"][2]), float(ln["stiffness"]))
     order = sorted(below, key=lambda name: below[name][0])
     zc = np.array([float(by_name[n]["pos"][2]) for n in order])
@@ -192,8 +199,7 @@ def case_errors(outdir: str, reference_dir: str) -> dict:
     out = compare(t, d, *reference_series(reference_dir))
     out.update({f"dsph_{k}": v for k, v in
                 compare(t, d, *reference_series(reference_dir, "DualSPHysics_Chrono")).items()})
-    plateau = (t >= PLATEAU[0]) & (t <= PLATEAU[1])
     meta = run_info(outdir)
-    out.update({"plateau_m": float(np.mean(d[plateau])), "dp": geo["dp"], "particles": meta.get("particles"),
+    out.update({"plateau_m": float(np.mean(_on_grid(t, d, PLATEAU))), "dp": geo["dp"], "particles": meta.get("particles"),
                 "steps": meta.get("steps"), "runtime_s": meta.get("runtime_s"), "status": meta.get("status")})
     return out

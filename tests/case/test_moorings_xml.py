@@ -97,7 +97,7 @@ def test_a_full_case_reads_into_the_moorings_dict(tmp_path):
                 <savevtk_points value="true" /><savecsv_points value="false" />
                 <start value="0.2" ramptime="0.5" />"""
     m, warnings = _read(tmp_path, moorings(head=head))
-    assert not warnings
+    assert len(warnings) == 1 and "<savevtk_points> is not written by sphdvi" in str(warnings[0])
     assert (m["savevtk_lines"], m["savevtk_moorings"], m["savecsv_points"], m["savevtk_points"]) == \
         (True, True, False, True)
     assert (m["start"], m["ramptime"], m["floatings"]) == (0.2, 0.5, [50])
@@ -325,3 +325,11 @@ def test_node_outputs_sphdvi_does_not_write_are_warned_about(tmp_path):
     m, warnings = _read(tmp_path, moorings(library(lines=lines)))
     assert m["lines"][0]["outputflags"] == "pDb"
     assert len(warnings) == 1 and "not D, b" in str(warnings[0])
+
+
+def test_a_line_whose_ends_coincide_is_refused(tmp_path):
+    """The nodes start between the two ends: the same point for both leaves every segment of zero
+    length (a NaN at the first step)."""
+    line = LINE0.replace('<fixconnection x="0.95" y="0" z="0" />', '<fixconnection x="1.35" y="0" z="0.4" />')
+    r, _ = _gencase(tmp_path, moorings(library(lines=LINEDEFAULT + line)))
+    assert r.exit_code == 2 and "two ends are the same point" in r.output, r.output

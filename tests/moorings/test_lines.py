@@ -72,7 +72,7 @@ def test_a_slack_line_settles_on_the_catenary_with_its_touchdown():
     f = m.fairlead_forces()[0, 1]
     assert f[0] == pytest.approx(-cat["HF"], rel=5e-3) and f[2] == pytest.approx(-cat["VF"], rel=5e-3)
     on_bed = m.pos[1:4, 2]
-    assert np.allclose(on_bed, -w / (3e6 * DIA), rtol=0.02)
+    assert np.allclose(on_bed, -w / (3e6 * DIA), rtol=0.01)
 
 
 def test_the_relaxation_before_t0_reaches_the_catenary():
@@ -158,3 +158,19 @@ def test_the_load_on_the_body_is_the_fairlead_force_and_its_moment():
     f = m.fairlead_forces()[0, 1]
     assert np.allclose(F[0], f)
     assert np.allclose(T[0], np.cross(np.array([0.4, 0.0, 0.35]) - BODY[0][0], f))
+
+
+def test_the_state_round_trips_exactly():
+    """get_state/set_state (restart.h5): a copy put into fresh lines gives the same state back, and
+    both advance to the same nodes bit for bit."""
+    m = moorings(spec(length=0.6))
+    hold(m, 0.01)
+    st = m.get_state()
+    other = moorings(spec(length=0.6))
+    other.set_state(st)
+    back = other.get_state()
+    for key in st:
+        assert np.array_equal(np.asarray(st[key]), np.asarray(back[key]), equal_nan=True), key
+    for mm in (m, other):
+        mm.step(0.01, 1e-4, *BODY)
+    assert np.array_equal(m.pos, other.pos) and np.array_equal(m.F, other.F)

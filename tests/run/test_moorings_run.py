@@ -44,6 +44,7 @@ def test_the_mooring_files_have_dualsphysics_names_and_columns(tmp_path):
     assert rows[0, 3] == pytest.approx(2.9e3 * (0.32 ** 0.5 / 0.55 - 1), rel=0.02)
     force = (data / "MoorDynPlus_force.csv").read_text().splitlines()[0].split(";")
     assert force[2:5] == ["Anchor.x_L0 [N]", "Anchor.y_L0 [N]", "Anchor.z_L0 [N]"] and len(force) == 14
+    forces = np.loadtxt(data / "MoorDynPlus_force.csv", delimiter=";", skiprows=1)
     pts = sorted(out.glob("FtForcePoints_ft*_pt*.csv"))
     assert [p.name for p in pts] == ["FtForcePoints_ft0000_pt00.csv", "FtForcePoints_ft0000_pt01.csv"]
     assert pts[0].read_text().splitlines()[0] == ("Part;Time [s];PosX [m];PosY [m];PosZ [m];ForceX [N];ForceY [N];"
@@ -52,6 +53,9 @@ def test_the_mooring_files_have_dualsphysics_names_and_columns(tmp_path):
     assert a[:, 0].tolist() == [0, 1]                       # TimeOut 0.05: parts 0 and 1
     # the left line pulls its fairlead (x 1.35) down and to the left, towards its anchor (x 0.95)
     assert a[0, 5] < 0 and a[0, 7] < 0 and a[0, 2] == pytest.approx(1.35)
+    # the same fairlead force in both files at the output of t = 0.05 (the step that reached it; no ramp)
+    assert forces[-1, 0] == a[1, 1] and a[1, 1] == pytest.approx(0.05, abs=2e-4)
+    assert forces[-1, 5:8] == pytest.approx(a[1, 5:8], rel=1e-8)
     # <savevtk_lines> (on by default): a polyline per line at each output, cell array Line
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkIOLegacy import vtkPolyDataReader
@@ -117,3 +121,11 @@ def test_moorings_in_a_body_only_run_are_refused(tmp_path):
     r = CliRunner().invoke(main, ["run", str(case), "-o", str(tmp_path / "o"), "-q", "--tmax", "0.01"])
     assert r.exit_code == 2, r.output
     assert "<special><moorings>: mooring lines in a body-only run" in r.output and "Traceback" not in r.output
+
+
+def test_moorings_with_periodic_boundaries_are_refused(tmp_path):
+    """A moored body crossing a periodic end would drag its lines across the domain: exit 2."""
+    r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(tmp_path / "o"), "-q", "--tmax", "0.01",
+                                  "--set", "XPeriodicIncZ=1e-12"])     # a written increment: periodic in x
+    assert r.exit_code == 2, r.output
+    assert "<special><moorings> with periodic boundaries is not supported" in r.output
