@@ -15,7 +15,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S16M: S16 with mDBC on the box (dp 0.02, 0.01 and 0.005: 2, 25 and 107 min on 2 threads)
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
                                              # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
-                                             # S19: flexible plate hit by a dam break (dp 0.002: 9 min on 2 threads; dp 0.001 on request, ~1 h)
+                                             # S19: flexible plate hit by a dam break (dp 0.002: 9 min on 2 threads; dp 0.001 on request, 72 min)
                                              # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
                                              # W9: W4's sea generated to second order (the same times)
     python tools/validate.py W3 --fine       # also the resolutions run only on request (W3 depth/dp 40, dp 0.01: ~15 min on 2 threads;
