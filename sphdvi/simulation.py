@@ -1575,7 +1575,8 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
     mooring_log = None
     if moorings is not None:
         from .io.moorings_out import MooringLog
-        mooring_log = MooringLog(outdir, moorings, moorings.spec["floatings"], float(params["TimeOut"]),
+        floatings = [int(m) for m in data["bodies"]["mkbound"]]
+        mooring_log = MooringLog(outdir, moorings, floatings, float(params["TimeOut"]),
                                  float(sol.time) if resume else None)
         if not resume:
             mooring_log.after_step(float(sol.time))

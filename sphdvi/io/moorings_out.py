@@ -8,8 +8,8 @@
 * ``moordynplus_data/Line_<id>_pos.csv``, ``_vel.csv``, ``_tension.csv``, ``_strain.csv`` (a line's
   ``outputFlags`` p, v, t, s: its nodes' positions and velocities, its segments' tensions EA·strain
   (no compression) and strains), at the same times;
-* ``FtForcePoints_ft<ffff>_pt<pp>.csv`` (``<savecsv_points>``): per moored floating (its order in
-  ``<mooredfloatings>``) and fairlead on it, ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...``
+* ``FtForcePoints_ft<ffff>_pt<pp>.csv`` (``<savecsv_points>``): per fairlead (``ffff`` its floating's
+  place among the case's floatings, ``pp`` its place among all the fairleads: :func:`force_point_files`), ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...``
   at every output (the force as the body feels it through the next step, after the start ramp);
 * ``MooringsVtk/MooringsLines_<nnnn>.vtk`` (``<savevtk_lines>``): at every output, a legacy VTK polydata
   (written by vtk) with one polyline per line through its nodes and the cell array ``Line`` (the line's
@@ -39,6 +39,22 @@ def _fmt(values) -> str:
     return ";".join(f"{v:.9g}" for v in np.ravel(values))
 
 
+def force_point_files(lines: list, moored: list, floatings: list) -> list:
+    """(file name, line, end) of each fairlead's FtForcePoints file, as DualSPHysics names them
+    (JDsFtForcePoints::SaveCsvPoints: ``FtForcePoints_ft%04d_pt%02u.csv`` of the point's floating id
+    and the point's index among all the points): the points of the moored floatings in mkbound order,
+    each body's in the order of its lines; a floating's id is its place among all the case's
+    floatings (``floatings``) in mkbound order."""
+    ftid = {mkb: i for i, mkb in enumerate(sorted(int(m) for m in floatings))}
+    out = []
+    for mkb in sorted(int(m) for m in moored):
+        for k, ln in enumerate(lines):
+            for e, end in enumerate(ln["ends"]):
+                if end["kind"] == "vessel" and int(end["body"]) == mkb:
+                    out.append((f"FtForcePoints_ft{ftid[mkb]:04d}_pt{len(out):02d}.csv", k, e))
+    return out
+
+
 def _rows_until(path: str, t: float | None, column: int) -> list:
     """The data rows of ``path`` whose time (in ``column``) is at most ``t`` (all when t is None)."""
     if not os.path.exists(path):
@@ -61,6 +77,8 @@ class MooringLog:
     """The files of this module (its docstring) for the lines of a :class:`~sphdvi.moorings.system.Moorings`."""
 
     def __init__(self, outdir: str, moorings, floatings: list, tout: float, resume_time: float | None = None):
+        """``floatings``: the mkbounds of every floating body of the case (the FtForcePoints files'
+        ``ft`` is a body's place among them, in mkbound order)."""
         self.m = moorings
         self.folder = os.path.join(outdir, FOLDER)
         spec = moorings.spec
@@ -94,20 +112,12 @@ class MooringLog:
         self.vtk_folder = os.path.join(outdir, "MooringsVtk") if spec.get("savevtk_lines", True) else None
         if self.vtk_folder is not None:
             os.makedirs(self.vtk_folder, exist_ok=True)
-        self.points = []         # (path, line, end) of each fairlead, per moored floating
+        self.points = []         # (path, line, end) of each fairlead
         if spec.get("savecsv_points", True):
-            order = {int(mkb): i for i, mkb in enumerate(floatings)}
-            count = {}
-            for k, ln in enumerate(spec["lines"]):
-                for e, end in enumerate(ln["ends"]):
-                    if end["kind"] != "vessel":
-                        continue
-                    ft = order[int(end["body"])]
-                    pt = count.get(ft, 0)
-                    count[ft] = pt + 1
-                    path = os.path.join(outdir, f"FtForcePoints_ft{ft:04d}_pt{pt:02d}.csv")
-                    self._open(path, POINTS_HEADER, 1, resume_time)
-                    self.points.append((path, k, e))
+            for name, k, e in force_point_files(spec["lines"], spec["floatings"], floatings):
+                path = os.path.join(outdir, name)
+                self._open(path, POINTS_HEADER, 1, resume_time)
+                self.points.append((path, k, e))
         if save and resume_time is not None and moorings.log_next is not None:
             self.next = moorings.log_next        # the schedule of the run that wrote the checkpoint
 
