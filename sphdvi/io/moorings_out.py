@@ -9,8 +9,9 @@
   ``outputFlags`` p, v, t, s: its nodes' positions and velocities, its segments' tensions EA·strain
   (no compression) and strains), at the same times;
 * ``FtForcePoints_ft<ffff>_pt<pp>.csv`` (``<savecsv_points>``): per fairlead (``ffff`` its floating's
-  place among the case's floatings, ``pp`` its place among all the fairleads: :func:`force_point_files`), ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...``
-  at every output (the force as the body feels it through the next step, after the start ramp);
+  place among the case's floatings, ``pp`` its place among all the fairleads: :func:`force_point_files`),
+  ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...`` at every output (the force as the body
+  feels it through the next step, after the start ramp);
 * ``MooringsVtk/MooringsLines_<nnnn>.vtk`` (``<savevtk_lines>``): at every output, a legacy VTK polydata
   (written by vtk) with one polyline per line through its nodes and the cell array ``Line`` (the line's
   id), as DualSPHysics writes it.
