@@ -25,14 +25,8 @@ import warnings
 
 import numpy as np
 
+from ..dvi._math import np_quat_to_mat
 from . import lines as L
-
-
-def _rotation(q) -> np.ndarray:
-    w, x, y, z = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def start_ramp(t: float, start: float, ramptime: float) -> float:
@@ -124,7 +118,7 @@ class Moorings:
                     b = body_index[int(end["body"])]
                     self.end_kind[k, e] = L.VESSEL
                     self.end_body[k, e] = b
-                    self.end_local[k, e] = _rotation(quat[b]).T @ (p - centre[b])
+                    self.end_local[k, e] = np_quat_to_mat(quat[b]).T @ (p - centre[b])
             anchor, fairlead = self.end_p0[k, 0], self.end_p0[k, 1]
             w = (mass / area - self.rho_w) * area * self.g
             nodes = initial_nodes(anchor, fairlead, float(ln["length"]), int(ln["segments"]), ea, w)

@@ -44,13 +44,6 @@ def reference_series(reference_dir: str, which: str = "EXP_Liao2015") -> tuple[n
     return data[order, 0], data[order, 1]
 
 
-def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """v turned by the unit quaternions q (rows w, x, y, z)."""
-    w, u = q[:, :1], q[:, 1:]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
-
-
 def plate_geometry(outdir: str) -> dict:
     """From the gencase file: the top trunk's centre c0 and Marker 1's start p0 (on the plate's
     centre line, MARKER_BELOW_TOP below the top of its particles' volume), the plate's height L,
@@ -82,8 +75,8 @@ def marker_displacement(outdir: str, geo: dict | None = None) -> tuple[np.ndarra
     t = np.asarray(mine["time"], dtype=float)
     c = np.column_stack([mine["x"], mine["y"], mine["z"]]).astype(float)
     q = np.column_stack([mine["qw"], mine["qx"], mine["qy"], mine["qz"]]).astype(float)
-    arm = np.broadcast_to(geo["p0"] - geo["c0"], c.shape)
-    marker = c + _rotate(q, arm)
+    from ..dvi._math import body_rotations
+    marker = c + body_rotations(q) @ (geo["p0"] - geo["c0"])
     return t, marker[:, 0] - geo["p0"][0]
 
 
