@@ -277,11 +277,11 @@ def _read_table(m):
     """(:class:`sphdvi.tables.TimeTable` of the file's used columns, {field: column}) of a file
     movement, from the file's cache (the columns contiguous, read once: a look-up does not copy them)."""
     ncols, cols = file_columns(m)
-    key = (m["file"], ncols, tuple(sorted(cols.items())))
+    key = (m["file"], ncols, tuple(sorted(cols.items())), m.get("reach"))
     if key not in _FILE_CACHE:
         from .case.datafiles import read_motion_table
         from .tables import TimeTable
-        data = read_motion_table(m["file"], ncols, cols, f"<{m['type']}> file")
+        data = read_motion_table(m["file"], ncols, cols, f"<{m['type']}> file", m.get("reach"))
         names = [name for name in cols if name != "fieldtime"]
         table = TimeTable(data[:, cols["fieldtime"]], data[:, [cols[name] for name in names]])
         _FILE_CACHE[key] = (table, {name: k for k, name in enumerate(names)})

@@ -96,19 +96,31 @@ def read_vector_table(path: str, what: str, allow_none: bool = False) -> tuple[l
     return a[:, 0].tolist(), values
 
 
-def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.ndarray:
+def read_motion_table(path: str, ncols: int, columns: dict, what: str, reach: float | None = None) -> np.ndarray:
     """A DualSPHysics motion file (``mvrectfile``/``mvrotfile``, JMotionDataFile): rows of
     ``ncols`` numbers (the ``fields`` attribute), of which ``columns`` (name -> 0-based
     column, ``fieldtime`` among them) are used. Checked as DualSPHysics needs them: at
     least two rows, the used values finite, the times never going back. A repeated time is
     taken, as JMotionMovActive takes it (its look-up steps over a segment of zero length; the
-    examples' 17_WaveRunup Mov_piston.dat opens with two rows at t = 0). -> (n, ncols)."""
-    a, lines = _read_rows(path, ncols, what, finite=False)
+    examples' 17_WaveRunup Mov_piston.dat opens with two rows at t = 0).
+
+    ``reach``: the movement's duration, when known.  Rows after a time that goes back are left
+    out when the rows before it already reach the first row's time + ``reach``: the movement
+    never looks them up (DualSPHysics's look-up walks forward from the start and stops there;
+    MoorDynPlus's example 03_WavesMoorings3D plays 30 s of a piston file that ends in stray rows
+    going back from 49.575 to 35.48 s).  -> (n, ncols): the rows kept (:func:`unreached_rows`)."""
+    return _motion_rows(path, ncols, columns, what, reach)[0]
+
+
+def _motion_rows(path: str, ncols: int, columns: dict, what: str, reach: float | None) -> tuple:
+    """:func:`read_motion_table`'s rows kept, with the line numbers of all the file's rows."""
+    a, all_lines = _read_rows(path, ncols, what, finite=False)
     if a.shape[0] < 2:
-        found = "no data rows" if a.shape[0] == 0 else f"one data row (line {lines[0]})"
+        found = "no data rows" if a.shape[0] == 0 else f"one data row (line {all_lines[0]})"
         raise CaseError(f"{what}: {found}", file=path,
                         expected=f"at least two lines of {ncols} numbers (time and position)")
-    a = a[:, :ncols]
+    keep = unreached_rows(a[:, columns.get("fieldtime", 0)], reach)
+    a, lines = a[:keep, :ncols], all_lines[:keep]
     for name, col in sorted(columns.items(), key=lambda kv: kv[1]):
         bad = np.flatnonzero(~np.isfinite(a[:, col]))
         if bad.size:
@@ -120,7 +132,19 @@ def read_motion_table(path: str, ncols: int, columns: dict, what: str) -> np.nda
         i = bad[0] + 1
         raise CaseError(f"{what}: time {t[i]:g} comes before {t[i - 1]:g} (line {lines[i - 1]})",
                         file=path, line=lines[i], expected="times that never go back (a repeated time is a step)")
-    return a
+    return a, all_lines
+
+
+def unreached_rows(t, reach: float | None) -> int:
+    """The number of leading rows of times ``t`` a movement of duration ``reach`` can look up,
+    when its times go back only after the rows that reach ``t[0] + |reach|`` (all rows otherwise,
+    and the check that follows refuses the file)."""
+    t = np.asarray(t, float)
+    back = np.flatnonzero(np.diff(t) < 0)
+    if reach is None or not back.size:
+        return len(t)
+    i = int(back[0]) + 1
+    return i if i >= 2 and t[i - 1] >= t[0] + abs(reach) else len(t)
 
 
 # DualSPHysics's other names of ``mvrectfile`` (JMotion::ReadXml)
@@ -146,7 +170,7 @@ def motion_file_columns(tag: str, given: dict, ncols: int | None = None) -> tupl
     return (int(ncols) if ncols else max(2, 1 + max(cols.values()))), cols
 
 
-def read_motion_file(reader, m, tag: str) -> dict:
+def read_motion_file(reader, m, tag: str, duration: float | None = None) -> dict:
     """Read and check the ``<file>`` of movement element ``m`` (``tag``: ``mvrectfile``, its
     aliases included, ``mvrotfile`` or ``mvrotadvfile``): ``fields`` is the number of columns of
     the file, ``fieldtime``, ``fieldx``, ``fieldy``, ``fieldz`` (``fieldang``; ``fieldang1``-``3``)
@@ -168,11 +192,16 @@ def read_motion_file(reader, m, tag: str) -> dict:
     if tag == "mvrectfile" and len(cols) == 1:
         reader.warn(f, "none of fieldx, fieldy, fieldz is given: the movement does not move the object")
     try:
-        read_motion_table(path, ncols, cols, "motion data")
+        a, lines = _motion_rows(path, ncols, cols, "motion data", duration)
     except CaseError as exc:
         where = path + (f":{exc.line}" if exc.line else "")
         raise reader.error(f, f"{where}: {exc.message}", exc.expected) from None
-    return {"file": path, "fields": cols, "ncols": ncols}
+    if len(a) < len(lines):
+        t, n = a[:, cols["fieldtime"]], len(a)
+        reader.warn(f, f"{path}:{lines[n]}: the time goes back after line {lines[n - 1]} ({t[-1]:g} s); the "
+                    f"movement plays the file from {t[0]:g} s for {abs(duration):g} s and never reaches the rows "
+                    f"from line {lines[n]} on: left out ({len(lines) - n} rows)")
+    return {"file": path, "fields": cols, "ncols": ncols, "reach": duration}
 
 
 def _time_table(path: str, what: str, name: str, unit: str, positive: bool) -> np.ndarray:

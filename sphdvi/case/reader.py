@@ -523,7 +523,7 @@ def _read_movement_chain(reader, obj, is2d=False):
         d.update(type=tag, id=mid)
         for part in MOVEMENTS[tag]:
             if part == "file":
-                d.update(read_motion_file(reader, m, tag))
+                d.update(read_motion_file(reader, m, tag, d["duration"]))
                 continue
             c = reader.child(m, part)
             if c is None:

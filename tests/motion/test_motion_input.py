@@ -121,6 +121,32 @@ def test_bad_motion_files(tmp_path, content, match, line):
     assert data in e.value.message
 
 
+def test_rows_going_back_beyond_the_movements_reach_are_left_out(tmp_path):
+    """MoorDynPlus's example 03_WavesMoorings3D plays 30 s of a piston file whose last rows go
+    back from 49.575 to 35.48 s: DualSPHysics never reaches them, and sphdvi leaves them out with
+    a warning (file:line), at gencase and at run time alike."""
+    content = "0;0;0;0\n1;1;0;0\n2;2;0;0\n3;3;0;0\n1.5;9;0;0\n1.6;9;0;0\n"
+    body = '<mvrectfile id="1" duration="2"><file name="m.csv" fields="4" fieldx="1"/></mvrectfile>'
+    (m,), reader = read(tmp_path, body, {"m.csv": content})
+    (w,) = list(reader.warnings)
+    assert f"{tmp_path / 'm.csv'}:5: the time goes back after line 4 (3 s)" in w
+    assert "from 0 s for 2 s" in w and "left out (2 rows)" in w
+    for t, x in ((1.5, 1.5), (2.0, 2.0), (5.0, 2.0)):        # the movement stops after 2 s
+        assert chain_transform(m, t).apply(np.zeros((1, 3)))[0][0, 0] == pytest.approx(x)
+    assert MotionSet([m]).transform(1, 1.5).d[0] == pytest.approx(1.5)      # the run's reading
+
+
+@pytest.mark.parametrize("duration,flash", [("3.5", False), ("-3.5", True)])
+def test_rows_going_back_within_the_movements_reach_are_an_error(tmp_path, duration, flash):
+    """The same file played longer than its rows before the jump back reach (a flash's |duration|
+    too): the file is refused, its line named."""
+    content = "0;0;0;0\n1;1;0;0\n2;2;0;0\n3;3;0;0\n1.5;9;0;0\n1.6;9;0;0\n"
+    body = f'<mvrectfile id="1" duration="{duration}"><file name="m.csv" fields="4" fieldx="1"/></mvrectfile>'
+    with pytest.raises(CaseError, match=r"time 1.5 comes before 3 \(line 4\)") as e:
+        read(tmp_path, body, {"m.csv": content})
+    assert f"{tmp_path / 'm.csv'}:5:" in e.value.message
+
+
 def test_missing_motion_file(tmp_path):
     with pytest.raises(CaseError, match="file 'm.csv' not found") as e:
         read(tmp_path, rectfile())
