@@ -413,7 +413,7 @@ def _read_lines(reader, el, solver: dict, bodies: list) -> list:
         if span == 0.0:
             raise reader.error(line_el, f"line {k}'s two ends are the same point {tuple(ends[0]['pos'])}",
                                "two connections at different points (the line's nodes start between them)")
-        if d["length"] < span:
+        if d["length"] < span * (1.0 - 1e-9):            # not for a rounding error (0.6 vs 0.6000000000000001)
             reader.warn(line_el, f"line {k}'s length {d['length']:g} m is shorter than the distance between its ends "
                         f"({span:.6g} m): it starts taut, stretched by {100.0 * (span / d['length'] - 1.0):.3g} %")
         for e in ends:

@@ -202,6 +202,16 @@ def test_warnings_waves_wavekin_short_line(tmp_path):
     assert "line 0's length 0.5 m is shorter than the distance between its ends" in text and "taut" in text
 
 
+def test_a_line_as_long_as_its_span_is_not_warned_for_a_rounding_error(tmp_path):
+    """MoorDynPlus's example 04_ConnectedBoxes: a 0.6 m line between ends 0.6 m apart, whose
+    distance computes as 0.6000000000000001, was warned "stretched by 2.22e-14 %"."""
+    line = LINE0.replace('x="1.35" y="0" z="0.4"', 'x="0.8" y="0" z="0"').replace('x="0.95"', 'x="0.2"')
+    m, warnings = _read(tmp_path, moorings(library(lines=LINEDEFAULT + line)))
+    assert len(m["lines"]) == 1 and not [w for w in warnings if "taut" in w]
+    m, warnings = _read(tmp_path, moorings(library(lines=LINEDEFAULT + line.replace('x="0.2"', 'x="0.19"'))))
+    assert [w for w in warnings if "stretched by 1.67 %" in w]
+
+
 def test_the_example_case_runs_through_gencase(tmp_path):
     r = CliRunner().invoke(main, ["gencase", str(EXAMPLE), "-o", str(tmp_path / "g")])
     assert r.exit_code == 0, r.output
