@@ -97,9 +97,6 @@ def read_moorings(reader, el) -> dict:
     for tag, default in SAVE_FLAGS:
         c = reader.child(el, tag)
         out[tag] = reader.boolean(c, "value", default) if c is not None else default
-        if c is not None and out[tag] and tag in ("savevtk_moorings", "savevtk_points"):
-            reader.warn(c, f"<{tag}> is not written by sphdvi (MooringsVtk/MooringsLines_*.vtk of <savevtk_lines> "
-                        "and FtForcePoints_*.csv hold the lines and their fairleads)")
     start = reader.child(el, "start")
     out["start"] = reader.num(start, "value", 0.0, nonnegative=True) if start is not None else 0.0
     out["ramptime"] = reader.num(start, "ramptime", 0.0, nonnegative=True) if start is not None else 0.0

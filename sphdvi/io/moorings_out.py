@@ -12,9 +12,12 @@
   place among the case's floatings, ``pp`` its place among all the fairleads: :func:`force_point_files`),
   ``Part;Time [s];PosX [m];...;ForceX [N];...;VelX [m/s];...`` at every output (the force as the body
   feels it through the next step, after the start ramp);
-* ``MooringsVtk/MooringsLines_<nnnn>.vtk`` (``<savevtk_lines>``): at every output, a legacy VTK polydata
-  (written by vtk) with one polyline per line through its nodes and the cell array ``Line`` (the line's
-  id), as DualSPHysics writes it.
+* ``MooringsVtk/MooringsLines_<nnnn>.vtk`` (``<savevtk_lines>``) and ``MooringsVtk/Moorings_<nnnn>.vtk``
+  (``<savevtk_moorings>``): at every output, a legacy VTK polydata (written by vtk) with one polyline
+  per line through its nodes, and a vertex (MooringsLines) or a sphere (Moorings) at each node, the
+  cell array ``Line`` (the line's id), as DualSPHysics writes them (:func:`write_lines_vtk`);
+* ``MooringsVtk/FtForcesPoints_<nnnn>.vtk`` (``<savevtk_points>``): the fairleads with ``FtId``,
+  ``Vel`` and ``Force`` (:func:`write_points_vtk`).
 
 Numbers are written with 9 significant digits (MoorDynPlus writes six decimals). A resume cuts
 each file back to the restart time, atomically; rows are appended at each output.
@@ -46,13 +49,20 @@ def force_point_files(lines: list, moored: list, floatings: list) -> list:
     and the point's index among all the points): the points of the moored floatings in mkbound order,
     each body's in the order of its lines; a floating's id is its place among all the case's
     floatings (``floatings``) in mkbound order."""
+    return [(f"FtForcePoints_ft{ft:04d}_pt{i:02d}.csv", k, e)
+            for i, (ft, k, e) in enumerate(fairleads(lines, moored, floatings))]
+
+
+def fairleads(lines: list, moored: list, floatings: list) -> list:
+    """(floating id, line, end) of each fairlead in DualSPHysics's order of force points
+    (:func:`force_point_files`)."""
     ftid = {mkb: i for i, mkb in enumerate(sorted(int(m) for m in floatings))}
     out = []
     for mkb in sorted(int(m) for m in moored):
         for k, ln in enumerate(lines):
             for e, end in enumerate(ln["ends"]):
                 if end["kind"] == "vessel" and int(end["body"]) == mkb:
-                    out.append((f"FtForcePoints_ft{ftid[mkb]:04d}_pt{len(out):02d}.csv", k, e))
+                    out.append((ftid[mkb], k, e))
     return out
 
 
@@ -110,9 +120,12 @@ class MooringLog:
                     cols = [col.format(i=i, a=a) for i in range(count) for a in ("xyz" if dim == 3 else "-")]
                     self._open(os.path.join(outdir, FOLDER, f"Line_{spec['lines'][k]['id']}_{name}.csv"),
                                "time [s];" + ";".join(c.replace(".-", "") for c in cols), 0, resume_time)
-        self.vtk_folder = os.path.join(outdir, "MooringsVtk") if spec.get("savevtk_lines", True) else None
+        self.vtk = {key: spec.get(key, default) for key, default in
+                    (("savevtk_lines", True), ("savevtk_moorings", True), ("savevtk_points", False))}
+        self.vtk_folder = os.path.join(outdir, "MooringsVtk") if any(self.vtk.values()) else None
         if self.vtk_folder is not None:
             os.makedirs(self.vtk_folder, exist_ok=True)
+        self.fairleads = fairleads(spec["lines"], spec["floatings"], floatings)
         self.points = []         # (path, line, end) of each fairlead
         if spec.get("savecsv_points", True):
             for name, k, e in force_point_files(spec["lines"], spec["floatings"], floatings):
@@ -161,45 +174,127 @@ class MooringLog:
     def record_part(self, part: int, t: float) -> None:
         """The FtForcePoints rows and the lines' VTK file of output ``part`` at ``t``; then every
         pending row to its file."""
-        if self.vtk_folder is not None:
-            write_lines_vtk(os.path.join(self.vtk_folder, f"MooringsLines_{part:04d}.vtk"), self.m)
-        if self.points:
-            m = self.m
+        m = self.m
+        if self.vtk["savevtk_lines"]:
+            write_lines_vtk(os.path.join(self.vtk_folder, f"MooringsLines_{part:04d}.vtk"), m)
+        if self.vtk["savevtk_moorings"]:
+            write_lines_vtk(os.path.join(self.vtk_folder, f"Moorings_{part:04d}.vtk"), m, spheres=True)
+        if self.points or self.vtk["savevtk_points"]:
             force = m.fairlead_forces() * m.ramp          # as the body feels it (the ramp of the step)
+            nodes = [m.first[k] if e == 0 else m.last[k] for _, k, e in self.fairleads]
             for path, k, e in self.points:
                 node = m.first[k] if e == 0 else m.last[k]
                 self.files[path].append(f"{part};{t:.9g};{_fmt(m.pos[node])};{_fmt(force[k, e])};{_fmt(m.vel[node])}\n")
+            if self.vtk["savevtk_points"]:
+                write_points_vtk(os.path.join(self.vtk_folder, f"FtForcesPoints_{part:04d}.vtk"),
+                                 [ft for ft, _, _ in self.fairleads], m.pos[nodes], m.vel[nodes],
+                                 np.array([force[k, e] for _, k, e in self.fairleads]).reshape(-1, 3))
         for path, rows in self.files.items():
             if rows:
                 append_text(path, "".join(rows))
                 rows.clear()
 
 
-def write_lines_vtk(path: str, moorings) -> None:
-    """One polyline per mooring line through its nodes, cell array ``Line`` (the line's id), as a
-    legacy VTK polydata file written by vtk (atomically)."""
+def write_lines_vtk(path: str, moorings, spheres: bool = False) -> None:
+    """The lines as DualSPHysics's JDsMooredFloatings::SaveVtkMoorings draws them, a legacy VTK
+    polydata file written by vtk (atomically): one polyline per line through its nodes, and either
+    a vertex at each node (``MooringsLines_<nnnn>.vtk``) or, with ``spheres``, a sphere of 16
+    sides at each node whose radius is a tenth of the line's first segment (``Moorings_<nnnn>.vtk``);
+    the cell array ``Line`` holds each cell's line id."""
+    pos = np.asarray(moorings.pos, dtype=np.float64)
+    first = np.asarray(moorings.first, dtype=np.int64)
+    last = np.asarray(moorings.last, dtype=np.int64)
+    ids = np.array([int(ln["id"]) for ln in moorings.lines], dtype=np.int32)
+    counts = last - first + 1
+    node_line = np.repeat(ids, counts)
+    nodes = np.concatenate([np.arange(a, b + 1) for a, b in zip(first, last)])
+    lines = (np.r_[0, np.cumsum(counts)], nodes)
+    if not spheres:
+        verts = (np.arange(len(nodes) + 1), nodes)
+        data = _polydata(pos, verts=verts, lines=lines, cell_line=np.r_[node_line, ids])
+    else:
+        unit, tri = _unit_sphere()
+        radius = np.repeat(np.linalg.norm(pos[first + 1] - pos[first], axis=1) / 10.0, counts)
+        ball = (pos[nodes, None, :] + radius[:, None, None] * unit[None]).reshape(-1, 3)
+        base = len(pos) + len(unit) * np.arange(len(nodes))
+        conn = (tri[None, :, :] + base[:, None, None]).ravel()
+        polys = (3 * np.arange(len(nodes) * len(tri) + 1), conn)
+        data = _polydata(np.vstack([pos, ball]), lines=lines, polys=polys,
+                         cell_line=np.r_[ids, np.repeat(node_line, len(tri))])
+    _write_polydata(path, data)
+
+
+def write_points_vtk(path: str, ftid, pos, vel, force) -> None:
+    """``MooringsVtk/FtForcesPoints_<nnnn>.vtk`` (``<savevtk_points>``), as DualSPHysics's
+    JDsFtForcePoints::SaveVtkPoints: a vertex at each fairlead with the point arrays ``FtId`` (its
+    floating's place among the case's floatings), ``Vel`` and ``Force`` (as in the CSV files)."""
     from vtkmodules.util.numpy_support import numpy_to_vtk
-    from vtkmodules.vtkCommonCore import vtkIntArray, vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData, vtkPolyLine
+    n = len(ftid)
+    data = _polydata(np.asarray(pos, float).reshape(n, 3), verts=(np.arange(n + 1), np.arange(n)))
+    for name, values in (("FtId", np.asarray(ftid, np.int32)), ("Vel", np.asarray(vel, np.float32).reshape(n, 3)),
+                         ("Force", np.asarray(force, np.float32).reshape(n, 3))):
+        arr = numpy_to_vtk(np.ascontiguousarray(values), deep=True)
+        arr.SetName(name)
+        data.GetPointData().AddArray(arr)
+    _write_polydata(path, data)
+
+
+_SPHERE: list = []
+
+
+def _unit_sphere() -> tuple:
+    """(points, triangles) of a unit sphere of 16 sides (vtkSphereSource), built once."""
+    if not _SPHERE:
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+        from vtkmodules.vtkFiltersSources import vtkSphereSource
+        src = vtkSphereSource()
+        src.SetRadius(1.0)
+        src.SetThetaResolution(16)
+        src.SetPhiResolution(16)
+        src.Update()
+        out = src.GetOutput()
+        pts = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
+        cells = out.GetPolys()
+        conn = vtk_to_numpy(cells.GetConnectivityArray()).astype(np.int64)
+        _SPHERE.extend([pts, conn.reshape(-1, 3)])
+    return _SPHERE[0], _SPHERE[1]
+
+
+def _cells(offsets, connectivity):
+    from vtkmodules.util.numpy_support import numpy_to_vtkIdTypeArray
+    from vtkmodules.vtkCommonDataModel import vtkCellArray
+    cells = vtkCellArray()
+    cells.SetData(numpy_to_vtkIdTypeArray(np.ascontiguousarray(offsets, dtype=np.int64), deep=True),
+                  numpy_to_vtkIdTypeArray(np.ascontiguousarray(connectivity, dtype=np.int64), deep=True))
+    return cells
+
+
+def _polydata(points, verts=None, lines=None, polys=None, cell_line=None):
+    """A vtkPolyData of ``points`` (float32, as DualSPHysics writes) and cells given as (offsets,
+    connectivity); ``cell_line``: the cell array ``Line``, in VTK's cell order (verts, lines, polys)."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    pts = vtkPoints()
+    pts.SetData(numpy_to_vtk(np.ascontiguousarray(points, dtype=np.float32), deep=True))
+    data = vtkPolyData()
+    data.SetPoints(pts)
+    if verts is not None:
+        data.SetVerts(_cells(*verts))
+    if lines is not None:
+        data.SetLines(_cells(*lines))
+    if polys is not None:
+        data.SetPolys(_cells(*polys))
+    if cell_line is not None:
+        arr = numpy_to_vtk(np.ascontiguousarray(cell_line, dtype=np.int32), deep=True)
+        arr.SetName("Line")
+        data.GetCellData().AddArray(arr)
+    return data
+
+
+def _write_polydata(path: str, data) -> None:
     from vtkmodules.vtkIOLegacy import vtkPolyDataWriter
     from .atomic import atomic_path
-    points = vtkPoints()
-    points.SetData(numpy_to_vtk(np.ascontiguousarray(moorings.pos, dtype=np.float32), deep=True))
-    cells = vtkCellArray()
-    ids = vtkIntArray()
-    ids.SetName("Line")
-    for k, line in enumerate(moorings.lines):
-        a, b = int(moorings.first[k]), int(moorings.last[k])
-        poly = vtkPolyLine()
-        poly.GetPointIds().SetNumberOfIds(b - a + 1)
-        for i, j in enumerate(range(a, b + 1)):
-            poly.GetPointIds().SetId(i, j)
-        cells.InsertNextCell(poly)
-        ids.InsertNextValue(int(line["id"]))
-    data = vtkPolyData()
-    data.SetPoints(points)
-    data.SetLines(cells)
-    data.GetCellData().AddArray(ids)
     with atomic_path(path) as tmp:
         w = vtkPolyDataWriter()
         w.SetFileName(tmp)

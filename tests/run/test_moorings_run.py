@@ -35,7 +35,10 @@ def test_the_mooring_files_have_dualsphysics_names_and_columns(tmp_path):
     """MoorDynPlus_tension.csv / _force.csv (the case's <savedata>: every 0.01 s from 0) and one
     FtForcePoints file per fairlead (every output): their headers, a row per time, and the
     fairlead's force in both (the lines start taut: stretched 2.85 %, 80 N)."""
-    out = run(tmp_path / "a", "--tmax", "0.05", "--set", "FtPause=0")
+    case = tmp_path / "CaseMooredBox2D_Def.xml"
+    case.write_text(CASE.read_text().replace('<savecsv_points value="true" />',
+                                             '<savecsv_points value="true" /><savevtk_points value="true" />'))
+    out = run(tmp_path / "a", "--tmax", "0.05", "--set", "FtPause=0", case=case)
     data = out / "moordynplus_data"
     head = (data / "MoorDynPlus_tension.csv").read_text().splitlines()
     assert head[0] == "time [s];dt [s];Anchor_L0 [N];Fairlead_L0 [N];Anchor_L1 [N];Fairlead_L1 [N]"
@@ -56,19 +59,37 @@ def test_the_mooring_files_have_dualsphysics_names_and_columns(tmp_path):
     # the same fairlead force in both files at the output of t = 0.05 (the step that reached it; no ramp)
     assert forces[-1, 0] == a[1, 1] and a[1, 1] == pytest.approx(0.05, abs=2e-4)
     assert forces[-1, 5:8] == pytest.approx(a[1, 5:8], rel=1e-8)
-    # <savevtk_lines> (on by default): a polyline per line at each output, cell array Line
+    # <savevtk_lines> and <savevtk_moorings> (on by default), <savevtk_points> (set here): at each output,
+    # a polyline per line with a vertex / a sphere at each node (cell array Line), and the fairleads
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkIOLegacy import vtkPolyDataReader
+
+    def read(name):
+        reader = vtkPolyDataReader()
+        reader.SetFileName(str(out / "MooringsVtk" / name))
+        reader.Update()
+        return reader.GetOutput()
     names = sorted(p.name for p in (out / "MooringsVtk").iterdir())
-    assert names == ["MooringsLines_0000.vtk", "MooringsLines_0001.vtk"]
-    reader = vtkPolyDataReader()
-    reader.SetFileName(str(out / "MooringsVtk" / "MooringsLines_0001.vtk"))
-    reader.Update()
-    poly = reader.GetOutput()
-    assert (poly.GetNumberOfPoints(), poly.GetNumberOfCells()) == (42, 2)
-    assert vtk_to_numpy(poly.GetCellData().GetArray("Line")).tolist() == [0, 1]
-    ends = vtk_to_numpy(poly.GetPoints().GetData())[[0, 21]]
-    assert ends[:, 0] == pytest.approx([0.95, 2.05]) and ends[:, 2] == pytest.approx([0.0, 0.0])
+    assert names == ["FtForcesPoints_0000.vtk", "FtForcesPoints_0001.vtk", "MooringsLines_0000.vtk",
+                     "MooringsLines_0001.vtk", "Moorings_0000.vtk", "Moorings_0001.vtk"]
+    poly = read("MooringsLines_0001.vtk")
+    assert (poly.GetNumberOfPoints(), poly.GetNumberOfVerts(), poly.GetNumberOfLines()) == (42, 42, 2)
+    assert vtk_to_numpy(poly.GetCellData().GetArray("Line")).tolist() == [0] * 21 + [1] * 21 + [0, 1]
+    nodes = vtk_to_numpy(poly.GetPoints().GetData())
+    assert nodes[[0, 21], 0] == pytest.approx([0.95, 2.05]) and nodes[[0, 21], 2] == pytest.approx([0.0, 0.0])
+    balls = read("Moorings_0001.vtk")
+    assert balls.GetNumberOfLines() == 2 and balls.GetNumberOfPolys() % 42 == 0
+    pts = vtk_to_numpy(balls.GetPoints().GetData())
+    assert np.array_equal(pts[:42], nodes)
+    per = (len(pts) - 42) // 42                             # each node's sphere: a tenth of its first segment
+    r = np.linalg.norm(pts[42:42 + per] - nodes[0], axis=1)
+    assert r == pytest.approx(np.linalg.norm(nodes[1] - nodes[0]) / 10, abs=3e-7)      # float32 at ~1 m
+    fair = read("FtForcesPoints_0001.vtk")
+    assert fair.GetNumberOfVerts() == 2
+    arrays = {k: vtk_to_numpy(fair.GetPointData().GetArray(k)) for k in ("FtId", "Vel", "Force")}
+    assert arrays["FtId"].tolist() == [0, 0]
+    assert arrays["Force"][0] == pytest.approx(a[1, 5:8], rel=1e-6)
+    assert vtk_to_numpy(fair.GetPoints().GetData())[0] == pytest.approx(a[1, 2:5], rel=1e-6)
 
 
 def test_a_resumed_run_ends_bitwise_as_an_uninterrupted_one(tmp_path):
