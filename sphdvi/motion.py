@@ -20,6 +20,9 @@ Movements (DualSPHysics ``JMotion``; times τ measured from the start of the mov
   start and the displacement measured from it, the velocity the slope of the rows' segment (0
   outside the file's times); ``fieldtime``, ``fieldx``... are 0-based column indices
   (DualSPHysics's JMotionDataFile);
+* ``mvpathfile``: an ``mvrectfile``'s positions and an ``mvrotadvfile``'s angles from one file, the
+  centre travelling with the path (``movecenter``, the default) or staying put
+  (:func:`_from_path_file`, sphdvi's reading as for ``mvrotadvfile``);
 * ``mvrotadvfile``: three Euler angles from a file (``fieldang1``-``3``; ``axes`` such as XYZ,
   ``intrinsic`` or about the fixed axes, each turn right-handed), the object turned about
   ``center`` to the orientation they give relative to the file's first row's
@@ -182,6 +185,9 @@ def _segment(m: dict, tau: float, state: dict) -> Rigid:
     if kind == "mvrotadvfile":
         state.update(carried)
         return _from_euler_file(m, tau)
+    if kind == "mvpathfile":
+        state.update(carried)
+        return _from_path_file(m, tau)
     raise ValueError(f"unsupported movement {kind}")
 
 
@@ -376,6 +382,38 @@ def _from_euler_file(m, tau) -> Rigid:
     R = euler_matrix(a, axes, intrinsic) @ R0.T
     c = np.asarray(m.get("center", (0.0, 0.0, 0.0)), float)
     return Rigid(R=R, d=c - R @ c, W=euler_rate(a, w, axes, intrinsic), c=c)
+
+
+def _from_path_file(m, tau) -> Rigid:
+    """An ``mvpathfile`` ``tau`` seconds after it started: the displacement d of its file's
+    positions from their first row (as ``mvrectfile``) and the turn R of its Euler angles from
+    their first row's (as ``mvrotadvfile``) about ``center``.  With ``movecenter`` (the default) the
+    centre travels along the path: x = c + d + R (x0 − c), v = ḋ + Ω × (x − (c + d)); without it
+    the centre stays where it is and the travelled object turns about it:
+    x = c + R (x0 + d − c), v = R ḋ + Ω × (x − c).  sphdvi's reading: DualSPHysics does not publish
+    how it applies the file (column missing: 0)."""
+    from .case.datafiles import EULER_FIELDS
+    table, fields = _load_table(m)
+    value, rate = _file_values(table, tau)
+    d, dv = np.zeros(3), np.zeros(3)
+    for k, name in enumerate(("fieldx", "fieldy", "fieldz")):
+        if name in fields:
+            d[k], dv[k] = value[fields[name]], rate[fields[name]]
+    units = _angle_units(m)
+    first, a, w = np.zeros(3), np.zeros(3), np.zeros(3)
+    for k, name in enumerate(EULER_FIELDS):
+        if name in fields:
+            j = fields[name]
+            first[k] = table.columns[j, 0] * units
+            a[k], w[k] = first[k] + value[j] * units, rate[j] * units
+    axes, intrinsic = m["axes"], bool(m["intrinsic"])
+    R0 = _of_movement(m, "euler0", lambda _: euler_matrix(first, axes, intrinsic))
+    R = euler_matrix(a, axes, intrinsic) @ R0.T
+    W = euler_rate(a, w, axes, intrinsic)
+    c = np.asarray(m.get("center", (0.0, 0.0, 0.0)), float)
+    if m.get("movecenter", True):
+        return Rigid(R=R, d=c + d - R @ c, V=dv, W=W, c=c + d)
+    return Rigid(R=R, d=c + R @ (d - c), V=R @ dv, W=W, c=c)
 
 
 def chain_transform(chain: dict, t: float, walks: dict | None = None) -> Rigid:

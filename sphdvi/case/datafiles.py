@@ -153,6 +153,8 @@ MOTION_FILE_ALIASES = {"mvfile": "mvrectfile", "mvpredef": "mvrectfile"}
 
 #: an ``mvrotadvfile``'s angle columns, in the order of its ``axes``
 EULER_FIELDS = ("fieldang1", "fieldang2", "fieldang3")
+#: an ``mvpathfile``'s position and angle columns (by default columns 1-6, after the time)
+PATH_FIELDS = ("fieldx", "fieldy", "fieldz", *EULER_FIELDS)
 
 
 def motion_file_columns(tag: str, given: dict, ncols: int | None = None) -> tuple[int, dict]:
@@ -167,6 +169,8 @@ def motion_file_columns(tag: str, given: dict, ncols: int | None = None) -> tupl
         cols.setdefault("fieldang", 1)
     if tag == "mvrotadvfile" and not any(k in cols for k in EULER_FIELDS):
         cols.update({k: i + 1 for i, k in enumerate(EULER_FIELDS)})
+    if tag == "mvpathfile" and not any(k in cols for k in PATH_FIELDS):
+        cols.update({k: i + 1 for i, k in enumerate(PATH_FIELDS)})
     return (int(ncols) if ncols else max(2, 1 + max(cols.values()))), cols
 
 
@@ -179,7 +183,8 @@ def read_motion_file(reader, m, tag: str, duration: float | None = None) -> dict
     f = reader.child(m, "file", True)
     path = reader.resolve_path(f, "name")
     names = {"mvrectfile": ("fieldtime", "fieldx", "fieldy", "fieldz"),
-             "mvrotadvfile": ("fieldtime", *EULER_FIELDS)}.get(tag, ("fieldtime", "fieldang"))
+             "mvrotadvfile": ("fieldtime", *EULER_FIELDS),
+             "mvpathfile": ("fieldtime", *PATH_FIELDS)}.get(tag, ("fieldtime", "fieldang"))
     given = {k: reader.integer(f, k, lo=0) for k in names if f.get(k) is not None}
     ncols, cols = motion_file_columns(tag, given,
                                       reader.integer(f, "fields", lo=2) if f.get("fields") is not None else None)

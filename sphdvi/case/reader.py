@@ -461,6 +461,7 @@ MOVEMENTS = {
     "mvcirsinu": ("freq", "ampl", "phase", "ref", "axisp1", "axisp2"),
     "mvrectfile": ("file",), "mvrotfile": ("file", "axisp1", "axisp2"),
     "mvrotadvfile": ("file",),          # and <center>, <intrinsic>, <axes>: _read_euler_axes
+    "mvpathfile": ("file",),            # the same and <movecenter>
 }
 
 
@@ -536,7 +537,7 @@ def _read_movement_chain(reader, obj, is2d=False):
                 d[part] = reader.num(c, "v")
             else:
                 d[part] = reader.vec3(c).tolist()
-        if tag == "mvrotadvfile":
+        if tag in ("mvrotadvfile", "mvpathfile"):
             d.update(_read_euler_axes(reader, m))
         if "axisp1" in d and "axisp2" in d:
             p1, p2 = np.asarray(d["axisp1"]), np.asarray(d["axisp2"])
@@ -568,7 +569,7 @@ def _read_movement_chain(reader, obj, is2d=False):
     return chain
 
 
-UNSUPPORTED_MOVEMENTS = {"mvpathfile": "positions and Euler angles from a file"}
+UNSUPPORTED_MOVEMENTS: dict = {}         # tag -> what it is, for a movement sphdvi refuses
 
 
 def _read_euler_axes(reader, m) -> dict:
@@ -583,10 +584,15 @@ def _read_euler_axes(reader, m) -> dict:
     intrinsic = reader.boolean(reader.child(m, "intrinsic", True), "value")
     c = reader.child(m, "center")
     center = reader.vec3(c).tolist() if c is not None else [0.0, 0.0, 0.0]
+    known = ("file", "axes", "intrinsic", "center") + (("movecenter",) if m.tag == "mvpathfile" else ())
     for e in reader.children(m):
-        if e.tag not in ("file", "axes", "intrinsic", "center"):
-            raise reader.error(e, f"unknown element <{e.tag}> in <{m.tag}>", "<file>, <axes>, <intrinsic>, <center>")
-    return {"axes": axes, "intrinsic": intrinsic, "center": center}
+        if e.tag not in known:
+            raise reader.error(e, f"unknown element <{e.tag}> in <{m.tag}>", ", ".join(f"<{k}>" for k in known))
+    out = {"axes": axes, "intrinsic": intrinsic, "center": center}
+    if m.tag == "mvpathfile":
+        mc = reader.child(m, "movecenter")
+        out["movecenter"] = reader.boolean(mc, "value") if mc is not None else True
+    return out
 
 
 def _movement_timing(reader, m, tag) -> dict:
@@ -617,12 +623,13 @@ def _warn_dropped_y(reader, m, d) -> None:
         parts = {"mvrect": ("vel",), "mvrectace": ("ace", "velini"), "mvrectsinu": ("ampl",)}[tag]
         bad = [p for p in parts if p in d and d[p][1] != 0]
         what = ", ".join(f"<{p}> y={d[p][1]:g}" for p in bad) or None
-    elif tag == "mvrectfile" and "fieldy" in d.get("fields", {}):
-        what = "the file's y column (fieldy)"
-    elif tag == "mvrotadvfile":
+    elif tag in ("mvrectfile", "mvrotadvfile", "mvpathfile"):
         from .datafiles import EULER_FIELDS
-        turns = [a for a, f in zip(d["axes"], EULER_FIELDS) if a != "Y" and f in d["fields"]]
-        what = f"angles about {' and '.join(sorted(set(turns)))} from the file" if turns else None
+        parts = ["the file's y column (fieldy)"] if tag != "mvrotadvfile" and "fieldy" in d.get("fields", {}) else []
+        if tag != "mvrectfile":
+            turns = [a for a, f in zip(d["axes"], EULER_FIELDS) if a != "Y" and f in d["fields"]]
+            parts += [f"angles about {' and '.join(sorted(set(turns)))} from the file"] if turns else []
+        what = "; ".join(parts) or None
     elif "axisp1" in d:
         axis = np.asarray(d["axisp2"], float) - np.asarray(d["axisp1"], float)
         if abs(axis[0]) > 1e-12 * np.linalg.norm(axis) or abs(axis[2]) > 1e-12 * np.linalg.norm(axis):
@@ -664,7 +671,7 @@ def _check_zero_loop(reader, movs, elements, first) -> None:
                                "a positive duration in the loop, or a movement without next")
 
 
-_TURNING = {"mvrot", "mvrotace", "mvrotsinu", "mvrotfile", "mvrotadvfile"}
+_TURNING = {"mvrot", "mvrotace", "mvrotsinu", "mvrotfile", "mvrotadvfile", "mvpathfile"}
 
 
 def _event_span(movs, event) -> tuple[float, float, bool]:

@@ -439,19 +439,6 @@ def test_mvnull_reads_no_duration_and_no_next(tmp_path):
     assert m["movements"][0]["duration"] == 0.0 and m["movements"][0]["next"] is None
 
 
-@pytest.mark.parametrize("tag", ["mvpathfile"])
-@pytest.mark.parametrize("nested", [False, True])
-def test_v54_file_movements_are_reported_as_not_supported(tmp_path, tag, nested):
-    """<mvpathfile> was refused as an "unknown motion element" (<mvrotadvfile>: test_motion_euler.py)."""
-    body = f'<{tag} id="1" duration="1"><file name="a.csv"/></{tag}>'
-    begin = '<begin mov="1" start="0"/>'
-    if nested:
-        body, begin = f'<obj>{begin}{body}</obj>', ""
-    with pytest.raises(CaseError, match=f"<{tag}> .*DualSPHysics v5.4.* is not supported by sphdvi") as e:
-        read(tmp_path, body, begin=begin)
-    assert e.value.element == tag
-
-
 MOTION_2D = ('<casedef>\n<geometry><definition dp="0.1"><pointmin x="0" y="0" z="0"/><pointmax x="1" y="{y}" z="1"/>'
              '</definition></geometry>\n<motion><objreal ref="1"><begin mov="1" start="0"/>\n{body}\n</objreal></motion>\n'
              '</casedef>')
