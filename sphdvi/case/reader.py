@@ -1081,6 +1081,9 @@ def read_special(reader, execution) -> dict:
         if c.tag == "nnphases":
             raise reader.error(c, f"<special><nnphases> belongs to {NNEWTONIAN_TEXT}",
                                "supported: " + ", ".join(sorted(SPECIAL_SUPPORTED)))
+        if c.tag == "boundextrap":
+            raise reader.error(c, "<special><boundextrap> is the obsolete name of <boundcorr> (DualSPHysics refuses it: "
+                               "\"The XML section 'boundextrap' is obsolete.\")", "<boundcorr> with the same content")
         if c.tag not in SPECIAL_SUPPORTED:
             raise reader.error(c, f"<special><{c.tag}> is not supported by sphdvi",
                                "supported: " + ", ".join(sorted(SPECIAL_SUPPORTED)))

@@ -223,3 +223,12 @@ def test_temperature_special_is_a_named_refusal(tmp_path):
     text = case_xml(special='<temperature><tempdef value="20"/></temperature>')
     with pytest.raises(CaseError, match=r"<special><temperature> is not supported by sphdvi"):
         build_case(write_case(tmp_path, text), str(tmp_path / "out"))
+
+
+def test_boundextrap_is_named_as_boundcorrs_obsolete_name(tmp_path):
+    """DualSPHysics refuses <special><boundextrap> ("The XML section 'boundextrap' is obsolete."): it is
+    <boundcorr>'s earlier name, which the error says."""
+    text = case_xml(special='<boundextrap><determlimit value="1e+3"/></boundextrap>')
+    with pytest.raises(CaseError, match=r"<boundextrap> is the obsolete name of <boundcorr>") as e:
+        build_case(write_case(tmp_path, text), str(tmp_path / "out"))
+    assert e.value.element == "boundextrap" and "<boundcorr> with the same content" in str(e.value)
