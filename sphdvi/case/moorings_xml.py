@@ -29,9 +29,16 @@ lumped-mass line model of :mod:`sphdvi.moorings`.
 * ``<savedata>`` (or its old name ``<output>``): ``<time starTime endTime dtOut>`` (sic; 0, to the
   end, the run's TimeOut) and the magnitudes ``<tension>``, ``<force>``, ``<velocity>``,
   ``<position>`` (on when present, unless ``value="false"``).
+* ``<connects>``: free connection nodes, ``<connect conref x y z M V>`` with an optional
+  ``<coeffini cda ca>`` (both then required; CdA and Ca 0 without it); a line's end ``<connect
+  conref>`` hangs on one. M and V default to 0 (a warning: MoorDynPlus 2025 estimates them from the
+  lines instead, with a volume of the wrong dimension and a NaN where the connect is no line's node
+  N); MoorDynPlus 2020's ``<initialCoeffs>``/``<initialForce>`` are warned as not read (DualSPHysics
+  5.4 ignores them). End order: a fixed end is node 0 and a connect node N; a vessel end is node N
+  and a connect node 0; of two connects the lower is node 0. Refused: a line with one connect at
+  both ends, an unknown or repeated conref; a connect no line uses is warned and left out (MoorDynPlus
+  drops it silently).
 * ``<waves>`` is accepted and not read, as MoorDynPlus does (a warning).
-
-Refused: free connection nodes (``<connect>`` line ends and their ``<connects>`` section).
 """
 import math
 
@@ -86,7 +93,6 @@ LINE_KEYS = ("ea", "diameter", "mass", "ba", "can", "cat", "cdn", "cdt", "breakt
 OUTPUT_FLAGS = "-pvUDtcbs"
 UNWRITTEN_FLAGS = "UDcb"       # accepted, warned: sphdvi.io.moorings_out writes p, v, t, s
 SAVEDATA_CHILDREN = {"time", "tension", "force", "velocity", "position"}
-NO_CONNECTS = "free connection nodes (<connects>) are not supported by sphdvi"
 
 
 def read_moorings(reader, el) -> dict:
@@ -178,9 +184,7 @@ def _read_library(reader, lib, floating_els: dict) -> dict:
     reader.check_children(lib, ROOT_CHILDREN)
     _no_repeats(reader, lib, ROOT_CHILDREN)
     reader.boolean(lib, "debug", False)
-    connects = reader.child(lib, "connects")
-    if connects is not None:
-        raise reader.error(connects, NO_CONNECTS, "lines whose ends are <fixconnection> or <vesselconnection>")
+    connects = _read_connects(reader, reader.child(lib, "connects"))
     waves = reader.child(lib, "waves")
     if waves is not None:
         reader.warn(waves, "<waves> is not read (nor by MoorDynPlus): the mooring lines see still water")
@@ -188,7 +192,8 @@ def _read_library(reader, lib, floating_els: dict) -> dict:
     solver = _read_solver(reader, solver_el)
     bodies = _read_bodies(reader, lib, floating_els)
     lines_el = reader.child(lib, "lines", required=True)
-    lines = _read_lines(reader, lines_el, solver, bodies)
+    lines = _read_lines(reader, lines_el, solver, bodies, connects)
+    connects = _used_connects(reader, connects, lines)
     attached = {e["body"] for ln in lines for e in ln["ends"] if e["body"] is not None}
     for mk, f in floating_els.items():
         if mk not in attached:
@@ -198,7 +203,55 @@ def _read_library(reader, lib, floating_els: dict) -> dict:
         raise reader.error(saves[1], "both <savedata> and <output> are given",
                            "one <savedata> (<output> is its old name)")
     return {"solver": solver, "bodies": [{k: b[k] for k in ("ref", "depth", "line")} for b in bodies],
-            "lines": lines, "savedata": _read_savedata(reader, saves[0]) if saves else None}
+            "lines": lines, "connects": connects, "savedata": _read_savedata(reader, saves[0]) if saves else None}
+
+
+def _read_connects(reader, el) -> dict:
+    """``<connects>``: conref -> {conref, pos, mass, volume, cda, ca, line, _el} in the file's order."""
+    out = {}
+    if el is None:
+        return out
+    for c in reader.children(el):
+        if c.tag != "connect":
+            raise reader.error(c, f"unknown element <{c.tag}> inside <connects>", '<connect conref x y z M V>')
+        ref = reader.integer(c, "conref", lo=0)
+        if ref in out:
+            raise reader.error(c, f"conref={ref} is given twice (line {out[ref]['line']})", "one <connect> per conref")
+        d = {"conref": ref, "pos": reader.vec3(c).tolist(), "line": c.sourceline, "_el": c}
+        for key, attr in (("mass", "M"), ("volume", "V")):
+            d[key] = reader.num(c, attr, 0.0, nonnegative=True)
+        if c.get("M") is None or c.get("V") is None:
+            absent = " and ".join(a for a in ("M", "V") if c.get(a) is None)
+            reader.warn(c, f"connect conref={ref}: {absent} not given, taken as 0 (MoorDynPlus 2025 estimates them "
+                        "from its lines, with a volume A L² of the wrong dimension)")
+        reader.check_children(c, {"coeffini", "initialCoeffs", "initialForce"})
+        coef = reader.child(c, "coeffini")
+        d["cda"] = reader.num(coef, "cda", nonnegative=True) if coef is not None else 0.0
+        d["ca"] = reader.num(coef, "ca", nonnegative=True) if coef is not None else 0.0
+        for old in ("initialCoeffs", "initialForce"):
+            if reader.child(c, old) is not None:
+                reader.warn(reader.child(c, old), f"<{old}> (MoorDynPlus 2020) is not read, as DualSPHysics 5.4 "
+                            "does not read it: <coeffini cda ca> gives the drag area and added mass")
+        out[ref] = d
+    return out
+
+
+def _used_connects(reader, connects: dict, lines: list) -> list:
+    """The connects the lines use, in ``<connects>`` order; each line end's ``connect`` set to its
+    place in that list (a connect no line uses is warned and left out, as MoorDynPlus drops it)."""
+    used = {e["conref"] for ln in lines for e in ln["ends"] if e["kind"] == "connect"}
+    out = []
+    for ref, d in connects.items():
+        if ref not in used:
+            reader.warn(d["_el"], f"connect conref={ref} is used by no line: left out")
+            continue
+        d["index"] = len(out)
+        out.append({k: v for k, v in d.items() if k not in ("_el", "index")})
+    for ln in lines:
+        for e in ln["ends"]:
+            if e["kind"] == "connect":
+                e["connect"] = connects[e["conref"]]["index"]
+    return out
 
 
 def _named_items(reader, el, table: dict, what: str) -> dict:
@@ -315,9 +368,7 @@ def _line_items(reader, el, is_line: bool):
         allowed += ["fixconnection", "vesselconnection"]
     for c in reader.children(el):
         key = c.tag.lower()
-        if is_line and key.startswith("connect"):
-            raise reader.error(c, f"<{c.tag}>: {NO_CONNECTS}", "<fixconnection> or <vesselconnection>")
-        if is_line and (key.startswith("fix") or key.startswith("vessel")):
+        if is_line and (key.startswith("fix") or key.startswith("vessel") or key == "connect"):
             conns.append(c)
             continue
         if key not in LINE_PARAMS or (key == "depth" and not is_line):
@@ -331,8 +382,16 @@ def _line_items(reader, el, is_line: bool):
     return params, conns
 
 
-def _read_connection(reader, c, body_refs: dict) -> dict:
-    """A ``<fixconnection x y z>`` or ``<vesselconnection bodyref x y z>`` (``M``, ``V``: 0)."""
+def _read_connection(reader, c, body_refs: dict, connects: dict) -> dict:
+    """A ``<fixconnection x y z>`` or ``<vesselconnection bodyref x y z>`` (``M``, ``V``: 0), or a
+    ``<connect conref>`` (at its connect's position)."""
+    if c.tag.lower() == "connect":
+        ref = reader.integer(c, "conref", lo=0)
+        if ref not in connects:
+            raise reader.error(c, f"conref={ref} is not a <connect> of <connects>",
+                               "the conref of a <connects><connect> (" + (", ".join(map(str, connects)) or
+                                                                          "none defined") + ")")
+        return {"kind": "connect", "body": None, "conref": ref, "pos": list(connects[ref]["pos"]), "_el": c}
     vessel = c.tag.lower().startswith("vessel")
     end = {"kind": "vessel" if vessel else "fixed", "body": None}
     if vessel:
@@ -348,7 +407,7 @@ def _read_connection(reader, c, body_refs: dict) -> dict:
     return end
 
 
-def _read_lines(reader, el, solver: dict, bodies: list) -> list:
+def _read_lines(reader, el, solver: dict, bodies: list, connects: dict) -> list:
     """``<lines>``: ``<linedefault>`` and each ``<line>`` merged over it, checked; the ends ordered
     (node 0 first)."""
     reader.check_children(el, {"linedefault", "line"})
@@ -389,11 +448,17 @@ def _read_lines(reader, el, solver: dict, bodies: list) -> list:
                                f"line {k} has {len(conns)} connection element(s)",
                                "exactly two: <fixconnection x y z> (an anchor) or <vesselconnection bodyref x y z> "
                                "(a point of a moored floating), one per end")
-        ends = [_read_connection(reader, c, body_refs) for c in conns]
-        if ends[0]["kind"] == ends[1]["kind"] == "vessel":
+        ends = [_read_connection(reader, c, body_refs, connects) for c in conns]
+        kinds = {ends[0]["kind"], ends[1]["kind"]}
+        if ends[0]["kind"] == ends[1]["kind"] == "connect" and ends[0]["conref"] == ends[1]["conref"]:
+            raise reader.error(conns[1], f"line {k} hangs both its ends on connect conref={ends[0]['conref']}",
+                               "two different connections")
+        if ends[0]["kind"] == ends[1]["kind"] in ("vessel", "connect"):
             ends = ends if ends[0]["pos"][2] <= ends[1]["pos"][2] else ends[::-1]
         elif ends[1]["kind"] == "fixed" and ends[0]["kind"] != "fixed":
             ends = ends[::-1]
+        elif kinds == {"vessel", "connect"} and ends[0]["kind"] == "vessel":
+            ends = ends[::-1]                     # MoorDynPlus: the vessel end is node N
         if ends[1]["kind"] == "fixed":
             reader.warn(line_el, f"line {k} has two fixed ends: it moves no body")
         body = next((e["body"] for e in (ends[1], ends[0]) if e["body"] is not None), None)

@@ -49,7 +49,10 @@ from ..sph import _env  # noqa: F401  (OMP_WAIT_POLICY before numba)
 from numba import njit
 
 #: end kinds (``end_kind``)
-FIXED, VESSEL = 0, 1
+FIXED, VESSEL, CONNECT = 0, 1, 2
+#: per-connect parameters, columns of the ``cprm`` array: mass M, volume V, drag area CdA, added-mass Ca
+C_M, C_V, C_CDA, C_CA = range(4)
+NCPRM = 4
 
 #: per-line parameters, columns of the ``prm`` array
 P_L, P_EA, P_C, P_D, P_A, P_RHO, P_CAN, P_CAT, P_CDN, P_CDT, P_ZBED, P_BREAK = range(12)
@@ -70,9 +73,10 @@ def _submerged(za, zb, zfs):
 
 
 @njit(cache=True)
-def _set_ends(t, t0, first, last, end_kind, end_p0, end_v, broken, pos, vel):
+def _set_ends(t, t0, first, last, end_kind, end_p0, end_v, end_conn, cpos, cvel, broken, pos, vel):
     """The end nodes of every unbroken line at time t: a fixed end where it was, a vessel end at
-    p0 + v (t − t0) with velocity v (a broken line's nodes stay where it broke)."""
+    p0 + v (t − t0) with velocity v, a connect end at its connect node (``cpos``, ``cvel``); a
+    broken line's nodes stay where it broke."""
     for k in range(first.shape[0]):
         if broken[k]:
             continue
@@ -82,9 +86,80 @@ def _set_ends(t, t0, first, last, end_kind, end_p0, end_v, broken, pos, vel):
                 for d in range(3):
                     pos[j, d] = end_p0[k, e, d] + end_v[k, e, d] * (t - t0)
                     vel[j, d] = end_v[k, e, d]
+            elif end_kind[k, e] == CONNECT:
+                c = end_conn[k, e]
+                for d in range(3):
+                    pos[j, d] = cpos[c, d]
+                    vel[j, d] = cvel[c, d]
             else:
                 for d in range(3):
                     vel[j, d] = 0.0
+
+
+@njit(cache=True)
+def connect_accelerations(pos, first, last, end_kind, end_conn, broken, prm, glob, fnet, cvel, cprm, cmat, cfor,
+                          cacc):
+    """The acceleration of every free connect node (MoorDyn's Connection, as MoorDynPlus's
+    IConnection): its force, the eq. (3) forces of the line end nodes it holds (each with its half
+    segment's weight, drag and seabed contact) plus its own (V ρ_w − M) g upwards and drag
+    −½ ρ_w CdA |v_i| v_i per component (MoorDyn's form), over its mass matrix, (M + ρ_w V Ca) I plus
+    each end node's m_i I + ρ_w v_i [Can (I − QQᵀ) + Cat QQᵀ] (Q along the end segment); solved as a
+    3 × 3 system (``cmat``, ``cfor``: work arrays). A broken line gives its connects nothing; a
+    connect without mass (every line of a massless connect broken) stays at rest.
+
+    Deviations from MoorDynPlus 2025: its (M + ρ_w V Ca) lands on all nine entries of the matrix
+    (a scalar added to a matrix: a sideways kick under a clump weight), here on the diagonal as
+    MoorDyn and MoorDynPlus 2020; the end forces and matrices are this evaluation's (MoorDynPlus's
+    lag one evaluation, and its acceleration is 0 at t = 0 exactly); a broken line's frozen end
+    force and mass are not kept."""
+    rho_w, g, zfs = glob[G_RHOW], glob[G_G], glob[G_ZFS]
+    nc = cacc.shape[0]
+    for c in range(nc):
+        for d in range(3):
+            cfor[c, d] = 0.0
+            for d2 in range(3):
+                cmat[c, d, d2] = 0.0
+    for k in range(first.shape[0]):
+        if broken[k]:
+            continue
+        l, area, rho, can, cat = prm[k, P_L], prm[k, P_A], prm[k, P_RHO], prm[k, P_CAN], prm[k, P_CAT]
+        for e in range(2):
+            if end_kind[k, e] != CONNECT:
+                continue
+            c = end_conn[k, e]
+            j = first[k] if e == 0 else last[k]
+            i = j + 1 if e == 0 else j - 1          # the end segment's other node
+            qx, qy, qz = pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1], pos[i, 2] - pos[j, 2]
+            qn = math.sqrt(qx * qx + qy * qy + qz * qz)
+            q = (qx / qn, qy / qn, qz / qn)
+            m = 0.5 * l * rho * area
+            vol = 0.5 * _submerged(pos[j, 2], pos[i, 2], zfs) * l * area
+            for d in range(3):
+                cfor[c, d] += fnet[j, d]
+                cmat[c, d, d] += m + rho_w * vol * can
+                for d2 in range(3):
+                    cmat[c, d, d2] += rho_w * vol * (cat - can) * q[d] * q[d2]
+    for c in range(nc):
+        mass, vol, cda, ca = cprm[c, C_M], cprm[c, C_V], cprm[c, C_CDA], cprm[c, C_CA]
+        for d in range(3):
+            cmat[c, d, d] += mass + rho_w * vol * ca
+            cfor[c, d] -= 0.5 * rho_w * cda * abs(cvel[c, d]) * cvel[c, d]
+        cfor[c, 2] += (vol * rho_w - mass) * g
+        a = cmat[c]
+        det = (a[0, 0] * (a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]) - a[0, 1] * (a[1, 0] * a[2, 2] - a[1, 2] * a[2, 0])
+               + a[0, 2] * (a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]))
+        if det <= 0.0:
+            for d in range(3):
+                cacc[c, d] = 0.0
+            continue
+        f0, f1, f2 = cfor[c, 0], cfor[c, 1], cfor[c, 2]
+        # Cramer's rule
+        cacc[c, 0] = (f0 * (a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]) - a[0, 1] * (f1 * a[2, 2] - a[1, 2] * f2)
+                      + a[0, 2] * (f1 * a[2, 1] - a[1, 1] * f2)) / det
+        cacc[c, 1] = (a[0, 0] * (f1 * a[2, 2] - a[1, 2] * f2) - f0 * (a[1, 0] * a[2, 2] - a[1, 2] * a[2, 0])
+                      + a[0, 2] * (a[1, 0] * f2 - f1 * a[2, 0])) / det
+        cacc[c, 2] = (a[0, 0] * (a[1, 1] * f2 - f1 * a[2, 1]) - a[0, 1] * (a[1, 0] * f2 - f1 * a[2, 0])
+                      + f0 * (a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0])) / det
 
 
 @njit(cache=True)
@@ -199,18 +274,25 @@ def _check_breaks(first, last, prm, broken, seg_t) -> int:
 
 @njit(cache=True)
 def advance_lines(t0, dt, nsub, pos, vel, first, last, end_kind, end_p0, end_v, prm, glob, broken,
-                  fnet, acc, seg_t, seg_len, pos_h, vel_h) -> int:
+                  fnet, acc, seg_t, seg_len, pos_h, vel_h, end_conn, cpos, cvel, cprm, cwork) -> int:
     """``nsub`` midpoint (RK2) sub-steps of dt/nsub from t0 for the internal nodes of every unbroken
-    line, the ends set by :func:`_set_ends`; then eq. (3) at the step's end (``fnet``, ``seg_t``,
-    ``seg_len``). ``pos_h``, ``vel_h``: work arrays shaped as ``pos``. Returns the number of lines
-    that broke (their nodes stay where they were)."""
+    line and every connect node (``cpos``, ``cvel``; ``cprm``: :data:`C_M`...; ``cwork``: the
+    connects' work arrays of :func:`empty_connect_work`), the ends set by :func:`_set_ends`; then
+    eq. (3) at the step's end (``fnet``, ``seg_t``, ``seg_len``) and the connects' accelerations.
+    ``pos_h``, ``vel_h``: work arrays shaped as ``pos``. Returns the number of lines that broke
+    (their nodes stay where they were)."""
+    cpos_h, cvel_h, cacc, cmat, cfor = cwork
     h = dt / nsub if nsub > 0 else 0.0
     nbroke = 0
+    nc = cpos.shape[0]
     for s in range(nsub):
         t = t0 + s * h
-        _set_ends(t, t0, first, last, end_kind, end_p0, end_v, broken, pos, vel)
+        _set_ends(t, t0, first, last, end_kind, end_p0, end_v, end_conn, cpos, cvel, broken, pos, vel)
         line_forces(pos, vel, first, last, prm, glob, broken, fnet, acc, seg_t, seg_len)
         nbroke += _check_breaks(first, last, prm, broken, seg_t)
+        if nc:
+            connect_accelerations(pos, first, last, end_kind, end_conn, broken, prm, glob, fnet, cvel, cprm, cmat,
+                                  cfor, cacc)
         for k in range(first.shape[0]):
             for j in range(first[k], last[k] + 1):
                 for d in range(3):
@@ -220,9 +302,17 @@ def advance_lines(t0, dt, nsub, pos, vel, first, last, end_kind, end_p0, end_v, 
                     else:
                         pos_h[j, d] = pos[j, d]
                         vel_h[j, d] = vel[j, d]
-        _set_ends(t + 0.5 * h, t0, first, last, end_kind, end_p0, end_v, broken, pos_h, vel_h)
+        for c in range(nc):
+            for d in range(3):
+                cpos_h[c, d] = cpos[c, d] + 0.5 * h * cvel[c, d]
+                cvel_h[c, d] = cvel[c, d] + 0.5 * h * cacc[c, d]
+        _set_ends(t + 0.5 * h, t0, first, last, end_kind, end_p0, end_v, end_conn, cpos_h, cvel_h, broken, pos_h,
+                  vel_h)
         line_forces(pos_h, vel_h, first, last, prm, glob, broken, fnet, acc, seg_t, seg_len)
         nbroke += _check_breaks(first, last, prm, broken, seg_t)
+        if nc:
+            connect_accelerations(pos_h, first, last, end_kind, end_conn, broken, prm, glob, fnet, cvel_h, cprm,
+                                  cmat, cfor, cacc)
         for k in range(first.shape[0]):
             if broken[k]:
                 continue
@@ -230,9 +320,16 @@ def advance_lines(t0, dt, nsub, pos, vel, first, last, end_kind, end_p0, end_v, 
                 for d in range(3):
                     pos[j, d] += h * vel_h[j, d]
                     vel[j, d] += h * acc[j, d]
-    _set_ends(t0 + dt, t0, first, last, end_kind, end_p0, end_v, broken, pos, vel)
+        for c in range(nc):
+            for d in range(3):
+                cpos[c, d] += h * cvel_h[c, d]
+                cvel[c, d] += h * cacc[c, d]
+    _set_ends(t0 + dt, t0, first, last, end_kind, end_p0, end_v, end_conn, cpos, cvel, broken, pos, vel)
     line_forces(pos, vel, first, last, prm, glob, broken, fnet, acc, seg_t, seg_len)
     nbroke += _check_breaks(first, last, prm, broken, seg_t)
+    if nc:
+        connect_accelerations(pos, first, last, end_kind, end_conn, broken, prm, glob, fnet, cvel, cprm, cmat, cfor,
+                              cacc)
     return nbroke
 
 
@@ -254,6 +351,13 @@ def empty_work(nnodes: int) -> dict:
     """The kernels' work arrays for ``nnodes`` nodes in all."""
     return {name: np.zeros((nnodes, 3)) for name in ("fnet", "acc", "pos_h", "vel_h")} | {
         "seg_t": np.zeros(nnodes), "seg_len": np.zeros(nnodes)}
+
+
+def empty_connect_work(nconnects: int) -> tuple:
+    """:func:`advance_lines`'s ``cwork`` for ``nconnects`` connect nodes: (pos_h, vel_h, acc, mass
+    matrices, forces)."""
+    return (np.zeros((nconnects, 3)), np.zeros((nconnects, 3)), np.zeros((nconnects, 3)),
+            np.zeros((nconnects, 3, 3)), np.zeros((nconnects, 3)))
 
 
 @njit(cache=True)

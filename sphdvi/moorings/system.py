@@ -95,6 +95,12 @@ class Moorings:
         self.end_p0 = np.zeros((nl, 2, 3))
         self.end_v = np.zeros((nl, 2, 3))
         self.broken = np.zeros(nl, np.bool_)
+        self.end_conn = np.full((nl, 2), -1, np.int64)
+        connects = spec.get("connects") or []
+        self.cpos = np.array([c["pos"] for c in connects], float).reshape(-1, 3)
+        self.cvel = np.zeros_like(self.cpos)
+        self.cprm = np.array([[c["mass"], c["volume"], c["cda"], c["ca"]] for c in connects], float).reshape(-1, L.NCPRM)
+        self.cwork = L.empty_connect_work(len(connects))
         self.glob = np.array([self.rho_w, self.g, sol["kbot"], sol["cbot"], sol["friction"], sol["fricdamp"],
                               sol["statdynfricscale"], sol["freesurface"], 1.0])
         self.nbodies = int(centre.shape[0])
@@ -111,6 +117,11 @@ class Moorings:
                 dtm = min(dtm, L.auto_time_step(float(ln["length"]), int(ln["segments"]), ea, mass / area,
                                                 self.rho_w, area))
             for e, end in enumerate(ln["ends"]):
+                if end["kind"] == "connect":
+                    self.end_kind[k, e] = L.CONNECT
+                    self.end_conn[k, e] = int(end["connect"])
+                    self.end_p0[k, e] = self.cpos[int(end["connect"])]
+                    continue
                 p = np.asarray(end["pos"], float)
                 self.end_p0[k, e] = p
                 self.end_extra[k, e] = (float(end.get("volume", 0.0)) * self.rho_w - float(end.get("mass", 0.0))) * g
@@ -156,18 +167,25 @@ class Moorings:
         w = self.work
         L.advance_lines(t0, dt, nsub, self.pos, self.vel, self.first, self.last, self.end_kind, self.end_p0,
                         self.end_v, self.prm, self.glob, self.broken, w["fnet"], w["acc"], w["seg_t"], w["seg_len"],
-                        w["pos_h"], w["vel_h"])
+                        w["pos_h"], w["vel_h"], self.end_conn, self.cpos, self.cvel, self.cprm,
+                        self.cwork)
         self._warn_breaks(t0 + dt)
         self._check_finite(t0 + dt)
 
     def _check_finite(self, t: float) -> None:
         """A node or force that is not finite stops the run (exit 3), naming the line (MoorDynPlus
         stops on a NaN in its state too)."""
+        from ..errors import DivergenceError
+        cbad = ~(np.isfinite(self.cpos).all(axis=1) & np.isfinite(self.cvel).all(axis=1))
+        if cbad.any():
+            c = int(np.flatnonzero(cbad)[0])
+            raise DivergenceError(f"<moorings> connect conref={self.spec['connects'][c]['conref']} is not finite at "
+                                  f"t = {t:.6g} s (sub-step {self.substep:.3g} s; a smaller dtM, or dtM auto, may "
+                                  "hold it)")
         bad = ~(np.isfinite(self.pos).all(axis=1) & np.isfinite(self.vel).all(axis=1)
                 & np.isfinite(self.work["fnet"]).all(axis=1))
         if not bad.any():
             return
-        from ..errors import DivergenceError
         j = int(np.flatnonzero(bad)[0])
         k = int(np.searchsorted(self.last, j))
         raise DivergenceError(f"<moorings> line {self.lines[k]['id']}: node {j - int(self.first[k])} is not finite "
@@ -180,7 +198,8 @@ class Moorings:
         self.end_v[:] = 0.0
         L.advance_lines(t, 0.0, 0, self.pos, self.vel, self.first, self.last, self.end_kind, self.end_p0,
                         self.end_v, self.prm, self.glob, self.broken, w["fnet"], w["acc"], w["seg_t"], w["seg_len"],
-                        w["pos_h"], w["vel_h"])
+                        w["pos_h"], w["vel_h"], self.end_conn, self.cpos, self.cvel, self.cprm,
+                        self.cwork)
 
     def _warn_breaks(self, t: float) -> None:
         for k in np.flatnonzero(self.broken & ~self.broke_warned):
@@ -263,7 +282,7 @@ class Moorings:
 
     # ---- restart ----
 
-    STATE_ARRAYS = ("pos", "vel", "broken", "end_p0", "F", "T", "broke_warned")
+    STATE_ARRAYS = ("pos", "vel", "broken", "end_p0", "F", "T", "broke_warned", "cpos", "cvel")
     STATE_WORK = ("fnet", "seg_t", "seg_len")           # the forces of the last evaluation, for outputs
     STATE_SCALARS = ("time", "ramp", "substep")
 
@@ -279,6 +298,8 @@ class Moorings:
     def set_state(self, st: dict) -> None:
         """Restore a :meth:`get_state` (copied in)."""
         for key in self.STATE_ARRAYS:
+            if key not in st and getattr(self, key).size == 0:
+                continue                 # a restart.h5 written before connects existed, of a case without them
             getattr(self, key)[...] = np.asarray(st[key])
         for key in self.STATE_WORK:
             self.work[key][...] = np.asarray(st[key])

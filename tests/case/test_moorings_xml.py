@@ -51,6 +51,10 @@ LINE1 = """<line savedata="false">
 SAVEDATA = """<savedata><time starTime="0.5" endTime="0" /><tension value="true" /><force /></savedata>"""
 
 
+CONNECTS = ('<connects><connect conref="1" x="1.1" y="0" z="0.15" M="0.2" V="5e-5">'
+            '<coeffini cda="0.01" ca="1" /></connect></connects>')
+
+
 def library(solver=SOLVER, bodies=BODIES, lines=None, savedata=SAVEDATA, extra=""):
     lines = lines if lines is not None else LINEDEFAULT + LINE0 + LINE1
     return f"""{solver}
@@ -202,6 +206,35 @@ def test_warnings_waves_wavekin_short_line(tmp_path):
     assert "line 0's length 0.5 m is shorter than the distance between its ends" in text and "taut" in text
 
 
+def test_connects_are_read_with_moordynpluss_end_order(tmp_path):
+    """A clump weight (conref 1) between an anchor and the body: two lines, the fixed one with the
+    connect at node N, the vessel one with the connect at node 0 (MoorDynPlus's ILine::ConfigLine);
+    the ends carry the connect's index and position."""
+    lines = (LINEDEFAULT + '<line><connect conref="1" /><fixconnection x="0.95" y="0" z="0" /></line>'
+             '<line><vesselconnection bodyref="50" x="1.35" y="0" z="0.4" /><connect conref="1" /></line>')
+    m, warnings = _read(tmp_path, moorings(library(extra=CONNECTS, lines=lines)))
+    assert not warnings
+    assert m["connects"] == [{"conref": 1, "pos": [1.1, 0.0, 0.15], "line": m["connects"][0]["line"], "mass": 0.2,
+                              "volume": 5e-5, "cda": 0.01, "ca": 1.0}]
+    (a0, a1), (b0, b1) = (ln["ends"] for ln in m["lines"])
+    assert (a0["kind"], a1["kind"], b0["kind"], b1["kind"]) == ("fixed", "connect", "connect", "vessel")
+    assert a1["connect"] == b0["connect"] == 0 and a1["pos"] == [1.1, 0.0, 0.15]
+
+
+def test_connect_warnings(tmp_path):
+    """M and V absent (0 here, estimated by MoorDynPlus 2025), v2020's <initialCoeffs>, a connect no
+    line uses (left out)."""
+    extra = ('<connects><connect conref="1" x="1.1" y="0" z="0.15"><initialCoeffs cda="1" ca="1" /></connect>'
+             '<connect conref="2" x="1" y="0" z="0.1" M="1" V="0" /></connects>')
+    lines = LINEDEFAULT + '<line><connect conref="1" /><fixconnection x="0.95" y="0" z="0" /></line>' + LINE0
+    m, warnings = _read(tmp_path, moorings(library(extra=extra, lines=lines)))
+    text = "\n".join(map(str, warnings))
+    assert "connect conref=1: M and V not given, taken as 0" in text
+    assert "<initialCoeffs> (MoorDynPlus 2020) is not read" in text
+    assert "connect conref=2 is used by no line: left out" in text
+    assert [c["conref"] for c in m["connects"]] == [1] and m["connects"][0]["cda"] == 0.0
+
+
 def test_a_line_as_long_as_its_span_is_not_warned_for_a_rounding_error(tmp_path):
     """MoorDynPlus's example 04_ConnectedBoxes: a 0.6 m line between ends 0.6 m apart, whose
     distance computes as 0.6000000000000001, was warned "stretched by 2.22e-14 %"."""
@@ -242,10 +275,18 @@ BAD = [
     (moorings(library(solver=SOLVER.replace("</s", '<cdScaleIC value="0" /></s'))), "<cdScaleIC value=0>"),
     (moorings(library(solver=SOLVER.replace("</s", '<dtM value="0.001" auto="maybe" /></s'))), "is not a boolean"),
     (moorings(library(solver=SOLVER.replace("</s", '<freeSurface value="0.4" /></s'))), "<freeSurface> is given twice"),
-    (moorings(library(extra='<connects><connect conref="1" x="0" y="0" z="0" /></connects>')),
-     "free connection nodes (<connects>) are not supported by sphdvi"),
     (moorings(library(lines=LINEDEFAULT + LINE0.replace("<fixconnection", '<connect conref="1"'))),
-     "free connection nodes (<connects>) are not supported by sphdvi"),
+     "conref=1 is not a <connect> of <connects>"),
+    (moorings(library(extra=CONNECTS.replace('conref="1"', 'conref="3"'))
+              .replace("<fixconnection", '<connect conref="1"')), "conref=1 is not a <connect> of <connects>"),
+    (moorings(library(extra=CONNECTS + '<connects />')), "a second <connects> inside <moordynplus>"),
+    (moorings(library(extra=CONNECTS.replace("</connects>", '<connect conref="1" x="0" y="0" z="0" M="1" V="0" />'
+                                                            '</connects>'))), "conref=1 is given twice"),
+    (moorings(library(extra=CONNECTS.replace("</connects>", "<buoy /></connects>"))),
+     "unknown element <buoy> inside <connects>"),
+    (moorings(library(extra=CONNECTS.replace('ca="1"', ""))), "missing attribute 'ca'"),
+    (moorings(library(extra=CONNECTS, lines=LINEDEFAULT + """<line><connect conref="1" /><connect conref="1" /></line>""")),
+     "line 0 hangs both its ends on connect conref=1"),
     (moorings(library(lines=LINEDEFAULT + LINE0.replace("<fixconnection x=\"0.95\" y=\"0\" z=\"0\" />", ""))),
      "line 0 has 1 connection element(s)"),
     (moorings(library(lines=LINEDEFAULT + LINE0.replace("</line>", '<fixconnection x="1" y="0" z="0" /></line>'))),
@@ -308,7 +349,7 @@ def test_bad_moorings_are_case_errors(tmp_path, special, message):
 
 
 @pytest.mark.parametrize("special, message", [next(b for b in BAD if b[1] == m) for m in (
-    "there are no moored floatings", "free connection nodes (<connects>) are not supported by sphdvi",
+    "there are no moored floatings", "line 0 hangs both its ends on connect conref=1",
     "line 0's anchor z=-0.1 lies below the seabed")])
 def test_gencase_exits_2_without_a_traceback(tmp_path, special, message):
     r, _ = _gencase(tmp_path, special)

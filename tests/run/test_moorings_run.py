@@ -107,6 +107,51 @@ def test_a_resumed_run_ends_bitwise_as_an_uninterrupted_one(tmp_path):
         assert (a / name).read_text() == (b / name).read_text(), name
 
 
+def connect_case(tmp_path):
+    """C4's case with the left line split at a sinker (a connect of 50 g, 2e-5 m³) half way: anchor ->
+    sinker (10 segments) and sinker -> box (10 segments)."""
+    text = CASE.read_text()
+    left = """<line comment="left line">
+                            <vesselconnection bodyref="50" x="1.35" y="0" z="0.4" />
+                            <fixconnection x="0.95" y="0" z="0" />
+                        </line>"""
+    assert left in text
+    split = """<line><connect conref="7" /><fixconnection x="0.95" y="0" z="0" />
+                            <length value="0.275" /><segments value="10" /></line>
+                        <line><vesselconnection bodyref="50" x="1.35" y="0" z="0.4" /><connect conref="7" />
+                            <length value="0.275" /><segments value="10" /></line>"""
+    text = text.replace(left, split).replace("<lines>", """<connects><connect conref="7" x="1.15" y="0" z="0.2" M="0.05"
+                            V="2e-5"><coeffini cda="0.002" ca="1" /></connect></connects>
+                    <lines>""")
+    case = tmp_path / "CaseSinker_Def.xml"
+    case.write_text(text)
+    return case
+
+
+def test_a_line_with_a_sinker_runs_and_resumes_bitwise(tmp_path):
+    """A connect in a run: the lines' files have a column pair per line (three lines), the sinker
+    moves under its lines and weight, and a resumed run ends bitwise as an uninterrupted one (the
+    connect's position and velocity are in restart.h5)."""
+    case = connect_case(tmp_path)
+    a = run(tmp_path / "a", "--tmax", "0.1", "--tout", "0.05", "--set", "FtPause=0", case=case)
+    b = run(tmp_path / "b", "--tmax", "0.05", "--tout", "0.05", "--set", "FtPause=0", case=case)
+    r = CliRunner().invoke(main, ["run", str(b), "--resume", "--tmax", "0.1", "--tout", "0.05", "--threads", "1",
+                                  "-q", "--set", "FtPause=0"])
+    assert r.exit_code == 0, r.output
+    head = (a / "moordynplus_data" / "MoorDynPlus_tension.csv").read_text().splitlines()[0]
+    assert head.endswith("Anchor_L2 [N];Fairlead_L2 [N]")
+    with h5py.File(a / "restart.h5", "r") as f:
+        cpos, cvel = f["arrays/moorings"]["cpos"][()], f["arrays/moorings"]["cvel"][()]
+        nodes = f["arrays/moorings"]["pos"][()]
+    assert cpos.shape == (1, 3) and np.abs(cvel).max() > 0
+    assert np.array_equal(nodes[10], cpos[0]) and np.array_equal(nodes[11], cpos[0])    # both lines' ends
+    (sa, ka), (sb, kb) = final_state(a), final_state(b)
+    for k in sa:
+        assert np.array_equal(sa[k], sb[k]), k
+    with h5py.File(b / "restart.h5", "r") as f:
+        assert np.array_equal(f["arrays/moorings"]["cpos"][()], cpos)
+
+
 @pytest.mark.slow
 def test_c4_the_moored_box_sinks_by_what_its_lines_pull(tmp_path):
     """C4 (sphdvi.validation.mooredbox): the box (0.3 x 0.2 m, half as dense as water) on two lines
