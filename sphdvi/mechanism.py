@@ -123,6 +123,59 @@ def _material_for(mkbound, case_json, body_property=None):
     return name, spec
 
 
+DEM_KEYS = (("friction", "Kfric"), ("restitution", "Restitution_Coefficient"), ("young", "Young_Modulus"),
+            ("poisson", "PoissonRatio"))
+
+
+def dem_material(mkbound: int, case_json: dict, body_property=None) -> dict:
+    """The DEM material of a boundary block (``RigidAlgorithm`` 2: JSph::LoadDemData), resolved as
+    :func:`_material_for`: {friction, restitution, young, poisson, name}. Raises ValueError naming
+    what is missing or out of range (DualSPHysics: "Object mk=.. (mkbound=..) - Value of Kfric is
+    invalid."; sphdvi also refuses e = 0 and E = 0, where the model's damping or stiffness is infinite)."""
+    name, spec = _material_for(mkbound, case_json, body_property)
+    if spec is None:
+        raise ValueError(f"mkbound {mkbound} has no property: DEM (RigidAlgorithm 2) needs its "
+                         + ", ".join(label for _, label in DEM_KEYS))
+    missing = [label for key, label in DEM_KEYS if spec.get(key) is None]
+    if missing:
+        raise ValueError(f"mkbound {mkbound}: its property '{name}' has no {' or '.join(missing)}, which DEM "
+                         f"(RigidAlgorithm 2) needs (DualSPHysics: \"Value of {missing[0]} is invalid.\")")
+    if not spec["restitution"] > 0.0:
+        raise ValueError(f"mkbound {mkbound}: property '{name}' has Restitution_Coefficient 0, an infinite DEM damping")
+    if not spec["young"] > 0.0:
+        raise ValueError(f"mkbound {mkbound}: property '{name}' has Young_Modulus 0, an infinite DEM stiffness")
+    return spec
+
+
+def dem_table(data: dict):
+    """The :class:`sphdvi.sph.dem.DemTable` of a case file read by :func:`sphdvi.io.casefile.read_case_h5`:
+    the DEM material of every boundary block (fixed, moving, floating) and the floating bodies'
+    masses. Raises CaseError for a block without a complete material."""
+    from .sph.dem import DemTable
+    js = data["json"]
+    p = data["particles"]
+    fluidcount = int(js["mkconfig"]["fluidcount"])
+    mk = np.asarray(p["mk"], np.int64)
+    mks = sorted(set(mk[np.asarray(p["type"]) != TYPE_FLUID].tolist()))
+    bodies = {int(b["mkbound"]): b for b in js.get("bodies_extra", [])}
+    mat_of_mk = np.full(int(mk.max()) + 1 if mk.size else 1, -1, np.int64)
+    rows = []
+    for k, m in enumerate(mks):
+        mkb = m - fluidcount - 1
+        body = bodies.get(mkb)
+        try:
+            spec = dem_material(mkb, js, body.get("property") if body else None)
+        except ValueError as exc:
+            raise CaseError(str(exc), element="properties", expected="a <property> with Kfric, "
+                            "Restitution_Coefficient, Young_Modulus and PoissonRatio for every boundary block, given "
+                            "by <floating property=..> or <properties><links><link mkbound=..>") from None
+        mat_of_mk[m] = k
+        tau = (1.0 - spec["poisson"] ** 2) / spec["young"]
+        rows.append((tau, spec["restitution"], spec["friction"], float(body["mass"]) if body else 0.0, spec["name"]))
+    tau, rest, kfric, mass, names = (list(c) for c in zip(*rows)) if rows else ([], [], [], [], [])
+    return DemTable(mat_of_mk, tau, rest, kfric, mass, names)
+
+
 def _first_value(key, props):
     """``key`` of the first property giving it as ``*_User``, else of the first giving it."""
     for user in (True, False):

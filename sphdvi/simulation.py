@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._version import __version__
-from .errors import DivergenceError, InputError, SphdviError
+from .errors import CaseError, DivergenceError, InputError, SphdviError
 from .run_checks import (and_list, box_text, check_boundary_in_domain, check_initial_density, fmt_vec, outside,
                          warn_inward_mdbc_normals, warn_thin_mdbc_walls, warn_undamped_mdbc)
 from .run_options import absolute_file_sets, apply_overrides, conflicting_options, resolved_parameters
@@ -307,7 +307,10 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
     threads = _usable_threads(threads)
     nfluid = int(np.count_nonzero(data["particles"]["type"] == 3))
     # inlet/outlet zones bring fluid of their own: such a case is an SPH run even with none drawn
-    sph_run = nfluid > 0 or bool((data["json"].get("special") or {}).get("inout"))
+    # so do the DEM contacts (RigidAlgorithm 2), which the SPH interaction computes: DualSPHysics's
+    # 14_DEM Bowling and ManyFloatings have no fluid
+    dem = int(params.get("RigidAlgorithm", 1) or 1) == 2 and bool((data["particles"]["type"] == 2).any())
+    sph_run = nfluid > 0 or bool((data["json"].get("special") or {}).get("inout")) or dem
     if sph_run:
         _check_dtfixed(float(params.get("DtFixed") or 0.0), params)
     if not resume:
@@ -853,10 +856,23 @@ class SPHRun:
             visco_table = read_visco_table(str(params["ViscoTime"]))
         from .sph.accinput import acc_inputs
         bound_corr = self._bound_corr(js.get("special", {}).get("boundcorr"), p, c, fluidcount)
+        if not float(c["cs0"]) > 0.0:
+            raise InputError(f"the speed of sound c0 is {float(c['cs0']):g} m/s (speedsystem {float(c['speedsystem']):g} "
+                             f"m/s: sqrt(|g| hswl) with |g| = {float(np.linalg.norm(c['gravity'])):g} and hswl = "
+                             f"{float(c['hswl']):g} m): an SPH run needs c0 > 0 (expected <speedsystem value=\"..\" "
+                             "auto=\"false\"/> or <speedsound value=\"..\" auto=\"false\"/> in <constantsdef>, "
+                             "then gencase again)")
+        dem = None
+        if int(params.get("RigidAlgorithm", 1) or 1) == 2 and self.floating is not None:
+            from .mechanism import dem_table
+            try:
+                dem = dem_table(data)
+            except CaseError as exc:
+                raise InputError(f"RigidAlgorithm 2 (DEM): {exc.message} (expected {exc.expected})") from None
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table,
                                 acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")),
-                                shift_zones=shift_zones(data), inout=self.inout, bound_corr=bound_corr)
+                                shift_zones=shift_zones(data), inout=self.inout, bound_corr=bound_corr, dem=dem)
         if self.floating is not None:       # Symplectic: the bodies at the half step for the corrector
             self.solver.half_step_hook = self.floating.predict
         for absorber in self.absorbers:

@@ -784,6 +784,8 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
         if case.parameters.get("RigidAlgorithm") not in (0, 3):
             reader.warn(None, "<special><chrono> is present but RigidAlgorithm is "
                         f"{case.parameters.get('RigidAlgorithm')}; sphdvi uses the DVI engine for the chrono bodies")
+    elif case.parameters.get("RigidAlgorithm") == 2:
+        _check_dem_materials(case, bound_labels, floating_labels, reader)
     elif case.parameters.get("RigidAlgorithm") == 3:
         raise CaseError("RigidAlgorithm=3 (Chrono) needs an <execution><special><chrono> section",
                         file=reader.file, line=reader.line_of("execution/parameters/parameter[@key='RigidAlgorithm']"),
@@ -914,6 +916,31 @@ def warn_gauges_outside(gauges, domain, is2d: bool, reader) -> None:
             reader.warnings.add(f"{g['type']} gauge '{g['name']}': {what} outside the simulation domain "
                                 f"{lo.tolist()} .. {hi.tolist()}; it records no fluid there",
                                 file=reader.file, line=g.get("line"), element=g["type"])
+
+
+def _check_dem_materials(case, bound_labels, floating_labels, reader) -> None:
+    """RigidAlgorithm 2 (DEM): every boundary block needs a material with Kfric,
+    Restitution_Coefficient, Young_Modulus and PoissonRatio (JSph::LoadDemData stops the run
+    without them); without floating bodies DualSPHysics switches DEM off, with a warning."""
+    from ..mechanism import dem_material
+    line = reader.line_of("execution/parameters/parameter[@key='RigidAlgorithm']")
+    if not floating_labels:
+        reader.warnings.add("RigidAlgorithm 2 (DEM) without floating bodies: no DEM contacts (DualSPHysics: \"The "
+                            "use of DEM was disabled because there are no floating objects\")", file=reader.file,
+                            line=line, element="parameter")
+        return
+    js = {"materials": {k: asdict(v) for k, v in case.materials.items()}, "material_links": case.material_links}
+    for mkb in sorted(bound_labels):
+        fd = next((f for f in case.floatings if mkb in f.mkbound), None)
+        try:
+            dem_material(int(mkb), js, fd.property if fd is not None and fd.property else None)
+        except ValueError as exc:
+            where = fd.line if fd is not None else next(
+                (ln["line"] for ln in case.material_links if mkb in ln.get("mkbound", [])), line)
+            raise CaseError(str(exc), file=reader.file, line=where, element="floating" if fd is not None else "link",
+                            expected="a <property> with Kfric, Restitution_Coefficient, Young_Modulus and PoissonRatio "
+                            "for every boundary block (fixed, moving and floating), by <floating property=..> or "
+                            "<properties><links><link mkbound=..>") from None
 
 
 # ---------------------------------------------------------------------------

@@ -60,7 +60,7 @@ PARAMETERS: dict[str, Param] = {
     "ShiftAdvCoef": Param("float", -0.01, "advanced shifting coefficient", (), -1e6, 0.0),
     "ShiftAdvALE": Param("int", 0, "advanced shifting ALE correction", (0, 1)),
     "ShiftAdvNCPress": Param("int", 0, "advanced shifting non-conservative pressure", (0, 1)),
-    "RigidAlgorithm": Param("int", 1, "0:collision-free, 1:SPH, 2:DEM (not implemented), 3:Chrono", (0, 1, 3)),
+    "RigidAlgorithm": Param("int", 1, "0:collision-free, 1:SPH, 2:DEM, 3:Chrono", (0, 1, 2, 3)),
     "FtPause": Param("float", 0.0, "time to freeze floatings at the start [s]", (), 0.0, 1e9),
     "FtIgnoreRadius": Param("int", 0, "periodic run with a floating body whose radius (1.2 x its particles' "
                             "largest distance from its centre) reaches a periodic length: 0 stops, 1 warns", (0, 1)),
@@ -122,11 +122,7 @@ NO_EFFECT = {
 
 # values of a key that DualSPHysics accepts and sphdvi does not implement: an error that says
 # what to use instead (checked before ``choices``, which leave these values out)
-REJECTED_VALUES = {
-    ("RigidAlgorithm", 2): "RigidAlgorithm=2 (DEM contacts between bodies) is not implemented in sphdvi; use 1 "
-                           "(bodies interact through SPH forces) or 3 with <special><chrono> (contacts solved "
-                           "by sphdvi's DVI multibody engine)",
-}
+REJECTED_VALUES: dict = {}
 
 # <constantsdef> entries that are sometimes given as parameters (DualSPHysics's -cfl option
 # changes the constant): their place in the case file

@@ -52,8 +52,8 @@ adds it).  Which neighbours they see follows DualSPHysics's FtMode
 1, ``RigidAlgorithm`` 1 (FtMode Sph, the default): every neighbour, fixed and
 moving walls (with Visco x ViscoBoundFactor) and other floating particles
 included: that DBC repulsion is the body's only contact with the walls;
-2, ``RigidAlgorithm`` 0 or 3 (FtMode Ext, collisions left to the multibody
-engine): fluid neighbours only, and the walls' continuity skips floating
+2, ``RigidAlgorithm`` 0, 2 or 3 (FtMode Ext, collisions left to the multibody
+engine or, under 2, to the DEM contacts of :mod:`sphdvi.sph.dem`): fluid neighbours only, and the walls' continuity skips floating
 particles; 0: no floating particles in the scene (those branches compiled out).
 With ``Shifting`` 1 a floating neighbour switches a fluid particle's shifting
 off, as a wall does.

@@ -168,9 +168,11 @@ class SPHSolver:
                  parallel_threshold=PARALLEL_THRESHOLD, light_threshold=LIGHT_THRESHOLD,
                  periodic=None, normals=None,
                  cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None, shift_zones=None,
-                 inout=None, bound_corr=None):
+                 inout=None, bound_corr=None, dem=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
+        self.dem = dem                                # RigidAlgorithm 2: the blocks' DEM materials (sphdvi.sph.dem)
+        self.dem_dt = 0.0                             # DualSPHysics's DemDtForce of the next interaction
         self.acc_inputs = list(acc_inputs or [])     # imposed accelerations (sphdvi.sph.accinput)
         self.inout = inout                            # inlet/outlet zones (sphdvi.sph.inout.InOut) or None
         # <boundcorr>: mDBC's density extrapolation on the DBC walls it lists (normals, determlimit)
@@ -390,7 +392,7 @@ class SPHSolver:
         if not np.any(state.ptype == 2):
             return 0
         ra = self.params.get("RigidAlgorithm")
-        return 1 if ra is None or int(ra) == 1 else 2
+        return 1 if ra is None or int(ra) == 1 else 2      # 0, 2 (DEM: sphdvi.sph.dem) and 3: FtMode Ext
 
     def _choose_cell_mode(self, mode):
         """Cells of h (5x5 / 125-cell stencil) where the grid stays small, else 2h.
@@ -721,8 +723,21 @@ class SPHSolver:
             self._advanced_shift(par, self.nb, ptype_rows, self.cell_sorted, oi, self.shiftpos, self.fstype,
                                  self.fsnormal, self._fs_work, nctype=self.nctype)
         k["rates"](*self._rates_args())
+        if self.dem is not None:
+            self._dem_contacts(par, self.nb, ptype_rows, self.cell_sorted, oi, oi, self.dtmax)
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
+
+    def _dem_contacts(self, par, nb, ptype_rows, cell_rows, oi, src, dtmax):
+        """RigidAlgorithm 2: the DEM contacts of the floating particles (:mod:`sphdvi.sph.dem`) on top
+        of their fluid forces, and the time-step maxima again with them."""
+        from . import dem as _dem
+        d = self.dem
+        ncx, ncy, ncz = self.cells.shape
+        fn = _dem.dem_parallel if par else _dem.dem_serial
+        fn(self.is2d, nb, ptype_rows, cell_rows, oi, src, self.cells.cell_start, ncx, ncy, ncz,
+           int(self.cst[18]), self.cst[1], self.state.mk, d.mat_of_mk, d.tau, d.restitution, d.kfric, d.body_mass,
+           self.dp, self.dem_dt, self.ace, self.viscdt, int(self.cst[19]), dtmax, self.cst)
 
     def _shift_adv_work(self, n):
         """Work arrays of the advanced shifting, one row per packed row: type, normal, grad C,
@@ -918,6 +933,8 @@ class SPHSolver:
                    self.ftmode, nb, ptype_e, cell_e, oi, self.cells.cell_start, *geo, self.cst, tau,
                    self.ace, self.ar, self.viscdt, self.shiftpos, self.shiftdet, self.gradvel, self._tvel(ne),
                    self.dtmax, self.nctype)
+        if self.dem is not None:
+            self._dem_contacts(par, nb, ptype_e, cell_e, oi, idx, self.dtmax)
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
 
@@ -1009,6 +1026,7 @@ class SPHSolver:
             # the shifting velocity of the ALE terms is dr/dt; Verlet's dt follows from
             # this step's rates, so the previous step's (or the imposed) dt stands in
             self.cst[20] = 1.0 / (self._fixed_dt(self.time) or self.last_dt or self.dt_pre)
+        self.dem_dt = self.last_dt or self.dtini        # DualSPHysics's DemDtForce: the previous step's dt
         self.compute_rates()
         dt = self._variable_dt(self.time)
         self.step_dt_terms = self.dt_terms
@@ -1041,6 +1059,7 @@ class SPHSolver:
         if self.shift == 4 and not self._need_shift_adv:
             self.shiftpos[:] = 0.0
         self._need_nopen = False
+        self.dem_dt = 0.5 * dt                           # DemDtForce: dt/2 in the predictor, dt in the corrector
         self.compute_rates()
         # DualSPHysics's ComputeStep_Sym: dt_p = DtVariable(false) from the predictor's terms
         dt_p = self._variable_dt(self.time + dt, count=False)
@@ -1059,6 +1078,7 @@ class SPHSolver:
             self._exclude(self.time + dt,
                           carry=("shiftpos", "nctype", "fstype", "fsnormal") if self.shift == 4 else ())
         self._in_corrector = True
+        self.dem_dt = dt
         try:
             self.compute_rates()
         finally:

@@ -112,8 +112,9 @@ def test_set_of_a_constant_and_of_dem():
     with pytest.raises(InputError, match=r"'Gamma' is a constant of the case.*<gamma value=.*<constantsdef>"):
         apply_overrides({"TimeOut": 0.1}, ["Gamma=5"])
     assert apply_overrides({"TimeOut": 0.1}, ["CFLnumber=5"])["CFLnumber"] == 5.0   # read by the time step only
-    with pytest.raises(InputError, match=r"RigidAlgorithm=2 \(DEM.*not implemented.*use 1.*or 3"):
-        apply_overrides({"TimeOut": 0.1}, ["RigidAlgorithm=2"])
+    assert apply_overrides({"TimeOut": 0.1}, ["RigidAlgorithm=2"])["RigidAlgorithm"] == 2      # DEM
+    with pytest.raises(InputError, match=r"RigidAlgorithm: 4 is not one of 0, 1, 2, 3"):
+        apply_overrides({"TimeOut": 0.1}, ["RigidAlgorithm=4"])
     with pytest.raises(InputError, match="unknown parameter 'Visc'; did you mean 'Visco'"):
         apply_overrides({"TimeOut": 0.1}, ["Visc=1"])
 
@@ -130,16 +131,19 @@ def test_set_rigid_algorithm_3_needs_a_chrono_section(done, tmp_path):
 
 def test_dualsphysics_keys_in_a_case_file(tmp_path):
     """SavePosDouble=2 (DualSPHysics reads != 0) and BoundaryMethod (not a DualSPHysics key,
-    ignored by it) are accepted with a warning naming the line; RigidAlgorithm=2 (DEM) is an error."""
+    ignored by it) are accepted with a warning naming the line; RigidAlgorithm=2 (DEM) without floating
+    bodies is warned (DualSPHysics switches DEM off)."""
     case = case_xml(tmp_path, '<parameter key="SavePosDouble" value="2" />'
                               '<parameter key="BoundaryMethod" value="2" />')
     r = invoke(["gencase", case, "-o", tmp_path / "g", "--dp", "0.1", "-q"])
     assert r.exit_code == 0, r.output
     assert "warning: <parameter>: parameter 'SavePosDouble' has no effect" in r.output
     assert "'BoundaryMethod' has no effect in sphdvi (it is not a DualSPHysics key" in r.output
-    r = invoke(["gencase", case_xml(tmp_path, '<parameter key="RigidAlgorithm" value="2" />', "b_Def.xml"),
-                "-o", tmp_path / "g2", "--dp", "0.1"])
-    assert_input_error(r, "b_Def.xml:", "RigidAlgorithm=2 (DEM", "expected one of 0, 1, 3")
+    dem = case_xml(tmp_path, "", "b_Def.xml")
+    dem.write_text(dem.read_text().replace('key="RigidAlgorithm" value="1"', 'key="RigidAlgorithm" value="2"'))
+    r = invoke(["gencase", dem, "-o", tmp_path / "g2", "--dp", "0.1"])
+    assert r.exit_code == 0, r.output
+    assert "RigidAlgorithm 2 (DEM) without floating bodies: no DEM contacts" in r.output
 
 
 # -- --resume: a checkpoint of another case ---------------------------------------------------
