@@ -491,12 +491,19 @@ def floating_bodies(case: Case, particles: dict, consts: Constants, primitives, 
     bodies = []
     ptype, label, pos = particles["type"], particles["label"], particles["pos"]
     vol = consts.dp ** (2 if consts.is2d else 3)
+    floating_drawn = set(np.unique(label[ptype == TYPE_FLOATING]).tolist())
     for fd in case.floatings:
-        drawn = [mkb for mkb in fd.mkbound if np.any((ptype == TYPE_FLOATING) & (label == mkb))]
+        drawn = [mkb for mkb in fd.mkbound if mkb in floating_drawn]
         if not drawn:
+            # GenCase passes over it where other <floating> elements made bodies (DualSPHysics's 14_DEM
+            # CaseManyFloatings draws mkbound 1-2000 and has a <floating mkbound="2001-42000">)
             mkb = fd.mkbound[0] if len(fd.mkbound) == 1 else f"{fd.mkbound[0]}-{fd.mkbound[-1]}"
-            raise CaseError(f"floating mkbound {mkb} has no particles", file=reader.file, line=fd.line,
-                            element="floating", expected="an mkbound drawn by the geometry commands")
+            if not floating_drawn:
+                raise CaseError(f"floating mkbound {mkb} has no particles", file=reader.file, line=fd.line,
+                                element="floating", expected="an mkbound drawn by the geometry commands")
+            reader.warnings.add(f"floating mkbound {mkb} drew no particles: this <floating> makes no body (the "
+                                "others do)", file=reader.file, line=fd.line, element="floating")
+            continue
         missing = [mkb for mkb in fd.mkbound if mkb not in drawn]
         if missing:
             # GenCase applies a <floating> to the mk blocks the geometry drew: DualSPHysics's chrono

@@ -184,12 +184,20 @@ def _auto_value(reader, parent, tag, **checks):
     return reader.num(el, "value", **checks)
 
 
+#: the largest mk a case may number (DualSPHysics's CODE_MKRANGEMAX of its 4-byte particle codes)
+MK_MAX = 65530
+
+
 def read_mkconfig(reader: CaseReader, casedef) -> tuple[int, int]:
     el = reader.child(casedef, "mkconfig")
     if el is None:
         return 240, 9
-    bc = reader.integer(el, "boundcount", 240, lo=1, hi=65000)
-    fc = reader.integer(el, "fluidcount", 9, lo=1, hi=65000)
+    bc = reader.integer(el, "boundcount", 240, lo=1, hi=MK_MAX)
+    fc = reader.integer(el, "fluidcount", 9, lo=1, hi=MK_MAX)
+    if bc + fc > MK_MAX:
+        raise reader.error(el, f"boundcount {bc} + fluidcount {fc} = {bc + fc} is above {MK_MAX}",
+                           f"boundcount + fluidcount <= {MK_MAX} (the largest mk, DualSPHysics's CODE_MKRANGEMAX; "
+                           "its 14_DEM CaseManyFloatings uses 65520 + 9)")
     for c in reader.children(el):
         if c.tag not in ("mkorientfluid", "mkorientbound"):
             raise reader.error(c, f"unknown element <{c.tag}> in <mkconfig>", "<mkorientfluid> or <mkorientbound>")

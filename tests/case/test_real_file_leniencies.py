@@ -99,7 +99,9 @@ FLOATING_COMMANDS = """
 
 def test_floating_range_with_undrawn_blocks(tmp_path):
     """<floating mkbound="51-53"> with mk 51 alone drawn: one body (51); a warning names 52-53.
-    A <floating> none of whose blocks were drawn stays an error."""
+    A <floating> none of whose blocks were drawn is warned beside one that made a body (DualSPHysics's
+    14_DEM CaseManyFloatings has such a <floating mkbound="2001-42000">), and an error when no
+    <floating> made one."""
     floatings = '<floatings><floating mkbound="{}"><massbody value="10" /></floating></floatings>'
     code, out = _gencase(tmp_path, case_xml(commands=FLOATING_COMMANDS, casedef_extra=floatings.format("51-53")))
     assert code == 0, out
@@ -108,6 +110,12 @@ def test_floating_range_with_undrawn_blocks(tmp_path):
     assert "Floating mkbound 52" not in out and "Floating mkbound 53" not in out
     code, out = _gencase(tmp_path, case_xml(commands=FLOATING_COMMANDS, casedef_extra=floatings.format("60-62")))
     assert code == 2 and "floating mkbound 60-62 has no particles" in out
+    both = floatings.format("51").replace("</floatings>", '<floating mkbound="60-40000" relativeweight="0.3" />'
+                                                          '</floatings>')
+    code, out = _gencase(tmp_path, case_xml(commands=FLOATING_COMMANDS, casedef_extra=both))
+    assert code == 0, out
+    assert "floating mkbound 60-40000 drew no particles: this <floating> makes no body (the others do)" in out
+    assert "Floating mkbound 51 (mk 61): 121 particles" in out
 
 
 def _gauge_case(output):
