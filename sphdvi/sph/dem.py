@@ -51,17 +51,18 @@ class DemTable:
 
 
 @njit(cache=True, error_model="numpy")
-def _dem_range(i0, i1, is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk,
+def _dem_range(i0, i1, is2d, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk,
                tau, rest, kfric, bmass, dp, dtforce, ace, viscdt):
     """The DEM contacts of the floating rows i0..i1 (module docstring) into their particles' ``ace``
-    and ``viscdt`` (rows ``oi``); ``src``: each packed row's particle (its real particle for a
-    periodic copy), for its mk."""
+    and ``viscdt`` (rows ``oi``); ``mk``: each packed row's mk (its real particle's for a periodic
+    copy), gathered in row order."""
     kn_geo = math.sqrt(dp / 4.0) * 4.0 / 3.0
     for i in range(i0, i1):
         o = oi[i]
         if o < 0 or ptype[i] != 2:
             continue
-        mi = mat_of_mk[mk[src[i]]]
+        mki = mk[i]
+        mi = mat_of_mk[mki]
         if is2d:
             xi, yi, zi = nb[i, 0], 0.0, nb[i, 1]
             vxi, vyi, vzi = nb[i, 2], 0.0, nb[i, 3]
@@ -94,8 +95,8 @@ def _dem_range(i0, i1, is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz
                     ptj = ptype[j]
                     if ptj == 3:
                         continue
-                    mj = mat_of_mk[mk[src[j]]]
-                    if mk[src[j]] == mk[src[i]]:
+                    mkj = mk[j]
+                    if mkj == mki:
                         continue            # the same body (or block)
                     if is2d:
                         dx, dy, dz = xi - nb[j, 0], 0.0, zi - nb[j, 1]
@@ -106,6 +107,7 @@ def _dem_range(i0, i1, is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz
                     r2 = dx * dx + dy * dy + dz * dz
                     if r2 > r2max or r2 < 1e-18:
                         continue
+                    mj = mat_of_mk[mkj]
                     r = math.sqrt(r2)
                     nx, ny, nz = dx / r, dy / r, dz / r
                     vn = dvx * nx + dvy * ny + dvz * nz
@@ -147,7 +149,7 @@ def _dem_range(i0, i1, is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz
 
 
 @njit(cache=True, error_model="numpy")
-def dem_serial(is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk, tau, rest,
+def dem_serial(is2d, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk, tau, rest,
                kfric, bmass, dp, dtforce, ace, viscdt, vel_type, dtmax, cst):
     """The DEM contacts of every floating row, then each chunk's time-step maxima again (the
     contacts change the floating particles' ace and viscdt: DualSPHysics's AceMax and ViscDtMax
@@ -156,19 +158,19 @@ def dem_serial(is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz, rs, r2
     for c in range((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _dem_range(i0, i1, is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk,
+        _dem_range(i0, i1, is2d, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk,
                    tau, rest, kfric, bmass, dp, dtforce, ace, viscdt)
         _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def dem_parallel(is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk, tau, rest,
+def dem_parallel(is2d, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk, tau, rest,
                  kfric, bmass, dp, dtforce, ace, viscdt, vel_type, dtmax, cst):
     """:func:`dem_serial` over chunks of rows in threads (each row writes its own particle)."""
     n = nb.shape[0]
     for c in prange((n + CHUNK - 1) // CHUNK):
         i0 = c * CHUNK
         i1 = min(n, i0 + CHUNK)
-        _dem_range(i0, i1, is2d, nb, ptype, cell, oi, src, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk,
+        _dem_range(i0, i1, is2d, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, rs, r2max, mk, mat_of_mk,
                    tau, rest, kfric, bmass, dp, dtforce, ace, viscdt)
         _dt_maxima(i0, i1, is2d, nb, ptype, oi, ace, viscdt, vel_type, dtmax, c, cst)

@@ -735,8 +735,9 @@ class SPHSolver:
         d = self.dem
         ncx, ncy, ncz = self.cells.shape
         fn = _dem.dem_parallel if par else _dem.dem_serial
-        fn(self.is2d, nb, ptype_rows, cell_rows, oi, src, self.cells.cell_start, ncx, ncy, ncz,
-           int(self.cst[18]), self.cst[1], self.state.mk, d.mat_of_mk, d.tau, d.restitution, d.kfric, d.body_mass,
+        mk_rows = self.state.mk if src is self._identity else np.take(self.state.mk, src)
+        fn(self.is2d, nb, ptype_rows, cell_rows, oi, self.cells.cell_start, ncx, ncy, ncz,
+           int(self.cst[18]), self.cst[1], mk_rows, d.mat_of_mk, d.tau, d.restitution, d.kfric, d.body_mass,
            self.dp, self.dem_dt, self.ace, self.viscdt, int(self.cst[19]), dtmax, self.cst)
 
     def _shift_adv_work(self, n):

@@ -161,7 +161,7 @@ def _pair(vel, over, mat_i, mat_j, body_i, body_j, wall, dtforce):
                      [mat_i["e"], mat_j["e"]], [mat_i["mu"], mat_j["mu"]], [body_i, body_j])
     ace, viscdt = np.zeros((2, 3)), np.zeros(2)
     idx = np.arange(2)
-    dem_serial(True, nb, ptype, np.zeros(2, np.int64), idx, idx, np.array([0, 2]), 1, 1, 1, 1, (2 * h) ** 2,
+    dem_serial(True, nb, ptype, np.zeros(2, np.int64), idx, np.array([0, 2]), 1, 1, 1, 1, (2 * h) ** 2,
                np.array([1, 2], np.int32), table.mat_of_mk, table.tau, table.restitution, table.kfric,
                table.body_mass, DP, dtforce, ace, viscdt, 2, np.zeros((1, 3)), np.zeros(30))
     return ace[0], viscdt[0]
