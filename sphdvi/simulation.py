@@ -262,6 +262,17 @@ def _same_value(a, b) -> bool:
         return bool(np.array_equal(a, b))
 
 
+def dem_coefficient_lines(dem, fluidcount: int) -> list:
+    """One line per boundary block of a :class:`sphdvi.sph.dem.DemTable`: its mkbound, material,
+    (1 − ν²)/E, restitution coefficient, Kfric and body mass (0 for a wall)."""
+    out = []
+    for mk in np.flatnonzero(dem.mat_of_mk >= 0):
+        k = int(dem.mat_of_mk[mk])
+        out.append(f"  mkbound {int(mk) - fluidcount - 1} (mk {int(mk)}): {dem.names[k]}  tau={dem.tau[k]:.6g} 1/Pa  "
+                   f"restitution={dem.restitution[k]:g}  kfric={dem.kfric[k]:g}  mass={dem.body_mass[k]:g} kg")
+    return out
+
+
 def run(case_h5: str, outdir: str, *, tmax=None, tout=None, threads=None, sets=(), resume=False,
         quiet=False, expect_dp=None, overwrite=False, stop=None, set_aside=None) -> RunResult:
     """Run a gencase output: body-only cases go to the multibody engine, the rest to SPH.
@@ -1497,6 +1508,10 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         files.start()
         if sol.keep_dt_terms:
             dtlog = DtLog(outdir, special["savedt"], tout)
+        if sol.dem is not None:                 # DualSPHysics's Run.out "Coefficients for DEM:"
+            files.log("RigidAlgorithm 2 (DCDEM, Canelas et al. 2016): DEM coefficients per boundary block")
+            for line in dem_coefficient_lines(sol.dem, int(data["json"]["mkconfig"]["fluidcount"])):
+                files.log(line)
         if sol.boundary == 2:                   # the normals mDBC starts from, for a look in ParaView
             from .io.vtkxml import write_normals_vtp
             st = sol.state

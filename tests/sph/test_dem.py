@@ -86,6 +86,8 @@ def test_a_block_at_rest_on_the_floor_sinks_by_hertzs_overlap(tmp_path):
     assert delta == pytest.approx(8.0e-6, rel=0.01)
     last = rows[-1]
     assert 0.055 - last["z"] == pytest.approx(delta, rel=5e-3)
+    log = (tmp_path / "out" / "run.log").read_text()       # DualSPHysics's Run.out "Coefficients for DEM"
+    assert "RigidAlgorithm 2 (DCDEM" in log and "mkbound 0 (mk 10): steel" in log and "mkbound 1 (mk 11): pvc" in log
     assert last["ffz"] == pytest.approx(mass * 9.81, rel=1e-6) and abs(last["vz"]) < 1e-9
 
 
