@@ -366,12 +366,19 @@ def _from_euler_file(m, tau) -> Rigid:
     """An ``mvrotadvfile`` ``tau`` seconds after it started: the orientation its file's Euler angles
     give (each angle interpolated linearly, :func:`_file_values`), relative to its first row's, about
     ``center``: x = c + R(τ) R(0)ᵀ (x0 − c); an angle without a column stays 0."""
-    from .case.datafiles import EULER_FIELDS
     table, fields = _load_table(m)
     value, rate = _file_values(table, tau)
+    R, W = _euler_turn(m, table, fields, value, rate)
+    c = np.asarray(m.get("center", (0.0, 0.0, 0.0)), float)
+    return Rigid(R=R, d=c - R @ c, W=W, c=c)
+
+
+def _euler_turn(m, table, fields, value, rate) -> tuple[np.ndarray, np.ndarray]:
+    """(R(τ) R(0)ᵀ, Ω) of a file movement's Euler angles (``fieldang1``-``3``; one without a column
+    stays 0) at the look-up ``value``, ``rate`` of :func:`_file_values`."""
+    from .case.datafiles import EULER_FIELDS
     units = _angle_units(m)
-    first = np.zeros(3)
-    a, w = np.zeros(3), np.zeros(3)
+    first, a, w = np.zeros(3), np.zeros(3), np.zeros(3)
     for k, name in enumerate(EULER_FIELDS):
         if name in fields:
             j = fields[name]
@@ -379,9 +386,7 @@ def _from_euler_file(m, tau) -> Rigid:
             a[k], w[k] = first[k] + value[j] * units, rate[j] * units
     axes, intrinsic = m["axes"], bool(m["intrinsic"])
     R0 = _of_movement(m, "euler0", lambda _: euler_matrix(first, axes, intrinsic))
-    R = euler_matrix(a, axes, intrinsic) @ R0.T
-    c = np.asarray(m.get("center", (0.0, 0.0, 0.0)), float)
-    return Rigid(R=R, d=c - R @ c, W=euler_rate(a, w, axes, intrinsic), c=c)
+    return euler_matrix(a, axes, intrinsic) @ R0.T, euler_rate(a, w, axes, intrinsic)
 
 
 def _from_path_file(m, tau) -> Rigid:
@@ -392,24 +397,13 @@ def _from_path_file(m, tau) -> Rigid:
     the centre stays where it is and the travelled object turns about it:
     x = c + R (x0 + d − c), v = R ḋ + Ω × (x − c).  sphdvi's reading: DualSPHysics does not publish
     how it applies the file (column missing: 0)."""
-    from .case.datafiles import EULER_FIELDS
     table, fields = _load_table(m)
     value, rate = _file_values(table, tau)
     d, dv = np.zeros(3), np.zeros(3)
     for k, name in enumerate(("fieldx", "fieldy", "fieldz")):
         if name in fields:
             d[k], dv[k] = value[fields[name]], rate[fields[name]]
-    units = _angle_units(m)
-    first, a, w = np.zeros(3), np.zeros(3), np.zeros(3)
-    for k, name in enumerate(EULER_FIELDS):
-        if name in fields:
-            j = fields[name]
-            first[k] = table.columns[j, 0] * units
-            a[k], w[k] = first[k] + value[j] * units, rate[j] * units
-    axes, intrinsic = m["axes"], bool(m["intrinsic"])
-    R0 = _of_movement(m, "euler0", lambda _: euler_matrix(first, axes, intrinsic))
-    R = euler_matrix(a, axes, intrinsic) @ R0.T
-    W = euler_rate(a, w, axes, intrinsic)
+    R, W = _euler_turn(m, table, fields, value, rate)
     c = np.asarray(m.get("center", (0.0, 0.0, 0.0)), float)
     if m.get("movecenter", True):
         return Rigid(R=R, d=c + d - R @ c, V=dv, W=W, c=c + d)
