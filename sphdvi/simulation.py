@@ -875,6 +875,9 @@ class SPHRun:
                              "then gencase again)")
         dem = None
         if int(params.get("RigidAlgorithm", 1) or 1) == 2 and self.floating is not None:
+            if js.get("chrono"):
+                from .case.gencase import DEM_WITH_CHRONO
+                raise InputError(f"{DEM_WITH_CHRONO} (expected RigidAlgorithm 3, or a case without <chrono>)")
             from .mechanism import dem_table
             try:
                 dem = dem_table(data)

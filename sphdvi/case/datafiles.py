@@ -206,7 +206,8 @@ def read_motion_file(reader, m, tag: str, duration: float | None = None) -> dict
         reader.warn(f, f"{path}:{lines[n]}: the time goes back after line {lines[n - 1]} ({t[-1]:g} s); the "
                     f"movement plays the file from {t[0]:g} s for {abs(duration):g} s and never reaches the rows "
                     f"from line {lines[n]} on: left out ({len(lines) - n} rows)")
-    return {"file": path, "fields": cols, "ncols": ncols, "reach": duration}
+    varying = [k for k, j in cols.items() if k != "fieldtime" and np.ptp(a[:, j]) > 0.0]
+    return {"file": path, "fields": cols, "ncols": ncols, "reach": duration, "varying": varying}
 
 
 def _time_table(path: str, what: str, name: str, unit: str, positive: bool) -> np.ndarray:

@@ -788,6 +788,11 @@ def check_case(case: Case, particles, bodies, mkinfo, domain, reader) -> None:
                 raise CaseError(f"chrono bodyfloating '{b['id']}' (mkbound {b['mkbound']}) is not in <floatings>",
                                 file=reader.file, line=b["line"], element="bodyfloating",
                                 expected=f'<floating mkbound="{b["mkbound"]}" ...> in <casedef><floatings>')
+        if case.parameters.get("RigidAlgorithm") == 2:
+            raise CaseError(DEM_WITH_CHRONO, file=reader.file, element="parameter",
+                            line=reader.line_of("execution/parameters/parameter[@key='RigidAlgorithm']"),
+                            expected="RigidAlgorithm 3 for the <chrono> section's bodies and links, or no <chrono> "
+                            "section for the DEM")
         if case.parameters.get("RigidAlgorithm") not in (0, 3):
             reader.warn(None, "<special><chrono> is present but RigidAlgorithm is "
                         f"{case.parameters.get('RigidAlgorithm')}; sphdvi uses the DVI engine for the chrono bodies")
@@ -923,6 +928,12 @@ def warn_gauges_outside(gauges, domain, is2d: bool, reader) -> None:
             reader.warnings.add(f"{g['type']} gauge '{g['name']}': {what} outside the simulation domain "
                                 f"{lo.tolist()} .. {hi.tolist()}; it records no fluid there",
                                 file=reader.file, line=g.get("line"), element=g["type"])
+
+
+#: RigidAlgorithm 2 with a <chrono> section: both would put contacts on the same bodies
+DEM_WITH_CHRONO = ("RigidAlgorithm 2 (DEM contacts) with a <special><chrono> section: DualSPHysics takes the "
+                   "<chrono> bodies under RigidAlgorithm 3 only, and sphdvi's multibody engine and the DEM would both "
+                   "put contacts on the same bodies")
 
 
 def _check_dem_materials(case, bound_labels, floating_labels, reader) -> None:

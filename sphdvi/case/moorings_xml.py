@@ -224,14 +224,14 @@ def _read_connects(reader, el) -> dict:
             absent = " and ".join(a for a in ("M", "V") if c.get(a) is None)
             reader.warn(c, f"connect conref={ref}: {absent} not given, taken as 0 (MoorDynPlus 2025 estimates them "
                         "from its lines, with a volume A L² of the wrong dimension)")
-        reader.check_children(c, {"coeffini", "initialCoeffs", "initialForce"})
+        reader.check_children(c, {"coeffini", "initialCoeffs", "initialForce", "forceini"})
         coef = reader.child(c, "coeffini")
         d["cda"] = reader.num(coef, "cda", nonnegative=True) if coef is not None else 0.0
         d["ca"] = reader.num(coef, "ca", nonnegative=True) if coef is not None else 0.0
-        for old in ("initialCoeffs", "initialForce"):
+        for old in ("initialCoeffs", "initialForce", "forceini"):
             if reader.child(c, old) is not None:
-                reader.warn(reader.child(c, old), f"<{old}> (MoorDynPlus 2020) is not read, as DualSPHysics 5.4 "
-                            "does not read it: <coeffini cda ca> gives the drag area and added mass")
+                reader.warn(reader.child(c, old), f"<{old}> is not read, as DualSPHysics 5.4's MoorDynPlus does not "
+                            "read it (<coeffini cda ca> gives the drag area and added mass; no initial force)")
         out[ref] = d
     return out
 

@@ -633,9 +633,10 @@ def _warn_dropped_y(reader, m, d) -> None:
         what = ", ".join(f"<{p}> y={d[p][1]:g}" for p in bad) or None
     elif tag in ("mvrectfile", "mvrotadvfile", "mvpathfile"):
         from .datafiles import EULER_FIELDS
-        parts = ["the file's y column (fieldy)"] if tag != "mvrotadvfile" and "fieldy" in d.get("fields", {}) else []
+        moving = d.get("varying", d.get("fields", {}))      # the columns whose values change
+        parts = ["the file's y column (fieldy)"] if tag != "mvrotadvfile" and "fieldy" in moving else []
         if tag != "mvrectfile":
-            turns = [a for a, f in zip(d["axes"], EULER_FIELDS) if a != "Y" and f in d["fields"]]
+            turns = [a for a, f in zip(d["axes"], EULER_FIELDS) if a != "Y" and f in moving]
             parts += [f"angles about {' and '.join(sorted(set(turns)))} from the file"] if turns else []
         what = "; ".join(parts) or None
     elif "axisp1" in d:

@@ -735,7 +735,13 @@ class SPHSolver:
         d = self.dem
         ncx, ncy, ncz = self.cells.shape
         fn = _dem.dem_parallel if par else _dem.dem_serial
-        mk_rows = self.state.mk if src is self._identity else np.take(self.state.mk, src)
+        if src is self._identity:
+            mk_rows = self.state.mk
+        else:                                   # gathered into row order, in a buffer kept between passes
+            buf = self._bufs.get("dem_mk")
+            if buf is None or buf.shape[0] < src.shape[0]:
+                buf = self._bufs["dem_mk"] = np.empty(src.shape[0] + src.shape[0] // 16 + 16, self.state.mk.dtype)
+            mk_rows = np.take(self.state.mk, src, out=buf[:src.shape[0]])
         fn(self.is2d, nb, ptype_rows, cell_rows, oi, self.cells.cell_start, ncx, ncy, ncz,
            int(self.cst[18]), self.cst[1], mk_rows, d.mat_of_mk, d.tau, d.restitution, d.kfric, d.body_mass,
            self.dp, self.dem_dt, self.ace, self.viscdt, int(self.cst[19]), dtmax, self.cst)

@@ -221,6 +221,21 @@ def test_connects_are_read_with_moordynpluss_end_order(tmp_path):
     assert a1["connect"] == b0["connect"] == 0 and a1["pos"] == [1.1, 0.0, 0.15]
 
 
+def test_two_connects_on_one_line_the_lower_is_node_0(tmp_path):
+    """fixed -> connect 2 -> connect 1 -> vessel: the middle line has a connect at each end, the lower
+    one (conref 2, z 0.1) as node 0 whatever the order they are written in."""
+    extra = ('<connects><connect conref="1" x="1.2" y="0" z="0.3" M="0.1" V="0" />'
+             '<connect conref="2" x="1.05" y="0" z="0.1" M="0.1" V="0" /></connects>')
+    lines = (LINEDEFAULT + '<line><fixconnection x="0.95" y="0" z="0" /><connect conref="2" /></line>'
+             '<line><connect conref="1" /><connect conref="2" /></line>'
+             '<line><connect conref="1" /><vesselconnection bodyref="50" x="1.35" y="0" z="0.4" /></line>')
+    m, _ = _read(tmp_path, moorings(library(extra=extra, lines=lines)))
+    ends = [[(e["kind"], e.get("conref")) for e in ln["ends"]] for ln in m["lines"]]
+    assert ends == [[("fixed", None), ("connect", 2)], [("connect", 2), ("connect", 1)],
+                    [("connect", 1), ("vessel", None)]]
+    assert [c["conref"] for c in m["connects"]] == [1, 2]
+
+
 def test_connect_warnings(tmp_path):
     """M and V absent (0 here, estimated by MoorDynPlus 2025), v2020's <initialCoeffs>, a connect no
     line uses (left out)."""
@@ -230,7 +245,7 @@ def test_connect_warnings(tmp_path):
     m, warnings = _read(tmp_path, moorings(library(extra=extra, lines=lines)))
     text = "\n".join(map(str, warnings))
     assert "connect conref=1: M and V not given, taken as 0" in text
-    assert "<initialCoeffs> (MoorDynPlus 2020) is not read" in text
+    assert "<initialCoeffs> is not read, as DualSPHysics 5.4's MoorDynPlus does not read it" in text
     assert "connect conref=2 is used by no line: left out" in text
     assert [c["conref"] for c in m["connects"]] == [1] and m["connects"][0]["cda"] == 0.0
 

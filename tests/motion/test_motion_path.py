@@ -117,3 +117,11 @@ def test_2d_warns_of_motion_out_of_the_plane(tmp_path):
     _, reader = read(tmp_path, path(axes="YXZ", file='<file name="p.csv" fields="7" fieldx="1" fieldz="3" '
                                                      'fieldang1="4"/>'), is2d=True)
     assert not [w for w in reader.warnings if "out of the x-z plane" in w]
+
+
+def test_2d_constant_columns_are_not_warned(tmp_path):
+    """A 2D ship-motion file whose y, roll and yaw columns hold zeros (the 7-column default layout):
+    nothing moves out of the x-z plane, so nothing is warned."""
+    flat = "0;0.1;0;0.3;0;5;0\n2;0.5;0;0.7;0;-10;0\n"
+    _, reader = read(tmp_path, path(axes="ZYX"), files={"p.csv": flat}, is2d=True)
+    assert not [w for w in reader.warnings if "out of the x-z plane" in w]

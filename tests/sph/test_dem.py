@@ -24,9 +24,8 @@ def case_xml(bodies, gravity=-9.81, materials=None, links='<link mkbound="0" pro
     """A 2D case: a steel floor (mkbound 0, z = 0, x −0.3..0.6) and ``bodies``: (mkbound, drawing
     commands, property) floating bodies of relativeweight 0.5; no fluid unless ``fluid``; without
     gravity a speedsystem of 2.2 m/s (c0 44 m/s, as with gravity) unless not ``fixed_speed``."""
-    mats = materials if materials is not None else (
-        '<property name="steel" Young_Modulus="2.1e11" PoissonRatio="0.3" Restitution_Coefficient="0.8" Kfric="0.45" />'
-        '<property name="pvc" Young_Modulus="3.0e9" PoissonRatio="0.3" Restitution_Coefficient="0.6" Kfric="0.45" />')
+    mats = materials if materials is not None else (material("steel", 2.1e11, 0.3, 0.8, 0.45)
+                                                    + material("pvc", 3.0e9, 0.3, 0.6, 0.45))
     draw = "".join(f'<setmkbound mk="{mk}" />{cmds}' for mk, cmds, _ in bodies)
     speed = ('<speedsystem value="0" auto="true" />' if gravity or not fixed_speed else
              '<speedsystem value="2.2" auto="false" />')
@@ -45,12 +44,21 @@ def case_xml(bodies, gravity=-9.81, materials=None, links='<link mkbound="0" pro
   <properties>{mats}<links>{links}</links></properties>
 </casedef>
 <execution><parameters>
-  <parameter key="StepAlgorithm" value="2" /><parameter key="Kernel" value="2" /><parameter key="ViscoTreatment" value="1" />
+  <parameter key="StepAlgorithm" value="2" /><parameter key="Kernel" value="2" />
+  <parameter key="ViscoTreatment" value="1" />
   <parameter key="Visco" value="0.01" /><parameter key="RigidAlgorithm" value="2" />
   <parameter key="TimeMax" value="{tmax}" /><parameter key="TimeOut" value="{tout}" />{extra}
   <simulationdomain><posmin x="default" y="default" z="default" /><posmax x="default" y="default" z="0.4" />
   </simulationdomain>
 </parameters></execution></case>"""
+
+
+def material(name, young=None, poisson=None, restitution=None, kfric=None):
+    """A <property> with its values as child elements, the form DualSPHysics's DEM reads (LoadDemData)."""
+    values = (("Young_Modulus", young), ("PoissonRatio", poisson), ("Restitution_Coefficient", restitution),
+              ("Kfric", kfric))
+    return f'<property name="{name}">' + "".join(f'<{k} value="{v}" />' for k, v in values if v is not None) + \
+        "</property>"
 
 
 def box(x, z, w, h):
@@ -111,11 +119,11 @@ def _drop_apex(mass, k, gn, gap, g=9.81):
 
 def test_a_body_dropped_on_one_particle_rebounds_as_the_contact_law_says(tmp_path):
     """cases/dem2d/CaseDemBounce2D: a pvc block (11 x 9 particles) with a one-particle foot under its
-    middle, dropped 1 cm onto the floor: one pair in contact (DualSPHysics's m* = M/2 against a wall, e = (0.6 + 0.8)/2 = 0.7). Its
-    rebound apex against that of the contact law's own equation of motion, integrated here (y < 0:
-    the overlap; 4.38 mm, below e² of the drop: the law's restitution is not the input's): the
-    contact is integrated by the SPH step, so the error falls with the step (measured −5.9 % at
-    CFL 0.2, −1.6 % at 0.05, −0.4 % at 0.0125: first order)."""
+    middle, dropped 1 cm onto the floor: one pair in contact (DualSPHysics's m* = M/2 against a wall,
+    e = (0.6 + 0.8)/2 = 0.7). Its rebound apex against that of the contact law's own equation of
+    motion, integrated here (y < 0: the overlap; 4.38 mm, below e² of the drop: the law's
+    restitution is not the input's): the contact is integrated by the SPH step, so the error falls
+    with the step (measured −5.9 % at CFL 0.2, −1.6 % at 0.05, −0.4 % at 0.0125: first order)."""
     mass = (11 * 9 + 1) * 1000 * DP * DP * 0.5
     gap = 0.01                  # the foot at z = 0.02 touches the floor row (z = 0) at z = dp
     k = kn(PVC, STEEL)
@@ -210,8 +218,7 @@ def test_gencase_refuses_a_block_without_dem_materials(tmp_path):
     path.write_text(case_xml([(1, box(0.0, 0.01, 0.11, 0.09), "pvc")], links=""))
     r = CliRunner().invoke(main, ["gencase", str(path), "-o", str(tmp_path / "g")])
     assert r.exit_code == 2 and "mkbound 0 has no property" in r.output and "Traceback" not in r.output
-    mats = ('<property name="steel" Young_Modulus="2.1e11" PoissonRatio="0.3" Restitution_Coefficient="0.8" Kfric="0.45" />'
-            '<property name="pvc" PoissonRatio="0.3" Restitution_Coefficient="0.6" Kfric="0.45" />')
+    mats = material("steel", 2.1e11, 0.3, 0.8, 0.45) + material("pvc", None, 0.3, 0.6, 0.45)
     path.write_text(case_xml([(1, box(0.0, 0.01, 0.11, 0.09), "pvc")], materials=mats))
     r = CliRunner().invoke(main, ["gencase", str(path), "-o", str(tmp_path / "g2")])
     assert r.exit_code == 2 and "mkbound 1: its property 'pvc' has no Young_Modulus" in r.output
@@ -238,13 +245,14 @@ def test_an_sph_run_without_a_speed_of_sound_is_refused(tmp_path):
     assert r.exit_code == 2 and "the speed of sound c0 is 0 m/s" in r.output and "<speedsystem" in r.output
 
 
-def test_a_dem_run_resumes_bitwise(tmp_path):
+@pytest.mark.parametrize("algorithm", [1, 2])
+def test_a_dem_run_resumes_bitwise(tmp_path, algorithm):
     """The DEM's Δt is the previous step's dt (Verlet) or the step's (Symplectic): nothing of its own
-    in restart.h5, and a Verlet run interrupted at 0.05 s and resumed ends bitwise as one run to 0.1 s."""
+    in restart.h5, and a run interrupted at 0.05 s and resumed ends bitwise as one run to 0.1 s."""
     import h5py
     foot = '<drawpoint x="0.05" y="0" z="0.02" />'
     text = case_xml([(1, box(0.0, 0.03, 0.1, 0.08) + foot, "pvc")], tmax=0.1, tout=0.05).replace(
-        '<parameter key="StepAlgorithm" value="2" />', '<parameter key="StepAlgorithm" value="1" />')
+        '<parameter key="StepAlgorithm" value="2" />', f'<parameter key="StepAlgorithm" value="{algorithm}" />')
     case = tmp_path / "CaseDem_Def.xml"
     case.write_text(text)
     for out, tmax in (("a", "0.1"), ("b", "0.05")):
@@ -275,3 +283,17 @@ def test_the_pile_case_runs(tmp_path):
     last = rows[rows["time"] == rows["time"].max()]
     assert len(last) == 200
     assert last["vz"] == pytest.approx(-9.81 * last["time"][0], rel=1e-7)
+
+
+def test_dem_with_a_chrono_section_is_refused(tmp_path):
+    """RigidAlgorithm 2 with a <special><chrono> section: DualSPHysics takes the chrono bodies under
+    RigidAlgorithm 3 only, and the DEM and sphdvi's multibody engine would both put contacts on the
+    bodies: exit 2 at gencase, naming the parameter."""
+    chrono = ('<special><chrono><savedata value="0.01" /><schemescale value="1" />'
+              '<bodyfloating id="box" mkbound="1" /></chrono></special>')
+    text = case_xml([(1, box(0.0, 0.01, 0.11, 0.09), "pvc")]).replace("<execution>", "<execution>" + chrono)
+    path = tmp_path / "CaseDemChrono_Def.xml"
+    path.write_text(text)
+    r = CliRunner().invoke(main, ["gencase", str(path), "-o", str(tmp_path / "g")])
+    assert r.exit_code == 2 and "RigidAlgorithm 2 (DEM contacts) with a <special><chrono> section" in r.output
+    assert "<parameter>" in r.output and "Traceback" not in r.output
