@@ -14,7 +14,6 @@ import argparse
 import os
 import sys
 import tempfile
-import time
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -22,6 +21,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import numba  # noqa: E402
 from click.testing import CliRunner  # noqa: E402
 
+from benchtiming import time_part  # noqa: E402
 from sphdvi.cli import main  # noqa: E402
 from sphdvi.io.casefile import read_case_h5  # noqa: E402
 from sphdvi.simulation import SPHRun, find_case_file, special_parameters  # noqa: E402
@@ -56,27 +56,7 @@ def main_() -> None:
         data = read_case_h5(find_case_file(tmp))
         run = SPHRun(data, special_parameters(data), tmp)
         sol = run.solver
-        spent = [0.0]
-        dem = sol._dem_contacts
-
-        def timed(*args):
-            t = time.perf_counter()
-            try:
-                return dem(*args)
-            finally:
-                spent[0] += time.perf_counter() - t
-        sol._dem_contacts = timed
-        sol.run(a.t0)
-        best = None
-        for _ in range(a.rounds):
-            spent[0] = 0.0
-            t = time.perf_counter()
-            for _ in range(a.steps):
-                sol.step()
-            wall = time.perf_counter() - t
-            if best is None or wall < best[0]:
-                best = (wall, spent[0], sol.last_dt)
-        wall, dem_time, dt = best
+        wall, dem_time, dt = time_part(sol, sol, "_dem_contacts", a.t0, a.steps, a.rounds)
         n = sol.state.n
         nf = int((sol.state.ptype == 2).sum())
         print(f"DEM pile (cases/dem2d/CaseDemPile2D): {n:,} particles ({nf:,} floating, "

@@ -15,7 +15,6 @@ import math
 import os
 import sys
 import tempfile
-import time
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -23,6 +22,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import numba  # noqa: E402
 from click.testing import CliRunner  # noqa: E402
 
+from benchtiming import time_part  # noqa: E402
 from sphdvi.cli import main  # noqa: E402
 from sphdvi.io.casefile import read_case_h5  # noqa: E402
 from sphdvi.run_options import apply_overrides  # noqa: E402
@@ -54,27 +54,7 @@ def main_() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         run = build(a.dp, tmp, a.segments)
         sol, moor = run.solver, run.floating.moorings
-        spent = [0.0]
-        step = moor.step
-
-        def timed(*args):
-            t = time.perf_counter()
-            try:
-                return step(*args)
-            finally:
-                spent[0] += time.perf_counter() - t
-        moor.step = timed
-        sol.run(a.t0)
-        best = None
-        for _ in range(a.rounds):
-            spent[0] = 0.0
-            t = time.perf_counter()
-            for _ in range(a.steps):
-                sol.step()
-            wall = time.perf_counter() - t
-            if best is None or wall < best[0]:
-                best = (wall, spent[0], sol.last_dt)
-        wall, lines_time, dt = best
+        wall, lines_time, dt = time_part(sol, moor, "step", a.t0, a.steps, a.rounds)
         n = sol.state.n
         nsub = max(1, math.ceil(dt / moor.dtm - 1e-9))
         nodes = int(moor.pos.shape[0])

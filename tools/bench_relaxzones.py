@@ -14,7 +14,6 @@ import argparse
 import os
 import sys
 import tempfile
-import time
 
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -22,6 +21,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import numba  # noqa: E402
 from click.testing import CliRunner  # noqa: E402
 
+from benchtiming import time_part  # noqa: E402
 from sphdvi.cli import main  # noqa: E402
 from sphdvi.io.casefile import read_case_h5  # noqa: E402
 from sphdvi.run_options import apply_overrides  # noqa: E402
@@ -54,27 +54,7 @@ def main_() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         run = build(a.dp, tmp, a.waves)
         sol, zone = run.solver, run.relax[0]
-        spent = [0.0]
-        apply = zone.apply
-
-        def timed(*args):
-            t = time.perf_counter()
-            try:
-                return apply(*args)
-            finally:
-                spent[0] += time.perf_counter() - t
-        zone.apply = timed
-        sol.run(a.t0)
-        best = None
-        for _ in range(a.rounds):
-            spent[0] = 0.0
-            t = time.perf_counter()
-            for _ in range(a.steps):
-                sol.step()
-            wall = time.perf_counter() - t
-            if best is None or wall < best[0]:
-                best = (wall, spent[0])
-        wall, pass_time = best
+        wall, pass_time, _ = time_part(sol, zone, "apply", a.t0, a.steps, a.rounds)
         n = sol.state.n
         what = f"spectrum of {a.waves} waves" if a.waves else "regular"
         print(f"W10 flume dp={a.dp:g} ({what} zone): {n:,} particles, {zone.count_inside(sol.state):,} in the zone, "
