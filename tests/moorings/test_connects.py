@@ -148,3 +148,14 @@ def test_a_sinker_between_anchor_and_fairlead_rests_where_two_catenaries_meet():
     assert m.cpos[0] == pytest.approx([xc, 0.0, zc], abs=1e-4)
     f = m.fairlead_forces()[1, 1]
     assert -f[0] == pytest.approx(fair["HF"], rel=2e-3) and -f[2] == pytest.approx(fair["VF"], rel=2e-3)
+
+
+def test_a_relaxation_without_vessel_lines_stops_after_four_spans():
+    """MoorDynPlus's DoDynamicRelaxIC tests the vessel fairleads' tensions only: with none (two anchors
+    and a clump weight) the test passes at its first check, after the fourth span of dtIC, not at tmaxIC."""
+    a = {"kind": "fixed", "body": None, "pos": [-0.4, 0.0, 1.0]}
+    b = {"kind": "fixed", "body": None, "pos": [0.4, 0.0, 1.0]}
+    sp = spec([line(0, 0.5, 10, [a, CON]), line(1, 0.5, 10, [b, CON])], [connect([0.0, 0.0, 0.7], mass=0.2)])
+    sp["solver"].update(tmaxic=5.0, dtic=0.1)
+    m = Moorings(sp, G, {50: 0}, *BODY)
+    assert m.relax_spans == 4

@@ -297,3 +297,19 @@ def test_dem_with_a_chrono_section_is_refused(tmp_path):
     r = CliRunner().invoke(main, ["gencase", str(path), "-o", str(tmp_path / "g")])
     assert r.exit_code == 2 and "RigidAlgorithm 2 (DEM contacts) with a <special><chrono> section" in r.output
     assert "<parameter>" in r.output and "Traceback" not in r.output
+
+
+def test_a_moving_wall_knocks_a_block_on(tmp_path):
+    """No gravity: a steel wall (one column of particles, mkbound 2) moving at 0.3 m/s along +x (<mvrect>)
+    meets a pvc block at rest 2 dp ahead of it. The contacts see the wall's own velocity (v_i − v_j), so
+    the block leaves faster than the wall, at up to (1 + e) times its speed, and the wall does not stop."""
+    wall = ('<setmkbound mk="2" /><drawbox><boxfill>solid</boxfill><point x="-0.02" y="-1" z="0.19" />'
+            '<size x="0" y="2" z="0.07" /></drawbox>')
+    motion = ('<motion><objreal ref="2"><begin mov="1" start="0" /><mvrect id="1" duration="1">'
+              '<vel x="0.3" y="0" z="0" /></mvrect></objreal></motion>')
+    text = case_xml([(1, box(0.0, 0.2, 0.05, 0.05), "pvc")], gravity=0.0, fluid=wall, tmax=0.12, tout=0.01,
+                    links='<link mkbound="0" property="steel" /><link mkbound="2" property="steel" />')
+    text = text.replace("</floatings>", "</floatings>" + motion)
+    _, rows = run(tmp_path, text)
+    assert rows["vx"][0] == 0.0
+    assert 0.3 < rows["vx"][-1] < 0.6 and abs(rows["vz"][-1]) < 1e-6
