@@ -365,7 +365,7 @@ def _line_items(reader, el, is_line: bool):
     params, conns, seen = {}, [], {}
     allowed = [v[0] for k, v in LINE_PARAMS.items() if is_line or k != "depth"]
     if is_line:
-        allowed += ["fixconnection", "vesselconnection"]
+        allowed += ["fixconnection", "vesselconnection", "connect"]
     for c in reader.children(el):
         key = c.tag.lower()
         if is_line and (key.startswith("fix") or key.startswith("vessel") or key == "connect"):

@@ -731,10 +731,10 @@ class SPHSolver:
     def _dem_contacts(self, par, nb, ptype_rows, cell_rows, oi, src, dtmax):
         """RigidAlgorithm 2: the DEM contacts of the floating particles (:mod:`sphdvi.sph.dem`) on top
         of their fluid forces, and the time-step maxima again with them."""
-        from . import dem as _dem
+        from .dem import dem_parallel, dem_serial       # imported (and compiled) only for RigidAlgorithm 2
         d = self.dem
         ncx, ncy, ncz = self.cells.shape
-        fn = _dem.dem_parallel if par else _dem.dem_serial
+        fn = dem_parallel if par else dem_serial
         if src is self._identity:
             mk_rows = self.state.mk
         else:                                   # gathered into row order, in a buffer kept between passes
