@@ -131,8 +131,10 @@ class ImposedMotions:
     ends, a null movement) is left as it is from then on, its particles already there with zero
     velocity (not with periodic boundaries, whose wrap moves them, nor in a placement without dt)."""
 
-    def __init__(self, motions, pos0: np.ndarray, fluidcount: int, normals0: np.ndarray | None = None):
+    def __init__(self, motions, pos0: np.ndarray, fluidcount: int, normals0: np.ndarray | None = None,
+                 skip_mkbounds=()):
         self.motions = motions
+        self.skip_mkbounds = np.asarray(list(skip_mkbounds), np.int64)   # moved otherwise (flexible structures)
         self.pos0 = pos0                    # initial positions, indexed by idp
         self.fluidcount = fluidcount
         self.normals0 = normals0            # initial mDBC normals, indexed by idp
@@ -144,6 +146,8 @@ class ImposedMotions:
         """Group the moving particles by mkbound, in idp order: slot of each idp, mkbound of each
         slot, their initial positions (and normals) by mkbound, and the work arrays."""
         sel = np.flatnonzero(s.ptype == 1)
+        if self.skip_mkbounds.size:
+            sel = sel[~np.isin(body_labels(s.mk[sel], self.fluidcount), self.skip_mkbounds)]
         idp = s.idp[sel].astype(np.int64)
         label = body_labels(s.mk[sel], self.fluidcount)
         order = np.lexsort((idp, label))

@@ -321,7 +321,9 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
     # so do the DEM contacts (RigidAlgorithm 2), which the SPH interaction computes: DualSPHysics's
     # 14_DEM Bowling and ManyFloatings have no fluid
     dem = int(params.get("RigidAlgorithm", 1) or 1) == 2 and bool((data["particles"]["type"] == 2).any())
-    sph_run = nfluid > 0 or bool((data["json"].get("special") or {}).get("inout")) or dem
+    # and so do flexible structures (DualSPHysics's CaseTurekHronCSM3 has no fluid)
+    special = data["json"].get("special") or {}
+    sph_run = nfluid > 0 or bool(special.get("inout")) or dem or bool(special.get("flexstrucs"))
     if sph_run:
         _check_dtfixed(float(params.get("DtFixed") or 0.0), params)
     if not resume:
@@ -762,7 +764,7 @@ class SPHRun:
     def __init__(self, data: dict, params: dict, outdir: str, resume: bool = False):
         from .motion import MotionSet
         from .sph.solver import SPHSolver
-        from .coupling import FloatingBodies, ImposedMotions
+        from .coupling import FloatingBodies, ImposedMotions, body_labels
         from .sph.state import FluidState
         self.data = data
         self.params = params
@@ -822,7 +824,6 @@ class SPHRun:
             normals0 = self._mdbc_only_on(normals0, p, fluidcount, str(params.get("MdbcMkbound") or "").strip())
             from .case.normals import (ghosts_in_own_wall, inward_normal_mkbounds, layers_needed,
                                        mdbc_floating_mask, thin_wall_mkbounds)
-            from .coupling import body_labels
             labels = body_labels(p["mk"], fluidcount)
             args = (p["pos"], normals0, p["type"], labels, float(c["dp"]), float(c["h"]))
             mask = ghosts_in_own_wall(*args)
@@ -835,8 +836,14 @@ class SPHRun:
             warn_undamped_mdbc(params, p, normals0, c)
         # the solids that move boundary particles, and the damping zones: each only when
         # the case has it
-        self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0)
-                       if (p["type"] == 1).any() else None)
+        flex_specs = js.get("special", {}).get("flexstrucs") or []
+        flex_mks = [int(b["mkbound"]) for b in flex_specs]
+        if flex_specs:
+            self._check_flex_parameters(params, periodic)
+        # the flexible structures' particles are moved by their solid, not by their motion
+        moved_by_motion = (p["type"] == 1) & ~np.isin(body_labels(p["mk"], fluidcount), flex_mks)
+        self.moving = (ImposedMotions(motions, p["pos"].copy(), fluidcount, normals0, skip_mkbounds=flex_mks)
+                       if moved_by_motion.any() else None)
         self.floating = (FloatingBodies(data, motions, fluidcount, normals0, float(params.get("FtPause", 0.0)))
                          if (p["type"] == 2).any() else None)
         if self.floating is not None and self.floating.moorings is not None and periodic:
@@ -883,10 +890,12 @@ class SPHRun:
                 dem = dem_table(data)
             except CaseError as exc:
                 raise InputError(f"RigidAlgorithm 2 (DEM): {exc.message} (expected {exc.expected})") from None
+        flex = self._flexible_structures(flex_specs, p, c, params, fluidcount) if flex_specs else None
         self.solver = SPHSolver(state, c, params, domain=domain, motion_hook=hook, periodic=periodic or None,
                                 normals=normals0, dt_table=dt_table, visco_table=visco_table,
                                 acc_inputs=acc_inputs(js.get("special", {}).get("accinputs")),
-                                shift_zones=shift_zones(data), inout=self.inout, bound_corr=bound_corr, dem=dem)
+                                shift_zones=shift_zones(data), inout=self.inout, bound_corr=bound_corr, dem=dem,
+                                flex=flex)
         if self.floating is not None:       # Symplectic: the bodies at the half step for the corrector
             self.solver.half_step_hook = self.floating.predict
         for absorber in self.absorbers:
@@ -906,6 +915,31 @@ class SPHRun:
         self.dtmin_warn_at = 1          # the next count of DtMin steps warned about (1, 10, 100, ...)
         self.step_warnings = []         # lines for run.log (and stderr) found by check()
         self.out_faces = set()          # faces of the domain that fluid excluded for its position crossed
+
+    @staticmethod
+    def _check_flex_parameters(params: dict, periodic) -> None:
+        """DualSPHysics's refusals of flexible structures with these parameters (checked again here:
+        --set may change what gencase checked)."""
+        from .case.flexstruc_xml import flexstruc_parameter_problem
+        problem = flexstruc_parameter_problem(params, bool(periodic))
+        if problem:
+            raise InputError(f"<special><flexstrucs>: {problem}")
+        if int(params.get("Boundary", 1)) == 2:
+            raise InputError("<special><flexstrucs> with Boundary=2 (mDBC) is not supported by sphdvi yet: its "
+                             "structures are DBC boundaries to the fluid (expected Boundary=1, e.g. --set Boundary=1)")
+
+    @staticmethod
+    def _flexible_structures(specs, p: dict, c: dict, params: dict, fluidcount: int):
+        """The flexible bodies of ``<special><flexstrucs>`` (sphdvi.sph.flexstruc) from the particles at
+        t = 0 (their reference configuration, also on a resumed run)."""
+        from .coupling import body_labels
+        from .sph.flexstruc import FlexStruc
+        labels = np.where(p["type"] == 3, -1, body_labels(p["mk"], fluidcount))
+        try:
+            return FlexStruc(specs, p["pos"], p["idp"], labels, p["type"], is2d=bool(c["is2d"]), h=float(c["h"]),
+                             dp=float(c["dp"]), kernel=int(params.get("Kernel", 2)))
+        except ValueError as exc:
+            raise InputError(f"<special><flexstrucs>: {exc}") from None
 
     def _relaxation_zones(self, specs, state, c: dict, params: dict) -> list:
         """``<special><relaxationzones>`` (sphdvi.sph.relaxzones): the zones, their ``<savemotion>`` files
@@ -1069,8 +1103,25 @@ class SPHRun:
                 + self._excluded_by_reason() + "; " + self._exclusion_cause(self._divergence_hint()))
         if not np.isfinite(sol.last_dt) or sol.last_dt <= 0:
             raise DivergenceError(f"t={sol.time:.6g} s, step {sol.nstep}: time step {sol.last_dt} is not valid")
+        if sol.flex is not None and sol.flex.fail[0] >= 0:
+            self._flex_failed(sol)
         # the floating bodies' states were checked where they changed (FloatingBodies.step / predict:
         # bodychecks.BodyWatch), before their particles reached the fluid
+
+    @staticmethod
+    def _flex_failed(sol) -> None:
+        """A flexible particle blew up or left the domain: DualSPHysics's "Issue with FlexStruc particle
+        update step" (it aborts too)."""
+        from .sph.flexstruc import FAIL_REASONS
+        f = sol.flex
+        k, why = int(f.fail[0]), int(f.fail[1])
+        row = int(f.rows[k])
+        spec = f.bodies[int(f.body[k])]
+        raise DivergenceError(
+            f"t={sol.time:.6g} s, step {sol.nstep}: particle {int(f.idp[k])} of the flexible structure "
+            f"mkbound={spec['mkbound']} at {fmt_vec(sol.state.pos[row])} {FAIL_REASONS.get(why, 'failed')}; cause: "
+            "the structure blew up or moved out of the domain (try a smaller cflnumber, a larger hgfactor, or a "
+            "larger <simulationdomain>)")
 
     def wall_density_warning(self) -> str:
         """Once a run with inlet/outlet zones: a line when a DBC wall particle (fixed or moving, not
@@ -1514,6 +1565,10 @@ def _run_sph_threaded(data, params, out_times, outdir, files, meta, resume, quie
         if sol.dem is not None:                 # DualSPHysics's Run.out "Coefficients for DEM:"
             files.log("RigidAlgorithm 2 (DCDEM, Canelas et al. 2016): DEM coefficients per boundary block")
             for line in dem_coefficient_lines(sol.dem, int(data["json"]["mkconfig"]["fluidcount"])):
+                files.log(line)
+        if sol.flex is not None:                # DualSPHysics's Run.out "Flexible Structures configuration:"
+            files.log("Flexible structures (total Lagrangian SPH, O'Connor & Rogers 2021)")
+            for line in sol.flex.config_lines():
                 files.log(line)
         if sol.boundary == 2:                   # the normals mDBC starts from, for a look in ParaView
             from .io.vtkxml import write_normals_vtp

@@ -21,6 +21,7 @@ from ..errors import CaseError, Warnings
 from .constants import hydrostatic_density, resolve_constants
 from .model import Body, Case, Constants
 from ..io.atomic import make_folder
+from .flexstruc_xml import check_flexstrucs
 from .reader import (case_name_from_path, open_case, parse_domain_spec, read_constantsdef,
                      read_mkconfig, read_sections, check_periodic)
 
@@ -115,6 +116,8 @@ def build_case(path: str, outdir: str | None = None, *, max_nodes: int = DEFAULT
     check_particle_values(particles, reader)
     domain = resolve_domain(case, particles, consts, reader)
     check_case(case, particles, bodies, mkinfo, domain, reader)
+    if case.special.get("flexstrucs"):
+        check_flexstrucs(case, particles, consts.is2d, reader)
     if case.special.get("inout"):
         check_inout(case.special["inout"], particles, consts.is2d, reader)
     if case.special.get("boundcorr"):

@@ -27,6 +27,7 @@ from .parameters import (NNEWTONIAN_TEXT, NOT_SUPPORTED, PARAMETERS, apply_delta
                          domain_from_deprecated, other_build_hint, parameter_warnings)
 from .schema import validate_structure
 from .inout_xml import read_boundcorr, read_inout
+from .flexstruc_xml import read_flexstrucs
 from .moorings_xml import read_moorings
 from .relaxzones_xml import read_relaxationzones
 from .wavepaddles_xml import read_wavepaddles
@@ -37,9 +38,9 @@ CASEDEF_CHILDREN = {"constantsdef", "mkconfig", "geometry", "floatings", "initia
 EXECUTION_CHILDREN = {"special", "parameters", "particles", "constants", "motion", "vres", "uservars", "vtkout"}
 SPECIAL_SUPPORTED = {"accinputs", "chrono", "gauges", "wavepaddles", "damping", "shifting", "timeout", "initialize",
                      "savedt", "outputparts", "inout", "boundcorr", "relaxationzones",
-                     "moorings"}
+                     "moorings", "flexstrucs"}
 SPECIAL_KNOWN = SPECIAL_SUPPORTED | {
-    "mlayerpistons", "flexstrucs", "boundextrap",
+    "mlayerpistons", "boundextrap",
     "forcepoints", "vres", "nnphases", "temperature"}
 
 
@@ -1397,4 +1398,5 @@ SPECIAL_READERS = {"accinputs": read_accinputs, "chrono": read_chrono, "gauges":
                    "wavepaddles": read_wavepaddles, "damping": read_damping, "shifting": read_shifting,
                    "timeout": read_timeout, "initialize": read_initialize, "savedt": read_savedt,
                    "outputparts": read_outputparts, "inout": read_inout, "boundcorr": read_boundcorr,
-                   "relaxationzones": read_relaxationzones, "moorings": read_moorings}
+                   "relaxationzones": read_relaxationzones, "moorings": read_moorings,
+                   "flexstrucs": read_flexstrucs}

@@ -168,10 +168,11 @@ class SPHSolver:
                  parallel_threshold=PARALLEL_THRESHOLD, light_threshold=LIGHT_THRESHOLD,
                  periodic=None, normals=None,
                  cell_mode="auto", dt_table=None, visco_table=None, acc_inputs=None, shift_zones=None,
-                 inout=None, bound_corr=None, dem=None):
+                 inout=None, bound_corr=None, dem=None, flex=None):
         if not isinstance(state, FluidState):
             raise TypeError("state must be a FluidState")
         self.dem = dem                                # RigidAlgorithm 2: the blocks' DEM materials (sphdvi.sph.dem)
+        self.flex = flex                              # <flexstrucs>: the flexible bodies (sphdvi.sph.flexstruc)
         self.dem_dt = 0.0                             # DualSPHysics's DemDtForce of the next interaction
         self.acc_inputs = list(acc_inputs or [])     # imposed accelerations (sphdvi.sph.accinput)
         self.inout = inout                            # inlet/outlet zones (sphdvi.sph.inout.InOut) or None
@@ -202,6 +203,8 @@ class SPHSolver:
         if domain is not None:
             self._domain = (np.array(domain[0], float), np.array(domain[1], float))
         self.periodicity = self._setup_periodic(periodic)
+        if flex is not None:
+            self._setup_flex()
         self.bc_normals = None
         if bound_corr is not None and self.boundary == 1:
             self.bc_normals = np.ascontiguousarray(bound_corr[0], dtype=np.float64).reshape(state.n, 3).copy()
@@ -368,6 +371,24 @@ class SPHSolver:
         # (h or 2h, a speed choice) does not change it
         self.movlimit = 0.9 * 2.0 * h
         self.ip[16] = self.movlimit
+
+    def _setup_flex(self):
+        """Flexible structures: no periodic conditions (DualSPHysics refuses them too); DtIni and DtMin
+        from the structure's sound speed where it exceeds the fluid's or there is no fluid (JSph's
+        LoadCaseConfig), unless the case sets them."""
+        if self.periodicity is not None:
+            raise ValueError("flexible structures are not allowed with periodic conditions")
+        cs = float(self.flex.csound.max())
+        if cs > self.cs0 or not np.any(self.state.ptype == 3):
+            p = self.params
+            if not float(p["DtIni"]):
+                self.dtini = self.h / cs
+            if not float(p["DtMin"]):
+                self.dtmin = float(p["CoefDtMin"]) * self.h / cs
+        self._flex_dom = np.zeros(6)
+        if self._domain is not None:
+            self._flex_dom[:3] = self._domain[0]
+            self._flex_dom[3:] = self._domain[1]
 
     def _warn_fixed_below_dtmin(self):
         """DtFixed, or a DtFixedFile value, below DtMin is kept (sphdvi steps with it), but
@@ -725,8 +746,39 @@ class SPHSolver:
         k["rates"](*self._rates_args())
         if self.dem is not None:
             self._dem_contacts(par, self.nb, ptype_rows, self.cell_sorted, oi, oi, self.dtmax)
+        if self.flex is not None:
+            self._flex_forces(par, ptype_rows, oi)
         if self.visco_kind == 2:
             k["sps"](self.gradvel, s.rhop, s.ptype, self.sps_smag, self.sps_blin, self.tau)
+
+    def _flex_forces(self, par, ptype_rows, oi):
+        """Flexible structures (:mod:`sphdvi.sph.flexstruc`): the fluid's forces on their particles, then
+        the elastic ones; their |a| enters the force condition of dt."""
+        from .flexstruc import fluid_on_structure
+        f = self.flex
+        s = self.state
+        ncx, ncy, ncz = self.cells.shape
+        fluid_on_structure(self.kernel, self.visco_kind, self.is2d, self.nb, ptype_rows, self.cell_sorted, oi,
+                           self.cells.cell_start, ncx, ncy, ncz, int(self.cst[18]), self.cst, s.idp, f.slot,
+                           f.clamp, f.body, f.rho_s, f.vol, self.ace)
+        f.elastic(s.pos, s.idp, self.ace, parallel=par)
+        if f.amax2 > self.dtmax[0, 0]:
+            self.dtmax[0, 0] = f.amax2
+
+    def _flex_update(self, kind, dt):
+        """Move the flexible particles: ``euler`` (Verlet steps), ``pre`` or ``corr`` (Symplectic)."""
+        from .flexstruc import update_corrector, update_euler, update_predictor
+        f = self.flex
+        s = self.state
+        f.locate(s.idp)
+        usedom = self._domain is not None
+        if kind == "euler":
+            update_euler(f.rows, f.clamp, s.pos, s.vel, self.ace, self.gravity, dt, self.ip[13] != 0.0, usedom,
+                         self._flex_dom, f.fail)
+        else:
+            fn = update_predictor if kind == "pre" else update_corrector
+            fn(f.rows, f.clamp, s.pos, s.vel, self.pos_pre, self.vel_pre, self.ace, self.gravity, dt, usedom,
+               self._flex_dom, f.fail)
 
     def _dem_contacts(self, par, nb, ptype_rows, cell_rows, oi, src, dtmax):
         """RigidAlgorithm 2: the DEM contacts of the floating particles (:mod:`sphdvi.sph.dem`) on top
@@ -975,6 +1027,8 @@ class SPHSolver:
         if fixed > 0.0 and self.dt_table is None:
             return fixed
         dt = self.cfl * min(dt1, dt2)
+        if self.flex is not None and self.flex.cmax > 0.0:
+            dt = min(dt, self.cfl * self.h / self.flex.cmax)      # DualSPHysics's dt3 of the structures
         if fixed > 0.0:
             self.dt_error = max(self.dt_error, fixed - dt)
             return fixed
@@ -1046,6 +1100,8 @@ class SPHSolver:
             self._verlet_count = 0
         k = self._integrators(self._use_parallel(light=True))
         nout = k["verlet"](*self._verlet_args(euler))
+        if self.flex is not None:
+            self._flex_update("euler", dt)
         if self.nopen:
             nout += self._nopen_apply(False)
         if nout:
@@ -1076,6 +1132,8 @@ class SPHSolver:
         k = self._integrators(self._use_parallel(light=True))
         npre = k["sym_pre"](s.pos, s.vel, s.rhop, self.pos_pre, self.vel_pre, self.rhop_pre,
                             self.ace, self.ar, s.ptype, self.ip, self.out)
+        if self.flex is not None:
+            self._flex_update("pre", dt)
         if self.half_step_hook is not None:
             # floating bodies to t + dt/2 for the corrector (DualSPHysics: RunFloating(dt/2, predictor))
             self.half_step_hook(self, 0.5 * dt)
@@ -1092,6 +1150,8 @@ class SPHSolver:
             self._in_corrector = False
         self._need_shift_adv = True
         nout = k["sym_corr"](*self._corr_args())
+        if self.flex is not None:
+            self._flex_update("corr", dt)
         if self.nopen:
             nout += self._nopen_apply(True)
         # the next step's dt: min(dt_p, dt_c) as ComputeStep_Sym (<savedt> keeps the corrector's

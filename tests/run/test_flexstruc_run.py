@@ -1,0 +1,89 @@
+"""Flexible structures through ``sphdvi run`` (gencase + the SPH loop): Turek & Hron's CSM3 beam
+(`cases/flexstruc2d`) falls as a free body until its bending wave reaches the tip, logs its
+configuration, resumes bitwise; the run-time refusals."""
+import math
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from sphdvi.cli import main
+
+CSM3 = Path(__file__).resolve().parents[2] / "cases" / "flexstruc2d" / "CaseTurekHronCSM3_Def.xml"
+
+
+def run(*args):
+    r = CliRunner().invoke(main, ["run", *map(str, args), "--threads", "1", "-q"])
+    return r
+
+
+def tip_uz(outdir, t_index):
+    """The mean vertical displacement of the two particles beside point A (0.6, 0.2) at output t_index."""
+    with h5py.File(Path(outdir) / "particles.vtkhdf", "r") as f:
+        g = f["VTKHDF"]
+        off, n = g["Steps/PointOffsets"][...], g["NumberOfPoints"][...]
+        P, idp = g["Points"][...], g["PointData/Idp"][...]
+        t = g["Steps/Values"][...]
+        p0, i0 = P[off[0]:off[0] + n[0]], idp[off[0]:off[0] + n[0]]
+        d = np.hypot(p0[:, 0] - 0.6, p0[:, 2] - 0.2)
+        tip = i0[d < d.min() + 1e-9]
+        pk, ik = P[off[t_index]:off[t_index] + n[t_index]], idp[off[t_index]:off[t_index] + n[t_index]]
+        return t[t_index], pk[np.isin(ik, tip), 2].mean() - p0[np.isin(i0, tip), 2].mean(), tip.size
+
+
+def test_csm3_beam_tip_first_falls_freely(tmp_path):
+    """A beam under a load switched on at t = 0 starts to move as a free body far from its clamp: the
+    clamp's influence spreads along it as sqrt(t sqrt(EI/(rho A))) (flexural waves), 0.07 m by 0.02 s,
+    a factor exp(-L^2/(4 l^2)) ~ 1e-3 at the tip, L = 0.35 m. So the tip falls g t^2/2 there."""
+    out = tmp_path / "csm3"
+    r = run(CSM3, "-o", out, "--tmax", "0.02", "--tout", "0.01")
+    assert r.exit_code == 0, r.output
+    for k in (1, 2):
+        t, uz, ntip = tip_uz(out, k)
+        assert ntip == 2
+        assert uz == pytest.approx(-0.5 * 2.0 * t * t, rel=0.01), (t, uz)
+    log = (out / "run.log").read_text()
+    assert "Flexible Structure 0 (mkbound:1):" in log and "Constitutive model: Plane Strain" in log
+    assert "Sound speed: 54.7723" in log
+    assert "(60 clamp particles, 324 flexible)" in log
+
+
+def test_a_flexible_structure_run_resumes_bitwise(tmp_path):
+    for d, tmax in (("a", 0.04), ("b", 0.02)):
+        r = run(CSM3, "-o", tmp_path / d, "--tmax", tmax, "--tout", "0.02")
+        assert r.exit_code == 0, r.output
+    r = run(tmp_path / "b", "--resume", "--tmax", "0.04")
+    assert r.exit_code == 0, r.output
+
+    def state(d):
+        with h5py.File(tmp_path / d / "restart.h5", "r") as f:
+            o = np.argsort(f["state/idp"][...])
+            return f["state/pos"][...][o], f["state/vel"][...][o], f["state/rhop"][...][o]
+    for x, y in zip(state("a"), state("b")):
+        assert np.array_equal(x, y)
+
+
+@pytest.mark.parametrize("sets, text", [
+    (["Boundary=2", "SlipMode=2", "StepAlgorithm=2"], "Boundary=2 (mDBC) is not supported by sphdvi yet"),
+    (["Boundary=2", "SlipMode=1"], "original mDBC (SlipMode=1)"),
+    (["XPeriodicIncZ=0.1"], "periodic conditions"),
+])
+def test_run_time_refusals(tmp_path, sets, text):
+    args = [CSM3, "-o", tmp_path / "o", "--tmax", "0.01"]
+    for s in sets:
+        args += ["--set", s]
+    r = run(*args)
+    assert r.exit_code == 2, r.output
+    assert text in r.output
+
+
+def test_a_structure_one_particle_thick_is_refused(tmp_path):
+    text = CSM3.read_text().replace('<size x="#0.4-Dp/2" y="0.02" z="#0.02-Dp" />',
+                                    '<size x="#0.4-Dp/2" y="0.02" z="0" />')
+    case = tmp_path / "CaseThin_Def.xml"
+    case.write_text(text)
+    r = run(case, "-o", tmp_path / "o", "--tmax", "0.01")
+    assert r.exit_code == 2, r.output
+    assert "too few neighbours within 2h" in r.output and "two particles thick" in r.output
