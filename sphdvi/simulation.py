@@ -919,14 +919,14 @@ class SPHRun:
     @staticmethod
     def _check_flex_parameters(params: dict, periodic) -> None:
         """DualSPHysics's refusals of flexible structures with these parameters (checked again here:
-        --set may change what gencase checked)."""
-        from .case.flexstruc_xml import flexstruc_parameter_problem
+        --set may change what gencase checked): periodic conditions, the original mDBC (SlipMode 1),
+        mDBC with Verlet. mDBC2 (Boundary 2 with SlipMode 2 or 3, Symplectic) is run as DualSPHysics
+        v5.4 runs it (sphdvi.sph.flexstruc)."""
+        from .case.flexstruc_xml import PARAMETER_FIXES, flexstruc_parameter_problem
         problem = flexstruc_parameter_problem(params, bool(periodic))
         if problem:
-            raise InputError(f"<special><flexstrucs>: {problem}")
-        if int(params.get("Boundary", 1)) == 2:
-            raise InputError("<special><flexstrucs> with Boundary=2 (mDBC) is not supported by sphdvi yet: its "
-                             "structures are DBC boundaries to the fluid (expected Boundary=1, e.g. --set Boundary=1)")
+            fix = PARAMETER_FIXES.get(problem)
+            raise InputError(f"<special><flexstrucs>: {problem}" + (f" (expected {fix})" if fix else ""))
 
     @staticmethod
     def _flexible_structures(specs, p: dict, c: dict, params: dict, fluidcount: int):

@@ -16,6 +16,7 @@ between successive resolutions, log(e1/e2)/log(dp1/dp2).
                                              # S16O: S16M with the box's normals from its outline, as GenCase's (dp 0.02, 0.01: ~2, 14 min)
                                              # S18: hinged buoyant flap (dp 0.04, 0.02, 0.01: 0.3, 1.5, 7 min on 2 threads)
                                              # S19: flexible plate hit by a dam break (dp 0.002: 9 min on 2 threads; dp 0.001 on request, 72 min)
+                                             # S20: Turek & Hron's CSM3 beam (4, 8 particles across: 1, 4 min on 1 thread; 16 on request, ~17 min to 1 s)
                                              # W4: irregular waves (20 s; dp 0.02, 0.01: 5, ~30 min on 2 threads)
                                              # W9: W4's sea generated to second order (the same times)
     python tools/validate.py W3 --fine       # also the resolutions run only on request (W3 depth/dp 40, dp 0.01: ~15 min on 2 threads;
@@ -266,6 +267,11 @@ def score_flex_obstacle(outdir):
     return case_errors(outdir, REFERENCE)
 
 
+def score_csm3(outdir):
+    from sphdvi.validation.csm3 import case_errors
+    return case_errors(outdir)
+
+
 def score_cylinder(outdir):
     from sphdvi.validation.cylinder import case_errors
     return case_errors(outdir, REFERENCE)
@@ -380,6 +386,16 @@ def cases() -> list:
              "the plate's deflection under the running water (t = 0.35-0.70 s) within 20 % of the experiment's and "
              "its arrival within 0.02 s (judgement: DualSPHysics's run of this model is 14 % low, Sun et al.'s SPH "
              "17 %)", slow=True),
+        Case("S20", "Turek & Hron's CSM3: an elastic beam (flexible structure, total Lagrangian SPH) clamped in a "
+             "cylinder swings under its weight; point A's displacement",
+             case_path("flexstruc2d", "CaseTurekHronCSM3_Def.xml"),
+             [Resolution("4 across", 0.005, ["--tmax", "2.5"]), Resolution("8 across", 0.0025, ["--tmax", "2"]),
+              Resolution("16 across", 0.00125, ["--tmax", "1", "--tout", "0.01"], on_request=True)],
+             score_csm3, [("uz mean %", "uz_mean", PCT), ("uz amp %", "uz_amp", PCT), ("ux mean %", "ux_mean", PCT),
+                          ("freq %", "frequency", PCT)],
+             "uz_mean", lambda e: abs(e["uz_mean"]) <= 0.25 and abs(e["frequency"]) <= 0.10,
+             "point A's mean deflection within 25 % and the frequency within 10 % at 8 particles across the beam "
+             "(judgement: total Lagrangian SPH converges at first order in dp/thickness)", slow=True),
         Case("A1", "tank under an imposed acceleration a_x = 0.1 g (<accinputs>): free-surface slope",
              case_path("acceltank2d", "CaseAccelTank2D_Def.xml"),
              [Resolution("depth/dp 15", 0.02), Resolution("depth/dp 30", 0.01)],

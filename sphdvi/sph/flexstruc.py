@@ -27,8 +27,9 @@ R_ij = X_i − X_j, δ_ij = (r_ij − F_i R_ij)·r_ij/r and δ_ji = (r_ij − F_
     a_i −= α V E W(|R_ij|) / (ρ_s |R_ij|² r) (δ_ij + δ_ji)/2 r_ij.
 
 The fluid acts on a flexible particle i through its fluid neighbours j as on a wall, with the
-reaction of the fluid's own terms (the flexible particle is a DBC boundary particle to the fluid:
-mass m_b = ρ0 dp^d, density from the boundary continuity, pressure from the fluid's EOS):
+reaction of the fluid's own terms (the flexible particle is a moving boundary particle to the fluid:
+mass m_b = ρ0 dp^d, pressure from its density by the fluid's EOS; under DBC the density comes from the
+boundary continuity, under mDBC from the ghost node, below):
 
     a_i += (m_b/m_s) Σ_j m_j [−(p_i + p_j)/(ρ_i ρ_j) + Π_ij] ∇_iW(r_ij)        (ViscoTreatment 1)
     a_i += (m_b/m_s) Σ_j m_j 4 ν_b r_ij·∇_iW(r_ij) / ((r² + η²)(ρ_i + ρ_j)) v_ij    (2, 3; no SPS)
@@ -39,6 +40,39 @@ semi-implicit Euler one, v += (a + g) dt, x += v dt; the Symplectic predictor x 
 v = v⁰ + (a + g) dt/2, the corrector v = v⁰ + (a + g) dt, x = x⁰ + (v⁰ + v) dt/2. The time step
 gains dt_3 = h / max_i c_i, c_i = c_s √(det F_i) (the P-wave speed √(E(1 − ν)/(ρ(1 + ν)(1 − 2ν)))
 at the current density ρ_s/det F_i), and the flexible particles' |a| enter the force condition.
+
+With mDBC (Boundary 2; DualSPHysics v5.4 allows its mDBC2 only, SlipMode 2 or 3 with Symplectic,
+and refuses SlipMode 1 and Verlet, as sphdvi does) the structure's particles are mDBC walls whose
+normals, ghost density and wall acceleration follow the solid:
+
+* F is found before the mDBC correction of each evaluation (:meth:`FlexStruc.geometry`, at the
+  positions of that evaluation: the predictor's and the corrector's in a Symplectic step, as
+  DualSPHysics's UpdateFlexStrucGeometry after each cell divide), the forces after the fluid's
+  interaction (:meth:`FlexStruc.forces`, from that F).
+* Normals: every flexible or clamp particle with a normal n0 at t = 0 (the case's, as any wall's)
+  takes n = |n0| F⁻ᵀn0 / |F⁻ᵀn0| (CalcFlexStrucNormals; :func:`turn_normals`), exactly R n0 under a
+  rotation R and normal to a stretched face; it overwrites the normals a moving clamp's motion turned.
+  A particle whose F is singular keeps its last normal (DualSPHysics would take inf/NaN).
+* Density: the flexible particles (not the clamps, which are ordinary walls there) take the Shepard
+  density at the ghost node, never the first-order one (InteractionMdbc2CorrectionT2's
+  !CODE_IsFlexStrucFlex test; :func:`FlexStruc.flex_of_idp` marks them by id for
+  :mod:`sphdvi.sph.mdbc`), before the pressure cloning; their ghost velocity is then the Shepard
+  average too (sphdvi's corrected ghost velocity, MdbcGhostVelocity 1, goes with a corrected density).
+* Wall acceleration of the pressure cloning: (v^{n+1} − v^n)/dt of the particle's own update
+  (:func:`keep_velocity` before it, :func:`structure_wall_ace` at the end of the step), as
+  DualSPHysics's CopyMotionVelAce runs over them with the moving walls.
+* The fluid's force on the structure takes mDBC's packed density, pressure and mass (zero for a
+  particle switched off, whose ghost node is dry: no force, as the fluid feels none from it) and, in
+  the viscous term, the particle's tangential velocity ``tvel`` as the fluid sees it (DualSPHysics's
+  TangenVel), so the pair forces stay equal and opposite.
+
+The wall acceleration enters the pressure the structure feels: a particle accelerating towards the
+water sees a higher pressure, a force proportional to the acceleration of the step before (an
+added mass ρ0 2|N| per unit area, explicit). Measured here: a light plate (ρ_s/ρ0 = 0.5, 3 particles
+thick, dp 0.01 m) hit by a dam break diverges at the impact, and runs to the end without the
+structure's wall acceleration; at ρ_s/ρ0 = 1 and 1.2 it runs; normals that reach deep into the
+structure (|N| up to 2.5 dp, the automatic normals of a plate that faces the water with all its
+columns) made it diverge at 1.2 and 3 as well. DualSPHysics computes the same term.
 
 Deviations from DualSPHysics v5.4 (documented in the README): the pairs are those of one body
 (DualSPHysics pairs every flexible-structure particle within 2h whatever its body, gluing bodies
@@ -60,6 +94,9 @@ from .interaction import _tensile
 from .kernels import kernel_alpha, kernel_fac, kernel_w
 
 MODEL_NAMES = {1: "Plane Strain", 2: "Plane Stress", 3: "St. Venant Kirchhoff"}
+#: below this many structure particles its passes run serially whatever the solver's choice (measured,
+#: tools/bench_flexstruc.py, 2 threads: 146 particles took twice as long threaded, 1,383 as long, 5,317 1/1.4)
+PARALLEL_MIN = 4000
 #: DualSPHysics's reason codes of a failed update (sphdvi's wording)
 FAIL_REASONS = {1: "has a non-finite position or velocity", 2: "left the simulation domain"}
 
@@ -195,18 +232,41 @@ def _geometry_range(k0, k1, is2d, pos, rows, pstart, pj, g0, L, vol, body, cdiag
     S = np.empty((3, 3))
     for i in range(k0, k1):
         ri = rows[i]
-        for a in range(3):
-            for b in range(3):
-                fh[a, b] = 0.0
-        for p in range(pstart[i], pstart[i + 1]):
-            rj = rows[pj[p]]
-            for a in range(3):
-                da = vol * (pos[rj, a] - pos[ri, a])
-                for b in range(3):
-                    fh[a, b] += da * g0[p, b]
-        if is2d:
-            fh[0, 1] = fh[1, 0] = fh[1, 2] = fh[2, 1] = 0.0
-            fh[1, 1] = 1.0
+        x0, x1, x2 = pos[ri, 0], pos[ri, 1], pos[ri, 2]
+        f00 = f01 = f02 = f10 = f11 = f12 = f20 = f21 = f22 = 0.0
+        if is2d:            # the x-z plane: F_yy = 1, no y coupling
+            for p in range(pstart[i], pstart[i + 1]):
+                rj = rows[pj[p]]
+                dx = vol * (pos[rj, 0] - x0)
+                dz = vol * (pos[rj, 2] - x2)
+                gx = g0[p, 0]
+                gz = g0[p, 2]
+                f00 += dx * gx
+                f02 += dx * gz
+                f20 += dz * gx
+                f22 += dz * gz
+            f11 = 1.0
+        else:
+            for p in range(pstart[i], pstart[i + 1]):
+                rj = rows[pj[p]]
+                dx = vol * (pos[rj, 0] - x0)
+                dy = vol * (pos[rj, 1] - x1)
+                dz = vol * (pos[rj, 2] - x2)
+                gx = g0[p, 0]
+                gy = g0[p, 1]
+                gz = g0[p, 2]
+                f00 += dx * gx
+                f01 += dx * gy
+                f02 += dx * gz
+                f10 += dy * gx
+                f11 += dy * gy
+                f12 += dy * gz
+                f20 += dz * gx
+                f21 += dz * gy
+                f22 += dz * gz
+        fh[0, 0], fh[0, 1], fh[0, 2] = f00, f01, f02
+        fh[1, 0], fh[1, 1], fh[1, 2] = f10, f11, f12
+        fh[2, 0], fh[2, 1], fh[2, 2] = f20, f21, f22
         for a in range(3):
             for b in range(3):
                 F[i, a, b] = fh[a, 0] * L[i, 0, b] + fh[a, 1] * L[i, 1, b] + fh[a, 2] * L[i, 2, b]
@@ -258,6 +318,69 @@ def geometry_parallel(is2d, pos, rows, pstart, pj, g0, L, vol, body, cdiag, coff
     for c in prange((n + CHUNK - 1) // CHUNK):
         _geometry_range(c * CHUNK, min(n, (c + 1) * CHUNK), is2d, pos, rows, pstart, pj, g0, L, vol, body,
                         cdiag, coff, cshear, F, PL, J)
+
+
+@njit(cache=True, error_model="numpy")
+def turn_normals(rows, F, n0, normals):
+    """normals[rows[k]] = |n0| F⁻ᵀn0 / |F⁻ᵀn0| for every particle k with a normal n0[k] ≠ 0
+    (DualSPHysics's CalcFlexStrucNormals): F⁻ᵀ = cof(F)/det F, so the direction is that of
+    cof(F) n0, turned round where det F < 0; a particle whose F is singular keeps its normal."""
+    for k in range(rows.shape[0]):
+        nx = n0[k, 0]
+        ny = n0[k, 1]
+        nz = n0[k, 2]
+        if nx == 0.0 and ny == 0.0 and nz == 0.0:
+            continue
+        f00, f01, f02 = F[k, 0, 0], F[k, 0, 1], F[k, 0, 2]
+        f10, f11, f12 = F[k, 1, 0], F[k, 1, 1], F[k, 1, 2]
+        f20, f21, f22 = F[k, 2, 0], F[k, 2, 1], F[k, 2, 2]
+        # the cofactor matrix C = det(F) F^-T
+        c00 = f11 * f22 - f12 * f21
+        c01 = f12 * f20 - f10 * f22
+        c02 = f10 * f21 - f11 * f20
+        c10 = f02 * f21 - f01 * f22
+        c11 = f00 * f22 - f02 * f20
+        c12 = f01 * f20 - f00 * f21
+        c20 = f01 * f12 - f02 * f11
+        c21 = f02 * f10 - f00 * f12
+        c22 = f00 * f11 - f01 * f10
+        det = f00 * c00 + f01 * c01 + f02 * c02
+        mx = c00 * nx + c01 * ny + c02 * nz
+        my = c10 * nx + c11 * ny + c12 * nz
+        mz = c20 * nx + c21 * ny + c22 * nz
+        m = math.sqrt(mx * mx + my * my + mz * mz)
+        if not (m > 0.0 and det != 0.0 and math.isfinite(m) and math.isfinite(det)):
+            continue
+        f = math.sqrt(nx * nx + ny * ny + nz * nz) / m
+        if det < 0.0:
+            f = -f
+        r = rows[k]
+        normals[r, 0] = f * mx
+        normals[r, 1] = f * my
+        normals[r, 2] = f * mz
+
+
+@njit(cache=True, error_model="numpy")
+def keep_velocity(rows, clamp, vel, v0):
+    """v0[k] = the velocity of flexible particle k (its row ``rows[k]``): v^n, before its update."""
+    for k in range(rows.shape[0]):
+        if clamp[k]:
+            continue
+        r = rows[k]
+        for m in range(3):
+            v0[k, m] = vel[r, m]
+
+
+@njit(cache=True, error_model="numpy")
+def structure_wall_ace(rows, clamp, vel, v0, dt, wall_ace):
+    """wall_ace[rows[k]] = (v^{n+1} − v^n)/dt of the flexible particles, mDBC2's wall acceleration
+    (DualSPHysics's CopyMotionVelAce runs over them as over the moving walls)."""
+    for k in range(rows.shape[0]):
+        if clamp[k]:
+            continue
+        r = rows[k]
+        for m in range(3):
+            wall_ace[r, m] = (vel[r, m] - v0[k, m]) / dt
 
 
 @njit(cache=True, error_model="numpy")
@@ -340,10 +463,13 @@ def elastic_parallel(is2d, pos, rows, clamp, pstart, pj, g0, rref, wref, vol, bo
 
 @njit(cache=True, error_model="numpy")
 def fluid_on_structure(kern, visco, is2d, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, rs, cst, idp, slot,
-                       clamp, body, rho_s, vol, ace):
+                       clamp, body, rho_s, vol, mdbc2, tvel, ace):
     """The fluid's pressure and viscous forces on every flexible particle (module docstring),
     added to its ``ace`` row: the reaction of the terms the fluid's interaction gives its fluid
-    neighbours (packed rows ``nb`` in cell order, ``oi`` their particles' rows)."""
+    neighbours (packed rows ``nb`` in cell order, ``oi`` their particles' rows).  ``mdbc2``
+    (SlipMode 2, 3): the viscosity sees the particle's tangential velocity ``tvel`` (per packed
+    row, :mod:`sphdvi.sph.mdbc`), as the fluid does; its packed density, pressure and mass are
+    mDBC's (zero mass when switched off: no force)."""
     h = cst[0]
     inv_h = 1.0 / h
     r2max = cst[1]
@@ -372,6 +498,8 @@ def fluid_on_structure(kern, visco, is2d, nb, ptype, cell, oi, cell_start, ncx, 
         else:
             xi, yi, zi = nb[i, 0], nb[i, 1], nb[i, 2]
             vxi, vyi, vzi = nb[i, 3], nb[i, 4], nb[i, 5]
+        if mdbc2:       # the velocity the fluid's viscosity sees (mDBC2)
+            vxi, vyi, vzi = tvel[i, 0], tvel[i, 1], tvel[i, 2]
         rhoi = nb[i, cm - 2]
         pi = nb[i, cm - 1]
         mb = nb[i, cm]
@@ -555,6 +683,9 @@ class FlexStruc:
         self.J = np.ones(K)
         self.out = np.zeros(((K + CHUNK - 1) // CHUNK + 1, 2))
         self.fail = np.full(2, -1, np.int64)
+        self.n0 = np.zeros((K, 3))          # the initial mDBC normals (set_normals0; zero: none)
+        self.has_normals = False
+        self.v0 = np.zeros((K, 3))          # v^n of the flexible particles (mDBC2's wall acceleration)
         self.amax2 = 0.0
         self.cmax = float(self.csound.max()) if self.csound.size else 0.0
 
@@ -613,19 +744,49 @@ class FlexStruc:
                 lost = self.idp[self.rows < 0]
                 raise RuntimeError(f"flexible-structure particles lost from the state: {lost[:5].tolist()}")
 
-    def elastic(self, pos, idp, ace, parallel=False):
-        """F, P L and det F of every particle, then the elastic and hourglass accelerations of the
-        flexible ones into ``ace``; sets ``amax2`` (max |a|² of their whole ace) and ``cmax``."""
+    def set_normals0(self, normals, idp):
+        """The initial mDBC normals n0 of the particles (flexible and clamp) from ``normals``, rows
+        in the order of ``idp`` (the particles at t = 0)."""
+        self.locate(idp)
+        self.n0 = np.ascontiguousarray(np.asarray(normals, float)[self.rows])
+        self.has_normals = bool(np.any(self.n0))
+
+    def flex_of_idp(self):
+        """int8 by particle id: 1 for the flexible particles (not the clamps), 0 else; mDBC2 gives
+        them the Shepard ghost density (:mod:`sphdvi.sph.mdbc`)."""
+        out = np.zeros(self.slot.shape[0], np.int8)
+        out[self.idp[~self.clamp]] = 1
+        return out
+
+    def geometry(self, pos, idp, parallel=False):
+        """F, P L and det F of every particle (flexible and clamp) from the current positions; before
+        the mDBC correction, which needs F for the normals (:meth:`turn_normals`)."""
         self.locate(idp)
         args = (self.is2d, pos, self.rows, self.pstart, self.pj, self.g0, self.L, self.vol, self.body,
                 self.cdiag, self.coff, self.cshear, self.F, self.PL, self.J)
-        (geometry_parallel if parallel else geometry_serial)(*args)
+        (geometry_parallel if parallel and self.size >= PARALLEL_MIN else geometry_serial)(*args)
+
+    def turn_normals(self, normals):
+        """The normals of the particles with an initial normal (rows as the last :meth:`geometry`'s),
+        n = |n0| F⁻ᵀn0 / |F⁻ᵀn0| (DualSPHysics's CalcFlexStrucNormals, clamps included)."""
+        if self.has_normals:
+            turn_normals(self.rows, self.F, self.n0, normals)
+
+    def elastic(self, pos, idp, ace, parallel=False):
+        """:meth:`geometry`, then :meth:`forces`."""
+        self.geometry(pos, idp, parallel=parallel)
+        self.forces(pos, ace, parallel=parallel)
+
+    def forces(self, pos, ace, parallel=False):
+        """The elastic and hourglass accelerations of the flexible particles into ``ace``, from the
+        last :meth:`geometry` (the same positions); sets ``amax2`` (max |a|² of their whole ace) and
+        ``cmax``."""
         out = self.out
         out[:] = 0.0
         eargs = (self.is2d, pos, self.rows, self.clamp, self.pstart, self.pj, self.g0, self.rref, self.wref,
                  self.vol, self.body, self.rho_s, self.youngmod, self.hgfactor, self.csound, self.F, self.PL,
                  self.J, ace, out)
-        (elastic_parallel if parallel else elastic_serial)(*eargs)
+        (elastic_parallel if parallel and self.size >= PARALLEL_MIN else elastic_serial)(*eargs)
         self.amax2 = float(out[:, 0].max())
         self.cmax = float(out[:, 1].max())
 

@@ -30,6 +30,12 @@ acts on wall neighbours only), the viscosity sees its own velocity (the
 tangential ghost velocity is the walls'), and the pressure cloning has no wall
 acceleration (DualSPHysics's MotionAce is zero for floating particles).
 
+Flexible structures (:mod:`sphdvi.sph.flexstruc`, mDBC2 only, as DualSPHysics v5.4): their
+particles are moving walls whose normals turn with the solid's F (set before each correction);
+the flexible ones (``flexid`` by particle id; the clamps are ordinary walls) take the Shepard ghost
+density (and velocity) whatever the matrix, before the pressure cloning, whose wall acceleration
+is that of their own update (InteractionMdbc2CorrectionT2's !CODE_IsFlexStrucFlex test).
+
 SlipMode 1 (DBC velocity; DualSPHysics's original mDBC)
     rho_b = rho_g + (r_b - g) . grad rho_g; the Shepard value
     sum m w / sum V w where |det A| is below ``threshold`` (1e-3); with no fluid
@@ -348,13 +354,15 @@ def _set_packed(nb, i, is2d, rho, cst, dry):
 
 @njit(cache=True, error_model="numpy")
 def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell,
-                 ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel, tvel, wace):
+                 ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel, idp, flexid, tvel, wace):
     """SlipMode 2, 3 (DualSPHysics's mDBC2, module docstring): density with
     pressure cloning, zero mass for a dry ghost node, and the tangential velocity
     the viscosity sees in tvel[i] (packed row i); ghost velocity corrected
     (``ghostvel`` 1) or the Shepard average (0, DualSPHysics).  Floating rows
     (ptype 2) with a normal get the density alone: rho0 when dry, their mass kept,
-    no wall acceleration in the cloning."""
+    no wall acceleration in the cloning.  The particles of a flexible structure
+    (``flexid[idp[row]]`` 1; ``flexid`` empty: none) take the Shepard ghost density and
+    velocity whatever the matrix (DualSPHysics's !CODE_IsFlexStrucFlex test)."""
     rhop0 = cst[10]
     cs02 = cst[5] * cst[5]
     n = 3 if is2d else 4
@@ -404,8 +412,14 @@ def _mdbc2_range(i0, i1, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, i
         ksum = a[0, 0]
         shepard = b[0, 0] / ksum
         corrected = False
+        flexible = False
+        if flexid.shape[0]:
+            pid = idp[o]
+            flexible = pid < flexid.shape[0] and flexid[pid] != 0
         if ksum < MDBC2_KSUM_MIN:
             rho_g = max(rhop0, shepard)
+        elif flexible:
+            rho_g = shepard
         else:
             rho_g = shepard
             norm_a = _inf_norm(a, n, 0)
@@ -473,13 +487,15 @@ def copy_to_periodic_rows(is2d, nb, ptype, src_row, tvel):
 
 @njit(cache=True, error_model="numpy")
 def mdbc_serial(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                cst, threshold, ksum_min, rhop, slip, ghostvel, dp, tvel, wace):
+                cst, threshold, ksum_min, rhop, slip, ghostvel, dp, idp, flexid, tvel, wace):
     """Set the density of every boundary particle with a normal and refresh its
     packed row (module docstring).  SlipMode 2, 3 also set ``tvel`` (packed rows,
     3 columns: the velocity the viscosity sees) and zero the packed mass of the
     particles whose ghost node is dry; ``wace`` is the wall acceleration per
-    particle (rows as ``normals``), or an array of another length for none.
-    ``threshold`` and ``ksum_min`` serve SlipMode 1 only."""
+    particle (rows as ``normals``), or an array of another length for none;
+    ``flexid`` (int8 by particle id, ``idp`` the ids by row as ``normals``) marks
+    the flexible-structure particles, which take the Shepard ghost density (empty:
+    none).  ``threshold`` and ``ksum_min`` serve SlipMode 1 only."""
     n = nb.shape[0]
     if slip == 1:
         _mdbc_range(0, n, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx,
@@ -487,12 +503,12 @@ def mdbc_serial(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, 
         _refresh_packed(0, n, is2d, ptype, oi, rhop, cst, nb)
     else:
         _mdbc2_range(0, n, kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx,
-                     ncy, ncz, cst, dp, rhop, slip, ghostvel, tvel, wace)
+                     ncy, ncz, cst, dp, rhop, slip, ghostvel, idp, flexid, tvel, wace)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def mdbc_parallel(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell, ncx, ncy, ncz,
-                  cst, threshold, ksum_min, rhop, slip, ghostvel, dp, tvel, wace):
+                  cst, threshold, ksum_min, rhop, slip, ghostvel, dp, idp, flexid, tvel, wace):
     """Threaded :func:`mdbc_serial`."""
     n = nb.shape[0]
     nchunk = (n + 511) // 512
@@ -508,7 +524,7 @@ def mdbc_parallel(kern, is2d, nb, ptype, oi, normals, cell_start, pmin, inv_cell
         for c in prange(nchunk):
             _mdbc2_range(c * 512, min(n, (c + 1) * 512), kern, is2d, nb, ptype, oi, normals,
                          cell_start, pmin, inv_cell, ncx, ncy, ncz, cst, dp, rhop, slip, ghostvel,
-                         tvel, wace)
+                         idp, flexid, tvel, wace)
 
 
 @njit(cache=True, error_model="numpy")

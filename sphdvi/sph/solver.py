@@ -78,6 +78,9 @@ REORDER_EVERY = 16
 # measure on this machine below ~50,000.
 LIGHT_THRESHOLD = 50000
 
+_NO_FLEX = np.zeros(0, np.int8)     # mDBC's flexible-particle flags by id: none
+_NO_IDS = np.zeros(0, np.int64)
+
 # Compiled entry points shared by all solvers, keyed by the feature flags
 # (kept off the instances so that solvers can be deep-copied and pickled).
 _ENTRY_CACHE = {}
@@ -156,6 +159,11 @@ class SPHSolver:
         ``<special><boundcorr>`` with DBC (Boundary=1): once a step (the predictor's interaction), mDBC's
         SlipMode 1 density extrapolation on the particles with a non-zero normal (the vector to their
         limit plane; :func:`sphdvi.sph.inout.boundcorr_normals`), first order where |det A| >= determlimit.
+    flex : sphdvi.sph.flexstruc.FlexStruc or None
+        ``<special><flexstrucs>``: elastic bodies of moving boundary particles, moved by their own solid
+        (the motion hook must leave them alone).  Under mDBC2 their normals (from ``normals`` at the
+        start) turn with the solid, they take the Shepard ghost density and their own wall acceleration
+        (:mod:`sphdvi.sph.flexstruc`).
 
     After :meth:`step`, ``ace`` (N, 3), ``ar`` (N,) and ``press`` hold the
     accelerations, density rates and pressures of the last interaction, in
@@ -225,6 +233,14 @@ class SPHSolver:
             self._wall_v0 = np.zeros((state.n, 3))     # the moving walls' velocity before the hook
         self._no_wall_ace = np.zeros((1, 3))
         self._no_tvel = np.zeros((1, 3))
+        # flexible structures under mDBC2: their normals turn with F (from those at the start), their
+        # ghost density is Shepard's, their wall acceleration is that of their own update
+        self._flex_of_idp = _NO_FLEX
+        self._flex_ace = False
+        if flex is not None and self._mdbc2_flag:
+            flex.set_normals0(self.normals, state.idp)
+            self._flex_of_idp = flex.flex_of_idp()
+            self._flex_ace = self._wall_ace_on
         self.ftmode = self._floating_mode(state)
         # Symplectic: called between the predictor and the corrector's interaction with the
         # half step dt/2, to move the floating bodies there (set by the caller; see _step_symplectic)
@@ -373,11 +389,18 @@ class SPHSolver:
         self.ip[16] = self.movlimit
 
     def _setup_flex(self):
-        """Flexible structures: no periodic conditions (DualSPHysics refuses them too); DtIni and DtMin
+        """Flexible structures: no periodic conditions, no original mDBC (SlipMode 1), no mDBC with Verlet
+        (DualSPHysics refuses them too; mDBC2 is run as its v5.4, sphdvi.sph.flexstruc); DtIni and DtMin
         from the structure's sound speed where it exceeds the fluid's or there is no fluid (JSph's
         LoadCaseConfig), unless the case sets them."""
         if self.periodicity is not None:
             raise ValueError("flexible structures are not allowed with periodic conditions")
+        if self.boundary == 2 and self.slip == 1:
+            raise ValueError("flexible structures are not allowed with original mDBC (SlipMode=1)")
+        if self.boundary == 2 and self.step_algorithm == 1:
+            raise ValueError("flexible structures with mDBC are not allowed with Verlet")
+        # the fluid's forces on the structure: only where there is (or an inlet brings) fluid
+        self._flex_fluid = bool(np.any(self.state.ptype == 3)) or self.inout is not None
         cs = float(self.flex.csound.max())
         if cs > self.cs0 or not np.any(self.state.ptype == 3):
             p = self.params
@@ -726,16 +749,22 @@ class SPHSolver:
         ptype_rows, oi, _ = self._rows
         if self.inout is not None and not self._in_corrector:
             self._inout_impose(ptype_rows, oi)
+        if self.flex is not None:
+            # F of the flexible structures before the mDBC correction, which needs their normals
+            self.flex.geometry(s.pos, s.idp, parallel=par)
+            if self._flex_of_idp.shape[0]:
+                self.flex.turn_normals(self.normals)
         corr = self._wall_correction()
         if corr is not None:
             from . import mdbc
             fn = mdbc.mdbc_parallel if par else mdbc.mdbc_serial
             ncx, ncy, ncz = self.cells.shape
             normals, threshold, ksum_min, slip, ghostvel = corr
+            flexid = self._flex_of_idp
             fn(self.kernel, self.is2d, self.nb, ptype_rows, oi, normals, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, threshold,
-               ksum_min, s.rhop, slip, ghostvel, self.dp, self._tvel(s.n),
-               self.wall_ace if self._wall_ace_on else self._no_wall_ace)
+               ksum_min, s.rhop, slip, ghostvel, self.dp, s.idp if flexid.shape[0] else _NO_IDS, flexid,
+               self._tvel(s.n), self.wall_ace if self._wall_ace_on else self._no_wall_ace)
             if self.nopen and self._need_nopen:
                 self._nopen_detect(par, self.nb, ptype_rows, self.cell_sorted, oi, self.normals,
                                    s.vel, s.pos, self.npshift)
@@ -753,24 +782,29 @@ class SPHSolver:
 
     def _flex_forces(self, par, ptype_rows, oi):
         """Flexible structures (:mod:`sphdvi.sph.flexstruc`): the fluid's forces on their particles, then
-        the elastic ones; their |a| enters the force condition of dt."""
+        the elastic ones (from the F found before the mDBC correction, the same positions); their |a|
+        enters the force condition of dt."""
         from .flexstruc import fluid_on_structure
         f = self.flex
         s = self.state
         ncx, ncy, ncz = self.cells.shape
-        fluid_on_structure(self.kernel, self.visco_kind, self.is2d, self.nb, ptype_rows, self.cell_sorted, oi,
-                           self.cells.cell_start, ncx, ncy, ncz, int(self.cst[18]), self.cst, s.idp, f.slot,
-                           f.clamp, f.body, f.rho_s, f.vol, self.ace)
-        f.elastic(s.pos, s.idp, self.ace, parallel=par)
+        mdbc2 = bool(self._mdbc2_flag)
+        if self._flex_fluid:
+            fluid_on_structure(self.kernel, self.visco_kind, self.is2d, self.nb, ptype_rows, self.cell_sorted, oi,
+                               self.cells.cell_start, ncx, ncy, ncz, int(self.cst[18]), self.cst, s.idp, f.slot,
+                               f.clamp, f.body, f.rho_s, f.vol, mdbc2, self._tvel(self.nb.shape[0]), self.ace)
+        f.forces(s.pos, self.ace, parallel=par)
         if f.amax2 > self.dtmax[0, 0]:
             self.dtmax[0, 0] = f.amax2
 
     def _flex_update(self, kind, dt):
         """Move the flexible particles: ``euler`` (Verlet steps), ``pre`` or ``corr`` (Symplectic)."""
-        from .flexstruc import update_corrector, update_euler, update_predictor
+        from .flexstruc import keep_velocity, update_corrector, update_euler, update_predictor
         f = self.flex
         s = self.state
         f.locate(s.idp)
+        if self._flex_ace and kind != "corr":
+            keep_velocity(f.rows, f.clamp, s.vel, f.v0)      # v^n, for the wall acceleration (step)
         usedom = self._domain is not None
         if kind == "euler":
             update_euler(f.rows, f.clamp, s.pos, s.vel, self.ace, self.gravity, dt, self.ip[13] != 0.0, usedom,
@@ -951,7 +985,7 @@ class SPHSolver:
             wace_e = np.ascontiguousarray(self.wall_ace[idx]) if self._wall_ace_on else self._no_wall_ace
             fn(self.kernel, self.is2d, nb, ptype_e, rows_e, normals_e, self.cells.cell_start,
                self.cells.pmin, 1.0 / self.cells.cellsize, ncx, ncy, ncz, self.cst, threshold,
-               ksum_min, rhop_e, slip, ghostvel, self.dp, self._tvel(ne), wace_e)
+               ksum_min, rhop_e, slip, ghostvel, self.dp, _NO_IDS, _NO_FLEX, self._tvel(ne), wace_e)
             # a copy's ghost node sees a truncated extended set: it takes its real particle's result
             real_e = order < n
             row_of = np.empty(n, np.int64)
@@ -1078,6 +1112,13 @@ class SPHSolver:
                 moving_wall_ace(self.state.ptype, self.state.vel, v0, dt, self.wall_ace)
             else:
                 self.motion_hook(self, self.time, dt)
+        if self._flex_ace:
+            # the flexible particles' (v^{n+1} - v^n)/dt (the hook's pass above leaves them 0: it does
+            # not move them), as DualSPHysics's CopyMotionVelAce over the flexible structures' particles
+            from .flexstruc import structure_wall_ace
+            f = self.flex
+            f.locate(self.state.idp)
+            structure_wall_ace(f.rows, f.clamp, self.state.vel, f.v0, dt, self.wall_ace)
         if self.inout is not None:
             self._inout_update()
         return dt

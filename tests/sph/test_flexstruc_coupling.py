@@ -60,7 +60,8 @@ def test_the_fluid_and_the_structure_exchange_equal_and_opposite_forces():
 
 
 @pytest.mark.parametrize("algorithm", [1, 2])
-def test_threaded_passes_give_the_serial_bits(algorithm):
+def test_threaded_passes_give_the_serial_bits(algorithm, monkeypatch):
+    monkeypatch.setattr("sphdvi.sph.flexstruc.PARALLEL_MIN", 0)      # the structure's threaded passes too
     import numba
     runs = []
     old = numba.get_num_threads()

@@ -86,7 +86,7 @@ def test_help_lists_every_case_and_the_slow_ones_all_adds():
     names = text.split("cases to run (")[1].split(")")[0].split()
     assert set(names) == {c.name for c in every} | {"S2"} and {"S3M", "S16O"} <= set(names)
     slow = [c.name for c in every if c.slow]
-    assert set(slow) == {"S4", "S8", "S16", "S16M", "S16O", "S18", "S19", "W4", "W9"}
+    assert set(slow) == {"S4", "S8", "S16", "S16M", "S16O", "S18", "S19", "S20", "W4", "W9"}
     assert "also the slow cases " + ", ".join(slow) in text
     assert "default: all but the slow " + ", ".join(slow) in text
 
