@@ -154,6 +154,25 @@ def neighbour_pairs_bruteforce(pos, radius, is2d):
     return set(zip(i.tolist(), j.tolist()))
 
 
+@njit(cache=True, inline="always")
+def stencil_bounds(c, ncx, ncy, ncz, rs, is2d):
+    """The cells within ``rs`` cells of cell ``c`` along each axis, clipped to the grid: (xlo, xhi,
+    ylo, yhi, zlo, zhi), inclusive (y 0..0 in 2D, whose grid is the x-z plane)."""
+    cx = c % ncx
+    if is2d:
+        cy = 0
+        cz = c // ncx
+    else:
+        cy = (c // ncx) % ncy
+        cz = c // (ncx * ncy)
+    xlo, xhi = max(cx - rs, 0), min(cx + rs, ncx - 1)
+    ylo, yhi = max(cy - rs, 0), min(cy + rs, ncy - 1)
+    zlo, zhi = max(cz - rs, 0), min(cz + rs, ncz - 1)
+    if is2d:
+        ylo, yhi = 0, 0
+    return xlo, xhi, ylo, yhi, zlo, zhi
+
+
 @njit(cache=True, error_model="numpy")
 def _walk_pairs(pos, cell, cell_start, ncx, ncy, ncz, is2d, radius, ptype, min_type, out, store):
     """The pairs (i < j, sorted-order indices) closer than ``radius`` through the cell stencil

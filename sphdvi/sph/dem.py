@@ -34,6 +34,7 @@ import numpy as np
 from ._env import CHUNK
 from numba import njit, prange
 
+from .cells import stencil_bounds
 from .interaction import _dt_maxima
 
 
@@ -71,19 +72,7 @@ def _dem_range(i0, i1, is2d, nb, ptype, cell, oi, cell_start, ncx, ncy, ncz, rs,
             xi, yi, zi = nb[i, 0], nb[i, 1], nb[i, 2]
             vxi, vyi, vzi = nb[i, 3], nb[i, 4], nb[i, 5]
             mpi = nb[i, 8]
-        c = cell[i]
-        cx = c % ncx
-        if is2d:
-            cy = 0
-            cz = c // ncx
-        else:
-            cy = (c // ncx) % ncy
-            cz = c // (ncx * ncy)
-        xlo, xhi = max(cx - rs, 0), min(cx + rs, ncx - 1)
-        ylo, yhi = max(cy - rs, 0), min(cy + rs, ncy - 1)
-        zlo, zhi = max(cz - rs, 0), min(cz + rs, ncz - 1)
-        if is2d:
-            ylo, yhi = 0, 0
+        xlo, xhi, ylo, yhi, zlo, zhi = stencil_bounds(cell[i], ncx, ncy, ncz, rs, is2d)
         ax = 0.0
         ay = 0.0
         az = 0.0

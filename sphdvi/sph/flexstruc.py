@@ -90,6 +90,7 @@ import numpy as np
 from ._env import CHUNK
 from numba import njit, prange
 
+from .cells import stencil_bounds
 from .interaction import _tensile
 from .kernels import kernel_alpha, kernel_fac, kernel_w
 
@@ -505,19 +506,7 @@ def fluid_on_structure(kern, visco, is2d, nb, ptype, cell, oi, cell_start, ncx, 
         mb = nb[i, cm]
         iri = nb[i, cm + 1]
         tens_i = _tensile(pi, rhoi) if kern == 1 else 0.0
-        c = cell[i]
-        cx = c % ncx
-        if is2d:
-            cy = 0
-            cz = c // ncx
-        else:
-            cy = (c // ncx) % ncy
-            cz = c // (ncx * ncy)
-        xlo, xhi = max(cx - rs, 0), min(cx + rs, ncx - 1)
-        ylo, yhi = max(cy - rs, 0), min(cy + rs, ncy - 1)
-        zlo, zhi = max(cz - rs, 0), min(cz + rs, ncz - 1)
-        if is2d:
-            ylo, yhi = 0, 0
+        xlo, xhi, ylo, yhi, zlo, zhi = stencil_bounds(cell[i], ncx, ncy, ncz, rs, is2d)
         ax = 0.0
         ay = 0.0
         az = 0.0

@@ -107,3 +107,27 @@ def test_the_dam_break_example_with_its_elastic_plate_runs(tmp_path):
         plate = mk[a][o0] == 13                            # mkbound 2, fluidcount 10
         u = P[b][o1][plate] - P[a][o0][plate]
     assert plate.sum() == 69 and np.abs(u).max() < 2e-4
+
+
+def test_a_3d_cantilever_tip_first_falls_freely(tmp_path):
+    """cases/flexstruc3d/CaseCantilever3D_Def.xml (St Venant-Kirchhoff, 4 x 4 particles across): as the 2D
+    beam, the tip (its end face's 16 particles) falls g t^2/2 until the clamp's influence arrives, and the
+    square beam does not move sideways."""
+    case = CSM3.parents[1] / "flexstruc3d" / "CaseCantilever3D_Def.xml"
+    out = tmp_path / "c3d"
+    r = run(case, "-o", out, "--tmax", "0.02", "--tout", "0.01")
+    assert r.exit_code == 0, r.output
+    with h5py.File(out / "particles.vtkhdf", "r") as f:
+        g = f["VTKHDF"]
+        off, n, t = g["Steps/PointOffsets"][...], g["NumberOfPoints"][...], g["Steps/Values"][...]
+        P, idp, mk = g["Points"][...], g["PointData/Idp"][...], g["PointData/Mk"][...]
+        p0, i0, m0 = P[off[0]:off[0] + n[0]], idp[off[0]:off[0] + n[0]], mk[off[0]:off[0] + n[0]]
+        beam = m0 == m0.max()
+        tip = i0[beam & (p0[:, 0] > p0[beam, 0].max() - 1e-9)]
+        assert tip.size == 16
+        for k in (1, 2):
+            pk, ik = P[off[k]:off[k] + n[k]], idp[off[k]:off[k] + n[k]]
+            u = pk[np.isin(ik, tip)].mean(axis=0) - p0[np.isin(i0, tip)].mean(axis=0)
+            assert u[2] == pytest.approx(-t[k] ** 2, rel=0.01)          # g/2 = 1 m/s^2
+            assert abs(u[1]) < 1e-9
+    assert "Constitutive model: St. Venant Kirchhoff" in (out / "run.log").read_text()
