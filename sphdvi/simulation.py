@@ -936,10 +936,16 @@ class SPHRun:
         from .sph.flexstruc import FlexStruc
         labels = np.where(p["type"] == 3, -1, body_labels(p["mk"], fluidcount))
         try:
-            return FlexStruc(specs, p["pos"], p["idp"], labels, p["type"], is2d=bool(c["is2d"]), h=float(c["h"]),
+            flex = FlexStruc(specs, p["pos"], p["idp"], labels, p["type"], is2d=bool(c["is2d"]), h=float(c["h"]),
                              dp=float(c["dp"]), kernel=int(params.get("Kernel", 2)))
         except ValueError as exc:
             raise InputError(f"<special><flexstrucs>: {exc}") from None
+        for spec, (_, nclamp) in zip(specs, flex.counts):
+            if not nclamp:
+                warnings.warn(f"<special><flexstrucs>: no particle of the clamp mkbound {spec['mkclamp']} lies within "
+                              f"2h of the flexible structure mkbound={spec['mkbound']} (line {spec.get('line')}): "
+                              "nothing holds it, it moves as a free elastic body")
+        return flex
 
     def _relaxation_zones(self, specs, state, c: dict, params: dict) -> list:
         """``<special><relaxationzones>`` (sphdvi.sph.relaxzones): the zones, their ``<savemotion>`` files

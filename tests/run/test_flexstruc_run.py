@@ -131,3 +131,14 @@ def test_a_3d_cantilever_tip_first_falls_freely(tmp_path):
             assert u[2] == pytest.approx(-t[k] ** 2, rel=0.01)          # g/2 = 1 m/s^2
             assert abs(u[1]) < 1e-9
     assert "Constitutive model: St. Venant Kirchhoff" in (out / "run.log").read_text()
+
+
+def test_a_structure_its_clamp_does_not_reach_is_warned(tmp_path):
+    """A clamp mk with no particle within 2h of the body holds nothing (DualSPHysics runs it silently)."""
+    text = CSM3.read_text().replace('<point x="0.2" y="0.0" z="0.2" />', '<point x="1.5" y="0.0" z="0.2" />')
+    case = tmp_path / "CaseFree_Def.xml"
+    case.write_text(text)
+    with pytest.warns(UserWarning, match=r"clamp mkbound \[0\] lies within 2h of the flexible structure "
+                                         r"mkbound=1 .*nothing holds it"):
+        r = run(case, "-o", tmp_path / "o", "--tmax", "0.001")
+    assert r.exit_code == 0, r.output
