@@ -374,3 +374,17 @@ def test_setmknext_errors(tmp_path, body, expected):
     with pytest.raises(CaseError) as e:
         draw(tmp_path, body)
     assert expected in str(e.value)
+
+
+# ---------------------------------------------------------------- <setfrdrawmode>
+def test_free_draw_mode_draws_on_the_lattice_and_warns(tmp_path):
+    """DualSPHysics's TurekHron FSI2 cases wrap their cylinder in <setfrdrawmode auto="true"> ...
+    auto="false">: GenCase's free drawing (its rule is not published) is drawn on the lattice, as
+    without it, with a warning; auto="false" alone says nothing."""
+    cyl = CYL.format(mode="full", mask="0")
+    plain, w0 = warnings_of(tmp_path, cyl)
+    free, w1 = warnings_of(tmp_path, '<setfrdrawmode auto="true" />' + cyl + '<setfrdrawmode auto="false" />')
+    assert np.array_equal(plain.pos, free.pos) and np.array_equal(plain.mk, free.mk)
+    assert not w0 and len(w1) == 1 and "free drawing" in w1[0] and "on the lattice" in w1[0]
+    _, w2 = warnings_of(tmp_path, '<setfrdrawmode auto="false" />' + cyl)
+    assert not w2

@@ -271,7 +271,7 @@ WEDGE_NORMALS = """
             <geometryfile file="[CaseName]_hdp_Actual.vtk" />
         </normals>"""
 
-# CaseWaveTank's piston and tank (mdbc/06), without its <setfrdrawmode> (not supported by sphdvi)
+# CaseWaveTank's piston and tank (mdbc/06), without its <setfrdrawmode> (drawn on the lattice by sphdvi, with a warning)
 WAVETANK = """
                     <newvar Tankx0="-0.5" Tankz0="0" />
                     <newvar Tankx1="6" Tankz1="0" />

@@ -4,8 +4,8 @@ fixed, moving, floating or fluid, with its count) and ``<constants>`` (h, b, mas
 Redrawing the case must give the same count per mk and the same constants; the record is parsed
 from the file's own text, never copied into the test.
 
-The files of the survey that sphdvi refuses on purpose (GenCase's free drawing mode
-``<setfrdrawmode>``, ``<special><inout>``) are not here; the ones where it
+The files of the survey that sphdvi draws otherwise on purpose (GenCase's free drawing mode
+``<setfrdrawmode>``, drawn on the lattice) or refused when they were surveyed (``<special><inout>``) are not here; the ones where it
 draws otherwise than GenCase are the ``xfail(strict=True)`` tests at the end, with the numbers
 measured.
 """

@@ -36,7 +36,7 @@ UNSUPPORTED = {
     "clipdomain", "clipplane", "clipbox",
     "clipreset", "setpattern", "patterns", "fillfigure", "fillprism",
     "setmknextauto", "setmkbackvoid", "setmkbackfluid",
-    "setmkbackbound", "setmkbackclear", "setfrdrawmode", "rotateadv",
+    "setmkbackbound", "setmkbackclear", "rotateadv",
 }
 BOX_LIMIT_MODES = {"full", "inner"}
 #: commands accepted without effect (they tune GenCase's own output or sampling)
@@ -148,7 +148,7 @@ class GeometryRunner:
         names = ["newvar", "newvarcte", "setvar", "newvarstr", "newvarstrcte", "setvarstr",
                  "delvar", "varssave", "varsload", "printf", "abort", "runlist",
                  "setmkfluid", "setmkbound", "setmkvoid", "setmknextbound", "setmknextfluid",
-                 "mksave", "mkload", "setdrawmode",
+                 "mksave", "mkload", "setdrawmode", "setfrdrawmode",
                  "setactive", "resetdraw", "setboxlimitmode", "move", "scale", "rotate", "rotateline", "matrixreset",
                  "matrixsave", "matrixload", "statesave", "stateload",
                  "drawpoint", "drawpoints", "drawline", "drawlines", "setlinebegin", "drawlineto",
@@ -486,6 +486,16 @@ class GeometryRunner:
         as a plain state command; nothing there says it touches what was drawn)."""
         self.state = DrawState()
         self.line_begin = None
+
+    def cmd_setfrdrawmode(self, el):
+        """GenCase's free drawing: with ``auto="true"`` the shapes that follow get particles off the
+        lattice (rings along a cylinder's or a sphere's surface, dp apart: its rule is not published);
+        sphdvi draws them on the lattice as without it, and warns. ``auto="false"`` (back to the
+        lattice) does nothing."""
+        if self.reader.boolean(el, "auto"):
+            self.reader.warn(el, "free drawing (auto=\"true\": particles off the lattice, along the shape) is not "
+                                 "supported by sphdvi, whose GenCase rule is not published: the shapes that follow are "
+                                 "drawn on the lattice, as with auto=\"false\"")
 
     def cmd_setboxlimitmode(self, el):
         """The limits of the ``<fillbox>`` commands that follow: ``inner`` (GenCase's default)
