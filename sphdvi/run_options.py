@@ -144,21 +144,27 @@ def apply_overrides(params: dict, sets: list[str] | tuple = (), tmax=None, tout=
     return out
 
 
-def resolved_parameters(params: dict, constants: dict, sph: bool) -> dict:
+def resolved_parameters(params: dict, constants: dict, sph: bool, structure_cs: float = 0.0,
+                        no_fluid: bool = False) -> dict:
     """run.json's ``parameters`` (the values the run uses), ``parameters_auto`` and ``constants``:
     DtIni and DtMin given as 0 resolved as DualSPHysics's JSph (DtIni = h/c0, DtMin =
     CoefDtMin h/c0; its Run.out prints those) and named in ``parameters_auto``; the earlier spelling
     MdbcFastSingle left out beside MDBCFastSingle; the case's constants (dp, h, B, c0, gamma, rhop0,
-    masses, 2D, ...) with the CFLnumber the run uses (``--set CFLnumber``)."""
+    masses, 2D, ...) with the CFLnumber the run uses (``--set CFLnumber``). With flexible structures whose
+    sound speed ``structure_cs`` exceeds c0, or with no fluid (``no_fluid``), DtIni and DtMin come from that
+    speed instead (JSph's LoadCaseConfig; sphdvi.sph.solver)."""
     out = {k: v for k, v in params.items() if k != "MdbcFastSingle"}
     auto = {}
     consts = dict(constants)
     if "CFLnumber" in params:
         consts["cflnumber"] = params["CFLnumber"]
     h, c0 = float(consts.get("h") or 0.0), float(consts.get("cs0") or 0.0)
-    if sph and h > 0 and c0 > 0:
-        for key, formula, value in (("DtIni", "h/c0", h / c0),
-                                    ("DtMin", "CoefDtMin*h/c0", float(params.get("CoefDtMin") or 0.0) * h / c0)):
+    speed, name = c0, "c0"
+    if structure_cs > 0 and (structure_cs > c0 or no_fluid):
+        speed, name = structure_cs, "cs_structure"
+    if sph and h > 0 and speed > 0:
+        for key, formula, value in (("DtIni", f"h/{name}", h / speed),
+                                    ("DtMin", f"CoefDtMin*h/{name}", float(params.get("CoefDtMin") or 0.0) * h / speed)):
             if not float(params.get(key) or 0.0):
                 out[key], auto[key] = value, formula
     return {"parameters": out, "parameters_auto": auto, "constants": consts}

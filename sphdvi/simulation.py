@@ -338,7 +338,8 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
         files.on_start = set_aside.discard     # the new run's start-up passed its checks
     base_meta = {
         "version": __version__, "case": data["casename"], "case_file": os.path.abspath(case_h5),
-        **resolved_parameters(params, data["constants"], sph_run),
+        **resolved_parameters(params, data["constants"], sph_run, _structure_sound_speed(special),
+                              no_fluid=nfluid == 0 and not special.get("inout")),
         "overrides": {"tmax": tmax, "tout": tout, "set": list(sets or ())},
         "threads": threads, "particles": int(data["particles"]["type"].size),
         "fluid_particles": nfluid, "python": sys.version.split()[0], "numpy": np.__version__,
@@ -348,6 +349,16 @@ def _run(files: RunFiles, case_h5: str, outdir: str, *, tmax, tout, threads, set
         if not sph_run:
             return _run_bodies_only(data, params, out_times, outdir, files, base_meta, t_start, quiet, resume, stop)
         return _run_sph(data, params, out_times, outdir, files, base_meta, threads, resume, quiet, t_start, stop)
+
+
+def _structure_sound_speed(special: dict) -> float:
+    """The largest sound speed of the case's flexible structures (0 without), which sets DtIni and DtMin
+    where it exceeds the fluid's (sphdvi.sph.solver)."""
+    bodies = special.get("flexstrucs") or []
+    if not bodies:
+        return 0.0
+    from .sph.flexstruc import sound_speed
+    return max(sound_speed(b["youngmod"], b["poissratio"], b["density"]) for b in bodies)
 
 
 def _stopped_at_startup(stop, files: RunFiles, meta: dict, outdir: str, resume: bool):

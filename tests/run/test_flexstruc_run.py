@@ -46,6 +46,15 @@ def test_csm3_beam_tip_first_falls_freely(tmp_path):
         assert uz == pytest.approx(-0.5 * 2.0 * t * t, rel=0.01), (t, uz)
     log = (out / "run.log").read_text()
     assert "Flexible Structure 0 (mkbound:1):" in log and "Constitutive model: Plane Strain" in log
+    # the structure's sound speed (54.77 m/s) exceeds c0 (50): DtIni = h/c_s, DtMin = CoefDtMin h/c_s, as run
+    import json
+    meta = json.loads((out / "run.json").read_text())
+    h = math.sqrt(2.0) * 0.005
+    cs = math.sqrt(1.4e6 * 0.6 / (1000 * 1.4 * 0.2))
+    assert meta["parameters"]["DtIni"] == pytest.approx(h / cs, rel=1e-12)
+    assert meta["parameters"]["DtMin"] == pytest.approx(0.001 * h / cs, rel=1e-12)
+    assert meta["parameters_auto"] == {"DtIni": "h/cs_structure", "DtMin": "CoefDtMin*h/cs_structure"}
+    assert f"dt=[1.29e-05, {h / cs:.3g}] s" in log
     assert "Sound speed: 54.7723" in log
     assert "(60 clamp particles, 324 flexible)" in log
 
