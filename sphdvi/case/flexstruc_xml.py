@@ -73,7 +73,7 @@ def _case_is_2d(reader) -> bool:
 def _read_body(reader, c, index: int, is2d: bool) -> dict:
     """One ``<flexstrucbody>``: its mks, its material and model, checked."""
     reader.check_children(c, BODY_CHILDREN)
-    _no_repeats(reader, c)
+    reader.check_no_repeats(c)
     for attr, what in (("mkbound", "the mkbound of the moving boundary that becomes the body"),
                        ("mkclamp", "the mkbound(s) of the boundary that holds the body")):
         if c.get(attr) is None:
@@ -83,15 +83,6 @@ def _read_body(reader, c, index: int, is2d: bool) -> dict:
     _check_model(reader, c, d, index, is2d)
     d["line"] = c.sourceline
     return d
-
-
-def _no_repeats(reader, c) -> None:
-    """Raise on a second child of ``c`` with the same tag."""
-    seen = set()
-    for k in reader.children(c):
-        if k.tag in seen:
-            raise reader.error(k, f"a second <{k.tag}> inside <{c.tag}>", f"at most one <{k.tag}>")
-        seen.add(k.tag)
 
 
 def _read_mkclamp(reader, c) -> list:

@@ -98,7 +98,7 @@ SAVEDATA_CHILDREN = {"time", "tension", "force", "velocity", "position"}
 def read_moorings(reader, el) -> dict:
     """``<special><moorings>`` -> the moorings dict (module docstring)."""
     reader.check_children(el, MOORINGS_CHILDREN)
-    _no_repeats(reader, el, MOORINGS_CHILDREN - {"moordyn"})
+    reader.check_no_repeats(el, MOORINGS_CHILDREN - {"moordyn"})
     out = {"line": el.sourceline}
     for tag, default in SAVE_FLAGS:
         c = reader.child(el, tag)
@@ -112,16 +112,6 @@ def read_moorings(reader, el) -> dict:
     if lib_reader is not reader:
         lib_reader.warn_unread_attributes(lib)
     return out
-
-
-def _no_repeats(reader, el, tags) -> None:
-    """Raise on a second child of ``el`` with one of ``tags``."""
-    seen = set()
-    for c in reader.children(el):
-        if c.tag in tags:
-            if c.tag in seen:
-                raise reader.error(c, f"a second <{c.tag}> inside <{el.tag}>", f"at most one <{c.tag}>")
-            seen.add(c.tag)
 
 
 def _read_floatings(reader, el):
@@ -182,7 +172,7 @@ def _library_root(reader, el):
 def _read_library(reader, lib, floating_els: dict) -> dict:
     """The ``<moordynplus>`` content: solver, bodies, lines, savedata."""
     reader.check_children(lib, ROOT_CHILDREN)
-    _no_repeats(reader, lib, ROOT_CHILDREN)
+    reader.check_no_repeats(lib, ROOT_CHILDREN)
     reader.boolean(lib, "debug", False)
     connects = _read_connects(reader, reader.child(lib, "connects"))
     waves = reader.child(lib, "waves")
@@ -328,7 +318,7 @@ def _read_bodies(reader, lib, floating_els: dict) -> list:
         reader.check_children(lis, {"body"})
         for k, b in enumerate(reader.children(lis, "body")):
             reader.check_children(b, {"depth"})
-            _no_repeats(reader, b, {"depth"})
+            reader.check_no_repeats(b, {"depth"})
             ref = reader.integer(b, "ref", k, lo=0)
             if ref in by_ref:
                 raise reader.error(b, f"body ref={ref} is already defined (line {by_ref[ref]['line']})",
@@ -411,7 +401,7 @@ def _read_lines(reader, el, solver: dict, bodies: list, connects: dict) -> list:
     """``<lines>``: ``<linedefault>`` and each ``<line>`` merged over it, checked; the ends ordered
     (node 0 first)."""
     reader.check_children(el, {"linedefault", "line"})
-    _no_repeats(reader, el, {"linedefault"})
+    reader.check_no_repeats(el, {"linedefault"})
     default_el = reader.child(el, "linedefault")
     defaults = _line_items(reader, default_el, False)[0] if default_el is not None else {}
     body_refs = {b["ref"]: b for b in bodies}
@@ -488,7 +478,7 @@ def _read_lines(reader, el, solver: dict, bodies: list, connects: dict) -> list:
 def _read_savedata(reader, el) -> dict:
     """``<savedata>``: ``<time starTime endTime dtOut>`` and the magnitudes written."""
     reader.check_children(el, SAVEDATA_CHILDREN)
-    _no_repeats(reader, el, SAVEDATA_CHILDREN)
+    reader.check_no_repeats(el, SAVEDATA_CHILDREN)
     out = {"start": 0.0, "end": None, "dtout": None}
     t = reader.child(el, "time")
     if t is not None:

@@ -364,6 +364,15 @@ class CaseReader:
                 raise self.error(c, f"unknown {what} <{c.tag}> inside <{el.tag}>",
                                  "one of " + ", ".join(f"<{a}>" for a in sorted(allowed)))
 
+    def check_no_repeats(self, el, tags=None) -> None:
+        """Raise on a second child of ``el`` with the same tag (among ``tags``; None: any tag)."""
+        seen = set()
+        for c in self.children(el):
+            if tags is None or c.tag in tags:
+                if c.tag in seen:
+                    raise self.error(c, f"a second <{c.tag}> inside <{el.tag}>", f"at most one <{c.tag}>")
+                seen.add(c.tag)
+
     def element_text(self, el) -> str:
         return (el.text or "").strip() if el is not None else ""
 

@@ -761,11 +761,6 @@ class FlexStruc:
         if self.has_normals:
             turn_normals(self.rows, self.F, self.n0, normals)
 
-    def elastic(self, pos, idp, ace, parallel=False):
-        """:meth:`geometry`, then :meth:`forces`."""
-        self.geometry(pos, idp, parallel=parallel)
-        self.forces(pos, ace, parallel=parallel)
-
     def forces(self, pos, ace, parallel=False):
         """The elastic and hourglass accelerations of the flexible particles into ``ace``, from the
         last :meth:`geometry` (the same positions); sets ``amax2`` (max |a|² of their whole ace) and

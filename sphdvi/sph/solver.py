@@ -393,16 +393,17 @@ class SPHSolver:
         (DualSPHysics refuses them too; mDBC2 is run as its v5.4, sphdvi.sph.flexstruc); DtIni and DtMin
         from the structure's sound speed where it exceeds the fluid's or there is no fluid (JSph's
         LoadCaseConfig), unless the case sets them."""
-        if self.periodicity is not None:
-            raise ValueError("flexible structures are not allowed with periodic conditions")
-        if self.boundary == 2 and self.slip == 1:
-            raise ValueError("flexible structures are not allowed with original mDBC (SlipMode=1)")
-        if self.boundary == 2 and self.step_algorithm == 1:
-            raise ValueError("flexible structures with mDBC are not allowed with Verlet")
+        from ..case.flexstruc_xml import flexstruc_parameter_problem      # the rule gencase checks (numpy only)
+        problem = flexstruc_parameter_problem(
+            {"Boundary": self.boundary, "SlipMode": self.slip, "StepAlgorithm": self.step_algorithm},
+            self.periodicity is not None)
+        if problem:
+            raise ValueError(problem)
+        has_fluid = bool(np.any(self.state.ptype == 3))
         # the fluid's forces on the structure: only where there is (or an inlet brings) fluid
-        self._flex_fluid = bool(np.any(self.state.ptype == 3)) or self.inout is not None
+        self._flex_fluid = has_fluid or self.inout is not None
         cs = float(self.flex.csound.max())
-        if cs > self.cs0 or not np.any(self.state.ptype == 3):
+        if cs > self.cs0 or not has_fluid:
             p = self.params
             if not float(p["DtIni"]):
                 self.dtini = self.h / cs

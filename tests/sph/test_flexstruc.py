@@ -35,7 +35,9 @@ def make(pos, idp, mk, ptype, model=1, hg=0.0, is2d=True, coefh=1.0):
 
 def evaluate(fs, pos, idp):
     ace = np.zeros_like(pos)
-    fs.elastic(np.ascontiguousarray(pos), idp, ace)
+    pos = np.ascontiguousarray(pos)
+    fs.geometry(pos, idp)
+    fs.forces(pos, ace)
     return ace
 
 
